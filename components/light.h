@@ -1,0 +1,22 @@
+// A punctual light (KHR_lights_punctual semantics). It shines along the entity's local -Z axis
+// (world direction = rotation * (0,0,-1)); spot and point lights sit at the entity's position.
+// Shadow parameters live in ShadowSettings, a separate component on the same entity.
+#pragma once
+
+#include <glm/glm.hpp>
+
+namespace kaskad {
+
+enum class LightType { directional, spot, point };
+
+struct Light {
+  LightType type = LightType::directional;
+  glm::vec3 color{1.0f};        ///< linear RGB
+  float intensity = 1.0f;       ///< directional: illuminance-like scale; spot/point: candela-like
+  float range = 0.0f;           ///< metres; 0 = infinite (spot/point only)
+  float inner_cone_deg = 0.0f;  ///< spot: full intensity inside this half-angle (degrees)
+  float outer_cone_deg = 45.0f; ///< spot: zero intensity outside this half-angle (degrees)
+  bool cast_shadows = false;    ///< only shadowed lights get shadow maps
+};
+
+}  // namespace kaskad

@@ -1,0 +1,32 @@
+// Where an entity's geometry comes from. Authored scenes name built-in primitives or glTF files;
+// the scene loader turns them into meshes in the AssetStore and MeshRenderer components.
+#pragma once
+
+#include <string>
+
+#include "runtime/ecs/entity.h"
+
+namespace kaskad {
+
+/// Built-in unit primitives, centred at the origin; size them with Transform::scale.
+/// plane: 1 x 1 in XZ facing +Y; box: 1 x 1 x 1; sphere: diameter 1; cylinder and cone: diameter 1,
+/// height 1 along Y.
+enum class PrimitiveShape { plane, box, sphere, cylinder, cone };
+
+struct PrimitiveMesh {
+  PrimitiveShape shape = PrimitiveShape::box;
+  int segments = 32;  ///< tessellation around the axis for sphere / cylinder / cone, in [3, 1024]
+};
+
+/// A glTF file (.gltf or .glb) instanced under this entity; path relative to the scene file.
+struct ModelRef {
+  std::string path;
+};
+
+/// Marks entities created from a ModelRef (or a built-in default); they are not written back
+/// to scene files, since loading the reference recreates them.
+struct Imported {
+  ecs::Entity source = ecs::kNullEntity;
+};
+
+}  // namespace kaskad

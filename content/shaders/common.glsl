@@ -1,0 +1,22 @@
+// Shared declarations. Change together with FrameBlock in runtime/render/renderer.cpp.
+#define MAX_LIGHTS 8
+#define LIGHT_DIRECTIONAL 0
+#define LIGHT_SPOT 1
+#define LIGHT_POINT 2
+
+layout(std140, binding = 0) uniform FrameBlock {
+  mat4 u_view_proj;
+  mat4 u_view;
+  mat4 u_light_view_proj;          // world -> shadow clip space of the shadowed light
+  vec4 u_camera_pos;               // xyz: world position
+  vec4 u_ambient;                  // rgb: linear ambient radiance, w: exposure
+  ivec4 u_counts;                  // x: light count, y: shadowed light index (-1: none)
+  vec4 u_light_color[MAX_LIGHTS];  // rgb: colour * intensity, w: type
+  vec4 u_light_dir[MAX_LIGHTS];    // xyz: direction the light travels, w: range (0 = infinite)
+  vec4 u_light_pos[MAX_LIGHTS];    // xyz: world position, w: cos(outer cone)
+  vec4 u_light_cone[MAX_LIGHTS];   // x: cos(inner cone)
+};
+
+// Per-draw uniforms (explicit locations: no name look-ups at draw time).
+layout(location = 0) uniform mat4 u_model;
+layout(location = 4) uniform mat3 u_normal_matrix;

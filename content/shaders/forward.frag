@@ -1,0 +1,114 @@
+// Forward shading: Blinn-Phong driven by glTF metallic-roughness inputs, linear lighting, sRGB
+// output through the sRGB colour target. Defines:
+//   SHADOW_FILTER  0: one hardware-compared tap, nearest; 1: one tap, bilinear compare (2x2 PCF);
+//                  2: 3x3 PCF of hardware compares (S4)
+#include "common.glsl"
+
+#ifndef SHADOW_FILTER
+#define SHADOW_FILTER 2
+#endif
+
+in vec3 v_world_pos;
+in vec3 v_world_normal;
+in vec2 v_uv;
+
+layout(location = 8) uniform vec4 u_base_color;
+layout(location = 9) uniform vec4 u_material;   // x metallic, y roughness, z normal scale, w receive shadows
+layout(location = 10) uniform vec3 u_emissive;
+
+layout(binding = 0) uniform sampler2D u_base_color_tex;  // 1x1 white when the material has none
+layout(binding = 1) uniform sampler2D u_normal_tex;      // 1x1 (0.5, 0.5, 1) when none
+layout(binding = 2) uniform sampler2DShadow u_shadow_map;
+
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out vec4 o_position;    // xyz world position, w mask (1 = geometry)
+layout(location = 2) out vec4 o_normal;      // xyz world normal facing the camera, w view depth
+layout(location = 3) out float o_visibility; // shadow visibility of the shadowed light
+
+// Cotangent frame from screen-space derivatives: normal mapping without stored tangents.
+vec3 perturb_normal(vec3 n, vec3 p, vec2 uv, vec3 tangent_normal) {
+  vec3 dp1 = dFdx(p), dp2 = dFdy(p);
+  vec2 duv1 = dFdx(uv), duv2 = dFdy(uv);
+  vec3 dp2perp = cross(dp2, n), dp1perp = cross(n, dp1);
+  vec3 t = dp2perp * duv1.x + dp1perp * duv2.x;
+  vec3 b = dp2perp * duv1.y + dp1perp * duv2.y;
+  float det = max(dot(t, t), dot(b, b));
+  if (det < 1e-20) return n;  // degenerate uvs: keep the geometric normal
+  float inv = inversesqrt(det);
+  return normalize(mat3(t * inv, b * inv, n) * tangent_normal);
+}
+
+// Visibility of the shadowed light at world position p: 1 lit, 0 shadowed (S4). Clamp-to-border
+// with border depth 1 and the z > 1 test keep everything outside the light frustum lit.
+float shadow_visibility(vec3 p) {
+  vec4 clip = u_light_view_proj * vec4(p, 1.0);
+  vec3 c = clip.xyz / clip.w * 0.5 + 0.5;
+  if (c.z > 1.0) return 1.0;
+#if SHADOW_FILTER == 2
+  float sum = 0.0;
+  for (int y = -1; y <= 1; ++y)
+    for (int x = -1; x <= 1; ++x) sum += textureOffset(u_shadow_map, c, ivec2(x, y));
+  return sum / 9.0;
+#else
+  return texture(u_shadow_map, c);  // filtering (nearest / linear) is set on the texture
+#endif
+}
+
+void main() {
+  vec4 base = u_base_color * texture(u_base_color_tex, v_uv);
+  vec3 view_vec = u_camera_pos.xyz - v_world_pos;
+  vec3 v = normalize(view_vec);
+  vec3 geometric_n = normalize(v_world_normal);
+  if (dot(geometric_n, v) < 0.0) geometric_n = -geometric_n;  // back faces face the camera
+  vec3 n = geometric_n;
+  vec3 tn = texture(u_normal_tex, v_uv).xyz * 2.0 - 1.0;
+  tn.xy *= u_material.z;
+  n = perturb_normal(n, v_world_pos, v_uv, normalize(tn));
+
+  float metallic = clamp(u_material.x, 0.0, 1.0);
+  float roughness = clamp(u_material.y, 0.03, 1.0);
+  vec3 diffuse_color = base.rgb * (1.0 - metallic);
+  vec3 f0 = mix(vec3(0.04), base.rgb, metallic);
+  // Blinn-Phong exponent from roughness (alpha = roughness^2, n = 2 / alpha^2 - 2), energy-normalised.
+  float alpha = roughness * roughness;
+  float shininess = max(2.0 / (alpha * alpha) - 2.0, 1.0);
+  float spec_norm = (shininess + 8.0) / 8.0;
+
+  float visibility = 1.0;
+  if (u_counts.y >= 0 && u_material.w > 0.5) visibility = shadow_visibility(v_world_pos);
+
+  vec3 color = u_ambient.rgb * diffuse_color + u_emissive;
+  for (int i = 0; i < u_counts.x; ++i) {
+    int type = int(u_light_color[i].w);
+    vec3 l;
+    float attenuation = 1.0;
+    if (type == LIGHT_DIRECTIONAL) {
+      l = -normalize(u_light_dir[i].xyz);
+    } else {
+      vec3 to_light = u_light_pos[i].xyz - v_world_pos;
+      float d2 = max(dot(to_light, to_light), 1e-8);
+      l = to_light * inversesqrt(d2);
+      attenuation = 1.0 / d2;
+      float range = u_light_dir[i].w;
+      if (range > 0.0) {  // KHR_lights_punctual's recommended smooth window
+        float r = d2 / (range * range);
+        attenuation *= clamp(1.0 - r * r, 0.0, 1.0);
+      }
+      if (type == LIGHT_SPOT) {
+        float cd = dot(-l, normalize(u_light_dir[i].xyz));
+        attenuation *= smoothstep(u_light_pos[i].w, u_light_cone[i].x, cd);
+      }
+    }
+    float ndl = max(dot(n, l), 0.0);
+    if (ndl <= 0.0) continue;
+    vec3 h = normalize(l + v);
+    vec3 spec = f0 * spec_norm * pow(max(dot(n, h), 0.0), shininess);
+    float shadow = (i == u_counts.y) ? visibility : 1.0;
+    color += (diffuse_color + spec) * u_light_color[i].rgb * ndl * attenuation * shadow;
+  }
+
+  o_color = vec4(color * u_ambient.w, 1.0);
+  o_position = vec4(v_world_pos, 1.0);
+  o_normal = vec4(geometric_n, -(u_view * vec4(v_world_pos, 1.0)).z);
+  o_visibility = visibility;
+}

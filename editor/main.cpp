@@ -1,0 +1,138 @@
+// kaskad_editor: a window onto a scene with toggles for the shadow settings and the light.
+// Same runtime and frame phases as the headless player; the editor only edits components and
+// settings between frames.  usage: kaskad_editor [SCENE] [--set key=value]...
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include "components/light.h"
+#include "components/name.h"
+#include "components/shadow_settings.h"
+#include "runtime/cli/player.h"
+#include "runtime/gpu/context.h"
+
+using namespace kaskad;
+
+namespace {
+
+// Shadow settings of the shadowed light, as editable widgets. Returns true when something changed.
+bool shadow_panel(ShadowSettings& s) {
+  bool changed = false;
+  static const int sizes[] = {256, 512, 1024, 2048, 4096};
+  int size_index = 3;
+  for (int i = 0; i < 5; ++i)
+    if (sizes[i] == s.map_size) size_index = i;
+  const char* size_names[] = {"256", "512", "1024", "2048", "4096"};
+  if (ImGui::Combo("map size", &size_index, size_names, 5)) {
+    s.map_size = sizes[size_index];
+    changed = true;
+  }
+  int filter = int(s.filter);
+  const char* filters[] = {"none (1 tap)", "bilinear (2x2 hardware)", "pcf 3x3"};
+  if (ImGui::Combo("filter", &filter, filters, 3)) {
+    s.filter = ShadowFilter(filter);
+    changed = true;
+  }
+  int cull = int(s.cull);
+  const char* culls[] = {"back", "front", "none"};
+  if (ImGui::Combo("shadow cull", &cull, culls, 3)) {
+    s.cull = CullMode(cull);
+    changed = true;
+  }
+  changed |= ImGui::SliderFloat("constant bias", &s.constant_bias, 0.0f, 50.0f);
+  changed |= ImGui::SliderFloat("slope bias", &s.slope_bias, 0.0f, 10.0f);
+  return changed;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scene_path = (content_dir() / "scenes" / "default.json").string();
+  std::vector<std::string> sets;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--set" && i + 1 < argc) {
+      sets.push_back(argv[++i]);
+    } else if (a == "-h" || a == "--help") {
+      std::puts("usage: kaskad_editor [SCENE] [--set key=value]...");
+      return 0;
+    } else {
+      scene_path = a;
+    }
+  }
+  auto scene = load_scene(scene_path, sets);
+  if (!scene) {
+    std::fprintf(stderr, "kaskad_editor: error: %s\n", scene.error().to_string().c_str());
+    return 1;
+  }
+  gpu::ContextOptions opt;
+  opt.headless = false;
+  opt.window_width = scene->render.width;
+  opt.window_height = scene->render.height;
+  opt.title = "Kaskad editor - " + scene_path;
+  auto player = Player::create(opt);
+  if (!player) {
+    std::fprintf(stderr, "kaskad_editor: error: %s\n", player.error().to_string().c_str());
+    return 1;
+  }
+  GLFWwindow* window = player->context->window();
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 450 core");
+
+  std::uint64_t frame = 0;
+  int max_frames = -1;  // KASKAD_EDITOR_FRAMES limits the run (for automated screenshots)
+  if (const char* f = std::getenv("KASKAD_EDITOR_FRAMES")) max_frames = std::atoi(f);
+  while (!glfwWindowShouldClose(window) && (max_frames < 0 || int(frame) < max_frames)) {
+    glfwPollEvents();
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window, &w, &h);
+    if (w <= 0 || h <= 0) continue;
+    RenderRun run;
+    run.width = w;
+    run.height = h;
+    auto t = render_frames(*player, *scene, run);
+    if (!t) {
+      std::fprintf(stderr, "kaskad_editor: error: %s\n", t.error().to_string().c_str());
+      break;
+    }
+    player->renderer->present(w, h);
+
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    ImGui::Begin("Kaskad");
+    ImGui::Text("frame %.2f ms (shadow GPU %.2f, forward GPU %.2f)", t->first_frame_ms,
+                t->last.stats.shadow_gpu_ms, t->last.stats.forward_gpu_ms);
+    ImGui::Text("%d draws, %zu shadow triangles", t->last.stats.draw_calls,
+                t->last.stats.shadow_triangles);
+    scene->world.view<Light, ShadowSettings>().each(
+        [&](ecs::Entity e, Light& light, ShadowSettings& s) {
+          const Name* n = scene->world.try_get<Name>(e);
+          ImGui::PushID(int(e.index));
+          if (ImGui::CollapsingHeader(n ? n->value.c_str() : "light", ImGuiTreeNodeFlags_DefaultOpen)) {
+            ImGui::Checkbox("cast shadows", &light.cast_shadows);
+            ImGui::SliderFloat("intensity", &light.intensity, 0.0f, 10.0f);
+            ImGui::ColorEdit3("colour", &light.color[0]);
+            shadow_panel(s);
+          }
+          ImGui::PopID();
+        });
+    ImGui::End();
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    player->context->swap_buffers();
+    ++frame;
+  }
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  return 0;
+}

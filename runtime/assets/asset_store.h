@@ -1,0 +1,57 @@
+// CPU-side geometry and textures of a scene. Components refer to entries by index (MeshId,
+// TextureId); the renderer uploads them to the GPU on first use.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "components/bounds.h"
+#include "components/mesh_renderer.h"
+
+namespace kaskad {
+
+/// Indexed triangle list. positions, normals and uvs have one entry per vertex (uvs may be empty);
+/// tangents are optional (xyz tangent, w handedness, glTF convention).
+struct MeshData {
+  std::string name;
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> uvs;
+  std::vector<glm::vec4> tangents;
+  std::vector<std::uint32_t> indices;  ///< 3 per triangle, each < positions.size()
+  Aabb bounds;                         ///< of positions (computed, never taken from accessor min/max)
+
+  std::size_t triangle_count() const { return indices.size() / 3; }
+  void compute_bounds() {
+    bounds = Aabb{};
+    for (const auto& p : positions) bounds.expand(p);
+  }
+};
+
+/// 8-bit RGBA texture. srgb: colour data (base colour, emissive) vs linear data (normal maps).
+struct TextureData {
+  std::string name;
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba8;  ///< width * height * 4 bytes, rows top to bottom
+  bool srgb = true;
+};
+
+struct AssetStore {
+  std::vector<MeshData> meshes;
+  std::vector<TextureData> textures;
+
+  MeshId add_mesh(MeshData mesh) {
+    meshes.push_back(std::move(mesh));
+    return MeshId(meshes.size() - 1);
+  }
+  TextureId add_texture(TextureData texture) {
+    textures.push_back(std::move(texture));
+    return TextureId(textures.size() - 1);
+  }
+};
+
+}  // namespace kaskad

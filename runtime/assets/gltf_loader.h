@@ -1,0 +1,34 @@
+// glTF 2.0 import (.gltf and .glb) through tinygltf, with KHR_draco_mesh_compression,
+// KHR_lights_punctual and cameras. Textures are decoded through OpenImageIO.
+#pragma once
+
+#include <filesystem>
+
+#include "runtime/assets/asset_store.h"
+#include "runtime/core/result.h"
+#include "runtime/ecs/world.h"
+
+namespace kaskad {
+
+struct GltfImportReport {
+  int nodes = 0;
+  int mesh_entities = 0;   ///< one entity per glTF primitive (triangles only)
+  int lights = 0;
+  int cameras = 0;
+  std::size_t triangles = 0;
+  std::vector<std::string> warnings;  ///< skipped non-triangle primitives, unsupported features, ...
+};
+
+/// Imports the default scene of a glTF file (or all root nodes when there is no default) into
+/// `world` and `assets`. Every node becomes an entity with Name, Transform (parent = the node's
+/// parent entity, or `parent` for root nodes) and Imported{source}; each triangle primitive becomes
+/// a child entity with MeshRenderer, Material and Imported; KHR_lights_punctual lights become
+/// Light (+ ShadowSettings for directional lights, cast_shadows = true) and cameras Camera
+/// components on their node's entity. The first imported camera is marked active when
+/// `activate_first_camera` is set.
+/// On error nothing is left half-imported in `world` is NOT guaranteed; callers discard the world.
+Result<GltfImportReport> import_gltf(const std::filesystem::path& path, ecs::World& world,
+                                     AssetStore& assets, ecs::Entity parent, ecs::Entity source,
+                                     bool activate_first_camera);
+
+}  // namespace kaskad

@@ -1,0 +1,302 @@
+// Image files through OpenImageIO 2.4.
+//
+// Every read goes through memory (Filesystem::IOMemReader) with an explicitly chosen reader: the
+// format comes from the file's magic bytes, then the MIME type, then the extension. We never let
+// OIIO "try every reader in turn" on unknown bytes (what ImageInput::open(filename) does when the
+// extension does not match), so corrupt or hostile data reaches at most one decoder.
+#include "runtime/assets/image_io.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <new>
+#include <string_view>
+#include <system_error>
+
+namespace kaskad {
+namespace {
+
+/// Largest image we decode, in float values (width * height * channels): 2^28 floats = 1 GiB,
+/// e.g. 16384 x 16384 x 1 or 8192 x 8192 x 4. Guards against headers that claim absurd sizes.
+constexpr std::uint64_t kMaxImageValues = std::uint64_t(1) << 28;
+
+/// Files larger than this are refused before reading them into memory (2 GiB).
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t(1) << 31;
+
+bool starts_with(const std::uint8_t* data, std::size_t size, std::string_view magic) {
+  return size >= magic.size() && std::memcmp(data, magic.data(), magic.size()) == 0;
+}
+
+/// OIIO format name from the first bytes of the data; empty when no known signature matches.
+std::string format_from_magic(const std::uint8_t* d, std::size_t n) {
+  using namespace std::string_view_literals;
+  if (starts_with(d, n, "\x89PNG\r\n\x1a\n"sv)) return "png";
+  if (starts_with(d, n, "\xff\xd8\xff"sv)) return "jpeg";
+  if (starts_with(d, n, "\x76\x2f\x31\x01"sv)) return "openexr";
+  if (starts_with(d, n, "#?RADIANCE"sv) || starts_with(d, n, "#?RGBE"sv)) return "hdr";
+  if (starts_with(d, n, "II*\0"sv) || starts_with(d, n, "MM\0*"sv)) return "tiff";
+  if (starts_with(d, n, "GIF8"sv)) return "gif";
+  if (n >= 12 && starts_with(d, n, "RIFF"sv) && std::memcmp(d + 8, "WEBP", 4) == 0) return "webp";
+  if (starts_with(d, n, "8BPS"sv)) return "psd";
+  if (starts_with(d, n, "DDS "sv)) return "dds";
+  if (starts_with(d, n, "BM"sv)) return "bmp";
+  return {};
+}
+
+/// OIIO format name for a MIME type (glTF images carry one); empty when unknown.
+std::string format_from_mime(const std::string& mime) {
+  if (mime == "image/png") return "png";
+  if (mime == "image/jpeg") return "jpeg";
+  if (mime == "image/webp") return "webp";
+  if (mime == "image/bmp") return "bmp";
+  if (mime == "image/gif") return "gif";
+  if (mime == "image/x-exr" || mime == "image/aces") return "openexr";
+  return {};
+}
+
+std::string lowercase_extension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  if (!ext.empty() && ext[0] == '.') ext.erase(0, 1);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+/// OIIO's readers by extension and by format name, parsed from its "extension_list" attribute
+/// ("openexr:exr,sxr;tiff:tif,tiff;..."). Built once; read-only afterwards.
+const std::map<std::string, std::string>& known_formats() {
+  static const std::map<std::string, std::string> formats = [] {
+    std::map<std::string, std::string> m;
+    std::string list;
+    OIIO::getattribute("extension_list", list);
+    std::size_t pos = 0;
+    while (pos < list.size()) {
+      std::size_t end = list.find(';', pos);
+      if (end == std::string::npos) end = list.size();
+      const std::string entry = list.substr(pos, end - pos);
+      const std::size_t colon = entry.find(':');
+      if (colon != std::string::npos) {
+        const std::string format = entry.substr(0, colon);
+        m[format] = format;
+        std::size_t e = colon + 1;
+        while (e < entry.size()) {
+          std::size_t comma = entry.find(',', e);
+          if (comma == std::string::npos) comma = entry.size();
+          m.emplace(entry.substr(e, comma - e), format);
+          e = comma + 1;
+        }
+      }
+      pos = end + 1;
+    }
+    return m;
+  }();
+  return formats;
+}
+
+/// Picks the reader: magic bytes first (they cannot lie about the format the way a name can),
+/// then the MIME type, then the extension of `name`. Empty when none is known to OIIO: passing an
+/// unknown name to ImageInput::create() would make OIIO probe every reader on the bytes.
+std::string choose_format(const std::uint8_t* data, std::size_t size, const std::string& name,
+                          const std::string& mime) {
+  std::string format = format_from_magic(data, size);
+  if (format.empty()) format = format_from_mime(mime);
+  if (format.empty()) format = lowercase_extension(name);
+  const auto& known = known_formats();
+  const auto it = known.find(format);
+  return it == known.end() ? std::string() : it->second;
+}
+
+/// OIIO error messages can span lines; keep them on one line for Error::to_string().
+std::string one_line(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  return s.empty() ? std::string("unknown OpenImageIO error") : s;
+}
+
+/// Decodes `size` bytes with the reader for `format`. `name` is only used in messages.
+Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::string& name,
+                     const std::string& format) {
+  if (size == 0) return Error{name, "", "empty image data (0 bytes)"};
+  if (format.empty()) return Error{name, "", "not a recognised image format"};
+
+  OIIO::Filesystem::IOMemReader proxy(data, size);
+  // The proxy must travel in the open() configuration: handing it to create() alone is not
+  // enough for every reader (the PNG reader then opens `name` as a file). UnassociatedAlpha keeps
+  // the stored values: OIIO would otherwise premultiply PNG/TGA colour by alpha on read.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  OIIO::Filesystem::IOProxy* proxy_ptr = &proxy;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_ptr);
+  auto in = OIIO::ImageInput::create(format, /*do_open=*/false, &config, &proxy);
+  if (!in) {
+    // The plugin failed to load; geterror() also clears OIIO's global error message.
+    return Error{name, "", "no " + format + " reader: " + one_line(OIIO::geterror())};
+  }
+  if (!in->supports("ioproxy")) {
+    return Error{name, "", std::string("the ") + in->format_name() +
+                               " reader cannot decode from memory"};
+  }
+
+  OIIO::ImageSpec spec;
+  if (!in->open(name, spec, config)) {
+    return Error{name, "", "not a valid " + std::string(in->format_name()) +
+                               " image: " + one_line(in->geterror())};
+  }
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth < 1) {
+    return Error{name, "", "zero-sized image (" + std::to_string(spec.width) + " x " +
+                               std::to_string(spec.height) + ", " +
+                               std::to_string(spec.nchannels) + " channels)"};
+  }
+  if (spec.depth > 1) return Error{name, "", "volume images are not supported"};
+  const std::uint64_t values =
+      std::uint64_t(spec.width) * std::uint64_t(spec.height) * std::uint64_t(spec.nchannels);
+  if (values > kMaxImageValues) {
+    return Error{name, "", "image too large (" + std::to_string(spec.width) + " x " +
+                               std::to_string(spec.height) + " x " +
+                               std::to_string(spec.nchannels) + " values, at most 2^28)"};
+  }
+
+  Image image;
+  image.width = spec.width;
+  image.height = spec.height;
+  image.channels = spec.nchannels;
+  image.channel_names = spec.channelnames;
+  image.pixels.resize(values);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
+    return Error{name, "", "corrupt or truncated image data: " + one_line(in->geterror())};
+  }
+  in->close();
+  return image;
+}
+
+/// Reads a whole file, with messages for the common ways this fails.
+Result<std::vector<std::uint8_t>> read_file(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) return Error{name, "", "file not found"};
+  if (std::filesystem::is_directory(status)) return Error{name, "", "is a directory, not a file"};
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return Error{name, "", "cannot read file size: " + ec.message()};
+  if (size == 0) return Error{name, "", "empty file (0 bytes)"};
+  if (size > kMaxFileBytes) return Error{name, "", "file larger than 2 GiB"};
+
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return Error{name, "", "cannot open file for reading"};
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
+  file.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size()));
+  if (std::size_t(file.gcount()) != bytes.size()) return Error{name, "", "short read"};
+  return bytes;
+}
+
+/// Formats written as 32-bit float; everything else is written as 8 bits per channel.
+bool is_float_format(const std::string& ext) {
+  return ext == "exr" || ext == "hdr" || ext == "tif" || ext == "tiff" || ext == "pfm";
+}
+
+/// Quantises [0,1] to 8 bits, round to nearest; NaN becomes 0 (clamp alone would keep NaN).
+std::uint8_t to_unorm8(float v) {
+  if (!(v > 0.0f)) return 0;
+  if (v >= 1.0f) return 255;
+  return std::uint8_t(std::lround(v * 255.0f));
+}
+
+}  // namespace
+
+Result<Image> load_image(const std::filesystem::path& path) {
+  try {
+    auto bytes = read_file(path);
+    if (!bytes) return bytes.error();
+    const auto& b = bytes.value();
+    return decode(b.data(), b.size(), path.string(),
+                  choose_format(b.data(), b.size(), path.string(), {}));
+  } catch (const std::bad_alloc&) {
+    return Error{path.string(), "", "out of memory while reading the image"};
+  } catch (const std::exception& e) {
+    return Error{path.string(), "", std::string("image read failed: ") + e.what()};
+  }
+}
+
+Result<Image> load_image_from_memory(const void* data, std::size_t size, const std::string& name,
+                                     const std::string& mime_type) {
+  if (data == nullptr || size == 0) return Error{name, "", "empty image data (0 bytes)"};
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  try {
+    return decode(bytes, size, name, choose_format(bytes, size, name, mime_type));
+  } catch (const std::bad_alloc&) {
+    return Error{name, "", "out of memory while decoding the image"};
+  } catch (const std::exception& e) {
+    return Error{name, "", std::string("image decode failed: ") + e.what()};
+  }
+}
+
+Status save_image(const std::filesystem::path& path, const Image& image) {
+  KASKAD_CHECK(image.width > 0 && image.height > 0 && image.channels > 0,
+               "image must be non-empty, was " + std::to_string(image.width) + " x " +
+                   std::to_string(image.height) + " x " + std::to_string(image.channels));
+  KASKAD_CHECK(image.pixels.size() ==
+                   std::size_t(image.width) * std::size_t(image.height) * image.channels,
+               "pixels.size() must be width * height * channels, was " +
+                   std::to_string(image.pixels.size()));
+  KASKAD_CHECK(image.channel_names.empty() || int(image.channel_names.size()) == image.channels,
+               "channel_names must be empty or one per channel, was " +
+                   std::to_string(image.channel_names.size()));
+
+  const std::string name = path.string();
+  const std::string ext = lowercase_extension(path);
+  auto out = OIIO::ImageOutput::create(name);
+  if (!out) {
+    return Error{name, "", "cannot write this image format: " + one_line(OIIO::geterror())};
+  }
+
+  // JPEG has no alpha: drop the last channel of grey+alpha and RGBA images.
+  const bool is_jpeg = std::string(out->format_name()) == "jpeg";
+  int channels = image.channels;
+  if (is_jpeg && (channels == 2 || channels == 4)) --channels;
+
+  const bool as_float = is_float_format(ext);
+  OIIO::ImageSpec spec(image.width, image.height, channels,
+                       as_float ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  // Our values are written as they are; without this OIIO un-premultiplies colour by alpha
+  // when writing PNG (and rounding makes an 8-bit round trip inexact).
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  if (!image.channel_names.empty()) {
+    spec.channelnames.assign(image.channel_names.begin(), image.channel_names.begin() + channels);
+    const auto alpha = std::find(spec.channelnames.begin(), spec.channelnames.end(), "A");
+    spec.alpha_channel =
+        alpha == spec.channelnames.end() ? -1 : int(alpha - spec.channelnames.begin());
+  }
+  if (!out->open(name, spec)) {
+    return Error{name, "", "cannot open for writing: " + one_line(out->geterror())};
+  }
+
+  // Repack into the written channel count and type; a float image may hold any value, 8-bit
+  // formats get [0,1] clamped and quantised here so that rounding is ours, not the plugin's.
+  const std::size_t pixel_count = std::size_t(image.width) * std::size_t(image.height);
+  bool written = false;
+  if (as_float) {
+    std::vector<float> data(pixel_count * channels);
+    for (std::size_t p = 0; p < pixel_count; ++p)
+      for (int c = 0; c < channels; ++c)
+        data[p * channels + c] = image.pixels[p * image.channels + c];
+    written = out->write_image(OIIO::TypeDesc::FLOAT, data.data());
+  } else {
+    std::vector<std::uint8_t> data(pixel_count * channels);
+    for (std::size_t p = 0; p < pixel_count; ++p)
+      for (int c = 0; c < channels; ++c)
+        data[p * channels + c] = to_unorm8(image.pixels[p * image.channels + c]);
+    written = out->write_image(OIIO::TypeDesc::UINT8, data.data());
+  }
+  if (!written) return Error{name, "", "write failed: " + one_line(out->geterror())};
+  if (!out->close()) return Error{name, "", "write failed: " + one_line(out->geterror())};
+  return {};
+}
+
+}  // namespace kaskad

@@ -1,0 +1,40 @@
+// Image files through OpenImageIO (PNG, JPEG, EXR, HDR, TIFF, ... whatever OIIO reads).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "runtime/core/result.h"
+
+namespace kaskad {
+
+/// Float pixels, channel-interleaved, rows top to bottom. Values are as stored in the file
+/// (no colour-space conversion): 8-bit files map to [0,1].
+struct Image {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  std::vector<std::string> channel_names;  ///< optional; e.g. {"R","G","B","A"} or {"P.X",...}
+  std::vector<float> pixels;               ///< width * height * channels
+
+  float& at(int x, int y, int c) { return pixels[(std::size_t(y) * width + x) * channels + c]; }
+  float at(int x, int y, int c) const {
+    return pixels[(std::size_t(y) * width + x) * channels + c];
+  }
+};
+
+/// Reads any image OIIO can read. Errors name the file and the problem (missing, unreadable,
+/// corrupt, zero-sized).
+Result<Image> load_image(const std::filesystem::path& path);
+
+/// Reads an image from memory (e.g. a glTF buffer view); `name` is used in error messages and
+/// `mime_type` (may be empty) helps choose the format.
+Result<Image> load_image_from_memory(const void* data, std::size_t size, const std::string& name,
+                                     const std::string& mime_type = {});
+
+/// Writes an image; the format follows the extension. 8-bit formats (PNG, JPEG) get values clamped
+/// to [0,1] and quantised; EXR keeps 32-bit float and channel_names.
+Status save_image(const std::filesystem::path& path, const Image& image);
+
+}  // namespace kaskad

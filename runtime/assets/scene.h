@@ -1,0 +1,33 @@
+// A loaded scene: the ECS world, its CPU assets and its render settings.
+#pragma once
+
+#include <filesystem>
+
+#include <glm/glm.hpp>
+
+#include "components/shadow_settings.h"
+#include "runtime/assets/asset_store.h"
+#include "runtime/ecs/world.h"
+
+namespace kaskad {
+
+/// Frame-wide render settings (scene file section "render").
+struct RenderSettings {
+  int width = 1280;                       ///< output image size, pixels
+  int height = 720;
+  glm::vec3 ambient{0.08f, 0.09f, 0.11f}; ///< linear ambient radiance added to every surface
+  glm::vec3 clear_color{0.55f, 0.65f, 0.8f};  ///< linear background colour
+  float exposure = 1.0f;                  ///< multiplies linear colour before sRGB encoding
+};
+
+struct Scene {
+  ecs::World world;
+  AssetStore assets;
+  RenderSettings render;
+  /// Defaults for shadowed lights (scene file section "shadow"); a light's own "shadow" block
+  /// overrides individual fields.
+  ShadowSettings shadow_defaults;
+  std::filesystem::path file;  ///< where it was loaded from (relative paths resolve against it)
+};
+
+}  // namespace kaskad

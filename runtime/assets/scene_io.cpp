@@ -1,0 +1,690 @@
+#include "runtime/assets/scene_io.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtx/euler_angles.hpp>
+
+#include "components/camera.h"
+#include "components/light.h"
+#include "components/material.h"
+#include "components/mesh_renderer.h"
+#include "components/model.h"
+#include "components/name.h"
+#include "components/transform.h"
+#include "runtime/assets/gltf_loader.h"
+#include "runtime/assets/primitives.h"
+#include "runtime/core/log.h"
+
+namespace kaskad {
+namespace {
+
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+
+constexpr int kFormatVersion = 1;
+
+// Content errors inside this file travel as exceptions and become Result errors at the public
+// functions; nothing escapes them.
+struct ContentError {
+  std::string where;
+  std::string message;
+};
+
+[[noreturn]] void fail(const std::string& where, const std::string& message) {
+  throw ContentError{where, message};
+}
+
+std::string type_name(const json& j) {
+  switch (j.type()) {
+    case json::value_t::null: return "null";
+    case json::value_t::boolean: return "a boolean";
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned: return "an integer";
+    case json::value_t::number_float: return "a number";
+    case json::value_t::string: return "a string";
+    case json::value_t::array: return "an array";
+    case json::value_t::object: return "an object";
+    default: return "a value";
+  }
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string s;
+  for (const auto& i : items) s += (s.empty() ? "" : ", ") + i;
+  return s;
+}
+
+// Shortest decimal form of a float, as a double: files read 0.1, not 0.10000000149011612, and
+// a load -> save -> load -> save cycle writes identical text.
+double num(float f) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, f);
+  double d = 0.0;
+  std::from_chars(buf, r.ptr, d);
+  return d;
+}
+json vec(const glm::vec3& v) { return json::array({num(v.x), num(v.y), num(v.z)}); }
+json vec(const glm::vec4& v) { return json::array({num(v.x), num(v.y), num(v.z), num(v.w)}); }
+
+// Reads the fields of one JSON object, tracking which keys were used so that unknown keys are
+// reported with the list of valid ones.
+class ObjectReader {
+ public:
+  ObjectReader(const json& j, std::string path) : j_(j), path_(std::move(path)) {
+    if (!j.is_object()) fail(path_, "expected an object, got " + type_name(j));
+  }
+
+  bool has(const char* key) {
+    known_.push_back(key);
+    return j_.contains(key);
+  }
+  const json& raw(const char* key) { return j_.at(key); }
+  std::string at(const char* key) const { return path_ + "/" + key; }
+
+  void number(const char* key, float& out, float lo, float hi) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    if (!v.is_number()) fail(at(key), "expected a number, got " + type_name(v));
+    const double d = v.get<double>();
+    if (!(d >= lo && d <= hi))
+      fail(at(key), "must be in [" + fmt(lo) + ", " + fmt(hi) + "], was " + fmt(d));
+    out = float(d);
+  }
+  void integer(const char* key, int& out, int lo, int hi) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    if (!v.is_number_integer()) fail(at(key), "expected an integer, got " + type_name(v));
+    const long long d = v.get<long long>();
+    if (d < lo || d > hi)
+      fail(at(key), "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                        "], was " + std::to_string(d));
+    out = int(d);
+  }
+  void boolean(const char* key, bool& out) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    if (!v.is_boolean()) fail(at(key), "expected true or false, got " + type_name(v));
+    out = v.get<bool>();
+  }
+  void string(const char* key, std::string& out) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    if (!v.is_string()) fail(at(key), "expected a string, got " + type_name(v));
+    out = v.get<std::string>();
+  }
+  template <int N>
+  void vector(const char* key, glm::vec<N, float>& out, float lo, float hi) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    if (!v.is_array() || v.size() != N)
+      fail(at(key), "expected an array of " + std::to_string(N) + " numbers, got " + type_name(v) +
+                        (v.is_array() ? " of " + std::to_string(v.size()) : ""));
+    for (int i = 0; i < N; ++i) {
+      if (!v[std::size_t(i)].is_number())
+        fail(at(key) + "/" + std::to_string(i), "expected a number, got " + type_name(v[std::size_t(i)]));
+      const double d = v[std::size_t(i)].get<double>();
+      if (!(d >= lo && d <= hi))
+        fail(at(key) + "/" + std::to_string(i),
+             "must be in [" + fmt(lo) + ", " + fmt(hi) + "], was " + fmt(d));
+      out[i] = float(d);
+    }
+  }
+  template <class E>
+  void enumeration(const char* key, E& out, const std::vector<std::pair<const char*, E>>& table) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    std::vector<std::string> names;
+    for (const auto& [n, e] : table) names.push_back(n);
+    if (!v.is_string()) fail(at(key), "expected one of " + join(names) + ", got " + type_name(v));
+    for (const auto& [n, e] : table)
+      if (v.get<std::string>() == n) {
+        out = e;
+        return;
+      }
+    fail(at(key), "unknown value '" + v.get<std::string>() + "'; expected one of " + join(names));
+  }
+  /// Fails on keys that no reader asked for.
+  void finish() const {
+    for (auto it = j_.begin(); it != j_.end(); ++it) {
+      if (std::find(known_.begin(), known_.end(), it.key()) == known_.end())
+        fail(at(it.key().c_str()), "unknown key '" + it.key() + "'; valid keys here: " +
+                                       join(known_));
+    }
+  }
+
+ private:
+  static std::string fmt(double d) {
+    std::ostringstream s;
+    s << d;
+    return s.str();
+  }
+  const json& j_;
+  std::string path_;
+  std::vector<std::string> known_;
+};
+
+template <class E>
+const char* enum_name(E value, const std::vector<std::pair<const char*, E>>& table) {
+  for (const auto& [n, e] : table)
+    if (e == value) return n;
+  return "?";
+}
+
+const std::vector<std::pair<const char*, LightType>> kLightTypes = {
+    {"directional", LightType::directional}, {"spot", LightType::spot}, {"point", LightType::point}};
+const std::vector<std::pair<const char*, CullMode>> kCullModes = {
+    {"back", CullMode::back}, {"front", CullMode::front}, {"none", CullMode::none}};
+const std::vector<std::pair<const char*, ShadowFilter>> kFilters = {
+    {"none", ShadowFilter::none}, {"bilinear", ShadowFilter::bilinear}, {"pcf3x3", ShadowFilter::pcf3x3}};
+const std::vector<std::pair<const char*, Projection>> kProjections = {
+    {"perspective", Projection::perspective}, {"orthographic", Projection::orthographic}};
+const std::vector<std::pair<const char*, PrimitiveShape>> kShapes = {
+    {"plane", PrimitiveShape::plane}, {"box", PrimitiveShape::box}, {"sphere", PrimitiveShape::sphere},
+    {"cylinder", PrimitiveShape::cylinder}, {"cone", PrimitiveShape::cone}};
+
+constexpr float kBig = 1.0e7f;  // |coordinate| limit: beyond it float precision is meaningless
+
+void read_shadow(ObjectReader& r, ShadowSettings& s) {
+  r.integer("map_size", s.map_size, 64, 16384);
+  r.number("constant_bias", s.constant_bias, 0.0f, 1.0e4f);
+  r.number("slope_bias", s.slope_bias, 0.0f, 100.0f);
+  r.enumeration("cull", s.cull, kCullModes);
+  r.enumeration("filter", s.filter, kFilters);
+  r.finish();
+  if (std::string bad = validate_shadow_settings(s); !bad.empty()) fail(r.at("map_size"), bad);
+}
+
+json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
+  json j = json::object();
+  auto put = [&](const char* key, json value, bool differs) {
+    if (!defaults || differs) j[key] = std::move(value);
+  };
+  put("map_size", s.map_size, defaults && s.map_size != defaults->map_size);
+  put("constant_bias", num(s.constant_bias), defaults && s.constant_bias != defaults->constant_bias);
+  put("slope_bias", num(s.slope_bias), defaults && s.slope_bias != defaults->slope_bias);
+  put("cull", enum_name(s.cull, kCullModes), defaults && s.cull != defaults->cull);
+  put("filter", enum_name(s.filter, kFilters), defaults && s.filter != defaults->filter);
+  return j;
+}
+
+// Rotation from exactly one of: rotation (quaternion x,y,z,w as in glTF), euler_deg (XYZ),
+// look_at (a world point, needs the translation) or direction (the -Z axis in world space).
+void read_rotation(ObjectReader& r, Transform& t) {
+  int given = 0;
+  for (const char* k : {"rotation", "euler_deg", "look_at", "direction"}) given += r.has(k);
+  if (given > 1)
+    fail(r.at("rotation"), "give only one of rotation, euler_deg, look_at, direction");
+  if (r.has("rotation")) {
+    glm::vec4 q{0, 0, 0, 1};
+    r.vector<4>("rotation", q, -2.0f, 2.0f);
+    const float len = glm::length(q);
+    if (len < 1e-6f) fail(r.at("rotation"), "quaternion has zero length");
+    q /= len;
+    t.rotation = glm::quat(q.w, q.x, q.y, q.z);
+  } else if (r.has("euler_deg")) {
+    glm::vec3 e{0.0f};
+    r.vector<3>("euler_deg", e, -36000.0f, 36000.0f);
+    t.rotation = glm::quat_cast(glm::eulerAngleXYZ(glm::radians(e.x), glm::radians(e.y),
+                                                   glm::radians(e.z)));
+  } else if (r.has("look_at") || r.has("direction")) {
+    glm::vec3 dir;
+    if (r.has("look_at")) {
+      glm::vec3 target{0.0f};
+      r.vector<3>("look_at", target, -kBig, kBig);
+      dir = target - t.translation;
+    } else {
+      dir = glm::vec3(0.0f);
+      r.vector<3>("direction", dir, -kBig, kBig);
+    }
+    const char* key = r.has("look_at") ? "look_at" : "direction";
+    if (glm::length(dir) < 1e-6f) fail(r.at(key), "direction has zero length");
+    dir = glm::normalize(dir);
+    const glm::vec3 up = std::abs(dir.y) > 0.999f ? glm::vec3(0, 0, -1) : glm::vec3(0, 1, 0);
+    // lookAt builds world->view; its inverse rotation is the entity's orientation.
+    t.rotation = glm::quat_cast(glm::inverse(glm::mat3(glm::lookAt(glm::vec3(0), dir, up))));
+  }
+}
+
+struct Pending {
+  ecs::Entity entity;
+  std::string parent;
+  std::string where;
+};
+
+void parse_entity(const json& j, const std::string& path, Scene& scene,
+                  std::map<std::string, ecs::Entity>& by_name, std::vector<Pending>& parents) {
+  ecs::World& w = scene.world;
+  ObjectReader r(j, path);
+  const ecs::Entity e = w.create();
+  std::string name;
+  r.string("name", name);
+  if (!name.empty()) {
+    if (name.find('.') != std::string::npos || name.find('=') != std::string::npos)
+      fail(r.at("name"), "names may not contain '.' or '=' (they are used in --set keys)");
+    if (by_name.count(name)) fail(r.at("name"), "duplicate entity name '" + name + "'");
+    by_name[name] = e;
+    w.emplace<Name>(e, Name{name});
+  }
+  Transform t;
+  if (r.has("transform")) {
+    ObjectReader tr(r.raw("transform"), r.at("transform"));
+    tr.vector<3>("translation", t.translation, -kBig, kBig);
+    tr.vector<3>("scale", t.scale, -kBig, kBig);
+    read_rotation(tr, t);
+    std::string parent;
+    tr.string("parent", parent);
+    if (!parent.empty()) parents.push_back({e, parent, tr.at("parent")});
+    tr.finish();
+  }
+  w.emplace<Transform>(e, t);
+
+  const bool has_primitive = r.has("primitive"), has_model = r.has("model");
+  if (has_primitive && has_model) fail(path, "an entity has either a primitive or a model, not both");
+  if (has_primitive) {
+    PrimitiveMesh p;
+    ObjectReader pr(r.raw("primitive"), r.at("primitive"));
+    pr.enumeration("shape", p.shape, kShapes);
+    pr.integer("segments", p.segments, 3, 1024);
+    pr.finish();
+    w.emplace<PrimitiveMesh>(e, p);
+  }
+  if (has_model) {
+    ModelRef m;
+    ObjectReader mr(r.raw("model"), r.at("model"));
+    mr.string("path", m.path);
+    mr.finish();
+    if (m.path.empty()) fail(r.at("model") + "/path", "a model needs a path");
+    w.emplace<ModelRef>(e, m);
+  }
+  if (r.has("renderer")) {
+    if (!has_primitive && !has_model) fail(r.at("renderer"), "renderer needs a primitive or model");
+    MeshRenderer mrend;
+    ObjectReader rr(r.raw("renderer"), r.at("renderer"));
+    rr.boolean("cast_shadows", mrend.cast_shadows);
+    rr.boolean("receive_shadows", mrend.receive_shadows);
+    rr.finish();
+    w.emplace<MeshRenderer>(e, mrend);
+  } else if (has_primitive || has_model) {
+    w.emplace<MeshRenderer>(e);
+  }
+  if (r.has("material")) {
+    if (!has_primitive)
+      fail(r.at("material"), has_model ? "models use their glTF materials; remove this block"
+                                       : "material needs a primitive");
+    Material m;
+    ObjectReader mr(r.raw("material"), r.at("material"));
+    mr.vector<4>("base_color", m.base_color, 0.0f, 1.0e4f);
+    mr.number("metallic", m.metallic, 0.0f, 1.0f);
+    mr.number("roughness", m.roughness, 0.0f, 1.0f);
+    mr.vector<3>("emissive", m.emissive, 0.0f, 1.0e6f);
+    mr.boolean("double_sided", m.double_sided);
+    mr.finish();
+    w.emplace<Material>(e, m);
+  } else if (has_primitive) {
+    w.emplace<Material>(e);
+  }
+  if (r.has("light")) {
+    Light l;
+    ObjectReader lr(r.raw("light"), r.at("light"));
+    lr.enumeration("type", l.type, kLightTypes);
+    lr.vector<3>("color", l.color, 0.0f, 1.0e4f);
+    lr.number("intensity", l.intensity, 0.0f, 1.0e9f);
+    lr.number("range", l.range, 0.0f, kBig);
+    lr.number("inner_cone_deg", l.inner_cone_deg, 0.0f, 90.0f);
+    lr.number("outer_cone_deg", l.outer_cone_deg, 0.0f, 90.0f);
+    lr.boolean("cast_shadows", l.cast_shadows);
+    lr.finish();
+    if (l.inner_cone_deg > l.outer_cone_deg)
+      fail(r.at("light") + "/inner_cone_deg", "must not exceed outer_cone_deg");
+    w.emplace<Light>(e, l);
+    ShadowSettings s = scene.shadow_defaults;
+    if (r.has("shadow")) {
+      ObjectReader sr(r.raw("shadow"), r.at("shadow"));
+      read_shadow(sr, s);
+    }
+    w.emplace<ShadowSettings>(e, s);
+  } else if (r.has("shadow")) {
+    fail(r.at("shadow"), "shadow settings belong to an entity with a light");
+  }
+  if (r.has("camera")) {
+    Camera c;
+    ObjectReader cr(r.raw("camera"), r.at("camera"));
+    cr.enumeration("projection", c.projection, kProjections);
+    cr.number("fov_y_deg", c.fov_y_deg, 0.01f, 179.0f);
+    cr.number("ortho_height", c.ortho_height, 1e-6f, kBig);
+    cr.number("near", c.near, 1e-7f, kBig);
+    cr.number("far", c.far, 1e-6f, 1e12f);
+    cr.number("aspect", c.aspect, 0.0f, 1000.0f);
+    cr.boolean("active", c.active);
+    cr.boolean("auto_frame", c.auto_frame);
+    cr.finish();
+    if (!(c.far > c.near)) fail(r.at("camera") + "/far", "far must be greater than near");
+    w.emplace<Camera>(e, c);
+  }
+  r.finish();
+}
+
+json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
+  const ecs::World& w = scene.world;
+  json j = json::object();
+  if (const auto* n = w.try_get<Name>(e)) j["name"] = n->value;
+  if (const auto* t = w.try_get<Transform>(e)) {
+    json tj = {{"translation", vec(t->translation)},
+               {"rotation", json::array({num(t->rotation.x), num(t->rotation.y),
+                                         num(t->rotation.z), num(t->rotation.w)})},
+               {"scale", vec(t->scale)}};
+    if (t->parent.valid() && w.alive(t->parent))
+      if (const auto* pn = w.try_get<Name>(t->parent)) tj["parent"] = pn->value;
+    j["transform"] = tj;
+  }
+  if (const auto* p = w.try_get<PrimitiveMesh>(e))
+    j["primitive"] = {{"shape", enum_name(p->shape, kShapes)}, {"segments", p->segments}};
+  if (const auto* m = w.try_get<ModelRef>(e)) {
+    // Model paths are relative to the scene file: rebase them when writing somewhere else.
+    std::string path = m->path;
+    if (!base.empty() && fs::path(path).is_relative()) {
+      const fs::path abs = fs::absolute(scene.file.parent_path() / path).lexically_normal();
+      path = abs.lexically_relative(fs::absolute(base).lexically_normal()).generic_string();
+    }
+    j["model"] = {{"path", path}};
+  }
+  if (const auto* mr = w.try_get<MeshRenderer>(e))
+    j["renderer"] = {{"cast_shadows", mr->cast_shadows}, {"receive_shadows", mr->receive_shadows}};
+  if (const auto* m = w.try_get<Material>(e)) {
+    j["material"] = {{"base_color", vec(m->base_color)},
+                     {"metallic", num(m->metallic)},
+                     {"roughness", num(m->roughness)},
+                     {"emissive", vec(m->emissive)},
+                     {"double_sided", m->double_sided}};
+  }
+  if (const auto* l = w.try_get<Light>(e)) {
+    j["light"] = {{"type", enum_name(l->type, kLightTypes)},
+                  {"color", vec(l->color)},
+                  {"intensity", num(l->intensity)},
+                  {"range", num(l->range)},
+                  {"inner_cone_deg", num(l->inner_cone_deg)},
+                  {"outer_cone_deg", num(l->outer_cone_deg)},
+                  {"cast_shadows", l->cast_shadows}};
+    if (const auto* s = w.try_get<ShadowSettings>(e)) {
+      json sj = write_shadow(*s, &scene.shadow_defaults);
+      if (!sj.empty()) j["shadow"] = sj;
+    }
+  }
+  if (const auto* c = w.try_get<Camera>(e)) {
+    j["camera"] = {{"projection", enum_name(c->projection, kProjections)},
+                   {"fov_y_deg", num(c->fov_y_deg)},
+                   {"ortho_height", num(c->ortho_height)},
+                   {"near", num(c->near)},
+                   {"far", num(c->far)},
+                   {"aspect", num(c->aspect)},
+                   {"active", c->active},
+                   {"auto_frame", c->auto_frame}};
+  }
+  return j;
+}
+
+Result<json> parse_json_file(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return Error{file.string(), "", "cannot open file"};
+  try {
+    return json::parse(in, nullptr, true, /*ignore_comments=*/false);
+  } catch (const json::parse_error& e) {
+    // e.byte gives the offset; turn it into line:column for people.
+    std::ifstream again(file, std::ios::binary);
+    std::string text((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
+    std::size_t line = 1, col = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        col = 1;
+      } else {
+        ++col;
+      }
+    }
+    std::string msg = e.what();
+    if (auto p = msg.find("parse error"); p != std::string::npos) msg = msg.substr(p);
+    return Error{file.string(), "line " + std::to_string(line) + ", column " + std::to_string(col),
+                 "malformed JSON: " + msg};
+  }
+}
+
+bool entity_less(ecs::Entity a, ecs::Entity b) { return a.index < b.index; }
+
+}  // namespace
+
+Result<json> read_scene_document(const fs::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".gltf" || ext == ".glb") {
+    // Inspect the file for its own lights and cameras; the real import happens in instantiate.
+    Scene probe;
+    auto report = import_gltf(file, probe.world, probe.assets, ecs::kNullEntity, ecs::kNullEntity,
+                              false);
+    if (!report) return report.error();
+    json doc = {{"kaskad_scene", kFormatVersion}, {"entities", json::array()}};
+    doc["entities"].push_back({{"name", "model"}, {"model", {{"path", file.filename().string()}}}});
+    if (report->cameras == 0) {
+      // Default camera: looks at the model from the front, slightly above; auto_frame backs it
+      // off until the bounds fit.
+      doc["entities"].push_back(
+          {{"name", "camera"},
+           {"transform", {{"direction", {-0.45, -0.35, -0.82}}}},
+           {"camera", {{"auto_frame", true}, {"active", true}}}});
+    }
+    if (report->lights == 0) {
+      doc["entities"].push_back(
+          {{"name", "sun"},
+           {"transform", {{"direction", {-0.4, -0.8, -0.45}}}},
+           {"light", {{"type", "directional"}, {"intensity", 2.5}, {"cast_shadows", true}}}});
+    }
+    return doc;
+  }
+  if (ext != ".json")
+    return Error{file.string(), "", "unknown scene file type '" + ext + "' (expected .json, .gltf or .glb)"};
+  return parse_json_file(file);
+}
+
+Status apply_override(json& doc, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    return Error{"--set", assignment, "expected key=value, e.g. shadow.map_size=2048"};
+  const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  std::vector<std::string> parts;
+  for (std::size_t start = 0;;) {
+    const auto dot = key.find('.', start);
+    parts.push_back(key.substr(start, dot - start));
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
+  auto keys_of = [](const json& j) {
+    std::vector<std::string> k;
+    if (j.is_object())
+      for (auto it = j.begin(); it != j.end(); ++it) k.push_back(it.key());
+    return join(k);
+  };
+  json* node = nullptr;
+  std::size_t i = 0;
+  if (doc.contains(parts[0]) && parts[0] != "entities" && parts[0] != "kaskad_scene") {
+    node = &doc[parts[0]];
+    i = 1;
+  } else {
+    std::vector<std::string> names;
+    for (auto& ent : doc["entities"]) {
+      if (ent.contains("name") && ent["name"] == parts[0]) node = &ent;
+      if (ent.contains("name")) names.push_back(ent["name"].get<std::string>());
+    }
+    if (!node)
+      return Error{"--set", key, "no setting section or entity named '" + parts[0] +
+                                     "'; sections: render, shadow; entities: " + join(names)};
+    i = 1;
+  }
+  if (i == parts.size()) return Error{"--set", key, "name a field; valid keys: " + keys_of(*node)};
+  for (; i < parts.size(); ++i) {
+    const std::string& p = parts[i];
+    if (node->is_object()) {
+      if (!node->contains(p))
+        return Error{"--set", key, "unknown key '" + p + "'; valid keys here: " + keys_of(*node)};
+      node = &(*node)[p];
+    } else if (node->is_array()) {
+      std::size_t idx = 0;
+      auto [ptr, ec] = std::from_chars(p.data(), p.data() + p.size(), idx);
+      if (ec != std::errc() || ptr != p.data() + p.size() || idx >= node->size())
+        return Error{"--set", key, "'" + p + "' is not an index in [0, " +
+                                       std::to_string(node->size()) + ")"};
+      node = &(*node)[idx];
+    } else {
+      return Error{"--set", key, "'" + parts[i - 1] + "' is a value, it has no field '" + p + "'"};
+    }
+  }
+  json value = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (value.is_discarded()) value = text;  // a bare word is a string
+  *node = value;
+  return {};
+}
+
+Result<Scene> parse_scene(const json& doc, const fs::path& file) {
+  Scene scene;
+  scene.file = file;
+  try {
+    ObjectReader root(doc, "");
+    int version = kFormatVersion;
+    root.integer("kaskad_scene", version, 1, kFormatVersion);
+    if (root.has("render")) {
+      ObjectReader r(root.raw("render"), "/render");
+      RenderSettings& s = scene.render;
+      r.integer("width", s.width, 1, 16384);
+      r.integer("height", s.height, 1, 16384);
+      r.vector<3>("ambient", s.ambient, 0.0f, 1.0e4f);
+      r.vector<3>("clear_color", s.clear_color, 0.0f, 1.0e4f);
+      r.number("exposure", s.exposure, 0.0f, 1.0e4f);
+      r.finish();
+    }
+    if (root.has("shadow")) {
+      ObjectReader r(root.raw("shadow"), "/shadow");
+      read_shadow(r, scene.shadow_defaults);
+    }
+    std::map<std::string, ecs::Entity> by_name;
+    std::vector<Pending> parents;
+    if (root.has("entities")) {
+      const json& ents = root.raw("entities");
+      if (!ents.is_array()) fail("/entities", "expected an array, got " + type_name(ents));
+      for (std::size_t i = 0; i < ents.size(); ++i)
+        parse_entity(ents[i], "/entities/" + std::to_string(i), scene, by_name, parents);
+    }
+    root.finish();
+    for (const Pending& p : parents) {
+      auto it = by_name.find(p.parent);
+      if (it == by_name.end()) fail(p.where, "no entity named '" + p.parent + "'");
+      if (it->second == p.entity) fail(p.where, "an entity cannot be its own parent");
+      scene.world.get<Transform>(p.entity).parent = it->second;
+    }
+  } catch (const ContentError& e) {
+    return Error{file.string(), e.where, e.message};
+  } catch (const json::exception& e) {
+    return Error{file.string(), "", e.what()};
+  }
+  return scene;
+}
+
+Status instantiate_scene(Scene& scene) {
+  ecs::World& w = scene.world;
+  std::vector<std::pair<ecs::Entity, PrimitiveMesh>> prims;
+  std::vector<std::pair<ecs::Entity, ModelRef>> models;
+  w.view<PrimitiveMesh>().each([&](ecs::Entity e, PrimitiveMesh& p) { prims.emplace_back(e, p); });
+  w.view<ModelRef>().each([&](ecs::Entity e, ModelRef& m) { models.emplace_back(e, m); });
+  // One mesh per distinct (shape, segments): instances share it.
+  std::map<std::pair<int, int>, MeshId> shared;
+  for (auto& [e, p] : prims) {
+    auto key = std::make_pair(int(p.shape), p.segments);
+    auto it = shared.find(key);
+    if (it == shared.end())
+      it = shared.emplace(key, scene.assets.add_mesh(make_primitive(p.shape, p.segments))).first;
+    w.get<MeshRenderer>(e).mesh = it->second;
+  }
+  for (auto& [e, m] : models) {
+    const fs::path path = scene.file.parent_path() / m.path;
+    auto report = import_gltf(path, w, scene.assets, e, e, /*activate_first_camera=*/true);
+    if (!report) return report.error();
+    for (const auto& warning : report->warnings) log::warn("%s: %s", path.string().c_str(), warning.c_str());
+    // The model entity's renderer flags apply to everything imported under it.
+    const MeshRenderer flags = w.get<MeshRenderer>(e);
+    w.view<MeshRenderer, Imported>().each([&](ecs::Entity, MeshRenderer& mr, Imported& imp) {
+      if (imp.source == e) {
+        mr.cast_shadows = flags.cast_shadows;
+        mr.receive_shadows = flags.receive_shadows;
+      }
+    });
+  }
+  return {};
+}
+
+json scene_to_json(const Scene& scene, const fs::path& base_dir) {
+  json doc;
+  doc["kaskad_scene"] = kFormatVersion;
+  const RenderSettings& r = scene.render;
+  doc["render"] = {{"width", r.width},
+                   {"height", r.height},
+                   {"ambient", vec(r.ambient)},
+                   {"clear_color", vec(r.clear_color)},
+                   {"exposure", num(r.exposure)}};
+  doc["shadow"] = write_shadow(scene.shadow_defaults, nullptr);
+  std::vector<ecs::Entity> authored;
+  scene.world.view<Transform>().each([&](ecs::Entity e, const Transform&) {
+    if (!scene.world.has<Imported>(e)) authored.push_back(e);
+  });
+  std::sort(authored.begin(), authored.end(), entity_less);  // creation order
+  json ents = json::array();
+  for (ecs::Entity e : authored) ents.push_back(entity_to_json(scene, e, base_dir));
+  doc["entities"] = ents;
+  return doc;
+}
+
+Status save_scene(const fs::path& file, const Scene& scene) {
+  const fs::path dir = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+  const std::string text = scene_to_json(scene, dir).dump(2) + "\n";
+  fs::path tmp = file;
+  tmp += ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) return Error{file.string(), "", "cannot write (directory missing or not writable)"};
+    out << text;
+    out.flush();
+    if (!out) return Error{file.string(), "", "write failed (disk full?)"};
+  }
+  std::error_code ec;
+  fs::rename(tmp, file, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    return Error{file.string(), "", "cannot replace the file: " + ec.message()};
+  }
+  return {};
+}
+
+Result<Scene> read_scene(const fs::path& file, const std::vector<std::string>& overrides) {
+  auto doc = read_scene_document(file);
+  if (!doc) return doc.error();
+  if (!overrides.empty()) {
+    // Overrides act on the canonical form, where every field is present with its value.
+    auto first = parse_scene(*doc, file);
+    if (!first) return first.error();
+    json canonical = scene_to_json(*first);
+    for (const auto& o : overrides) KASKAD_TRY(apply_override(canonical, o));
+    doc = std::move(canonical);
+  }
+  auto scene = parse_scene(*doc, file);
+  if (!scene) {
+    Error e = scene.error();
+    if (!overrides.empty()) e.message += " (after --set overrides)";
+    return e;
+  }
+  return scene;
+}
+
+}  // namespace kaskad

@@ -1,0 +1,54 @@
+// Scene files (JSON, content/scenes/) and direct glTF scenes.
+//
+// Loading is three steps so that `--set` overrides act on the same canonical document that
+// save_scene() writes:
+//   read_scene_document  file -> JSON (a .gltf/.glb is wrapped into a one-entity scene)
+//   parse_scene          JSON -> Scene with the authored entities only (validated, no file I/O)
+//   instantiate_scene    primitives -> meshes, glTF references -> imported entities
+// load_scene (runtime/cli/player.h) runs all three plus the load phase (transforms, auto cameras).
+// The format is documented in README.md ("Scene files").
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "runtime/assets/scene.h"
+#include "runtime/core/result.h"
+
+namespace kaskad {
+
+/// Reads a .json scene, or wraps a .gltf/.glb file: its entity plus, when the file has none of its
+/// own, a camera named "camera" (auto_frame) and a directional light named "sun".
+Result<nlohmann::json> read_scene_document(const std::filesystem::path& file);
+
+/// Applies one "key=value" override to a canonical document. Keys: "render.FIELD",
+/// "shadow.FIELD", or "ENTITY.SECTION.FIELD" (e.g. "sun.light.intensity"); array elements by
+/// index ("box.transform.translation.1"). The value is JSON, or a bare string. Unknown keys are
+/// errors that list the valid keys at that level.
+Status apply_override(nlohmann::json& document, const std::string& assignment);
+
+/// Builds the authored part of a scene from a document. Errors name `file` and the JSON path.
+Result<Scene> parse_scene(const nlohmann::json& document, const std::filesystem::path& file);
+
+/// read_scene_document, then (when there are overrides) canonicalise and apply them in order,
+/// then parse_scene. Errors after overrides say so.
+Result<Scene> read_scene(const std::filesystem::path& file,
+                         const std::vector<std::string>& overrides = {});
+
+/// Creates meshes for primitives and imports glTF references (paths relative to scene.file).
+/// Cameras with auto_frame are framed by the load phase (load_scene in runtime/cli/player.h).
+Status instantiate_scene(Scene& scene);
+
+/// The canonical document of the authored entities and settings (imported entities excluded).
+/// With a `base_dir`, model paths are rewritten relative to it (for a file written there);
+/// without, they stay relative to scene.file.
+nlohmann::json scene_to_json(const Scene& scene, const std::filesystem::path& base_dir = {});
+
+/// Writes scene_to_json() with two-space indentation. Written to a temporary file first and then
+/// renamed, so a failure never leaves a half-written scene behind.
+Status save_scene(const std::filesystem::path& file, const Scene& scene);
+
+}  // namespace kaskad

@@ -1,0 +1,51 @@
+// The headless (or windowed) player: loads a scene, renders frames through the frame phases, times
+// them, and writes images and AOVs. Used by the `kaskad` CLI, the editor and the render tests.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "runtime/assets/scene.h"
+#include "runtime/core/result.h"
+#include "runtime/gpu/context.h"
+#include "runtime/render/renderer.h"
+#include "systems/frame.h"
+
+namespace kaskad {
+
+/// Where shaders, scenes and models live: $KASKAD_CONTENT_DIR, else the build-time content/ path.
+std::filesystem::path content_dir();
+
+/// Reads, canonicalises, applies `overrides` (--set), parses and instantiates a scene, then runs
+/// the load phase: transforms, and framing of auto_frame cameras for render.width/height.
+Result<Scene> load_scene(const std::filesystem::path& file,
+                         const std::vector<std::string>& overrides = {});
+
+/// A GL context plus a renderer reading shaders from content_dir()/shaders.
+struct Player {
+  std::unique_ptr<gpu::Context> context;
+  std::unique_ptr<render::Renderer> renderer;
+
+  static Result<Player> create(const gpu::ContextOptions& options);
+};
+
+struct RenderRun {
+  int frames = 1;  ///< frames rendered; the last one is kept for read-back
+  int width = 0;   ///< 0: take render.width / render.height from the scene
+  int height = 0;
+};
+
+struct RenderTimings {
+  double first_frame_ms = 0.0;              ///< includes shader compiles and uploads
+  std::vector<double> frame_ms;             ///< every frame after the first (CPU wall, GPU finished)
+  double median_ms() const;                 ///< median of frame_ms (first frame if it is empty)
+  FrameReport last;                         ///< phase times and counters of the last frame
+};
+
+/// Renders `run.frames` frames of `scene`, waiting for the GPU after each so the times are honest.
+Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRun& run);
+
+}  // namespace kaskad

@@ -1,0 +1,45 @@
+#include "runtime/core/log.h"
+
+#include <atomic>
+#include <cstdio>
+
+namespace kaskad::log {
+namespace {
+std::atomic<Level> g_level{Level::info};
+std::atomic<int> g_errors{0};
+
+void vlog(Level lvl, const char* tag, const char* fmt, va_list args) {
+  if (lvl < g_level.load()) return;
+  std::fprintf(stderr, "[kaskad %s] ", tag);
+  std::vfprintf(stderr, fmt, args);
+  std::fputc('\n', stderr);
+}
+}  // namespace
+
+void set_level(Level lvl) { g_level = lvl; }
+Level level() { return g_level; }
+
+#define KASKAD_LOG_FN(name, lvl, tag) \
+  void name(const char* fmt, ...) {   \
+    va_list args;                     \
+    va_start(args, fmt);              \
+    vlog(lvl, tag, fmt, args);        \
+    va_end(args);                     \
+  }
+KASKAD_LOG_FN(debug, Level::debug, "debug")
+KASKAD_LOG_FN(info, Level::info, "info")
+KASKAD_LOG_FN(warn, Level::warn, "warn")
+#undef KASKAD_LOG_FN
+
+void error(const char* fmt, ...) {
+  ++g_errors;
+  va_list args;
+  va_start(args, fmt);
+  vlog(Level::error, "error", fmt, args);
+  va_end(args);
+}
+
+int error_count() { return g_errors; }
+void reset_error_count() { g_errors = 0; }
+
+}  // namespace kaskad::log

@@ -1,0 +1,70 @@
+// RAII owners for OpenGL objects. Public APIs pass these typed handles, never a raw GLuint
+// (STYLE.md 11): the type says what the object is, and ownership is explicit (move-only).
+#pragma once
+
+#include <epoxy/gl.h>
+
+#include <utility>
+
+namespace kaskad::gpu {
+
+/// Move-only owner of one GL object name; Deleter::destroy(GLuint) frees it.
+template <class Deleter>
+class GlObject {
+ public:
+  GlObject() = default;
+  explicit GlObject(GLuint id) : id_(id) {}
+  ~GlObject() { reset(); }
+  GlObject(GlObject&& o) noexcept : id_(std::exchange(o.id_, 0)) {}
+  GlObject& operator=(GlObject&& o) noexcept {
+    if (this != &o) {
+      reset();
+      id_ = std::exchange(o.id_, 0);
+    }
+    return *this;
+  }
+  GlObject(const GlObject&) = delete;
+  GlObject& operator=(const GlObject&) = delete;
+
+  /// The GL name, for GL calls inside the gpu/render modules only.
+  GLuint id() const { return id_; }
+  explicit operator bool() const { return id_ != 0; }
+  void reset() {
+    if (id_ != 0) Deleter::destroy(id_);
+    id_ = 0;
+  }
+
+ private:
+  GLuint id_ = 0;
+};
+
+namespace detail {
+struct BufferDeleter { static void destroy(GLuint id) { glDeleteBuffers(1, &id); } };
+struct TextureDeleter { static void destroy(GLuint id) { glDeleteTextures(1, &id); } };
+struct FramebufferDeleter { static void destroy(GLuint id) { glDeleteFramebuffers(1, &id); } };
+struct RenderbufferDeleter { static void destroy(GLuint id) { glDeleteRenderbuffers(1, &id); } };
+struct VertexArrayDeleter { static void destroy(GLuint id) { glDeleteVertexArrays(1, &id); } };
+struct ProgramDeleter { static void destroy(GLuint id) { glDeleteProgram(id); } };
+struct ShaderDeleter { static void destroy(GLuint id) { glDeleteShader(id); } };
+struct QueryDeleter { static void destroy(GLuint id) { glDeleteQueries(1, &id); } };
+struct SamplerDeleter { static void destroy(GLuint id) { glDeleteSamplers(1, &id); } };
+}  // namespace detail
+
+using Buffer = GlObject<detail::BufferDeleter>;
+using Texture = GlObject<detail::TextureDeleter>;
+using Framebuffer = GlObject<detail::FramebufferDeleter>;
+using Renderbuffer = GlObject<detail::RenderbufferDeleter>;
+using VertexArray = GlObject<detail::VertexArrayDeleter>;
+using Program = GlObject<detail::ProgramDeleter>;
+using Shader = GlObject<detail::ShaderDeleter>;
+using Query = GlObject<detail::QueryDeleter>;
+using Sampler = GlObject<detail::SamplerDeleter>;
+
+// DSA creation helpers (OpenGL 4.5).
+inline Buffer make_buffer() { GLuint id = 0; glCreateBuffers(1, &id); return Buffer(id); }
+inline Texture make_texture(GLenum target) { GLuint id = 0; glCreateTextures(target, 1, &id); return Texture(id); }
+inline Framebuffer make_framebuffer() { GLuint id = 0; glCreateFramebuffers(1, &id); return Framebuffer(id); }
+inline VertexArray make_vertex_array() { GLuint id = 0; glCreateVertexArrays(1, &id); return VertexArray(id); }
+inline Query make_query(GLenum target) { GLuint id = 0; glCreateQueries(target, 1, &id); return Query(id); }
+
+}  // namespace kaskad::gpu

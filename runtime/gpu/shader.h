@@ -1,0 +1,34 @@
+// GLSL program building from files under content/shaders/. Sources may `#include "file.glsl"`;
+// every included file gets its own GLSL source-string number via `#line`, so compiler messages are
+// mapped back to the original file and line instead of the concatenated string.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "runtime/core/result.h"
+#include "runtime/gpu/gl_handles.h"
+
+namespace kaskad::gpu {
+
+/// A preprocessed stage: the text handed to GL plus the files its `#line` numbers refer to.
+struct ShaderSource {
+  std::string text;
+  std::vector<std::string> files;  ///< index = GLSL source-string number used in #line
+};
+
+/// Reads `path` (relative to `root`), expands includes (depth <= 16, no cycles) and prepends
+/// `#version 450 core` and one `#define NAME VALUE` per entry of `defines`.
+Result<ShaderSource> preprocess_shader(const std::filesystem::path& root,
+                                       const std::string& path,
+                                       const std::vector<std::pair<std::string, std::string>>& defines);
+
+/// Rewrites a GL info log so "0:12(5): error: ..." reads "forward.frag:12(5): error: ...".
+std::string map_shader_log(const std::string& log, const std::vector<std::string>& files);
+
+/// Compiles and links a vertex + fragment program. Errors carry the mapped compiler/linker log.
+Result<Program> build_program(const ShaderSource& vertex, const ShaderSource& fragment);
+
+}  // namespace kaskad::gpu

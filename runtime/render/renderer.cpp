@@ -1,0 +1,467 @@
+#include "runtime/render/renderer.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <unordered_map>
+
+#include "runtime/core/log.h"
+#include "runtime/gpu/shader.h"
+
+namespace kaskad::render {
+namespace {
+
+// std140 mirror of FrameBlock in content/shaders/common.glsl (change together).
+struct alignas(16) FrameBlock {
+  glm::mat4 view_proj;
+  glm::mat4 view;
+  glm::mat4 light_view_proj;
+  glm::vec4 camera_pos;
+  glm::vec4 ambient;
+  glm::ivec4 counts;
+  glm::vec4 light_color[kMaxLights];
+  glm::vec4 light_dir[kMaxLights];
+  glm::vec4 light_pos[kMaxLights];
+  glm::vec4 light_cone[kMaxLights];
+};
+static_assert(sizeof(FrameBlock) == 3 * 64 + 3 * 16 + 4 * kMaxLights * 16);
+
+// Fixed attribute and uniform locations (see the shaders).
+constexpr GLuint kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
+constexpr GLint kUniModel = 0, kUniNormalMatrix = 4, kUniBaseColor = 8, kUniMaterial = 9,
+                kUniEmissive = 10;
+constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2;
+
+struct GpuMesh {
+  gpu::VertexArray vao;
+  gpu::Buffer vertices;
+  gpu::Buffer indices;
+  GLsizei index_count = 0;
+};
+
+struct GpuTexture {
+  gpu::Texture texture;
+};
+
+gpu::Texture make_solid_texture(const std::array<std::uint8_t, 4>& rgba, GLenum internal_format) {
+  gpu::Texture t = gpu::make_texture(GL_TEXTURE_2D);
+  glTextureStorage2D(t.id(), 1, internal_format, 1, 1);
+  glTextureSubImage2D(t.id(), 0, 0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  return t;
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  std::filesystem::path shader_dir;
+  std::unordered_map<std::string, gpu::Program> programs;  // key: pass + defines
+  std::vector<GpuMesh> meshes;                             // indexed by MeshId
+  std::vector<std::unique_ptr<GpuTexture>> textures;       // indexed by TextureId
+  gpu::Texture white, flat_normal;
+  gpu::Buffer frame_ubo;
+
+  // Forward targets.
+  int width = 0, height = 0;
+  gpu::Framebuffer fbo;
+  gpu::Texture color, position, normal, visibility, depth;
+
+  // Shadow map.
+  int shadow_size = 0;
+  ShadowFilter shadow_filter = ShadowFilter::none;
+  gpu::Framebuffer shadow_fbo;
+  gpu::Texture shadow_map;
+  bool shadow_valid = false;
+
+  std::array<gpu::Query, 2> timers;
+  bool timers_pending = false;
+
+  Result<GLuint> program(const std::string& vs, const std::string& fs,
+                         const std::vector<std::pair<std::string, std::string>>& defines,
+                         int& compiled) {
+    std::string key = vs + "|" + fs;
+    for (const auto& [k, v] : defines) key += "|" + k + "=" + v;
+    // Hot path: one hash probe per pass; compile only on a miss.
+    if (auto it = programs.find(key); it != programs.end()) return it->second.id();
+    auto v = gpu::preprocess_shader(shader_dir, vs, defines);
+    if (!v) return v.error();
+    auto f = gpu::preprocess_shader(shader_dir, fs, defines);
+    if (!f) return f.error();
+    auto p = gpu::build_program(*v, *f);
+    if (!p) return p.error();
+    ++compiled;
+    GLuint id = p->id();
+    programs.emplace(key, std::move(p.value()));
+    return id;
+  }
+
+  const GpuMesh& mesh(MeshId id, const AssetStore& assets) {
+    if (id >= meshes.size()) meshes.resize(std::size_t(id) + 1);
+    GpuMesh& m = meshes[id];
+    if (m.vao) return m;
+    const MeshData& src = assets.meshes[id];
+    const std::size_t n = src.positions.size();
+    // One buffer, three streams: positions | normals | uvs (uvs zero when the mesh has none).
+    const std::size_t pos_bytes = n * sizeof(glm::vec3), uv_bytes = n * sizeof(glm::vec2);
+    std::vector<std::uint8_t> data(2 * pos_bytes + uv_bytes, 0);
+    std::memcpy(data.data(), src.positions.data(), pos_bytes);
+    if (src.normals.size() == n) std::memcpy(data.data() + pos_bytes, src.normals.data(), pos_bytes);
+    if (src.uvs.size() == n) std::memcpy(data.data() + 2 * pos_bytes, src.uvs.data(), uv_bytes);
+    m.vertices = gpu::make_buffer();
+    glNamedBufferStorage(m.vertices.id(), GLsizeiptr(std::max<std::size_t>(data.size(), 1)),
+                         data.data(), 0);
+    m.indices = gpu::make_buffer();
+    glNamedBufferStorage(m.indices.id(),
+                         GLsizeiptr(std::max<std::size_t>(src.indices.size() * 4, 4)),
+                         src.indices.empty() ? nullptr : src.indices.data(), 0);
+    m.index_count = GLsizei(src.indices.size());
+    m.vao = gpu::make_vertex_array();
+    const GLuint vao = m.vao.id();
+    glVertexArrayVertexBuffer(vao, 0, m.vertices.id(), 0, sizeof(glm::vec3));
+    glVertexArrayVertexBuffer(vao, 1, m.vertices.id(), GLintptr(pos_bytes), sizeof(glm::vec3));
+    glVertexArrayVertexBuffer(vao, 2, m.vertices.id(), GLintptr(2 * pos_bytes), sizeof(glm::vec2));
+    const GLuint attrs[3] = {kAttrPosition, kAttrNormal, kAttrUv};
+    const GLint sizes[3] = {3, 3, 2};
+    for (int i = 0; i < 3; ++i) {
+      glEnableVertexArrayAttrib(vao, attrs[i]);
+      glVertexArrayAttribFormat(vao, attrs[i], sizes[i], GL_FLOAT, GL_FALSE, 0);
+      glVertexArrayAttribBinding(vao, attrs[i], GLuint(i));
+    }
+    glVertexArrayElementBuffer(vao, m.indices.id());
+    return m;
+  }
+
+  GLuint texture(TextureId id, const AssetStore& assets, bool is_normal_map) {
+    if (id == kNoTexture || id >= assets.textures.size())
+      return is_normal_map ? flat_normal.id() : white.id();
+    if (id >= textures.size()) textures.resize(std::size_t(id) + 1);
+    if (!textures[id]) {
+      const TextureData& src = assets.textures[id];
+      auto t = std::make_unique<GpuTexture>();
+      t->texture = gpu::make_texture(GL_TEXTURE_2D);
+      const GLuint tex = t->texture.id();
+      const int levels = 1 + int(std::floor(std::log2(std::max(1, std::max(src.width, src.height)))));
+      // Colour data is sRGB-encoded; normal maps are linear. Normal maps reuse the same cache slot
+      // as long as a texture is used in one role only (glTF practice).
+      const GLenum fmt = (src.srgb && !is_normal_map) ? GL_SRGB8_ALPHA8 : GL_RGBA8;
+      glTextureStorage2D(tex, levels, fmt, std::max(1, src.width), std::max(1, src.height));
+      if (src.width > 0 && src.height > 0 &&
+          src.rgba8.size() == std::size_t(src.width) * src.height * 4) {
+        glTextureSubImage2D(tex, 0, 0, 0, src.width, src.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                            src.rgba8.data());
+      }
+      glGenerateTextureMipmap(tex);
+      glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+      glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_REPEAT);
+      glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_REPEAT);
+      textures[id] = std::move(t);
+    }
+    return textures[id]->texture.id();
+  }
+
+  void ensure_targets(int w, int h) {
+    if (fbo && w == width && h == height) return;
+    width = w;
+    height = h;
+    auto make = [&](gpu::Texture& t, GLenum fmt) {
+      t = gpu::make_texture(GL_TEXTURE_2D);
+      glTextureStorage2D(t.id(), 1, fmt, w, h);
+      glTextureParameteri(t.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTextureParameteri(t.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    };
+    make(color, GL_SRGB8_ALPHA8);
+    make(position, GL_RGBA32F);
+    make(normal, GL_RGBA32F);
+    make(visibility, GL_R32F);
+    make(depth, GL_DEPTH_COMPONENT32F);
+    fbo = gpu::make_framebuffer();
+    glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0, color.id(), 0);
+    glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT1, position.id(), 0);
+    glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT2, normal.id(), 0);
+    glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT3, visibility.id(), 0);
+    glNamedFramebufferTexture(fbo.id(), GL_DEPTH_ATTACHMENT, depth.id(), 0);
+    const GLenum bufs[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                            GL_COLOR_ATTACHMENT3};
+    glNamedFramebufferDrawBuffers(fbo.id(), 4, bufs);
+  }
+
+  void ensure_shadow_map(int size, ShadowFilter filter) {
+    if (shadow_fbo && size == shadow_size && filter == shadow_filter) return;
+    if (!shadow_fbo || size != shadow_size) {
+      shadow_size = size;
+      shadow_map = gpu::make_texture(GL_TEXTURE_2D);
+      glTextureStorage2D(shadow_map.id(), 1, GL_DEPTH_COMPONENT24, size, size);
+      // S4: clamp to border with border depth 1, so lookups outside the map compare as lit.
+      glTextureParameteri(shadow_map.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+      glTextureParameteri(shadow_map.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+      const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+      glTextureParameterfv(shadow_map.id(), GL_TEXTURE_BORDER_COLOR, border);
+      glTextureParameteri(shadow_map.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+      glTextureParameteri(shadow_map.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+      shadow_fbo = gpu::make_framebuffer();
+      glNamedFramebufferTexture(shadow_fbo.id(), GL_DEPTH_ATTACHMENT, shadow_map.id(), 0);
+      glNamedFramebufferDrawBuffer(shadow_fbo.id(), GL_NONE);
+      glNamedFramebufferReadBuffer(shadow_fbo.id(), GL_NONE);
+    }
+    shadow_filter = filter;
+    const GLint f = filter == ShadowFilter::bilinear ? GL_LINEAR : GL_NEAREST;
+    glTextureParameteri(shadow_map.id(), GL_TEXTURE_MIN_FILTER, f);
+    glTextureParameteri(shadow_map.id(), GL_TEXTURE_MAG_FILTER, f);
+  }
+};
+
+Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& shader_dir) {
+  std::unique_ptr<Renderer> r(new Renderer());
+  r->impl_ = std::make_unique<Impl>();
+  Impl& im = *r->impl_;
+  im.shader_dir = shader_dir;
+  if (!std::filesystem::exists(shader_dir / "forward.frag"))
+    return Error{shader_dir.string(), "", "shader directory has no forward.frag"};
+  im.white = make_solid_texture({255, 255, 255, 255}, GL_SRGB8_ALPHA8);
+  im.flat_normal = make_solid_texture({128, 128, 255, 255}, GL_RGBA8);
+  im.frame_ubo = gpu::make_buffer();
+  glNamedBufferStorage(im.frame_ubo.id(), sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  im.timers[0] = gpu::make_query(GL_TIME_ELAPSED);
+  im.timers[1] = gpu::make_query(GL_TIME_ELAPSED);
+  // Empty shadow map so the sampler is complete even in frames without a shadow pass.
+  im.ensure_shadow_map(64, ShadowFilter::none);
+  return r;
+}
+
+Renderer::~Renderer() = default;
+
+Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
+  Impl& im = *impl_;
+  KASKAD_CHECK(frame.width > 0 && frame.height > 0 && frame.width <= 16384 &&
+                   frame.height <= 16384,
+               "frame size must be in [1, 16384], was " + std::to_string(frame.width) + "x" +
+                   std::to_string(frame.height));
+  // Timer results of the previous frame (available after finish()).
+  if (im.timers_pending) {
+    GLuint64 ns[2] = {0, 0};
+    glGetQueryObjectui64v(im.timers[0].id(), GL_QUERY_RESULT, &ns[0]);
+    glGetQueryObjectui64v(im.timers[1].id(), GL_QUERY_RESULT, &ns[1]);
+    stats_.shadow_gpu_ms = double(ns[0]) * 1e-6;
+    stats_.forward_gpu_ms = double(ns[1]) * 1e-6;
+  }
+  stats_.draw_calls = stats_.shadow_draw_calls = 0;
+  stats_.triangles = stats_.shadow_triangles = 0;
+
+  // Frame uniforms.
+  FrameBlock fb{};
+  fb.view_proj = frame.camera.proj * frame.camera.view;
+  fb.view = frame.camera.view;
+  fb.light_view_proj = frame.shadow.view_proj;
+  fb.camera_pos = glm::vec4(frame.camera.position, 1.0f);
+  fb.ambient = glm::vec4(frame.ambient, frame.exposure);
+  const int light_count = std::min<int>(int(frame.lights.size()), kMaxLights);
+  if (int(frame.lights.size()) > kMaxLights)
+    log::warn("%zu lights; only the first %d are shaded", frame.lights.size(), kMaxLights);
+  const bool shadowed = frame.shadow.light_index >= 0 && frame.shadow.light_index < light_count;
+  fb.counts = glm::ivec4(light_count, shadowed ? frame.shadow.light_index : -1, 0, 0);
+  for (int i = 0; i < light_count; ++i) {
+    const LightItem& l = frame.lights[std::size_t(i)];
+    fb.light_color[i] = glm::vec4(l.color, float(int(l.type)));
+    fb.light_dir[i] = glm::vec4(l.direction, l.range);
+    fb.light_pos[i] = glm::vec4(l.position, l.cos_outer);
+    fb.light_cone[i] = glm::vec4(l.cos_inner, 0, 0, 0);
+  }
+  glNamedBufferSubData(im.frame_ubo.id(), 0, sizeof fb, &fb);
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
+
+  for (const DrawItem& d : frame.draws)
+    if (d.mesh >= assets.meshes.size())
+      return Error{"", "draw list", "mesh id " + std::to_string(d.mesh) + " is out of range"};
+
+  // Pass 1: shadow map (S4): depth only, light viewport, bias by polygon offset, chosen culling.
+  glBeginQuery(GL_TIME_ELAPSED, im.timers[0].id());
+  if (shadowed) {
+    const ShadowSettings& s = frame.shadow.settings;
+    im.ensure_shadow_map(s.map_size, s.filter);
+    auto prog = im.program("shadow_depth.vert", "shadow_depth.frag", {}, stats_.programs_compiled);
+    if (!prog) {
+      glEndQuery(GL_TIME_ELAPSED);
+      return prog.error();
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, im.shadow_fbo.id());
+    glViewport(0, 0, s.map_size, s.map_size);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glClearDepth(1.0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    if (s.cull == CullMode::none) {
+      glDisable(GL_CULL_FACE);
+    } else {
+      glEnable(GL_CULL_FACE);
+      glCullFace(s.cull == CullMode::front ? GL_FRONT : GL_BACK);
+    }
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(s.slope_bias, s.constant_bias);
+    glUseProgram(*prog);
+    for (const DrawItem& d : frame.draws) {
+      if (!d.cast_shadows) continue;
+      const GpuMesh& m = im.mesh(d.mesh, assets);
+      if (m.index_count == 0) continue;
+      glProgramUniformMatrix4fv(*prog, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+      glBindVertexArray(m.vao.id());
+      glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+      ++stats_.shadow_draw_calls;
+      stats_.shadow_triangles += std::size_t(m.index_count / 3);
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    im.shadow_valid = true;
+  }
+  glEndQuery(GL_TIME_ELAPSED);
+
+  // Pass 2: forward shading into colour + AOV targets.
+  glBeginQuery(GL_TIME_ELAPSED, im.timers[1].id());
+  const ShadowFilter filter = shadowed ? frame.shadow.settings.filter : ShadowFilter::none;
+  auto prog = im.program("forward.vert", "forward.frag",
+                         {{"SHADOW_FILTER", std::to_string(int(filter))}},
+                         stats_.programs_compiled);
+  if (!prog) {
+    glEndQuery(GL_TIME_ELAPSED);
+    return prog.error();
+  }
+  im.ensure_targets(frame.width, frame.height);
+  glBindFramebuffer(GL_FRAMEBUFFER, im.fbo.id());
+  glViewport(0, 0, frame.width, frame.height);
+  glEnable(GL_FRAMEBUFFER_SRGB);
+  const float clear_color[4] = {frame.clear_color.r * frame.exposure,
+                                frame.clear_color.g * frame.exposure,
+                                frame.clear_color.b * frame.exposure, 1.0f};
+  const float zero[4] = {0, 0, 0, 0};
+  const float one = 1.0f;
+  glClearBufferfv(GL_COLOR, 0, clear_color);
+  glClearBufferfv(GL_COLOR, 1, zero);
+  glClearBufferfv(GL_COLOR, 2, zero);
+  glClearBufferfv(GL_COLOR, 3, zero);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glClearBufferfv(GL_DEPTH, 0, &one);
+  glUseProgram(*prog);
+  glBindTextureUnit(kTexShadow, im.shadow_map.id());
+  for (const DrawItem& d : frame.draws) {
+    const GpuMesh& m = im.mesh(d.mesh, assets);
+    if (m.index_count == 0) continue;
+    if (d.material.double_sided) {
+      glDisable(GL_CULL_FACE);
+    } else {
+      glEnable(GL_CULL_FACE);
+      glCullFace(GL_BACK);
+    }
+    const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(d.model)));
+    const glm::vec4 params(d.material.metallic, d.material.roughness, d.material.normal_scale,
+                           d.receive_shadows ? 1.0f : 0.0f);
+    glProgramUniformMatrix4fv(*prog, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+    glProgramUniformMatrix3fv(*prog, kUniNormalMatrix, 1, GL_FALSE, &normal_matrix[0][0]);
+    glProgramUniform4fv(*prog, kUniBaseColor, 1, &d.material.base_color[0]);
+    glProgramUniform4fv(*prog, kUniMaterial, 1, &params[0]);
+    glProgramUniform3fv(*prog, kUniEmissive, 1, &d.material.emissive[0]);
+    glBindTextureUnit(kTexBaseColor, im.texture(d.material.base_color_texture, assets, false));
+    glBindTextureUnit(kTexNormal, im.texture(d.material.normal_texture, assets, true));
+    glBindVertexArray(m.vao.id());
+    glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+    ++stats_.draw_calls;
+    stats_.triangles += std::size_t(m.index_count / 3);
+  }
+  glDisable(GL_FRAMEBUFFER_SRGB);
+  glEndQuery(GL_TIME_ELAPSED);
+  im.timers_pending = true;
+  glBindVertexArray(0);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return {};
+}
+
+void Renderer::finish() { glFinish(); }
+
+namespace {
+
+// Reads one attachment as floats and flips rows so the image is top to bottom.
+std::vector<float> read_texture(GLuint tex, int w, int h, GLenum format, int channels) {
+  std::vector<float> px(std::size_t(w) * h * channels);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(tex, 0, format, GL_FLOAT, GLsizei(px.size() * sizeof(float)), px.data());
+  std::vector<float> flipped(px.size());
+  const std::size_t row = std::size_t(w) * channels;
+  for (int y = 0; y < h; ++y)
+    std::memcpy(&flipped[std::size_t(y) * row], &px[std::size_t(h - 1 - y) * row],
+                row * sizeof(float));
+  return flipped;
+}
+
+}  // namespace
+
+Image Renderer::read_color() const {
+  const Impl& im = *impl_;
+  Image img;
+  img.width = im.width;
+  img.height = im.height;
+  img.channels = 4;
+  img.channel_names = {"R", "G", "B", "A"};
+  // The sRGB target stores encoded values; reading as GL_RGBA/GL_FLOAT returns them unconverted
+  // only for non-sRGB formats, so read bytes instead.
+  std::vector<std::uint8_t> bytes(std::size_t(im.width) * im.height * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(im.color.id(), 0, GL_RGBA, GL_UNSIGNED_BYTE, GLsizei(bytes.size()),
+                    bytes.data());
+  img.pixels.resize(bytes.size());
+  const std::size_t row = std::size_t(im.width) * 4;
+  for (int y = 0; y < im.height; ++y)
+    for (std::size_t i = 0; i < row; ++i)
+      img.pixels[std::size_t(y) * row + i] = bytes[std::size_t(im.height - 1 - y) * row + i] / 255.0f;
+  return img;
+}
+
+Image Renderer::read_aovs() const {
+  const Impl& im = *impl_;
+  const int w = im.width, h = im.height;
+  const auto pos = read_texture(im.position.id(), w, h, GL_RGBA, 4);
+  const auto nrm = read_texture(im.normal.id(), w, h, GL_RGBA, 4);
+  const auto vis = read_texture(im.visibility.id(), w, h, GL_RED, 1);
+  Image img;
+  img.width = w;
+  img.height = h;
+  img.channel_names = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z", "Z", "visibility", "mask"};
+  img.channels = int(img.channel_names.size());
+  img.pixels.resize(std::size_t(w) * h * img.channels);
+  for (std::size_t i = 0; i < std::size_t(w) * h; ++i) {
+    float* o = &img.pixels[i * img.channels];
+    o[0] = pos[i * 4 + 0];
+    o[1] = pos[i * 4 + 1];
+    o[2] = pos[i * 4 + 2];
+    o[3] = nrm[i * 4 + 0];
+    o[4] = nrm[i * 4 + 1];
+    o[5] = nrm[i * 4 + 2];
+    o[6] = nrm[i * 4 + 3];
+    o[7] = vis[i];
+    o[8] = pos[i * 4 + 3];
+  }
+  return img;
+}
+
+Image Renderer::read_shadow_map() const {
+  const Impl& im = *impl_;
+  Image img;
+  img.width = img.height = im.shadow_size;
+  img.channels = 1;
+  img.channel_names = {"Y"};
+  img.pixels = read_texture(im.shadow_map.id(), im.shadow_size, im.shadow_size,
+                            GL_DEPTH_COMPONENT, 1);
+  return img;
+}
+
+void Renderer::present(int window_width, int window_height) const {
+  const Impl& im = *impl_;
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glNamedFramebufferReadBuffer(im.fbo.id(), GL_COLOR_ATTACHMENT0);
+  glBlitNamedFramebuffer(im.fbo.id(), 0, 0, 0, im.width, im.height, 0, 0, window_width,
+                         window_height, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+}
+
+}  // namespace kaskad::render

@@ -1,0 +1,112 @@
+// The forward renderer: a depth-only shadow pass for one shadowed light, then one forward pass
+// that writes colour and the AOVs (world position + mask, facing normal + view depth, shadow
+// visibility) into an offscreen framebuffer. Headless and windowed use the same passes; a window
+// only adds present().
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "components/light.h"
+#include "components/material.h"
+#include "components/shadow_settings.h"
+#include "runtime/assets/asset_store.h"
+#include "runtime/assets/image_io.h"
+#include "runtime/core/result.h"
+#include "runtime/gpu/gl_handles.h"
+
+namespace kaskad::render {
+
+struct CameraView {
+  glm::mat4 view{1.0f};
+  glm::mat4 proj{1.0f};
+  glm::vec3 position{0.0f};
+};
+
+struct DrawItem {
+  MeshId mesh = kNoMesh;
+  glm::mat4 model{1.0f};
+  Material material;
+  bool cast_shadows = true;
+  bool receive_shadows = true;
+};
+
+/// A light as the shaders see it. `color` already includes the intensity.
+struct LightItem {
+  LightType type = LightType::directional;
+  glm::vec3 color{1.0f};
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};  ///< the way the light travels (unit)
+  glm::vec3 position{0.0f};
+  float range = 0.0f;
+  float cos_inner = 1.0f;
+  float cos_outer = 0.7f;
+};
+
+struct ShadowPass {
+  int light_index = -1;          ///< index into FrameInput::lights; -1: no shadow pass
+  glm::mat4 view_proj{1.0f};     ///< world -> light clip space
+  ShadowSettings settings;
+};
+
+struct FrameInput {
+  int width = 1280;
+  int height = 720;
+  CameraView camera;
+  std::vector<DrawItem> draws;
+  std::vector<LightItem> lights;  ///< at most kMaxLights are used
+  ShadowPass shadow;
+  glm::vec3 ambient{0.05f};
+  glm::vec3 clear_color{0.0f};
+  float exposure = 1.0f;
+};
+
+inline constexpr int kMaxLights = 8;  // change together with MAX_LIGHTS in common.glsl
+
+struct FrameStats {
+  int draw_calls = 0;
+  std::size_t triangles = 0;          ///< submitted in the forward pass
+  int shadow_draw_calls = 0;
+  std::size_t shadow_triangles = 0;   ///< submitted to the shadow map
+  double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
+  double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)
+  int programs_compiled = 0;          ///< since the renderer was created
+};
+
+class Renderer {
+ public:
+  /// Needs a current GL 4.5 context. `shader_dir` holds the GLSL files (content/shaders).
+  static Result<std::unique_ptr<Renderer>> create(const std::filesystem::path& shader_dir);
+  ~Renderer();
+
+  /// Records and submits the shadow and forward passes. Meshes and textures are uploaded from
+  /// `assets` on first use. Errors: shader compile/link failures (content errors).
+  Status render(const FrameInput& frame, const AssetStore& assets);
+
+  /// Blocks until the GPU is done (for honest frame timing and read-back).
+  void finish();
+
+  /// sRGB-encoded colour of the last frame, RGBA in [0,1], rows top to bottom.
+  Image read_color() const;
+  /// AOVs of the last frame: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask (see README).
+  Image read_aovs() const;
+  /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom.
+  Image read_shadow_map() const;
+
+  /// Copies the colour target to the default framebuffer (windowed mode).
+  void present(int window_width, int window_height) const;
+
+  const FrameStats& stats() const { return stats_; }
+
+ private:
+  Renderer() = default;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  FrameStats stats_;
+};
+
+}  // namespace kaskad::render

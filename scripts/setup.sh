@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs what Kaskad needs from Debian 12 packages (as root, only what is missing), then
+# configures and builds a CMake preset (default: release). Idempotent: a second run only rebuilds
+# what changed.   usage: bash scripts/setup.sh [release|debug|asan]
+set -euo pipefail
+preset="${1:-release}"
+cd "$(dirname "$0")/.."
+
+packages=(
+  cmake g++ make pkg-config git
+  libglfw3-dev libegl-dev libepoxy-dev libglm-dev libgl-dev
+  libegl-mesa0 libgl1-mesa-dri mesa-utils
+  libtinygltf-dev libdraco-dev draco
+  libopenimageio-dev openimageio-tools
+  nlohmann-json3-dev libimgui-dev libstb-dev libembree-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  python3-matplotlib python3-numpy xvfb xauth
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+jobs="$(nproc 2>/dev/null || echo 2)"
+cmake --preset "$preset" >/dev/null
+cmake --build --preset "$preset" -j "$jobs"

@@ -1,0 +1,30 @@
+// Camera selection and framing.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "components/bounds.h"
+#include "components/camera.h"
+#include "runtime/ecs/world.h"
+
+namespace kaskad {
+
+struct CameraState {
+  ecs::Entity entity = ecs::kNullEntity;  ///< null when the scene has no camera
+  Camera camera;
+  glm::mat4 view{1.0f};   ///< world -> view (scale removed from the camera's world matrix)
+  glm::mat4 proj{1.0f};   ///< OpenGL clip space, aspect resolved
+  glm::vec3 position{0.0f};
+  float aspect = 1.0f;
+};
+
+/// The first Camera with active = true, else the first Camera; needs WorldTransform.
+/// `output_aspect` is used when the camera's own aspect is 0.
+CameraState select_camera(const ecs::World& world, float output_aspect);
+
+/// Moves every auto_frame camera back along its view axis until `bounds` fits its field of view,
+/// and sets near/far to enclose the bounds. Updates Transform (root cameras only; a parented
+/// auto_frame camera is left alone with a warning).
+void frame_auto_cameras(ecs::World& world, const Aabb& bounds, float output_aspect);
+
+}  // namespace kaskad

@@ -1,0 +1,92 @@
+#include "systems/frame.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "components/light.h"
+#include "components/material.h"
+#include "components/mesh_renderer.h"
+#include "components/transform.h"
+#include "systems/transform_system.h"
+
+namespace kaskad {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+}  // namespace
+
+render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx,
+                                     const CameraState& camera, const ShadowData& shadow) {
+  const ecs::World& world = scene.world;
+  render::FrameInput in;
+  in.width = ctx.width;
+  in.height = ctx.height;
+  in.camera.view = camera.view;
+  in.camera.proj = camera.proj;
+  in.camera.position = camera.position;
+  in.ambient = scene.render.ambient;
+  in.clear_color = scene.render.clear_color;
+  in.exposure = scene.render.exposure;
+
+  const Material default_material;
+  world.view<MeshRenderer, WorldTransform>().each(
+      [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
+        if (mr.mesh == kNoMesh) return;
+        const Material* mat = world.try_get<Material>(e);
+        in.draws.push_back({mr.mesh, wt.matrix, mat ? *mat : default_material, mr.cast_shadows,
+                            mr.receive_shadows});
+      });
+
+  world.view<Light, WorldTransform>().each(
+      [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {
+        render::LightItem item;
+        item.type = l.type;
+        item.color = l.color * l.intensity;
+        item.direction = light_direction(wt.matrix);
+        item.position = glm::vec3(wt.matrix[3]);
+        item.range = l.range;
+        item.cos_inner = std::cos(glm::radians(l.inner_cone_deg));
+        item.cos_outer = std::cos(glm::radians(l.outer_cone_deg));
+        if (e == shadow.light) {
+          in.shadow.light_index = int(in.lights.size());
+          in.shadow.view_proj = shadow.projection.view_proj();
+          in.shadow.settings = shadow.settings;
+        }
+        in.lights.push_back(item);
+      });
+  return in;
+}
+
+Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
+                 FrameReport& report) {
+  auto t = Clock::now();
+  update_transforms(scene.world, scene.assets);
+  report.transforms_ms = ms_since(t);
+
+  t = Clock::now();
+  report.camera = select_camera(scene.world, float(ctx.width) / float(ctx.height));
+  report.camera_ms = ms_since(t);
+  if (!report.camera.entity.valid())
+    return Error{scene.file.string(), "", "the scene has no camera"};
+
+  t = Clock::now();
+  report.shadow = update_basic_shadow(scene.world);
+  report.shadows_ms = ms_since(t);
+
+  t = Clock::now();
+  const render::FrameInput input = build_frame_input(scene, ctx, report.camera, report.shadow);
+  report.draw_list_ms = ms_since(t);
+
+  t = Clock::now();
+  Status st = renderer.render(input, scene.assets);
+  report.render_ms = ms_since(t);
+  report.stats = renderer.stats();
+  return st;
+}
+
+}  // namespace kaskad

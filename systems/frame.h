@@ -1,0 +1,43 @@
+// The frame, in order. This is the one place the phases are listed (STYLE.md 3).
+//
+//   1. Transforms  after it: every Transform has a current WorldTransform and every MeshRenderer
+//                  a current WorldBounds.
+//   2. Camera      after it: the active camera's view/projection for this frame's aspect.
+//   3. Shadows     after it: the shadowed light (if any) has a projection fitted to the scene.
+//   4. DrawList    after it: the renderer's FrameInput holds every drawable, light and setting.
+//   5. Render      after it: shadow and forward passes are submitted (not necessarily finished).
+#pragma once
+
+#include <cstdint>
+
+#include "runtime/assets/scene.h"
+#include "runtime/core/result.h"
+#include "runtime/render/renderer.h"
+#include "systems/camera_system.h"
+#include "systems/shadow_map_system.h"
+
+namespace kaskad {
+
+struct FrameContext {
+  int width = 1280;
+  int height = 720;
+  std::uint64_t index = 0;  ///< frame number since the scene was loaded
+};
+
+/// What a frame did, for stats output and tests. CPU times in milliseconds.
+struct FrameReport {
+  double transforms_ms = 0, camera_ms = 0, shadows_ms = 0, draw_list_ms = 0, render_ms = 0;
+  CameraState camera;
+  ShadowData shadow;
+  render::FrameStats stats;
+};
+
+/// Runs phases 1-5. Errors: no camera in the scene, shader build failures.
+Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
+                 FrameReport& report);
+
+/// Phase 4 on its own (pure: no GL), exposed for tests.
+render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx,
+                                     const CameraState& camera, const ShadowData& shadow);
+
+}  // namespace kaskad

@@ -1,0 +1,41 @@
+// The basic shadow map of one directional light (S4 with S2's basics): an orthographic light
+// projection fitted to the scene bounds. It is the baseline the cascades are measured against.
+// Maths only; the renderer draws the pass.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "components/bounds.h"
+#include "components/shadow_settings.h"
+#include "runtime/ecs/world.h"
+
+namespace kaskad {
+
+struct LightProjection {
+  glm::mat4 view{1.0f};
+  glm::mat4 proj{1.0f};
+  glm::mat4 view_proj() const { return proj * view; }
+};
+
+/// An orthographic light looking along `direction` (unit, the way light travels) whose x/y extent
+/// and near/far enclose `bounds` tightly (the 8 corners in light space). A non-empty box is
+/// required; degenerate (flat) extents are widened to a small epsilon so the matrix stays
+/// invertible. The up vector is the world axis least parallel to the direction, so straight-down
+/// lights work.
+LightProjection fit_ortho_light_to_bounds(const glm::vec3& direction, const Aabb& bounds);
+
+/// Result of the shadow phase for the renderer.
+struct ShadowData {
+  ecs::Entity light = ecs::kNullEntity;  ///< the shadowed light, null when there is none
+  LightProjection projection;
+  ShadowSettings settings;
+};
+
+/// Picks the first directional Light with cast_shadows (entity order), fits its projection to
+/// the bounds of all shadow casters and receivers. Needs current WorldTransform/WorldBounds.
+ShadowData update_basic_shadow(const ecs::World& world);
+
+/// World-space direction a light entity shines along: rotation * (0, 0, -1), normalised.
+glm::vec3 light_direction(const glm::mat4& world_matrix);
+
+}  // namespace kaskad

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# The `kaskad` CLI end to end: good runs produce files, bad input gives a clear message naming the
+# file and place, a non-zero exit, and no crash (exit codes >= 128 are signals: always a failure).
+set -u
+: "${KASKAD:?path to the kaskad binary}" "${KASKAD_CONTENT:?content dir}"
+tmp="${TMPDIR:-/tmp}/cli_test.$$"
+mkdir -p "$tmp"
+trap 'rm -rf "$tmp"' EXIT
+passed=0 failed=0
+
+check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
+  local name="$1" want="$2" pattern="$3"
+  shift 4
+  local out rc
+  out="$("$@" 2>&1)"
+  rc=$?
+  if [ "$rc" -ge 128 ]; then
+    echo "FAIL $name: crashed (exit $rc)"; echo "$out" | tail -5; failed=$((failed + 1)); return
+  fi
+  if [ "$want" = "nonzero" ] && [ "$rc" -eq 0 ] || [ "$want" = "0" ] && [ "$rc" -ne 0 ]; then
+    echo "FAIL $name: exit $rc, expected $want"; echo "$out" | tail -5; failed=$((failed + 1)); return
+  fi
+  if ! grep -qE -- "$pattern" <<<"$out"; then
+    echo "FAIL $name: output lacks /$pattern/"; echo "$out" | tail -5; failed=$((failed + 1)); return
+  fi
+  echo "ok   $name"
+  passed=$((passed + 1))
+}
+
+# Good runs.
+check render_default 0 "median .* ms" -- "$KASKAD" render --headless --size 160x90 --frames 3 \
+  -o "$tmp/default.png" --aov "$tmp/default.exr"
+[ -s "$tmp/default.png" ] && [ -s "$tmp/default.exr" ] || { echo "FAIL render_default: no files"; failed=$((failed + 1)); }
+if command -v oiiotool >/dev/null; then
+  check aov_channels 0 "P.X, P.Y, P.Z, N.X, N.Y, N.Z, Z, visibility, mask" -- oiiotool --info -v "$tmp/default.exr"
+fi
+check render_gltf 0 "wrote" -- "$KASKAD" render "$KASKAD_CONTENT/models/Box/glTF-Draco-Binary/Box_Draco.glb" \
+  --headless --size 96x64 --frames 1 -o "$tmp/box.png" --set sun.light.intensity=3
+check save_roundtrip 0 "wrote" -- "$KASKAD" save "$KASKAD_CONTENT/scenes/default.json" -o "$tmp/a.json" --set shadow.map_size=1024
+check save_roundtrip2 0 "wrote" -- "$KASKAD" save "$tmp/a.json" -o "$tmp/b.json"
+if cmp -s "$tmp/a.json" "$tmp/b.json"; then echo "ok   save_identical"; passed=$((passed + 1)); else echo "FAIL save_identical"; failed=$((failed + 1)); fi
+check help 0 "usage" -- "$KASKAD" --help
+
+# Bad input: clear errors, non-zero exits, no crashes.
+check unknown_command nonzero "unknown command" -- "$KASKAD" paint
+check bad_size nonzero "--size" -- "$KASKAD" render --size 12 --headless
+check bad_set_key nonzero "map_sise.*valid keys" -- "$KASKAD" render --headless --set shadow.map_sise=1
+check bad_set_value nonzero "map_size.*power of two" -- "$KASKAD" render --headless --set shadow.map_size=100
+check missing_scene nonzero "nope.json.*cannot open" -- "$KASKAD" render "$tmp/nope.json" --headless
+printf '{ "entities": [ { "name": "x", "light": { "type": "laser" } } ] }' >"$tmp/bad.json"
+check bad_enum nonzero "bad.json.*/entities/0/light/type.*laser" -- "$KASKAD" render "$tmp/bad.json" --headless
+printf '{ "entities": [ ' >"$tmp/trunc.json"
+check truncated_json nonzero "trunc.json.*line 1.*malformed JSON" -- "$KASKAD" render "$tmp/trunc.json" --headless
+printf 'glTF garbage' >"$tmp/garbage.glb"
+check garbage_glb nonzero "garbage.glb" -- "$KASKAD" render "$tmp/garbage.glb" --headless
+printf '{ "entities": [ { "name": "c", "camera": {} } ] }' >"$tmp/nolight.json"
+check no_geometry 0 "wrote" -- "$KASKAD" render "$tmp/nolight.json" --headless --size 32x32 --frames 1 -o "$tmp/empty.png"
+printf '{ "entities": [ { "name": "b", "primitive": { "shape": "box" } } ] }' >"$tmp/nocam.json"
+check no_camera nonzero "no camera" -- "$KASKAD" render "$tmp/nocam.json" --headless
+check unwritable_output nonzero "cannot|could not|error" -- "$KASKAD" render --headless --size 32x32 --frames 1 -o /proc/nope/x.png
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,171 @@
+#include "runtime/assets/primitives.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <map>
+#include <string>
+#include <tuple>
+
+namespace kaskad {
+namespace {
+
+constexpr PrimitiveShape kAllShapes[] = {PrimitiveShape::plane, PrimitiveShape::box,
+                                         PrimitiveShape::sphere, PrimitiveShape::cylinder,
+                                         PrimitiveShape::cone};
+constexpr PrimitiveShape kClosedShapes[] = {PrimitiveShape::box, PrimitiveShape::sphere,
+                                            PrimitiveShape::cylinder, PrimitiveShape::cone};
+constexpr int kSegmentCounts[] = {3, 4, 5, 8, 32, 33, 1024};
+
+std::string shape_name(PrimitiveShape s) {
+  switch (s) {
+    case PrimitiveShape::plane: return "plane";
+    case PrimitiveShape::box: return "box";
+    case PrimitiveShape::sphere: return "sphere";
+    case PrimitiveShape::cylinder: return "cylinder";
+    case PrimitiveShape::cone: return "cone";
+  }
+  return "?";
+}
+
+TEST(Primitives, AttributesAreConsistentAndIndicesInRange) {
+  for (PrimitiveShape shape : kAllShapes) {
+    for (int segments : kSegmentCounts) {
+      SCOPED_TRACE(shape_name(shape) + " " + std::to_string(segments));
+      const MeshData m = make_primitive(shape, segments);
+      ASSERT_FALSE(m.positions.empty());
+      EXPECT_EQ(m.normals.size(), m.positions.size());
+      EXPECT_EQ(m.uvs.size(), m.positions.size());
+      ASSERT_EQ(m.indices.size() % 3, 0u);
+      ASSERT_GT(m.triangle_count(), 0u);
+      for (std::uint32_t i : m.indices) ASSERT_LT(i, m.positions.size());
+      for (const glm::vec2& uv : m.uvs) {
+        ASSERT_GE(uv.x, 0.0f);
+        ASSERT_LE(uv.x, 1.0f);
+        ASSERT_GE(uv.y, 0.0f);
+        ASSERT_LE(uv.y, 1.0f);
+      }
+    }
+  }
+}
+
+TEST(Primitives, BoundsAreTheUnitSizes) {
+  const float h = 0.5f;
+  auto expect_box = [](const Aabb& b, glm::vec3 lo, glm::vec3 hi) {
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_FLOAT_EQ(b.min[a], lo[a]) << "axis " << a;
+      EXPECT_FLOAT_EQ(b.max[a], hi[a]) << "axis " << a;
+    }
+  };
+  expect_box(make_primitive(PrimitiveShape::plane, 3).bounds, {-h, 0, -h}, {h, 0, h});
+  expect_box(make_primitive(PrimitiveShape::box, 3).bounds, {-h, -h, -h}, {h, h, h});
+  // With segments a multiple of 4, a column lies on each of +-X and +-Z.
+  for (PrimitiveShape round : {PrimitiveShape::sphere, PrimitiveShape::cylinder,
+                               PrimitiveShape::cone}) {
+    SCOPED_TRACE(shape_name(round));
+    expect_box(make_primitive(round, 32).bounds, {-h, -h, -h}, {h, h, h});
+    // Any other count still stays inside the unit box and reaches its top and bottom.
+    const Aabb b = make_primitive(round, 7).bounds;
+    EXPECT_FLOAT_EQ(b.min.y, -h);
+    EXPECT_FLOAT_EQ(b.max.y, h);
+    EXPECT_GE(b.min.x, -h);
+    EXPECT_LE(b.max.x, h);
+    EXPECT_GT(b.max.x, 0.4f);  // coarse: the widest ring of a 7-segment sphere is at 60 degrees
+  }
+}
+
+TEST(Primitives, NormalsAreUnitLength) {
+  for (PrimitiveShape shape : kAllShapes) {
+    for (int segments : kSegmentCounts) {
+      SCOPED_TRACE(shape_name(shape) + " " + std::to_string(segments));
+      for (const glm::vec3& n : make_primitive(shape, segments).normals)
+        ASSERT_NEAR(glm::length(n), 1.0f, 1e-5f);
+    }
+  }
+}
+
+TEST(Primitives, SphereNormalsPointAwayFromTheCentre) {
+  for (int segments : kSegmentCounts) {
+    const MeshData m = make_primitive(PrimitiveShape::sphere, segments);
+    for (std::size_t i = 0; i < m.positions.size(); ++i) {
+      ASSERT_GE(glm::dot(m.normals[i], m.positions[i]), 0.0f);
+      ASSERT_NEAR(glm::length(m.positions[i]), 0.5f, 1e-6f);
+      // A sphere's normal is its position direction.
+      ASSERT_NEAR(glm::length(m.normals[i] - 2.0f * m.positions[i]), 0.0f, 1e-5f);
+    }
+  }
+}
+
+TEST(Primitives, NormalsPointOutwardFromTheAxis) {
+  // Convex shapes centred on the origin: every normal faces away from the centre of its face,
+  // i.e. dot(normal, position) > 0 on the curved sides and caps.
+  for (PrimitiveShape shape : kClosedShapes) {
+    for (int segments : kSegmentCounts) {
+      SCOPED_TRACE(shape_name(shape) + " " + std::to_string(segments));
+      const MeshData m = make_primitive(shape, segments);
+      for (std::size_t i = 0; i < m.positions.size(); ++i)
+        ASSERT_GT(glm::dot(m.normals[i], m.positions[i]), 0.0f) << "vertex " << i;
+    }
+  }
+}
+
+TEST(Primitives, FrontFacesAreCounterClockwiseFromOutside) {
+  // The right-handed geometric normal cross(b - a, c - a) must agree with the vertex normals and
+  // point away from the origin (all shapes are convex and contain the origin, or are the plane).
+  for (PrimitiveShape shape : kAllShapes) {
+    for (int segments : kSegmentCounts) {
+      SCOPED_TRACE(shape_name(shape) + " " + std::to_string(segments));
+      const MeshData m = make_primitive(shape, segments);
+      for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+        const auto ia = m.indices[3 * t], ib = m.indices[3 * t + 1], ic = m.indices[3 * t + 2];
+        const glm::vec3 a = m.positions[ia], b = m.positions[ib], c = m.positions[ic];
+        const glm::vec3 face = glm::cross(b - a, c - a);
+        ASSERT_GT(glm::length(face), 0.0f) << "degenerate triangle " << t;
+        for (auto i : {ia, ib, ic}) ASSERT_GT(glm::dot(face, m.normals[i]), 0.0f) << "tri " << t;
+        if (shape != PrimitiveShape::plane) {
+          ASSERT_GT(glm::dot(face, (a + b + c) / 3.0f), 0.0f) << "tri " << t;
+        }
+      }
+    }
+  }
+}
+
+TEST(Primitives, ClosedShapesShareEveryEdgeBetweenExactlyTwoTriangles) {
+  // Weld vertices by exact position (split copies must be bit-identical), then count each
+  // undirected edge; a closed, consistently wound mesh uses each directed edge exactly once.
+  for (PrimitiveShape shape : kClosedShapes) {
+    for (int segments : kSegmentCounts) {
+      SCOPED_TRACE(shape_name(shape) + " " + std::to_string(segments));
+      const MeshData m = make_primitive(shape, segments);
+      std::map<std::tuple<float, float, float>, int> ids;
+      std::vector<int> welded;
+      for (const glm::vec3& p : m.positions)
+        welded.push_back(ids.emplace(std::make_tuple(p.x, p.y, p.z), int(ids.size())).first->second);
+
+      std::map<std::pair<int, int>, int> undirected, directed;
+      for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+        for (int e = 0; e < 3; ++e) {
+          const int a = welded[m.indices[3 * t + e]];
+          const int b = welded[m.indices[3 * t + (e + 1) % 3]];
+          ASSERT_NE(a, b) << "triangle " << t << " is degenerate after welding";
+          ++undirected[{std::min(a, b), std::max(a, b)}];
+          ++directed[{a, b}];
+        }
+      }
+      for (const auto& [edge, count] : undirected)
+        ASSERT_EQ(count, 2) << "edge " << edge.first << "-" << edge.second;
+      for (const auto& [edge, count] : directed) ASSERT_EQ(count, 1) << "inconsistent winding";
+      // Euler characteristic of a sphere-like closed surface: V - E + F = 2.
+      EXPECT_EQ(int(ids.size()) - int(undirected.size()) + int(m.triangle_count()), 2);
+    }
+  }
+}
+
+TEST(Primitives, SegmentsOutsideTheRangeAreAPreconditionFailure) {
+  EXPECT_DEATH((void)make_primitive(PrimitiveShape::sphere, 2), "segments must be in");
+  EXPECT_DEATH((void)make_primitive(PrimitiveShape::cone, 1025), "segments must be in");
+}
+
+}  // namespace
+}  // namespace kaskad

@@ -1,0 +1,189 @@
+// Scene files: round trip, overrides, and errors that name the file and the place.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "components/camera.h"
+#include "components/light.h"
+#include "components/model.h"
+#include "components/name.h"
+#include "components/transform.h"
+#include "runtime/assets/scene_io.h"
+
+namespace kaskad {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kContent = KASKAD_CONTENT_DIR;
+
+fs::path temp_dir() {
+  const fs::path d = fs::path(KASKAD_TEST_TMP) / "scene_io";
+  fs::create_directories(d);
+  return d;
+}
+
+fs::path write_file(const std::string& name, const std::string& text) {
+  const fs::path p = temp_dir() / name;
+  std::ofstream(p, std::ios::binary) << text;
+  return p;
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+ecs::Entity find(const Scene& s, const std::string& name) {
+  ecs::Entity found;
+  s.world.view<Name>().each([&](ecs::Entity e, const Name& n) {
+    if (n.value == name) found = e;
+  });
+  return found;
+}
+
+TEST(SceneIo, DefaultSceneRoundTripsExactly) {
+  auto a = read_scene(kContent / "scenes" / "default.json");
+  ASSERT_TRUE(a.ok()) << a.error().to_string();
+  const fs::path first = temp_dir() / "first.json", second = temp_dir() / "second.json";
+  ASSERT_TRUE(save_scene(first, *a).ok());
+  auto b = read_scene(first);
+  ASSERT_TRUE(b.ok()) << b.error().to_string();
+  ASSERT_TRUE(save_scene(second, *b).ok());
+  EXPECT_EQ(read_file(first), read_file(second));
+  // Nothing lost: same entities with the same values.
+  EXPECT_EQ(a->world.size(), b->world.size());
+  const ecs::Entity sun_a = find(*a, "sun"), sun_b = find(*b, "sun");
+  ASSERT_TRUE(sun_a.valid() && sun_b.valid());
+  EXPECT_EQ(a->world.get<Light>(sun_a).intensity, b->world.get<Light>(sun_b).intensity);
+  const glm::quat qa = a->world.get<Transform>(sun_a).rotation;
+  const glm::quat qb = b->world.get<Transform>(sun_b).rotation;
+  EXPECT_NEAR(std::abs(glm::dot(qa, qb)), 1.0f, 1e-6f);
+  EXPECT_EQ(a->shadow_defaults.map_size, b->shadow_defaults.map_size);
+}
+
+TEST(SceneIo, ParentsAndModelsRoundTrip) {
+  const fs::path p = write_file("parents.json", R"({
+    "entities": [
+      { "name": "root", "transform": { "translation": [1, 2, 3] } },
+      { "name": "child", "transform": { "parent": "root", "euler_deg": [0, 90, 0] },
+        "primitive": { "shape": "cone", "segments": 12 }, "renderer": { "cast_shadows": false } },
+      { "name": "truck", "model": { "path": ")" + (kContent / "models/Box/glTF-Binary/Box.glb").string() + R"(" } }
+    ] })");
+  auto s = read_scene(p);
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  const ecs::Entity child = find(*s, "child");
+  EXPECT_EQ(s->world.get<Transform>(child).parent, find(*s, "root"));
+  EXPECT_FALSE(s->world.get<MeshRenderer>(child).cast_shadows);
+  const fs::path out = temp_dir() / "parents_out.json";
+  ASSERT_TRUE(save_scene(out, *s).ok());
+  auto again = read_scene(out);
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_EQ(again->world.get<Transform>(find(*again, "child")).parent, find(*again, "root"));
+  EXPECT_EQ(again->world.get<PrimitiveMesh>(find(*again, "child")).segments, 12);
+}
+
+TEST(SceneIo, ModelPathsAreRebasedWhenSavedElsewhere) {
+  fs::create_directories(temp_dir() / "a" / "b");
+  const fs::path model = fs::absolute(kContent / "models/Box/glTF-Binary/Box.glb");
+  fs::copy_file(model, temp_dir() / "a" / "Box.glb", fs::copy_options::overwrite_existing);
+  const fs::path p = temp_dir() / "a" / "scene.json";
+  std::ofstream(p) << R"({ "entities": [ { "name": "m", "model": { "path": "Box.glb" } } ] })";
+  auto s = read_scene(p);
+  ASSERT_TRUE(s.ok());
+  const fs::path out = temp_dir() / "a" / "b" / "moved.json";
+  ASSERT_TRUE(save_scene(out, *s).ok());
+  auto moved = read_scene(out);
+  ASSERT_TRUE(moved.ok());
+  EXPECT_EQ(moved->world.get<ModelRef>(find(*moved, "m")).path, "../Box.glb");
+  EXPECT_TRUE(instantiate_scene(*moved).ok());
+}
+
+TEST(SceneIo, OverridesChangeSettingsAndComponentFields) {
+  auto s = read_scene(kContent / "scenes" / "default.json",
+                      {"shadow.map_size=4096", "sun.light.intensity=3.5", "render.width=640",
+                       "camera.camera.fov_y_deg=30", "box_floating.transform.translation.1=2.5",
+                       "shadow.filter=none"});
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  EXPECT_EQ(s->shadow_defaults.map_size, 4096);
+  EXPECT_EQ(s->shadow_defaults.filter, ShadowFilter::none);
+  EXPECT_EQ(s->world.get<ShadowSettings>(find(*s, "sun")).map_size, 4096);
+  EXPECT_FLOAT_EQ(s->world.get<Light>(find(*s, "sun")).intensity, 3.5f);
+  EXPECT_EQ(s->render.width, 640);
+  EXPECT_FLOAT_EQ(s->world.get<Camera>(find(*s, "camera")).fov_y_deg, 30.0f);
+  EXPECT_FLOAT_EQ(s->world.get<Transform>(find(*s, "box_floating")).translation.y, 2.5f);
+}
+
+void expect_error(const Result<Scene>& r, const std::vector<std::string>& parts) {
+  ASSERT_FALSE(r.ok());
+  const std::string msg = r.error().to_string();
+  for (const auto& p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
+}
+
+TEST(SceneIo, OverrideErrorsListValidKeys) {
+  const fs::path def = kContent / "scenes" / "default.json";
+  expect_error(read_scene(def, {"shadow.map_sise=4"}), {"map_sise", "map_size", "filter"});
+  expect_error(read_scene(def, {"nobody.light.intensity=1"}), {"nobody", "sun", "render"});
+  expect_error(read_scene(def, {"sun.light.colour=1"}), {"colour", "color", "intensity"});
+  expect_error(read_scene(def, {"shadow.map_size=1000"}), {"map_size", "power of two", "1000"});
+  expect_error(read_scene(def, {"shadow.map_size=big"}), {"map_size", "integer", "string"});
+  expect_error(read_scene(def, {"render.width"}), {"key=value"});
+  expect_error(read_scene(def, {"sun.transform.translation.7=1"}), {"index"});
+  expect_error(read_scene(def, {"shadow.filter=pcf5"}), {"pcf5", "pcf3x3"});
+}
+
+TEST(SceneIo, MalformedFilesGiveErrorsNamingFileAndPlace) {
+  expect_error(read_scene(write_file("bad1.json", "{\n  \"entities\": [\n    { \"name\": }\n")),
+               {"bad1.json", "line 3", "malformed JSON"});
+  expect_error(read_scene(write_file("bad2.json", R"({"entities": [{"name": "a", "lihgt": {}}]})")),
+               {"bad2.json", "/entities/0/lihgt", "unknown key", "light"});
+  expect_error(read_scene(write_file("bad3.json", R"({"entities": [{"light": {"intensity": "bright"}}]})")),
+               {"bad3.json", "/entities/0/light/intensity", "expected a number"});
+  expect_error(read_scene(write_file("bad4.json", R"({"entities": [{"light": {"type": "area"}}]})")),
+               {"/entities/0/light/type", "area", "directional"});
+  expect_error(read_scene(write_file("bad5.json", R"({"entities": [{"camera": {"near": 10, "far": 1}}]})")),
+               {"/entities/0/camera/far", "greater than near"});
+  expect_error(read_scene(write_file("bad6.json", R"({"entities": [{"transform": {"parent": "ghost"}}]})")),
+               {"/entities/0/transform/parent", "ghost"});
+  expect_error(read_scene(write_file("bad7.json", R"({"entities": [{"name": "x"}, {"name": "x"}]})")),
+               {"/entities/1/name", "duplicate"});
+  expect_error(read_scene(write_file("bad8.json", R"({"entities": {}})")), {"/entities", "array"});
+  expect_error(read_scene(write_file("bad9.json", R"([1, 2])")), {"bad9.json", "object"});
+  expect_error(read_scene(write_file("bad10.json", R"({"entities": [{"transform": {"scale": [1, 2]}}]})")),
+               {"/entities/0/transform/scale", "3 numbers"});
+  expect_error(read_scene(write_file("bad11.json", R"({"kaskad_scene": 99})")), {"kaskad_scene", "99"});
+  expect_error(read_scene(write_file("bad12.json", "")), {"bad12.json", "malformed JSON"});
+  expect_error(read_scene(temp_dir() / "does_not_exist.json"), {"does_not_exist.json", "cannot open"});
+  expect_error(read_scene(write_file("bad.txt", "{}")), {"bad.txt", ".json"});
+}
+
+TEST(SceneIo, MissingModelIsAnErrorAtInstantiation) {
+  auto s = read_scene(write_file("missing_model.json",
+                                 R"({"entities": [{"name": "m", "model": {"path": "nowhere.glb"}}]})"));
+  ASSERT_TRUE(s.ok());
+  Status st = instantiate_scene(*s);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().to_string().find("nowhere.glb"), std::string::npos) << st.error().to_string();
+}
+
+TEST(SceneIo, GltfFileIsWrappedWithDefaultCameraAndSun) {
+  auto s = read_scene(kContent / "models/Box/glTF-Binary/Box.glb");
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  EXPECT_TRUE(find(*s, "camera").valid());
+  EXPECT_TRUE(find(*s, "sun").valid());
+  EXPECT_TRUE(s->world.get<Camera>(find(*s, "camera")).auto_frame);
+  auto overridden = read_scene(kContent / "models/Box/glTF-Binary/Box.glb", {"sun.light.intensity=7"});
+  ASSERT_TRUE(overridden.ok()) << overridden.error().to_string();
+  EXPECT_FLOAT_EQ(overridden->world.get<Light>(find(*overridden, "sun")).intensity, 7.0f);
+}
+
+TEST(SceneIo, SaveToUnwritablePlaceFailsCleanly) {
+  auto s = read_scene(kContent / "scenes" / "default.json");
+  ASSERT_TRUE(s.ok());
+  Status st = save_scene(temp_dir() / "no" / "such" / "dir" / "x.json", *s);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().to_string().find("x.json"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace kaskad
