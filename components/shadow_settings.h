@@ -14,7 +14,11 @@ enum class ShadowFilter { none, bilinear, pcf3x3 };
 struct ShadowSettings {
   int map_size = 2048;            ///< texels per side; power of two in [64, 16384]
   float constant_bias = 2.0f;     ///< glPolygonOffset units (multiples of the depth resolution)
-  float slope_bias = 2.0f;        ///< glPolygonOffset factor (scales with the depth slope, S2)
+  float slope_bias = 3.0f;        ///< glPolygonOffset factor (scales with the depth slope, S2).
+                                  ///< 3 because the 3x3 PCF taps reach 1.5 texels along each axis,
+                                  ///< where depth changes by up to 1.5 (|dz/dx| + |dz/dy|), at most
+                                  ///< 3x the max slope that glPolygonOffset scales by; 2 leaves acne
+                                  ///< rings on the default scene's ground plane
   CullMode cull = CullMode::back; ///< back is the default for the shadow pass (S2); front reduces
                                   ///< acne but loses single-sided casters (S4, S2)
   ShadowFilter filter = ShadowFilter::pcf3x3;  ///< S4's 3x3 PCF by default

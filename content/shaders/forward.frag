@@ -45,9 +45,17 @@ float shadow_visibility(vec3 p) {
   vec3 c = clip.xyz / clip.w * 0.5 + 0.5;
   if (c.z > 1.0) return 1.0;
 #if SHADOW_FILTER == 2
+  // textureOffset needs constant offsets: the 3x3 kernel is written out.
   float sum = 0.0;
-  for (int y = -1; y <= 1; ++y)
-    for (int x = -1; x <= 1; ++x) sum += textureOffset(u_shadow_map, c, ivec2(x, y));
+  sum += textureOffset(u_shadow_map, c, ivec2(-1, -1));
+  sum += textureOffset(u_shadow_map, c, ivec2(0, -1));
+  sum += textureOffset(u_shadow_map, c, ivec2(1, -1));
+  sum += textureOffset(u_shadow_map, c, ivec2(-1, 0));
+  sum += texture(u_shadow_map, c);
+  sum += textureOffset(u_shadow_map, c, ivec2(1, 0));
+  sum += textureOffset(u_shadow_map, c, ivec2(-1, 1));
+  sum += textureOffset(u_shadow_map, c, ivec2(0, 1));
+  sum += textureOffset(u_shadow_map, c, ivec2(1, 1));
   return sum / 9.0;
 #else
   return texture(u_shadow_map, c);  // filtering (nearest / linear) is set on the texture

@@ -11,12 +11,14 @@
 namespace kaskad {
 
 struct GltfImportReport {
-  int nodes = 0;
-  int mesh_entities = 0;   ///< one entity per glTF primitive (triangles only)
+  int nodes = 0;          ///< node entities created
+  int mesh_entities = 0;  ///< one entity per glTF primitive instance (triangles only)
   int lights = 0;
   int cameras = 0;
+  /// Triangles of the meshes added to the AssetStore; a mesh used by several nodes counts once.
   std::size_t triangles = 0;
-  std::vector<std::string> warnings;  ///< skipped non-triangle primitives, unsupported features, ...
+  /// Skipped primitives (points, lines), unsupported features, textures that failed to load.
+  std::vector<std::string> warnings;
 };
 
 /// Imports the default scene of a glTF file (or all root nodes when there is no default) into
@@ -26,7 +28,12 @@ struct GltfImportReport {
 /// Light (+ ShadowSettings for directional lights, cast_shadows = true) and cameras Camera
 /// components on their node's entity. The first imported camera is marked active when
 /// `activate_first_camera` is set.
-/// On error nothing is left half-imported in `world` is NOT guaranteed; callers discard the world.
+/// Conversions: spot cone angles and yfov become degrees; an infinite perspective zfar becomes
+/// far = 1000 * near; missing normals are generated flat (glTF 3.7.2.1), missing uvs and tangents
+/// stay empty; strips and fans become triangle lists. Everything read from the file is validated;
+/// a texture that cannot be loaded is a warning, not an error.
+/// On error the entities created so far stay in `world` (there is no rollback): callers discard
+/// the world.
 Result<GltfImportReport> import_gltf(const std::filesystem::path& path, ecs::World& world,
                                      AssetStore& assets, ecs::Entity parent, ecs::Entity source,
                                      bool activate_first_camera);

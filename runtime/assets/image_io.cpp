@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <new>
@@ -69,8 +70,19 @@ std::string lowercase_extension(const std::filesystem::path& path) {
   return ext;
 }
 
-/// OIIO's readers by extension and by format name, parsed from its "extension_list" attribute
-/// ("openexr:exr,sxr;tiff:tif,tiff;..."). Built once; read-only afterwards.
+/// The still-image formats we let OIIO decode. Debian's OIIO also has readers for camera RAW,
+/// video (ffmpeg), DICOM, FITS, OpenVDB, ...: decoders a texture never needs and that would only
+/// widen what a hostile file could reach.
+constexpr std::string_view kAllowedFormats[] = {"png",   "jpeg", "openexr", "hdr", "tiff", "bmp",
+                                                "targa", "gif",  "webp",    "pnm", "dds",  "psd"};
+
+bool allowed_format(std::string_view format) {
+  return std::find(std::begin(kAllowedFormats), std::end(kAllowedFormats), format) !=
+         std::end(kAllowedFormats);
+}
+
+/// OIIO's readers of allowed formats by extension and by format name, parsed from its
+/// "extension_list" attribute ("openexr:exr,sxr;tiff:tif,tiff;..."). Built once; read-only after.
 const std::map<std::string, std::string>& known_formats() {
   static const std::map<std::string, std::string> formats = [] {
     std::map<std::string, std::string> m;
@@ -82,7 +94,7 @@ const std::map<std::string, std::string>& known_formats() {
       if (end == std::string::npos) end = list.size();
       const std::string entry = list.substr(pos, end - pos);
       const std::size_t colon = entry.find(':');
-      if (colon != std::string::npos) {
+      if (colon != std::string::npos && allowed_format(entry.substr(0, colon))) {
         const std::string format = entry.substr(0, colon);
         m[format] = format;
         std::size_t e = colon + 1;
@@ -124,7 +136,11 @@ std::string one_line(std::string s) {
 Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::string& name,
                      const std::string& format) {
   if (size == 0) return Error{name, "", "empty image data (0 bytes)"};
-  if (format.empty()) return Error{name, "", "not a recognised image format"};
+  if (format.empty()) {
+    return Error{name, "",
+                 "not a recognised image format (no known signature, MIME type or "
+                 "file extension)"};
+  }
 
   OIIO::Filesystem::IOMemReader proxy(data, size);
   // The proxy must travel in the open() configuration: handing it to create() alone is not
@@ -140,27 +156,30 @@ Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::stri
     return Error{name, "", "no " + format + " reader: " + one_line(OIIO::geterror())};
   }
   if (!in->supports("ioproxy")) {
-    return Error{name, "", std::string("the ") + in->format_name() +
-                               " reader cannot decode from memory"};
+    return Error{name, "",
+                 std::string("the ") + in->format_name() + " reader cannot decode from memory"};
   }
 
   OIIO::ImageSpec spec;
   if (!in->open(name, spec, config)) {
-    return Error{name, "", "not a valid " + std::string(in->format_name()) +
-                               " image: " + one_line(in->geterror())};
+    return Error{
+        name, "",
+        "not a valid " + std::string(in->format_name()) + " image: " + one_line(in->geterror())};
   }
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth < 1) {
-    return Error{name, "", "zero-sized image (" + std::to_string(spec.width) + " x " +
-                               std::to_string(spec.height) + ", " +
-                               std::to_string(spec.nchannels) + " channels)"};
+    return Error{name, "",
+                 "zero-sized image (" + std::to_string(spec.width) + " x " +
+                     std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) +
+                     " channels)"};
   }
   if (spec.depth > 1) return Error{name, "", "volume images are not supported"};
   const std::uint64_t values =
       std::uint64_t(spec.width) * std::uint64_t(spec.height) * std::uint64_t(spec.nchannels);
   if (values > kMaxImageValues) {
-    return Error{name, "", "image too large (" + std::to_string(spec.width) + " x " +
-                               std::to_string(spec.height) + " x " +
-                               std::to_string(spec.nchannels) + " values, at most 2^28)"};
+    return Error{name, "",
+                 "image too large (" + std::to_string(spec.width) + " x " +
+                     std::to_string(spec.height) + " x " + std::to_string(spec.nchannels) +
+                     " values, at most 2^28)"};
   }
 
   Image image;
@@ -241,10 +260,10 @@ Status save_image(const std::filesystem::path& path, const Image& image) {
   KASKAD_CHECK(image.width > 0 && image.height > 0 && image.channels > 0,
                "image must be non-empty, was " + std::to_string(image.width) + " x " +
                    std::to_string(image.height) + " x " + std::to_string(image.channels));
-  KASKAD_CHECK(image.pixels.size() ==
-                   std::size_t(image.width) * std::size_t(image.height) * image.channels,
-               "pixels.size() must be width * height * channels, was " +
-                   std::to_string(image.pixels.size()));
+  KASKAD_CHECK(
+      image.pixels.size() == std::size_t(image.width) * std::size_t(image.height) * image.channels,
+      "pixels.size() must be width * height * channels, was " +
+          std::to_string(image.pixels.size()));
   KASKAD_CHECK(image.channel_names.empty() || int(image.channel_names.size()) == image.channels,
                "channel_names must be empty or one per channel, was " +
                    std::to_string(image.channel_names.size()));

@@ -1,4 +1,5 @@
-// Image files through OpenImageIO (PNG, JPEG, EXR, HDR, TIFF, ... whatever OIIO reads).
+// Image files through OpenImageIO: PNG, JPEG, EXR, HDR, TIFF, BMP, TGA, GIF, WebP, PNM, DDS, PSD.
+// The format comes from the data's signature, else the MIME type, else the extension.
 #pragma once
 
 #include <filesystem>
@@ -34,7 +35,8 @@ Result<Image> load_image_from_memory(const void* data, std::size_t size, const s
                                      const std::string& mime_type = {});
 
 /// Writes an image; the format follows the extension. 8-bit formats (PNG, JPEG) get values clamped
-/// to [0,1] and quantised; EXR keeps 32-bit float and channel_names.
+/// to [0,1] and quantised; EXR keeps 32-bit float and channel_names. Reading an EXR back may
+/// reorder its channels (OIIO puts R, G, B, A first): look channels up by name.
 Status save_image(const std::filesystem::path& path, const Image& image);
 
 }  // namespace kaskad

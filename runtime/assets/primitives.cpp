@@ -73,9 +73,9 @@ MeshData make_box() {
     glm::vec3 n, right, up;
   };
   const Face faces[] = {
-      {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}},  {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
-      {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}},  {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
-      {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},   {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}},
+      {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
+      {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}}, {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
+      {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}},
   };
   for (const Face& f : faces) {
     const glm::vec3 c = 0.5f * f.n;
@@ -131,9 +131,7 @@ MeshData make_sphere(int segments) {
 void add_cap(MeshData& m, int segments, float y, bool top) {
   const glm::vec3 n{0, top ? 1.0f : -1.0f, 0};
   // Planar uvs: seen from outside, image top-left at (-x, -z) for the top cap, (-x, +z) below.
-  auto cap_uv = [&](glm::vec3 p) {
-    return glm::vec2(0.5f + p.x, top ? 0.5f + p.z : 0.5f - p.z);
-  };
+  auto cap_uv = [&](glm::vec3 p) { return glm::vec2(0.5f + p.x, top ? 0.5f + p.z : 0.5f - p.z); };
   const auto centre = add_vertex(m, {0, y, 0}, n, {0.5f, 0.5f});
   const auto first = std::uint32_t(m.positions.size());
   for (int j = 0; j < segments; ++j) {
@@ -206,11 +204,21 @@ MeshData make_primitive(PrimitiveShape shape, int segments) {
                "segments must be in [3, 1024], was " + std::to_string(segments));
   MeshData mesh;
   switch (shape) {
-    case PrimitiveShape::plane: mesh = make_plane(); break;
-    case PrimitiveShape::box: mesh = make_box(); break;
-    case PrimitiveShape::sphere: mesh = make_sphere(segments); break;
-    case PrimitiveShape::cylinder: mesh = make_cylinder(segments); break;
-    case PrimitiveShape::cone: mesh = make_cone(segments); break;
+    case PrimitiveShape::plane:
+      mesh = make_plane();
+      break;
+    case PrimitiveShape::box:
+      mesh = make_box();
+      break;
+    case PrimitiveShape::sphere:
+      mesh = make_sphere(segments);
+      break;
+    case PrimitiveShape::cylinder:
+      mesh = make_cylinder(segments);
+      break;
+    case PrimitiveShape::cone:
+      mesh = make_cone(segments);
+      break;
   }
   mesh.compute_bounds();
   return mesh;

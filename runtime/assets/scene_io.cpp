@@ -226,7 +226,8 @@ void read_rotation(ObjectReader& r, Transform& t) {
     r.vector<4>("rotation", q, -2.0f, 2.0f);
     const float len = glm::length(q);
     if (len < 1e-6f) fail(r.at("rotation"), "quaternion has zero length");
-    q /= len;
+    // Renormalise only what is visibly off: a saved unit quaternion must read back bit-exact.
+    if (std::abs(len - 1.0f) > 1e-5f) q /= len;
     t.rotation = glm::quat(q.w, q.x, q.y, q.z);
   } else if (r.has("euler_deg")) {
     glm::vec3 e{0.0f};

@@ -10,6 +10,8 @@
 //   Draco stream lacks a declared attribute id, and converts values into a 4-element stack array
 //   with the stream's component count. Corrupt files could crash it, so gltf_loader.cpp decodes
 //   KHR_draco_mesh_compression itself with libdraco, validating every index (see decode_draco).
+//   Without Draco support tinygltf refuses index accessors that have no buffer view, as Draco
+//   primitives' do, so the loader drops those from the JSON first (see strip_draco_indices).
 // - JSON through nlohmann/json (tinygltf's default; Debian's nlohmann-json3-dev).
 #pragma once
 

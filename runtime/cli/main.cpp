@@ -199,7 +199,11 @@ int run_render(Args a) {
 
   fs::path out = a.output.empty() ? fs::path("out") / (scene_path.stem().string() + ".png")
                                   : fs::path(a.output);
-  if (out.has_parent_path()) fs::create_directories(out.parent_path());
+  if (out.has_parent_path()) {
+    std::error_code ec;
+    fs::create_directories(out.parent_path(), ec);
+    if (ec) return fail(Error{out.string(), "", "cannot create its directory: " + ec.message()});
+  }
   if (auto s = save_image(out, player->renderer->read_color()); !s) return fail(s.error());
   std::printf("wrote     %s\n", fs::absolute(out).string().c_str());
   if (!a.aov.empty()) {

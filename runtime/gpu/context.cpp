@@ -31,7 +31,9 @@ const char* debug_source(GLenum source) {
 
 void GLAPIENTRY on_debug_message(GLenum source, GLenum type, GLuint id, GLenum severity,
                                  GLsizei /*length*/, const GLchar* message, const void* /*user*/) {
-  if (type == GL_DEBUG_TYPE_ERROR) {
+  // Shader compile and link failures reach the caller as content errors (with the log mapped to
+  // file:line); Mesa also reports them here as type ERROR, so they are not counted twice.
+  if (type == GL_DEBUG_TYPE_ERROR && source != GL_DEBUG_SOURCE_SHADER_COMPILER) {
     ++g_debug_errors;
     log::error("GL error (%s, id %u): %s", debug_source(source), id, message);
   } else if (severity == GL_DEBUG_SEVERITY_HIGH || severity == GL_DEBUG_SEVERITY_MEDIUM) {

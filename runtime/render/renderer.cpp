@@ -46,10 +46,11 @@ struct GpuTexture {
   gpu::Texture texture;
 };
 
-gpu::Texture make_solid_texture(const std::array<std::uint8_t, 4>& rgba, GLenum internal_format) {
+// A 1x1 texture standing in for a missing material texture.
+gpu::Texture make_solid_texture(const std::array<float, 4>& rgba, GLenum internal_format) {
   gpu::Texture t = gpu::make_texture(GL_TEXTURE_2D);
   glTextureStorage2D(t.id(), 1, internal_format, 1, 1);
-  glTextureSubImage2D(t.id(), 0, 0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  glTextureSubImage2D(t.id(), 0, 0, 0, 1, 1, GL_RGBA, GL_FLOAT, rgba.data());
   return t;
 }
 
@@ -220,8 +221,10 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
   im.shader_dir = shader_dir;
   if (!std::filesystem::exists(shader_dir / "forward.frag"))
     return Error{shader_dir.string(), "", "shader directory has no forward.frag"};
-  im.white = make_solid_texture({255, 255, 255, 255}, GL_SRGB8_ALPHA8);
-  im.flat_normal = make_solid_texture({128, 128, 255, 255}, GL_RGBA8);
+  im.white = make_solid_texture({1, 1, 1, 1}, GL_SRGB8_ALPHA8);
+  // Exactly (0.5, 0.5, 1): decodes to (0, 0, 1), so the cotangent frame leaves the normal as is.
+  // An 8-bit 128 would tilt every normal by 0.2 degrees, with visible derivative noise.
+  im.flat_normal = make_solid_texture({0.5f, 0.5f, 1, 1}, GL_RGBA16F);
   im.frame_ubo = gpu::make_buffer();
   glNamedBufferStorage(im.frame_ubo.id(), sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   im.timers[0] = gpu::make_query(GL_TIME_ELAPSED);

@@ -80,6 +80,27 @@ TEST(ImageIo, ExrRoundTripKeepsFloatsAndNamedChannels) {
   EXPECT_EQ(loaded->pixels, image.pixels);
 }
 
+TEST(ImageIo, ExrChannelsAreFoundByNameAfterReordering) {
+  Image image;
+  image.width = 1;
+  image.height = 1;
+  image.channels = 4;
+  image.channel_names = {"Z", "A", "N.y", "B"};
+  image.pixels = {1.0f, 2.0f, 3.0f, 4.0f};
+  const auto path = temp_dir() / "reordered.exr";
+  ASSERT_TRUE(save_image(path, image).ok());
+  auto loaded = load_image(path);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+  ASSERT_EQ(loaded->channels, 4);
+  for (int c = 0; c < 4; ++c) {
+    const auto it = std::find(loaded->channel_names.begin(), loaded->channel_names.end(),
+                              image.channel_names[std::size_t(c)]);
+    ASSERT_NE(it, loaded->channel_names.end()) << image.channel_names[std::size_t(c)];
+    EXPECT_EQ(loaded->pixels[std::size_t(it - loaded->channel_names.begin())],
+              image.pixels[std::size_t(c)]);
+  }
+}
+
 TEST(ImageIo, ExrRoundTripRgba) {
   Image image = make_levels_image(4, 4, 4);
   image.pixels[0] = 12.5f;  // HDR value
@@ -199,7 +220,8 @@ TEST(ImageIo, TruncatedPngIsAnError) {
 TEST(ImageIo, TruncatedJpegAndHdrAreErrorsOrDecodedPartially) {
   // libjpeg pads a truncated scan with grey and warns; either outcome is fine as long as it is
   // reported without crashing and a successful result is complete.
-  for (const char* file : {"env/cube/SwedishRoyalCastle/py.jpg", "env/equirect/venice_sunset_1k.hdr"}) {
+  for (const char* file :
+       {"env/cube/SwedishRoyalCastle/py.jpg", "env/equirect/venice_sunset_1k.hdr"}) {
     auto bytes = read_bytes(content_path(file));
     auto image = load_image_from_memory(bytes.data(), bytes.size() / 2, file);
     if (image.ok()) {

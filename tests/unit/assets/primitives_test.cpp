@@ -20,11 +20,16 @@ constexpr int kSegmentCounts[] = {3, 4, 5, 8, 32, 33, 1024};
 
 std::string shape_name(PrimitiveShape s) {
   switch (s) {
-    case PrimitiveShape::plane: return "plane";
-    case PrimitiveShape::box: return "box";
-    case PrimitiveShape::sphere: return "sphere";
-    case PrimitiveShape::cylinder: return "cylinder";
-    case PrimitiveShape::cone: return "cone";
+    case PrimitiveShape::plane:
+      return "plane";
+    case PrimitiveShape::box:
+      return "box";
+    case PrimitiveShape::sphere:
+      return "sphere";
+    case PrimitiveShape::cylinder:
+      return "cylinder";
+    case PrimitiveShape::cone:
+      return "cone";
   }
   return "?";
 }
@@ -61,8 +66,8 @@ TEST(Primitives, BoundsAreTheUnitSizes) {
   expect_box(make_primitive(PrimitiveShape::plane, 3).bounds, {-h, 0, -h}, {h, 0, h});
   expect_box(make_primitive(PrimitiveShape::box, 3).bounds, {-h, -h, -h}, {h, h, h});
   // With segments a multiple of 4, a column lies on each of +-X and +-Z.
-  for (PrimitiveShape round : {PrimitiveShape::sphere, PrimitiveShape::cylinder,
-                               PrimitiveShape::cone}) {
+  for (PrimitiveShape round :
+       {PrimitiveShape::sphere, PrimitiveShape::cylinder, PrimitiveShape::cone}) {
     SCOPED_TRACE(shape_name(round));
     expect_box(make_primitive(round, 32).bounds, {-h, -h, -h}, {h, h, h});
     // Any other count still stays inside the unit box and reaches its top and bottom.
@@ -141,7 +146,8 @@ TEST(Primitives, ClosedShapesShareEveryEdgeBetweenExactlyTwoTriangles) {
       std::map<std::tuple<float, float, float>, int> ids;
       std::vector<int> welded;
       for (const glm::vec3& p : m.positions)
-        welded.push_back(ids.emplace(std::make_tuple(p.x, p.y, p.z), int(ids.size())).first->second);
+        welded.push_back(
+            ids.emplace(std::make_tuple(p.x, p.y, p.z), int(ids.size())).first->second);
 
       std::map<std::pair<int, int>, int> undirected, directed;
       for (std::size_t t = 0; t < m.triangle_count(); ++t) {
@@ -163,6 +169,8 @@ TEST(Primitives, ClosedShapesShareEveryEdgeBetweenExactlyTwoTriangles) {
 }
 
 TEST(Primitives, SegmentsOutsideTheRangeAreAPreconditionFailure) {
+  // Other tests of this binary may have started threads (OIIO's pool): re-exec, do not just fork.
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
   EXPECT_DEATH((void)make_primitive(PrimitiveShape::sphere, 2), "segments must be in");
   EXPECT_DEATH((void)make_primitive(PrimitiveShape::cone, 1025), "segments must be in");
 }

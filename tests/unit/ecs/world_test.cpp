@@ -311,14 +311,21 @@ TEST_F(ViewTest, ConstWorldGivesConstViews) {
 }
 
 TEST_F(ViewTest, ViewMadeBeforeComponentsSeesThem) {
-  auto v = w.view<Position>();
+  // A mutable world registers the pools when the view is made, and iteration reads the pools'
+  // current contents, so a kept view sees components added after it was made.
+  const auto v = w.view<Position, A>();
   w.emplace<Position>(es[0], 1.0f, 1.0f, 1.0f);
-  // The view picked its driving pool when made; a fresh view is the documented way, but the pool
-  // pointers stay valid, so a re-made view sees the new component.
+  w.emplace<Position>(es[7], 2.0f, 2.0f, 2.0f);
+  std::set<std::uint32_t> seen;
+  v.each([&](Entity e, Position&, A&) { seen.insert(e.index); });
+  EXPECT_EQ(seen, (std::set<std::uint32_t>{es[0].index, es[7].index}));
   int n = 0;
-  w.view<Position>().each([&](Position&) { ++n; });
-  EXPECT_EQ(n, 1);
-  (void)v;
+  for (auto [e, p, a] : v) {
+    EXPECT_EQ(a.owner, e.index);
+    EXPECT_GT(p.x, 0.0f);
+    ++n;
+  }
+  EXPECT_EQ(n, 2);
 }
 
 TEST_F(ViewTest, AllowedChangesDuringIteration) {
@@ -368,7 +375,9 @@ TEST(WorldProperty, ViewsMatchBruteForceModelUnderChurn) {
   std::set<std::uint32_t> has_a, has_b, has_c;  // entity indices (the model)
   std::vector<Entity> dead;
 
-  auto pick = [&]() { return live[std::uniform_int_distribution<std::size_t>(0, live.size() - 1)(rng)]; };
+  auto pick = [&]() {
+    return live[std::uniform_int_distribution<std::size_t>(0, live.size() - 1)(rng)];
+  };
 
   auto check = [&]() {
     ASSERT_EQ(w.size(), live.size());
@@ -398,13 +407,15 @@ TEST(WorldProperty, ViewsMatchBruteForceModelUnderChurn) {
       EXPECT_EQ(c.owner, e.index);
       got.insert(e.index);
     }
-    expect_view("A,B,C",
-                [&](std::uint32_t i) { return has_a.count(i) && has_b.count(i) && has_c.count(i); });
+    expect_view("A,B,C", [&](std::uint32_t i) {
+      return has_a.count(i) && has_b.count(i) && has_c.count(i);
+    });
     w.view<B>(exclude<A>).each([&](Entity e, B&) { got.insert(e.index); });
     expect_view("B !A", [&](std::uint32_t i) { return has_b.count(i) && !has_a.count(i); });
     for (auto [e, c] : w.view<C>(exclude<A, B>)) got.insert(e.index);
-    expect_view("C !A !B",
-                [&](std::uint32_t i) { return has_c.count(i) && !has_a.count(i) && !has_b.count(i); });
+    expect_view("C !A !B", [&](std::uint32_t i) {
+      return has_c.count(i) && !has_a.count(i) && !has_b.count(i);
+    });
     for (Entity d : dead) ASSERT_FALSE(w.alive(d) || w.has<A>(d) || w.has<B>(d));
   };
 
@@ -452,10 +463,69 @@ TEST(WorldProperty, ViewsMatchBruteForceModelUnderChurn) {
     } else {
       w.sort_like<C, A>();
     }
-    if (op % 250 == 0) check();
+    if (op % 20 == 0) check();
   }
   check();
   EXPECT_GT(has_a.size(), 50u) << "the churn should leave a non-trivial world";
+}
+
+// --- Aligned-prefix cache (View step 2) ----------------------------------------------------------
+
+// Views remember how far pools are aligned; anything that moves elements must invalidate that,
+// while appends must not break it. Values carry their owner, so a stale prefix would show up as a
+// mismatched pair.
+TEST(WorldAlignment, RemovalInsideARememberedPrefixIsSeen) {
+  World w;
+  std::vector<Entity> es;
+  for (std::uint32_t i = 0; i < 100; ++i) {
+    es.push_back(w.create());
+    w.emplace<A>(es.back(), A{es.back().index});
+    w.emplace<B>(es.back(), B{es.back().index, 0.0f});
+  }
+  auto expect_pairs = [&](std::size_t want) {
+    std::size_t n = 0;
+    w.view<A, B>().each([&](Entity e, A& a, B& b) {
+      EXPECT_EQ(a.owner, e.index);
+      EXPECT_EQ(b.owner, e.index);
+      ++n;
+    });
+    std::size_t m = 0;
+    for (auto [e, a, b] : w.view<A, B>()) {
+      EXPECT_EQ(a.owner, e.index);
+      EXPECT_EQ(b.owner, e.index);
+      ++m;
+    }
+    EXPECT_EQ(n, want);
+    EXPECT_EQ(m, want);
+  };
+  expect_pairs(100);   // remembers a full-length prefix
+  w.remove<B>(es[3]);  // B's last element moves to position 3
+  expect_pairs(99);
+  w.emplace<B>(es[3], B{es[3].index, 0.0f});  // appended at the end: B is now out of order
+  expect_pairs(100);
+  w.sort_like<A, B>();  // aligned again, remembered by sort_like itself
+  expect_pairs(100);
+  for (std::uint32_t i = 0; i < 10; ++i) {  // appends keep the remembered prefix valid
+    const Entity e = w.create();
+    w.emplace<A>(e, A{e.index});
+    w.emplace<B>(e, B{e.index, 0.0f});
+  }
+  expect_pairs(110);
+  w.destroy(es[0]);
+  expect_pairs(109);
+  w.remove<A>(es[50]);
+  w.emplace<A>(es[50], A{es[50].index});
+  expect_pairs(109);
+  const World& cw = w;  // const views read the cache but never write it
+  std::size_t n = 0;
+  cw.view<A, B>().each([&](Entity e, const A& a, const B& b) {
+    EXPECT_EQ(a.owner, e.index);
+    EXPECT_EQ(b.owner, e.index);
+    ++n;
+  });
+  EXPECT_EQ(n, 109u);
+  w.clear();
+  expect_pairs(0);
 }
 
 // --- sort_like -----------------------------------------------------------------------------------
@@ -575,7 +645,7 @@ TEST(CommandBuffer, DestroyDuringIteration) {
     if (a.owner % 5 == 0) cb.remove<A>(e);
   EXPECT_EQ(w.size(), 100u);
   cb.flush(w);
-  EXPECT_EQ(w.size(), 100u);  // 50 destroyed, 50 created
+  EXPECT_EQ(w.size(), 100u);     // 50 destroyed, 50 created
   EXPECT_EQ(w.count<A>(), 40u);  // odd owners not divisible by 5: 50 - 10
   EXPECT_EQ(w.count<C>(), 50u);
   w.view<A>().each([](A& a) { EXPECT_TRUE(a.owner % 2 == 1 && a.owner % 5 != 0); });
@@ -592,8 +662,8 @@ TEST(CommandBuffer, CommandsOnEntitiesDestroyedBeforeFlushAreSkipped) {
   cb.emplace<A>(f, A{2});  // f dies in this buffer before this command runs
   const Entity p = cb.create();
   cb.destroy(p);
-  cb.emplace<B>(p);  // its created entity is already gone
-  w.destroy(e);      // dies before the flush
+  cb.emplace<B>(p);                  // its created entity is already gone
+  w.destroy(e);                      // dies before the flush
   const Entity reused = w.create();  // takes e's slot with a new generation
   ASSERT_EQ(reused.index, e.index);
 

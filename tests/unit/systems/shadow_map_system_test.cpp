@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include <glm/gtc/quaternion.hpp>
+
 #include "systems/shadow_map_system.h"
 
 namespace kaskad {
