@@ -1,7 +1,10 @@
 // kaskad_editor: a window onto a scene with toggles for the shadow settings and the light.
 // Same runtime and frame phases as the headless player; the editor only edits components and
 // settings between frames.  usage: kaskad_editor [SCENE] [--set key=value]...
+#include <epoxy/gl.h>
+
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -14,6 +17,7 @@
 #include "components/light.h"
 #include "components/name.h"
 #include "components/shadow_settings.h"
+#include "runtime/assets/image_io.h"
 #include "runtime/cli/player.h"
 #include "runtime/gpu/context.h"
 
@@ -128,8 +132,28 @@ int main(int argc, char** argv) {
     ImGui::End();
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-    player->context->swap_buffers();
     ++frame;
+    const char* shot = std::getenv("KASKAD_EDITOR_SCREENSHOT");
+    if (shot && max_frames >= 0 && int(frame) == max_frames) {
+      // The window as the user sees it (scene + UI), for automated checks.
+      Image img;
+      img.width = w;
+      img.height = h;
+      img.channels = 3;
+      std::vector<unsigned char> bytes(std::size_t(w) * h * 3);
+      glPixelStorei(GL_PACK_ALIGNMENT, 1);
+      glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, bytes.data());
+      img.pixels.resize(bytes.size());
+      for (int y = 0; y < h; ++y)
+        for (int i = 0; i < w * 3; ++i)
+          img.pixels[std::size_t(y) * w * 3 + i] = bytes[std::size_t(h - 1 - y) * w * 3 + i] / 255.0f;
+      if (auto st = save_image(shot, img); !st) {
+        std::fprintf(stderr, "kaskad_editor: error: %s\n", st.error().to_string().c_str());
+        return 1;
+      }
+      std::printf("wrote %s\n", shot);
+    }
+    player->context->swap_buffers();
   }
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
