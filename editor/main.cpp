@@ -88,6 +88,7 @@ int main(int argc, char** argv) {
   GLFWwindow* window = player->context->window();
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini dropped into the working directory
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL3_Init("#version 450 core");
 
@@ -102,6 +103,7 @@ int main(int argc, char** argv) {
     RenderRun run;
     run.width = w;
     run.height = h;
+    run.write_aovs = false;
     auto t = render_frames(*player, *scene, run);
     if (!t) {
       std::fprintf(stderr, "kaskad_editor: error: %s\n", t.error().to_string().c_str());
@@ -112,6 +114,9 @@ int main(int argc, char** argv) {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
+    ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(330, 0), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowBgAlpha(0.8f);
     ImGui::Begin("Kaskad");
     ImGui::Text("frame %.2f ms (shadow GPU %.2f, forward GPU %.2f)", t->first_frame_ms,
                 t->last.stats.shadow_gpu_ms, t->last.stats.forward_gpu_ms);

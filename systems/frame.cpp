@@ -32,6 +32,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.ambient = scene.render.ambient;
   in.clear_color = scene.render.clear_color;
   in.exposure = scene.render.exposure;
+  in.write_aovs = ctx.write_aovs;
 
   const Material default_material;
   world.view<MeshRenderer, WorldTransform>().each(

@@ -22,6 +22,7 @@ struct FrameContext {
   int width = 1280;
   int height = 720;
   std::uint64_t index = 0;  ///< frame number since the scene was loaded
+  bool write_aovs = true;   ///< render the AOV targets too (see render::FrameInput)
 };
 
 /// What a frame did, for stats output and tests. CPU times in milliseconds.

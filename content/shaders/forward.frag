@@ -2,6 +2,7 @@
 // output through the sRGB colour target. Defines:
 //   SHADOW_FILTER  0: one hardware-compared tap, nearest; 1: one tap, bilinear compare (2x2 PCF);
 //                  2: 3x3 PCF of hardware compares (S4)
+//   WRITE_AOVS     1: also write the AOV targets (locations 1-3); 0: colour only (cheaper)
 #include "common.glsl"
 
 #ifndef SHADOW_FILTER
@@ -20,10 +21,16 @@ layout(binding = 0) uniform sampler2D u_base_color_tex;  // 1x1 white when the m
 layout(binding = 1) uniform sampler2D u_normal_tex;      // 1x1 (0.5, 0.5, 1) when none
 layout(binding = 2) uniform sampler2DShadow u_shadow_map;
 
+#ifndef WRITE_AOVS
+#define WRITE_AOVS 1
+#endif
+
 layout(location = 0) out vec4 o_color;
+#if WRITE_AOVS
 layout(location = 1) out vec4 o_position;    // xyz world position, w mask (1 = geometry)
 layout(location = 2) out vec4 o_normal;      // xyz world normal facing the camera, w view depth
 layout(location = 3) out float o_visibility; // shadow visibility of the shadowed light
+#endif
 
 // Cotangent frame from screen-space derivatives: normal mapping without stored tangents.
 vec3 perturb_normal(vec3 n, vec3 p, vec2 uv, vec3 tangent_normal) {
@@ -116,7 +123,9 @@ void main() {
   }
 
   o_color = vec4(color * u_ambient.w, 1.0);
+#if WRITE_AOVS
   o_position = vec4(v_world_pos, 1.0);
   o_normal = vec4(geometric_n, -(u_view * vec4(v_world_pos, 1.0)).z);
   o_visibility = visibility;
+#endif
 }

@@ -180,6 +180,7 @@ int run_render(Args a) {
 
   RenderRun run;
   run.frames = a.frames;
+  run.write_aovs = !a.aov.empty();  // the AOV targets cost fill rate: only when asked for
   auto timings = render_frames(*player, *scene, run);
   if (!timings) return fail(timings.error());
   if (!player->context->headless()) {

@@ -54,6 +54,7 @@ Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRu
   FrameContext ctx;
   ctx.width = run.width > 0 ? run.width : scene.render.width;
   ctx.height = run.height > 0 ? run.height : scene.render.height;
+  ctx.write_aovs = run.write_aovs;
   for (int i = 0; i < std::max(1, run.frames); ++i) {
     ctx.index = std::uint64_t(i);
     const auto t0 = std::chrono::steady_clock::now();

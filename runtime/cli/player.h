@@ -36,6 +36,7 @@ struct RenderRun {
   int frames = 1;  ///< frames rendered; the last one is kept for read-back
   int width = 0;   ///< 0: take render.width / render.height from the scene
   int height = 0;
+  bool write_aovs = true;  ///< needed for Renderer::read_aovs(); off saves fill rate
 };
 
 struct RenderTimings {

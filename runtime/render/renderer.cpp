@@ -78,6 +78,7 @@ struct Renderer::Impl {
 
   std::array<gpu::Query, 2> timers;
   bool timers_pending = false;
+  bool aovs_written = false;
 
   Result<GLuint> program(const std::string& vs, const std::string& fs,
                          const std::vector<std::pair<std::string, std::string>>& defines,
@@ -184,9 +185,6 @@ struct Renderer::Impl {
     glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT2, normal.id(), 0);
     glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT3, visibility.id(), 0);
     glNamedFramebufferTexture(fbo.id(), GL_DEPTH_ATTACHMENT, depth.id(), 0);
-    const GLenum bufs[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
-                            GL_COLOR_ATTACHMENT3};
-    glNamedFramebufferDrawBuffers(fbo.id(), 4, bufs);
   }
 
   void ensure_shadow_map(int size, ShadowFilter filter) {
@@ -324,13 +322,18 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   glBeginQuery(GL_TIME_ELAPSED, im.timers[1].id());
   const ShadowFilter filter = shadowed ? frame.shadow.settings.filter : ShadowFilter::none;
   auto prog = im.program("forward.vert", "forward.frag",
-                         {{"SHADOW_FILTER", std::to_string(int(filter))}},
+                         {{"SHADOW_FILTER", std::to_string(int(filter))},
+                          {"WRITE_AOVS", frame.write_aovs ? "1" : "0"}},
                          stats_.programs_compiled);
   if (!prog) {
     glEndQuery(GL_TIME_ELAPSED);
     return prog.error();
   }
   im.ensure_targets(frame.width, frame.height);
+  const GLenum bufs[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                          GL_COLOR_ATTACHMENT3};
+  glNamedFramebufferDrawBuffers(im.fbo.id(), frame.write_aovs ? 4 : 1, bufs);
+  im.aovs_written = frame.write_aovs;
   glBindFramebuffer(GL_FRAMEBUFFER, im.fbo.id());
   glViewport(0, 0, frame.width, frame.height);
   glEnable(GL_FRAMEBUFFER_SRGB);
@@ -340,9 +343,11 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   const float zero[4] = {0, 0, 0, 0};
   const float one = 1.0f;
   glClearBufferfv(GL_COLOR, 0, clear_color);
-  glClearBufferfv(GL_COLOR, 1, zero);
-  glClearBufferfv(GL_COLOR, 2, zero);
-  glClearBufferfv(GL_COLOR, 3, zero);
+  if (frame.write_aovs) {
+    glClearBufferfv(GL_COLOR, 1, zero);
+    glClearBufferfv(GL_COLOR, 2, zero);
+    glClearBufferfv(GL_COLOR, 3, zero);
+  }
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
@@ -423,6 +428,7 @@ Image Renderer::read_color() const {
 
 Image Renderer::read_aovs() const {
   const Impl& im = *impl_;
+  KASKAD_CHECK(im.aovs_written, "the last frame was rendered without write_aovs");
   const int w = im.width, h = im.height;
   const auto pos = read_texture(im.position.id(), w, h, GL_RGBA, 4);
   const auto nrm = read_texture(im.normal.id(), w, h, GL_RGBA, 4);

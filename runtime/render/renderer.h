@@ -63,6 +63,9 @@ struct FrameInput {
   glm::vec3 ambient{0.05f};
   glm::vec3 clear_color{0.0f};
   float exposure = 1.0f;
+  /// Write the AOV targets (position, normal + depth, visibility). Off, the forward pass writes
+  /// colour only: on llvmpipe the three float targets cost more than the shading itself.
+  bool write_aovs = true;
 };
 
 inline constexpr int kMaxLights = 8;  // change together with MAX_LIGHTS in common.glsl
@@ -93,6 +96,7 @@ class Renderer {
   /// sRGB-encoded colour of the last frame, RGBA in [0,1], rows top to bottom.
   Image read_color() const;
   /// AOVs of the last frame: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask (see README).
+  /// Precondition: the last frame was rendered with write_aovs.
   Image read_aovs() const;
   /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom.
   Image read_shadow_map() const;
