@@ -17,6 +17,10 @@ struct Material {
   float normal_scale = 1.0f;                   ///< glTF normalTexture.scale
   glm::vec3 emissive{0.0f};                    ///< linear emitted radiance
   bool double_sided = false;                   ///< glTF doubleSided: light both faces
+  bool alpha_mask = false;                     ///< glTF alphaMode MASK: discard below alpha_cutoff
+  float alpha_cutoff = 0.5f;                   ///< glTF alphaCutoff
+
+  bool operator==(const Material&) const = default;
 };
 
 }  // namespace kaskad

@@ -63,6 +63,13 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   return in;
 }
 
+Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx) {
+  update_transforms(scene.world, scene.assets);
+  const CameraState camera = select_camera(scene.world, float(ctx.width) / float(ctx.height));
+  const ShadowData shadow = update_basic_shadow(scene.world);
+  return renderer.prewarm(build_frame_input(scene, ctx, camera, shadow));
+}
+
 Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
                  FrameReport& report) {
   auto t = Clock::now();

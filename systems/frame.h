@@ -37,6 +37,9 @@ struct FrameReport {
 Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
                  FrameReport& report);
 
+/// Phases 1-4, then compiles every program the frame will use (scene load: no compiles later).
+Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx);
+
 /// Phase 4 on its own (pure: no GL), exposed for tests.
 render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx,
                                      const CameraState& camera, const ShadowData& shadow);

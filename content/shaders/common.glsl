@@ -20,3 +20,10 @@ layout(std140, binding = 0) uniform FrameBlock {
 // Per-draw uniforms (explicit locations: no name look-ups at draw time).
 layout(location = 0) uniform mat4 u_model;
 layout(location = 4) uniform mat3 u_normal_matrix;
+// Per-material uniforms (set when the material changes; draws are sorted by material).
+layout(location = 8) uniform vec4 u_base_color;
+layout(location = 9) uniform vec4 u_material;  // x metallic, y roughness, z normal scale, w alpha cutoff
+layout(location = 10) uniform vec3 u_emissive;
+
+layout(binding = 0) uniform sampler2D u_base_color_tex;
+layout(binding = 1) uniform sampler2D u_normal_tex;

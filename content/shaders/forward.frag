@@ -1,32 +1,19 @@
 // Forward shading: Blinn-Phong driven by glTF metallic-roughness inputs, linear lighting, sRGB
-// output through the sRGB colour target. Defines:
-//   SHADOW_FILTER  0: one hardware-compared tap, nearest; 1: one tap, bilinear compare (2x2 PCF);
-//                  2: 3x3 PCF of hardware compares (S4)
-//   WRITE_AOVS     1: also write the AOV targets (locations 1-3); 0: colour only (cheaper)
+// output through the sRGB colour target. Features (content/shaders/features.json) are selected by
+// the preprocessor only; see README.md in this folder.
 #include "common.glsl"
-
-#ifndef SHADOW_FILTER
-#define SHADOW_FILTER 2
-#endif
+#include "features.glsl"
 
 in vec3 v_world_pos;
 in vec3 v_world_normal;
 in vec2 v_uv;
 
-layout(location = 8) uniform vec4 u_base_color;
-layout(location = 9) uniform vec4 u_material;   // x metallic, y roughness, z normal scale, w receive shadows
-layout(location = 10) uniform vec3 u_emissive;
-
-layout(binding = 0) uniform sampler2D u_base_color_tex;  // 1x1 white when the material has none
-layout(binding = 1) uniform sampler2D u_normal_tex;      // 1x1 (0.5, 0.5, 1) when none
+#if VARIANT_HAS_SHADOW
 layout(binding = 2) uniform sampler2DShadow u_shadow_map;
-
-#ifndef WRITE_AOVS
-#define WRITE_AOVS 1
 #endif
 
 layout(location = 0) out vec4 o_color;
-#if WRITE_AOVS
+#if VARIANT_HAS_AOVS
 layout(location = 1) out vec4 o_position;    // xyz world position, w mask (1 = geometry)
 layout(location = 2) out vec4 o_normal;      // xyz world normal facing the camera, w view depth
 layout(location = 3) out float o_visibility; // shadow visibility of the shadowed light
@@ -47,11 +34,12 @@ vec3 perturb_normal(vec3 n, vec3 p, vec2 uv, vec3 tangent_normal) {
 
 // Visibility of the shadowed light at world position p: 1 lit, 0 shadowed (S4). Clamp-to-border
 // with border depth 1 and the z > 1 test keep everything outside the light frustum lit.
+#if VARIANT_HAS_SHADOW
 float shadow_visibility(vec3 p) {
   vec4 clip = u_light_view_proj * vec4(p, 1.0);
   vec3 c = clip.xyz / clip.w * 0.5 + 0.5;
   if (c.z > 1.0) return 1.0;
-#if SHADOW_FILTER == 2
+#if VARIANT_SHADOW_FILTER == VARIANT_SHADOW_FILTER_PCF3X3
   // textureOffset needs constant offsets: the 3x3 kernel is written out.
   float sum = 0.0;
   sum += textureOffset(u_shadow_map, c, ivec2(-1, -1));
@@ -68,17 +56,28 @@ float shadow_visibility(vec3 p) {
   return texture(u_shadow_map, c);  // filtering (nearest / linear) is set on the texture
 #endif
 }
+#endif
 
 void main() {
-  vec4 base = u_base_color * texture(u_base_color_tex, v_uv);
+  vec4 base = u_base_color;
+#if MATERIAL_HAS_BASE_COLOR_TEXTURE
+  if (ENABLED(BIT_BASE_COLOR_TEXTURE)) base *= texture(u_base_color_tex, v_uv);
+#endif
+#if MATERIAL_HAS_ALPHA_MASK
+  if (ENABLED(BIT_ALPHA_MASK) && base.a < u_material.w) discard;
+#endif
   vec3 view_vec = u_camera_pos.xyz - v_world_pos;
   vec3 v = normalize(view_vec);
   vec3 geometric_n = normalize(v_world_normal);
   if (dot(geometric_n, v) < 0.0) geometric_n = -geometric_n;  // back faces face the camera
   vec3 n = geometric_n;
-  vec3 tn = texture(u_normal_tex, v_uv).xyz * 2.0 - 1.0;
-  tn.xy *= u_material.z;
-  n = perturb_normal(n, v_world_pos, v_uv, normalize(tn));
+#if MATERIAL_HAS_NORMAL_MAP
+  if (ENABLED(BIT_NORMAL_MAP)) {
+    vec3 tn = texture(u_normal_tex, v_uv).xyz * 2.0 - 1.0;
+    tn.xy *= u_material.z;
+    n = perturb_normal(n, v_world_pos, v_uv, normalize(tn));
+  }
+#endif
 
   float metallic = clamp(u_material.x, 0.0, 1.0);
   float roughness = clamp(u_material.y, 0.03, 1.0);
@@ -90,9 +89,14 @@ void main() {
   float spec_norm = (shininess + 8.0) / 8.0;
 
   float visibility = 1.0;
-  if (u_counts.y >= 0 && u_material.w > 0.5) visibility = shadow_visibility(v_world_pos);
+#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
+  if (ENABLED(BIT_RECEIVE_SHADOWS)) visibility = shadow_visibility(v_world_pos);
+#endif
 
-  vec3 color = u_ambient.rgb * diffuse_color + u_emissive;
+  vec3 color = u_ambient.rgb * diffuse_color;
+#if MATERIAL_HAS_EMISSIVE
+  if (ENABLED(BIT_EMISSIVE)) color += u_emissive;
+#endif
   for (int i = 0; i < u_counts.x; ++i) {
     int type = int(u_light_color[i].w);
     vec3 l;
@@ -123,7 +127,7 @@ void main() {
   }
 
   o_color = vec4(color * u_ambient.w, 1.0);
-#if WRITE_AOVS
+#if VARIANT_HAS_AOVS
   o_position = vec4(v_world_pos, 1.0);
   o_normal = vec4(geometric_n, -(u_view * vec4(v_world_pos, 1.0)).z);
   o_visibility = visibility;

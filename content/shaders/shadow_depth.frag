@@ -1,2 +1,17 @@
 // Depth only: colour writes are off; the rasteriser writes depth (with glPolygonOffset bias).
-void main() {}
+// Alpha-masked materials discard their cut-out texels so they cast cut-out shadows.
+#include "common.glsl"
+#include "features.glsl"
+
+#if MATERIAL_HAS_ALPHA_MASK
+in vec2 v_uv;
+#endif
+
+void main() {
+#if MATERIAL_HAS_ALPHA_MASK
+  if (ENABLED(BIT_ALPHA_MASK)) {
+    float alpha = u_base_color.a * texture(u_base_color_tex, v_uv).a;
+    if (alpha < u_material.w) discard;
+  }
+#endif
+}

@@ -28,6 +28,11 @@ namespace {
 /// Largest image we decode, in float values (width * height * channels): 2^28 floats = 1 GiB,
 /// e.g. 16384 x 16384 x 1 or 8192 x 8192 x 4. Guards against headers that claim absurd sizes.
 constexpr std::uint64_t kMaxImageValues = std::uint64_t(1) << 28;
+/// Limits per side and on channels, checked before decoding too: OIIO reads in chunks of up to
+/// 64 scanlines (or a whole tile) and allocates that chunk by the header's sizes, so a 175-byte
+/// BMP claiming 16M x 5 pixels made it ask for 12.8 GB (found by tests/fuzz/fuzz_image.cpp).
+constexpr int kMaxImageSide = 32768;
+constexpr int kMaxChannels = 16;
 
 /// Files larger than this are refused before reading them into memory (2 GiB).
 constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t(1) << 31;
@@ -173,6 +178,14 @@ Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::stri
                      " channels)"};
   }
   if (spec.depth > 1) return Error{name, "", "volume images are not supported"};
+  if (spec.width > kMaxImageSide || spec.height > kMaxImageSide || spec.nchannels > kMaxChannels ||
+      spec.tile_width > kMaxImageSide || spec.tile_height > kMaxImageSide || spec.tile_depth > 1) {
+    return Error{name, "",
+                 "image too large (" + std::to_string(spec.width) + " x " +
+                     std::to_string(spec.height) + " pixels, " + std::to_string(spec.nchannels) +
+                     " channels; at most " + std::to_string(kMaxImageSide) + " pixels a side and " +
+                     std::to_string(kMaxChannels) + " channels)"};
+  }
   const std::uint64_t values =
       std::uint64_t(spec.width) * std::uint64_t(spec.height) * std::uint64_t(spec.nchannels);
   if (values > kMaxImageValues) {

@@ -25,8 +25,8 @@ struct Image {
   }
 };
 
-/// Reads any image OIIO can read. Errors name the file and the problem (missing, unreadable,
-/// corrupt, zero-sized).
+/// Reads an image. Errors name the file and the problem (missing, unreadable, corrupt,
+/// zero-sized, or beyond the limits: 32768 pixels a side, 16 channels, 2^28 values).
 Result<Image> load_image(const std::filesystem::path& path);
 
 /// Reads an image from memory (e.g. a glTF buffer view); `name` is used in error messages and

@@ -194,9 +194,13 @@ int run_render(Args a) {
               scene->render.width, scene->render.height, timings->first_frame_ms,
               timings->median_ms(), a.frames);
   std::printf("last      %d draws, %zu triangles; shadow pass %d draws, %zu triangles; "
-              "GPU shadow %.2f ms, forward %.2f ms; %d programs compiled\n",
+              "GPU shadow %.2f ms, forward %.2f ms; %d program and %d material switches\n",
               st.draw_calls, st.triangles, st.shadow_draw_calls, st.shadow_triangles,
-              st.shadow_gpu_ms, st.forward_gpu_ms, st.programs_compiled);
+              st.shadow_gpu_ms, st.forward_gpu_ms, st.program_switches, st.material_switches);
+  std::printf("shaders   %d compiled, %d from the binary cache, %.1f ms (prewarm %.1f ms); "
+              "%d compiled after the first frame\n",
+              st.shaders.programs_compiled, st.shaders.cache_hits, st.shaders.compile_ms,
+              timings->prewarm_ms, st.shaders.runtime_compiles);
 
   fs::path out = a.output.empty() ? fs::path("out") / (scene_path.stem().string() + ".png")
                                   : fs::path(a.output);

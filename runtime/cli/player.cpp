@@ -30,12 +30,19 @@ Result<Scene> load_scene(const std::filesystem::path& file,
   return scene;
 }
 
-Result<Player> Player::create(const gpu::ContextOptions& options) {
+render::RendererOptions Player::defaults() {
+  render::RendererOptions o;
+  o.shader_cache_dir = render::default_shader_cache_dir();
+  return o;
+}
+
+Result<Player> Player::create(const gpu::ContextOptions& options,
+                              const render::RendererOptions& renderer_options) {
   Player p;
   auto ctx = gpu::Context::create(options);
   if (!ctx) return ctx.error();
   p.context = std::move(ctx.value());
-  auto r = render::Renderer::create(content_dir() / "shaders");
+  auto r = render::Renderer::create(content_dir() / "shaders", renderer_options);
   if (!r) return r.error();
   p.renderer = std::move(r.value());
   return p;
@@ -55,6 +62,12 @@ Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRu
   ctx.width = run.width > 0 ? run.width : scene.render.width;
   ctx.height = run.height > 0 ? run.height : scene.render.height;
   ctx.write_aovs = run.write_aovs;
+  if (run.prewarm) {
+    const auto t0 = std::chrono::steady_clock::now();
+    KASKAD_TRY(prewarm_frame(scene, *player.renderer, ctx));
+    t.prewarm_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
   for (int i = 0; i < std::max(1, run.frames); ++i) {
     ctx.index = std::uint64_t(i);
     const auto t0 = std::chrono::steady_clock::now();
@@ -63,6 +76,7 @@ Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRu
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (i == 0) {
+      player.renderer->shaders().first_frame_done();
       t.first_frame_ms = ms;
     } else {
       t.frame_ms.push_back(ms);

@@ -29,7 +29,10 @@ struct Player {
   std::unique_ptr<gpu::Context> context;
   std::unique_ptr<render::Renderer> renderer;
 
-  static Result<Player> create(const gpu::ContextOptions& options);
+  /// Renderer options default to the shader binary cache in default_shader_cache_dir().
+  static Result<Player> create(const gpu::ContextOptions& options,
+                               const render::RendererOptions& renderer_options = defaults());
+  static render::RendererOptions defaults();
 };
 
 struct RenderRun {
@@ -37,10 +40,12 @@ struct RenderRun {
   int width = 0;   ///< 0: take render.width / render.height from the scene
   int height = 0;
   bool write_aovs = true;  ///< needed for Renderer::read_aovs(); off saves fill rate
+  bool prewarm = true;     ///< compile the scene's programs before the first frame
 };
 
 struct RenderTimings {
-  double first_frame_ms = 0.0;              ///< includes shader compiles and uploads
+  double prewarm_ms = 0.0;                  ///< shader programs built/loaded before frame 1
+  double first_frame_ms = 0.0;              ///< includes uploads (and compiles if not prewarmed)
   std::vector<double> frame_ms;             ///< every frame after the first (CPU wall, GPU finished)
   double median_ms() const;                 ///< median of frame_ms (first frame if it is empty)
   FrameReport last;                         ///< phase times and counters of the last frame

@@ -1,5 +1,6 @@
 #include "runtime/gpu/shader.h"
 
+#include <algorithm>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -103,7 +104,8 @@ std::string map_shader_log(const std::string& log, const std::vector<std::string
   return rewrite(rewrite(log, mesa_re, true), nv_re, false);
 }
 
-Result<Program> build_program(const ShaderSource& vertex, const ShaderSource& fragment) {
+Result<Program> build_program(const ShaderSource& vertex, const ShaderSource& fragment,
+                              bool retrievable) {
   auto vs = compile_stage(GL_VERTEX_SHADER, vertex);
   if (!vs) return vs.error();
   auto fs = compile_stage(GL_FRAGMENT_SHADER, fragment);
@@ -111,6 +113,7 @@ Result<Program> build_program(const ShaderSource& vertex, const ShaderSource& fr
   Program program(glCreateProgram());
   glAttachShader(program.id(), vs->id());
   glAttachShader(program.id(), fs->id());
+  if (retrievable) glProgramParameteri(program.id(), GL_PROGRAM_BINARY_RETRIEVABLE_HINT, GL_TRUE);
   glLinkProgram(program.id());
   glDetachShader(program.id(), vs->id());
   glDetachShader(program.id(), fs->id());
@@ -124,6 +127,32 @@ Result<Program> build_program(const ShaderSource& vertex, const ShaderSource& fr
     return Error{vertex.files.empty() ? "" : vertex.files[0], "link",
                  map_shader_log(log.c_str(), vertex.files)};
   }
+  return program;
+}
+
+std::vector<std::uint8_t> program_binary(const Program& program, GLenum& format) {
+  GLint length = 0;
+  glGetProgramiv(program.id(), GL_PROGRAM_BINARY_LENGTH, &length);
+  std::vector<std::uint8_t> out(std::size_t(std::max(length, 0)));
+  if (out.empty()) return out;
+  GLsizei written = 0;
+  glGetProgramBinary(program.id(), length, &written, &format, out.data());
+  out.resize(std::size_t(std::max(written, 0)));
+  return out;
+}
+
+Result<Program> program_from_binary(GLenum format, const std::vector<std::uint8_t>& binary) {
+  GLint formats = 0;
+  glGetIntegerv(GL_NUM_PROGRAM_BINARY_FORMATS, &formats);
+  std::vector<GLint> supported(std::size_t(std::max(formats, 0)));
+  if (formats > 0) glGetIntegerv(GL_PROGRAM_BINARY_FORMATS, supported.data());
+  if (std::find(supported.begin(), supported.end(), GLint(format)) == supported.end())
+    return Error{"", "program binary", "format not supported by this driver"};
+  Program program(glCreateProgram());
+  glProgramBinary(program.id(), format, binary.data(), GLsizei(binary.size()));
+  GLint ok = 0;
+  glGetProgramiv(program.id(), GL_LINK_STATUS, &ok);
+  if (!ok) return Error{"", "program binary", "rejected by the driver"};
   return program;
 }
 

@@ -3,6 +3,7 @@
 // mapped back to the original file and line instead of the concatenated string.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -29,6 +30,14 @@ Result<ShaderSource> preprocess_shader(const std::filesystem::path& root,
 std::string map_shader_log(const std::string& log, const std::vector<std::string>& files);
 
 /// Compiles and links a vertex + fragment program. Errors carry the mapped compiler/linker log.
-Result<Program> build_program(const ShaderSource& vertex, const ShaderSource& fragment);
+/// `retrievable`: ask the driver to keep the binary for program_binary().
+Result<Program> build_program(const ShaderSource& vertex, const ShaderSource& fragment,
+                              bool retrievable = false);
+
+/// A linked program's binary (GL_ARB_get_program_binary); empty when the driver gives none.
+std::vector<std::uint8_t> program_binary(const Program& program, GLenum& format);
+
+/// A program from a binary; an Error when the driver rejects it (e.g. after a driver update).
+Result<Program> program_from_binary(GLenum format, const std::vector<std::uint8_t>& binary);
 
 }  // namespace kaskad::gpu

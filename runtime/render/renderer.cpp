@@ -6,7 +6,8 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <unordered_map>
+#include <numeric>
+#include <tuple>
 
 #include "runtime/core/log.h"
 #include "runtime/gpu/shader.h"
@@ -32,7 +33,7 @@ static_assert(sizeof(FrameBlock) == 3 * 64 + 3 * 16 + 4 * kMaxLights * 16);
 // Fixed attribute and uniform locations (see the shaders).
 constexpr GLuint kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
 constexpr GLint kUniModel = 0, kUniNormalMatrix = 4, kUniBaseColor = 8, kUniMaterial = 9,
-                kUniEmissive = 10;
+                kUniEmissive = 10, kUniOracleFeatures = 11;
 constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2;
 
 struct GpuMesh {
@@ -57,8 +58,8 @@ gpu::Texture make_solid_texture(const std::array<float, 4>& rgba, GLenum interna
 }  // namespace
 
 struct Renderer::Impl {
-  std::filesystem::path shader_dir;
-  std::unordered_map<std::string, gpu::Program> programs;  // key: pass + defines
+  std::unique_ptr<ShaderLibrary> shaders;
+  bool oracle = false;
   std::vector<GpuMesh> meshes;                             // indexed by MeshId
   std::vector<std::unique_ptr<GpuTexture>> textures;       // indexed by TextureId
   gpu::Texture white, flat_normal;
@@ -79,25 +80,6 @@ struct Renderer::Impl {
   std::array<gpu::Query, 2> timers;
   bool timers_pending = false;
   bool aovs_written = false;
-
-  Result<GLuint> program(const std::string& vs, const std::string& fs,
-                         const std::vector<std::pair<std::string, std::string>>& defines,
-                         int& compiled) {
-    std::string key = vs + "|" + fs;
-    for (const auto& [k, v] : defines) key += "|" + k + "=" + v;
-    // Hot path: one hash probe per pass; compile only on a miss.
-    if (auto it = programs.find(key); it != programs.end()) return it->second.id();
-    auto v = gpu::preprocess_shader(shader_dir, vs, defines);
-    if (!v) return v.error();
-    auto f = gpu::preprocess_shader(shader_dir, fs, defines);
-    if (!f) return f.error();
-    auto p = gpu::build_program(*v, *f);
-    if (!p) return p.error();
-    ++compiled;
-    GLuint id = p->id();
-    programs.emplace(key, std::move(p.value()));
-    return id;
-  }
 
   const GpuMesh& mesh(MeshId id, const AssetStore& assets) {
     if (id >= meshes.size()) meshes.resize(std::size_t(id) + 1);
@@ -212,13 +194,17 @@ struct Renderer::Impl {
   }
 };
 
-Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& shader_dir) {
+Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& shader_dir,
+                                                  const RendererOptions& options) {
   std::unique_ptr<Renderer> r(new Renderer());
   r->impl_ = std::make_unique<Impl>();
   Impl& im = *r->impl_;
-  im.shader_dir = shader_dir;
   if (!std::filesystem::exists(shader_dir / "forward.frag"))
     return Error{shader_dir.string(), "", "shader directory has no forward.frag"};
+  auto lib = ShaderLibrary::create(shader_dir, options.shader_cache_dir, options.uber_oracle);
+  if (!lib) return lib.error();
+  im.shaders = std::move(lib.value());
+  im.oracle = options.uber_oracle;
   im.white = make_solid_texture({1, 1, 1, 1}, GL_SRGB8_ALPHA8);
   // Exactly (0.5, 0.5, 1): decodes to (0, 0, 1), so the cotangent frame leaves the normal as is.
   // An 8-bit 128 would tilt every normal by 0.2 degrees, with visible derivative noise.
@@ -233,6 +219,60 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
 }
 
 Renderer::~Renderer() = default;
+
+ShaderLibrary& Renderer::shaders() { return *impl_->shaders; }
+
+VariantKey frame_variant(const FrameInput& frame) {
+  VariantKey k;
+  const bool shadowed = frame.shadow.light_index >= 0 &&
+                        frame.shadow.light_index < std::min<int>(int(frame.lights.size()), kMaxLights);
+  if (shadowed) {
+    k.set(VariantKey::kShadow, 1);
+    k.set(VariantKey::kShadowFilter, std::uint32_t(frame.shadow.settings.filter));
+  }
+  if (frame.write_aovs) k.set(VariantKey::kAovs, 1);
+  return k;
+}
+
+VariantKey material_variant(const DrawItem& d) {
+  const Material& m = d.material;
+  VariantKey k;
+  if (m.base_color_texture != kNoTexture) k.set(VariantKey::kBaseColorTexture, 1);
+  if (m.normal_texture != kNoTexture) k.set(VariantKey::kNormalMap, 1);
+  if (m.alpha_mask) k.set(VariantKey::kAlphaMask, 1);
+  if (m.emissive.r > 0.0f || m.emissive.g > 0.0f || m.emissive.b > 0.0f)
+    k.set(VariantKey::kEmissive, 1);
+  if (d.receive_shadows) k.set(VariantKey::kReceiveShadows, 1);
+  return k;
+}
+
+std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
+  const VariantKey fk = frame_variant(frame);
+  std::vector<ProgramRequest> out;
+  for (const DrawItem& d : frame.draws) {
+    const VariantKey k = material_variant(d) | fk;
+    out.push_back({Pass::forward, k.filtered_for(Pass::forward)});
+    if (fk.has(VariantKey::kShadow) && d.cast_shadows)
+      out.push_back({Pass::depth, k.filtered_for(Pass::depth)});
+  }
+  auto less = [](const ProgramRequest& a, const ProgramRequest& b) {
+    return std::pair(a.pass, a.key) < std::pair(b.pass, b.key);
+  };
+  std::sort(out.begin(), out.end(), less);
+  out.erase(std::unique(out.begin(), out.end(),
+                        [](const ProgramRequest& a, const ProgramRequest& b) {
+                          return a.pass == b.pass && a.key == b.key;
+                        }),
+            out.end());
+  return out;
+}
+
+Status Renderer::prewarm(const FrameInput& frame) {
+  const auto requests = required_programs(frame);
+  Status st = impl_->shaders->prewarm(requests);
+  stats_.shaders = impl_->shaders->stats();
+  return st;
+}
 
 Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   Impl& im = *impl_;
@@ -277,16 +317,62 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     if (d.mesh >= assets.meshes.size())
       return Error{"", "draw list", "mesh id " + std::to_string(d.mesh) + " is out of range"};
 
+  // Draw order: sorted by program (variant key), then by material, so program and material
+  // state change as rarely as possible. Keys are computed once per draw.
+  const VariantKey frame_key = frame_variant(frame);
+  std::vector<VariantKey> keys(frame.draws.size());
+  for (std::size_t i = 0; i < frame.draws.size(); ++i)
+    keys[i] = material_variant(frame.draws[i]) | frame_key;
+  auto material_order = [&](std::uint32_t a, std::uint32_t b) {
+    const Material& ma = frame.draws[a].material;
+    const Material& mb = frame.draws[b].material;
+    return std::tie(ma.base_color_texture, ma.normal_texture, ma.double_sided, ma.metallic,
+                    ma.roughness) < std::tie(mb.base_color_texture, mb.normal_texture,
+                                             mb.double_sided, mb.metallic, mb.roughness);
+  };
+  auto sorted_by = [&](Pass pass) {
+    std::vector<std::uint32_t> order(frame.draws.size());
+    for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+      const VariantKey ka = keys[a].filtered_for(pass), kb = keys[b].filtered_for(pass);
+      if (ka != kb) return ka < kb;
+      return material_order(a, b);
+    });
+    return order;
+  };
+  stats_.program_switches = stats_.material_switches = 0;
+  // Material uniforms and textures for a draw; skipped when equal to the previous draw's.
+  const Material* bound_material = nullptr;
+  auto bind_material = [&](GLuint prog, const DrawItem& d, VariantKey key) {
+    const Material& m = d.material;
+    if (bound_material && *bound_material == m) return;
+    bound_material = &m;
+    ++stats_.material_switches;
+    const glm::vec4 params(m.metallic, m.roughness, m.normal_scale, m.alpha_cutoff);
+    glProgramUniform4fv(prog, kUniBaseColor, 1, &m.base_color[0]);
+    glProgramUniform4fv(prog, kUniMaterial, 1, &params[0]);
+    glProgramUniform3fv(prog, kUniEmissive, 1, &m.emissive[0]);
+    if (im.oracle) glProgramUniform1ui(prog, kUniOracleFeatures, key.material().bits());
+    glBindTextureUnit(kTexBaseColor, im.texture(m.base_color_texture, assets, false));
+    glBindTextureUnit(kTexNormal, im.texture(m.normal_texture, assets, true));
+  };
+  auto use_program = [&](Pass pass, VariantKey key, GLuint& current) -> Status {
+    auto prog = im.shaders->program(pass, key);
+    if (!prog) return prog.error();
+    if (*prog != current) {
+      current = *prog;
+      glUseProgram(current);
+      ++stats_.program_switches;
+      bound_material = nullptr;  // material uniforms are per program
+    }
+    return {};
+  };
+
   // Pass 1: shadow map (S4): depth only, light viewport, bias by polygon offset, chosen culling.
   glBeginQuery(GL_TIME_ELAPSED, im.timers[0].id());
   if (shadowed) {
     const ShadowSettings& s = frame.shadow.settings;
     im.ensure_shadow_map(s.map_size, s.filter);
-    auto prog = im.program("shadow_depth.vert", "shadow_depth.frag", {}, stats_.programs_compiled);
-    if (!prog) {
-      glEndQuery(GL_TIME_ELAPSED);
-      return prog.error();
-    }
     glBindFramebuffer(GL_FRAMEBUFFER, im.shadow_fbo.id());
     glViewport(0, 0, s.map_size, s.map_size);
     glEnable(GL_DEPTH_TEST);
@@ -302,12 +388,19 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     }
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(s.slope_bias, s.constant_bias);
-    glUseProgram(*prog);
-    for (const DrawItem& d : frame.draws) {
+    GLuint current = 0;
+    for (std::uint32_t i : sorted_by(Pass::depth)) {
+      const DrawItem& d = frame.draws[i];
       if (!d.cast_shadows) continue;
       const GpuMesh& m = im.mesh(d.mesh, assets);
       if (m.index_count == 0) continue;
-      glProgramUniformMatrix4fv(*prog, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+      if (Status st = use_program(Pass::depth, keys[i], current); !st) {
+        glDisable(GL_POLYGON_OFFSET_FILL);
+        glEndQuery(GL_TIME_ELAPSED);
+        return st;
+      }
+      if (keys[i].has(VariantKey::kAlphaMask)) bind_material(current, d, keys[i]);
+      glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
       glBindVertexArray(m.vao.id());
       glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
       ++stats_.shadow_draw_calls;
@@ -318,17 +411,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   }
   glEndQuery(GL_TIME_ELAPSED);
 
-  // Pass 2: forward shading into colour + AOV targets.
+  // Pass 2: forward shading into colour (+ AOV targets when asked for).
   glBeginQuery(GL_TIME_ELAPSED, im.timers[1].id());
-  const ShadowFilter filter = shadowed ? frame.shadow.settings.filter : ShadowFilter::none;
-  auto prog = im.program("forward.vert", "forward.frag",
-                         {{"SHADOW_FILTER", std::to_string(int(filter))},
-                          {"WRITE_AOVS", frame.write_aovs ? "1" : "0"}},
-                         stats_.programs_compiled);
-  if (!prog) {
-    glEndQuery(GL_TIME_ELAPSED);
-    return prog.error();
-  }
   im.ensure_targets(frame.width, frame.height);
   const GLenum bufs[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
                           GL_COLOR_ATTACHMENT3};
@@ -352,32 +436,33 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   glClearBufferfv(GL_DEPTH, 0, &one);
-  glUseProgram(*prog);
-  glBindTextureUnit(kTexShadow, im.shadow_map.id());
-  for (const DrawItem& d : frame.draws) {
+  if (shadowed) glBindTextureUnit(kTexShadow, im.shadow_map.id());
+  GLuint current = 0;
+  for (std::uint32_t i : sorted_by(Pass::forward)) {
+    const DrawItem& d = frame.draws[i];
     const GpuMesh& m = im.mesh(d.mesh, assets);
     if (m.index_count == 0) continue;
+    if (Status st = use_program(Pass::forward, keys[i], current); !st) {
+      glDisable(GL_FRAMEBUFFER_SRGB);
+      glEndQuery(GL_TIME_ELAPSED);
+      return st;
+    }
     if (d.material.double_sided) {
       glDisable(GL_CULL_FACE);
     } else {
       glEnable(GL_CULL_FACE);
       glCullFace(GL_BACK);
     }
+    bind_material(current, d, keys[i]);
     const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(d.model)));
-    const glm::vec4 params(d.material.metallic, d.material.roughness, d.material.normal_scale,
-                           d.receive_shadows ? 1.0f : 0.0f);
-    glProgramUniformMatrix4fv(*prog, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-    glProgramUniformMatrix3fv(*prog, kUniNormalMatrix, 1, GL_FALSE, &normal_matrix[0][0]);
-    glProgramUniform4fv(*prog, kUniBaseColor, 1, &d.material.base_color[0]);
-    glProgramUniform4fv(*prog, kUniMaterial, 1, &params[0]);
-    glProgramUniform3fv(*prog, kUniEmissive, 1, &d.material.emissive[0]);
-    glBindTextureUnit(kTexBaseColor, im.texture(d.material.base_color_texture, assets, false));
-    glBindTextureUnit(kTexNormal, im.texture(d.material.normal_texture, assets, true));
+    glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+    glProgramUniformMatrix3fv(current, kUniNormalMatrix, 1, GL_FALSE, &normal_matrix[0][0]);
     glBindVertexArray(m.vao.id());
     glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
     ++stats_.draw_calls;
     stats_.triangles += std::size_t(m.index_count / 3);
   }
+  stats_.shaders = im.shaders->stats();
   glDisable(GL_FRAMEBUFFER_SRGB);
   glEndQuery(GL_TIME_ELAPSED);
   im.timers_pending = true;

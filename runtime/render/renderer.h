@@ -19,6 +19,8 @@
 #include "runtime/assets/image_io.h"
 #include "runtime/core/result.h"
 #include "runtime/gpu/gl_handles.h"
+#include "runtime/render/shader_library.h"
+#include "runtime/render/variant_key.h"
 
 namespace kaskad::render {
 
@@ -77,13 +79,34 @@ struct FrameStats {
   std::size_t shadow_triangles = 0;   ///< submitted to the shadow map
   double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
   double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)
-  int programs_compiled = 0;          ///< since the renderer was created
+  int program_switches = 0;           ///< glUseProgram calls in the frame (draws are sorted)
+  int material_switches = 0;          ///< material uniform/texture updates in the frame
+  ShaderStats shaders;                ///< compiles, cache hits, compile ms (since creation)
+};
+
+/// The frame features of a frame (shadow, filter, AOVs): the VARIANT_* part of every key.
+VariantKey frame_variant(const FrameInput& frame);
+/// The material features of a draw (MATERIAL_* part): from the material's data.
+VariantKey material_variant(const DrawItem& draw);
+/// Every (pass, key) a frame draws with, sorted and unique: what prewarm compiles and what
+/// `kaskad variants` lists. Pure: no GL.
+std::vector<ProgramRequest> required_programs(const FrameInput& frame);
+
+struct RendererOptions {
+  std::filesystem::path shader_cache_dir;  ///< empty: no binary cache
+  bool uber_oracle = false;  ///< tests only: one über-program per pass, features by uniform
 };
 
 class Renderer {
  public:
   /// Needs a current GL 4.5 context. `shader_dir` holds the GLSL files (content/shaders).
-  static Result<std::unique_ptr<Renderer>> create(const std::filesystem::path& shader_dir);
+  static Result<std::unique_ptr<Renderer>> create(const std::filesystem::path& shader_dir,
+                                                  const RendererOptions& options = {});
+
+  /// Compiles (or loads from the binary cache) every program `frame` needs, before the first
+  /// frame. Programs built later count as runtime compiles in stats().shaders.
+  Status prewarm(const FrameInput& frame);
+  ShaderLibrary& shaders();
   ~Renderer();
 
   /// Records and submits the shadow and forward passes. Meshes and textures are uploaded from

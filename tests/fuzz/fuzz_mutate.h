@@ -2,11 +2,13 @@
 // under plain g++ with -fsanitize=address,undefined (no clang needed):
 //
 //   fuzz_gltf ITERATIONS [FIRST]
+//   fuzz_gltf FILE...
 //
 // runs iterations FIRST .. FIRST+ITERATIONS-1. Iteration i mutates a seed with a generator seeded
 // from i alone, so any iteration can be replayed on its own ("fuzz_gltf 1 4711"); set
 // KASKAD_FUZZ_SAVE=path to also write each input there before it runs (the input of a crash is
-// then left in that file). Only compiled with KASKAD_FUZZ_STANDALONE.
+// then left in that file); the second form replays saved inputs. Only compiled with
+// KASKAD_FUZZ_STANDALONE.
 #pragma once
 
 #include <algorithm>
@@ -148,8 +150,17 @@ inline Bytes make_input(const std::vector<Bytes>& seeds, std::uint64_t iteration
 }
 
 /// The standalone main(): argv[1] iterations (default 1000), argv[2] first iteration (default 0).
+/// When argv[1] names a file, each file argument runs once instead (replaying a saved input).
 inline int run_standalone(int argc, char** argv, const std::vector<Bytes>& seeds, EntryPoint entry,
                           Fixup fixup = nullptr) {
+  if (argc > 1 && std::filesystem::is_regular_file(argv[1])) {
+    for (int a = 1; a < argc; ++a) {
+      const Bytes input = read_file(argv[a]);
+      entry(input.data(), input.size());
+      std::printf("%s ran clean\n", argv[a]);
+    }
+    return 0;
+  }
   if (seeds.empty()) {
     std::fprintf(stderr, "no seed files found\n");
     return 2;

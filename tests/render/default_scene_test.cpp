@@ -88,7 +88,9 @@ class DefaultSceneTest : public ::testing::Test {
   static void SetUpTestSuite() {
     gpu::ContextOptions opt;
     opt.headless = true;
-    auto p = Player::create(opt);
+    render::RendererOptions ro;
+    ro.shader_cache_dir = std::filesystem::path(KASKAD_TEST_TMP) / "shader_cache";
+    auto p = Player::create(opt, ro);
     ASSERT_TRUE(p.ok()) << p.error().to_string();
     player_ = new Player(std::move(p.value()));
   }

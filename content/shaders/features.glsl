@@ -1,0 +1,19 @@
+// Feature selection. In a variant build every feature block is `#if FEATURE_DEFINE` and ENABLED()
+// is true: no uniform decides anything. The test oracle (KASKAD_UBER_ORACLE, compiled only by the
+// tests) turns every material feature on and lets ENABLED(bit) read u_oracle_features instead,
+// so the same blocks run with uniform-driven selection for comparison.
+#ifdef KASKAD_UBER_ORACLE
+layout(location = 11) uniform uint u_oracle_features;  // VariantKey material bits
+#define ENABLED(bit) ((u_oracle_features & (1u << uint(bit))) != 0u)
+#else
+#define ENABLED(bit) true
+#endif
+
+// Material feature bit offsets (runtime/render/variant_key.h; change together).
+#define BIT_BASE_COLOR_TEXTURE 0
+#define BIT_NORMAL_MAP 1
+#define BIT_ALPHA_MASK 2
+#define BIT_EMISSIVE 3
+#define BIT_REFLECTION_CUBE 4
+#define BIT_REFLECTION_SPHERE 5
+#define BIT_RECEIVE_SHADOWS 6

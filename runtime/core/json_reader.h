@@ -1,0 +1,197 @@
+// Helpers for reading validated JSON content files (scenes, materials, the feature manifest):
+// typed getters with ranges, unknown-key detection listing the valid keys, and JSON-path error
+// locations. Parsers throw ContentError internally and convert it to kaskad::Error at their API.
+#pragma once
+
+#include <charconv>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "runtime/core/result.h"
+
+namespace kaskad::json_reader {
+
+using json = nlohmann::json;
+
+/// A content error inside a parser: thrown by fail() and turned into a kaskad::Error (with the
+/// file name) at the parser's public function; it never escapes a public API.
+struct ContentError {
+  std::string where;
+  std::string message;
+};
+
+[[noreturn]] inline void fail(const std::string& where, const std::string& message) {
+  throw ContentError{where, message};
+}
+
+inline std::string type_name(const json& j) {
+  switch (j.type()) {
+    case json::value_t::null: return "null";
+    case json::value_t::boolean: return "a boolean";
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned: return "an integer";
+    case json::value_t::number_float: return "a number";
+    case json::value_t::string: return "a string";
+    case json::value_t::array: return "an array";
+    case json::value_t::object: return "an object";
+    default: return "a value";
+  }
+}
+
+inline std::string join(const std::vector<std::string>& items) {
+  std::string s;
+  for (const auto& i : items) s += (s.empty() ? "" : ", ") + i;
+  return s;
+}
+
+// Shortest decimal form of a float, as a double: files read 0.1, not 0.10000000149011612, and
+// a load -> save -> load -> save cycle writes identical text.
+inline double num(float f) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, f);
+  double d = 0.0;
+  std::from_chars(buf, r.ptr, d);
+  return d;
+}
+inline json vec(const glm::vec3& v) { return json::array({num(v.x), num(v.y), num(v.z)}); }
+inline json vec(const glm::vec4& v) { return json::array({num(v.x), num(v.y), num(v.z), num(v.w)}); }
+
+// Reads the fields of one JSON object, tracking which keys were used so that unknown keys are
+// reported with the list of valid ones.
+class ObjectReader {
+ public:
+  ObjectReader(const json& j, std::string path) : j_(j), path_(std::move(path)) {
+    if (!j.is_object()) fail(path_, "expected an object, got " + type_name(j));
+  }
+
+  bool has(const char* key) {
+    known_.push_back(key);
+    return j_.contains(key);
+  }
+  const json& raw(const char* key) { return j_.at(key); }
+  std::string at(const char* key) const { return path_ + "/" + key; }
+
+  void number(const char* key, float& out, float lo, float hi) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    if (!v.is_number()) fail(at(key), "expected a number, got " + type_name(v));
+    const double d = v.get<double>();
+    if (!(d >= lo && d <= hi))
+      fail(at(key), "must be in [" + fmt(lo) + ", " + fmt(hi) + "], was " + fmt(d));
+    out = float(d);
+  }
+  void integer(const char* key, int& out, int lo, int hi) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    if (!v.is_number_integer()) fail(at(key), "expected an integer, got " + type_name(v));
+    const long long d = v.get<long long>();
+    if (d < lo || d > hi)
+      fail(at(key), "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                        "], was " + std::to_string(d));
+    out = int(d);
+  }
+  void boolean(const char* key, bool& out) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    if (!v.is_boolean()) fail(at(key), "expected true or false, got " + type_name(v));
+    out = v.get<bool>();
+  }
+  void string(const char* key, std::string& out) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    if (!v.is_string()) fail(at(key), "expected a string, got " + type_name(v));
+    out = v.get<std::string>();
+  }
+  template <int N>
+  void vector(const char* key, glm::vec<N, float>& out, float lo, float hi) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    if (!v.is_array() || v.size() != N)
+      fail(at(key), "expected an array of " + std::to_string(N) + " numbers, got " + type_name(v) +
+                        (v.is_array() ? " of " + std::to_string(v.size()) : ""));
+    for (int i = 0; i < N; ++i) {
+      if (!v[std::size_t(i)].is_number())
+        fail(at(key) + "/" + std::to_string(i), "expected a number, got " + type_name(v[std::size_t(i)]));
+      const double d = v[std::size_t(i)].get<double>();
+      if (!(d >= lo && d <= hi))
+        fail(at(key) + "/" + std::to_string(i),
+             "must be in [" + fmt(lo) + ", " + fmt(hi) + "], was " + fmt(d));
+      out[i] = float(d);
+    }
+  }
+  template <class E>
+  void enumeration(const char* key, E& out, const std::vector<std::pair<const char*, E>>& table) {
+    if (!has(key)) return;
+    const json& v = j_.at(key);
+    std::vector<std::string> names;
+    for (const auto& [n, e] : table) names.push_back(n);
+    if (!v.is_string()) fail(at(key), "expected one of " + join(names) + ", got " + type_name(v));
+    for (const auto& [n, e] : table)
+      if (v.get<std::string>() == n) {
+        out = e;
+        return;
+      }
+    fail(at(key), "unknown value '" + v.get<std::string>() + "'; expected one of " + join(names));
+  }
+  /// Fails on keys that no reader asked for.
+  void finish() const {
+    for (auto it = j_.begin(); it != j_.end(); ++it) {
+      if (std::find(known_.begin(), known_.end(), it.key()) == known_.end())
+        fail(at(it.key().c_str()), "unknown key '" + it.key() + "'; valid keys here: " +
+                                       join(known_));
+    }
+  }
+
+ private:
+  static std::string fmt(double d) {
+    std::ostringstream s;
+    s << d;
+    return s.str();
+  }
+  const json& j_;
+  std::string path_;
+  std::vector<std::string> known_;
+};
+
+template <class E>
+const char* enum_name(E value, const std::vector<std::pair<const char*, E>>& table) {
+  for (const auto& [n, e] : table)
+    if (e == value) return n;
+  return "?";
+}
+
+/// Parses a JSON file; syntax errors give the file, line and column.
+inline Result<json> parse_json_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return Error{file.string(), "", "cannot open file"};
+  try {
+    return json::parse(in, nullptr, true, /*ignore_comments=*/false);
+  } catch (const json::parse_error& e) {
+    // e.byte gives the offset; turn it into line:column for people.
+    std::ifstream again(file, std::ios::binary);
+    std::string text((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
+    std::size_t line = 1, col = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        col = 1;
+      } else {
+        ++col;
+      }
+    }
+    std::string msg = e.what();
+    if (auto p = msg.find("parse error"); p != std::string::npos) msg = msg.substr(p);
+    return Error{file.string(), "line " + std::to_string(line) + ", column " + std::to_string(col),
+                 "malformed JSON: " + msg};
+  }
+}
+
+}  // namespace kaskad::json_reader

@@ -1,0 +1,713 @@
+// The Embree reference tracer. Procedure of a shadow reference (shadow_reference):
+//   1. build: every MeshRenderer's triangles, transformed to world space on the CPU (the same
+//      WorldTransform the renderer uploads), into one Embree triangle geometry per entity; casters
+//      are attached to the occluder scene, every geometry to the surface scene;
+//   2. per AOV pixel: the rasterised position P and normal N, the origin P + offset * N;
+//   3. punctual lights: one shadow ray, traced 16 at a time (rtcOccluded16) along an image row;
+//      area lights: sqrt(M) x sqrt(M) jittered strata over the emitter, 16 samples per packet;
+//   4. rows are shared out to worker threads through one atomic counter.
+#include "runtime/reference/ray_tracer.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <numbers>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "components/mesh_renderer.h"
+#include "components/transform.h"
+
+namespace kaskad::reference {
+namespace {
+
+/// Where Embree's error callback leaves its message for check_device().
+struct ErrorLog {
+  std::mutex mutex;
+  std::string last;
+};
+
+}  // namespace
+
+struct RayTracer::Impl {
+  RTCDevice device = nullptr;
+  RTCScene occluders = nullptr;  // cast_shadows = true
+  RTCScene surfaces = nullptr;   // every MeshRenderer
+  std::vector<ecs::Entity> surface_entity;  // by geometry ID in `surfaces`
+  std::vector<bool> surface_receives;       // MeshRenderer::receive_shadows, by geometry ID
+  Aabb bounds;
+  float offset = RayTracer::kRayOffsetScale;
+  std::size_t occluder_triangles = 0;
+  std::size_t surface_triangles = 0;
+
+  ErrorLog errors;  // filled by Embree's error callback
+
+  Impl() = default;
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+  ~Impl() {
+    if (occluders) rtcReleaseScene(occluders);
+    if (surfaces) rtcReleaseScene(surfaces);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+constexpr int kPacket = 16;  // rtcOccluded16; the device reports native 16-wide support on AVX-512
+
+const char* error_name(RTCError e) {
+  switch (e) {
+    case RTC_ERROR_NONE:
+      return "no error";
+    case RTC_ERROR_UNKNOWN:
+      return "unknown error";
+    case RTC_ERROR_INVALID_ARGUMENT:
+      return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION:
+      return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY:
+      return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU:
+      return "unsupported CPU";
+    case RTC_ERROR_CANCELLED:
+      return "cancelled";
+  }
+  return "unrecognised error";
+}
+
+void on_embree_error(void* user, RTCError code, const char* message) {
+  auto* log = static_cast<ErrorLog*>(user);
+  std::lock_guard lock(log->mutex);
+  log->last = std::string(error_name(code)) + (message ? std::string(": ") + message : "");
+}
+
+/// Status of the device after `what`: rtcGetDeviceError plus the callback's message.
+Status check_device(RTCDevice device, ErrorLog& log, const std::string& what) {
+  const RTCError code = rtcGetDeviceError(device);
+  if (code == RTC_ERROR_NONE) return {};
+  std::string message;
+  {
+    std::lock_guard lock(log.mutex);
+    message = log.last.empty() ? error_name(code) : log.last;
+  }
+  return Error{"", what, "Embree: " + message};
+}
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+/// A unit vector perpendicular to unit `axis`, as close to `hint` as possible.
+glm::vec3 perpendicular(const glm::vec3& axis, const glm::vec3& hint) {
+  glm::vec3 r = hint - glm::dot(hint, axis) * axis;
+  if (glm::dot(r, r) < 1e-12f) {
+    // hint parallel to axis: the world axis least parallel to it.
+    const glm::vec3 a = glm::abs(axis);
+    const glm::vec3 other = (a.x <= a.y && a.x <= a.z) ? glm::vec3(1, 0, 0)
+                            : (a.y <= a.z)              ? glm::vec3(0, 1, 0)
+                                                        : glm::vec3(0, 0, 1);
+    r = other - glm::dot(other, axis) * axis;
+  }
+  return glm::normalize(r);
+}
+
+/// PCG32 (O'Neill 2014, "PCG: a family of simple fast space-efficient statistically good
+/// algorithms for random number generation"), XSH-RR output. Seeded per pixel, so results do not
+/// depend on which thread traced which row.
+class Pcg32 {
+ public:
+  explicit Pcg32(std::uint64_t seed, std::uint64_t stream = 0x5851f42d4c957f2dULL)
+      : inc_((stream << 1u) | 1u) {
+    next();
+    state_ += seed;
+    next();
+  }
+  std::uint32_t next() {
+    const std::uint64_t old = state_;
+    state_ = old * 6364136223846793005ULL + inc_;
+    const auto xorshifted = std::uint32_t(((old >> 18u) ^ old) >> 27u);
+    const auto rot = std::uint32_t(old >> 59u);
+    return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
+  }
+  /// Uniform in [0, 1): the top 24 bits, so the value is exact in a float and never rounds to 1.
+  float uniform() { return float(next() >> 8) * 0x1p-24f; }
+
+ private:
+  std::uint64_t state_ = 0;
+  std::uint64_t inc_;
+};
+
+/// Seed of one pixel's samples: the pixel index and the user seed, mixed (SplitMix64's finaliser)
+/// so that neighbouring pixels get unrelated streams.
+std::uint64_t pixel_seed(std::size_t pixel, std::uint32_t seed) {
+  std::uint64_t z = (std::uint64_t(seed) << 32) ^ std::uint64_t(pixel);
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+struct ShadowRay {
+  glm::vec3 origin;
+  glm::vec3 direction;  // unit
+  float tmax;
+};
+
+/// occluded[i] (0 or 1) for each ray, traced in packets of 16 (rtcOccluded16). Rays must be valid (finite,
+/// tmax > 0): Embree is built without its invalid-ray filter.
+void trace_occluded(RTCScene scene, std::span<const ShadowRay> rays, std::uint8_t* occluded) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  for (std::size_t first = 0; first < rays.size(); first += kPacket) {
+    const int n = int(std::min<std::size_t>(kPacket, rays.size() - first));
+    alignas(64) int valid[kPacket];
+    RTCRay16 packet;
+    for (int i = 0; i < kPacket; ++i) {
+      const ShadowRay& r = rays[first + std::size_t(std::min(i, n - 1))];
+      valid[i] = i < n ? -1 : 0;
+      packet.org_x[i] = r.origin.x;
+      packet.org_y[i] = r.origin.y;
+      packet.org_z[i] = r.origin.z;
+      packet.dir_x[i] = r.direction.x;
+      packet.dir_y[i] = r.direction.y;
+      packet.dir_z[i] = r.direction.z;
+      packet.tnear[i] = 0.0f;
+      packet.tfar[i] = r.tmax;
+      packet.time[i] = 0.0f;
+      packet.mask[i] = 0xffffffffu;
+      packet.id[i] = unsigned(i);
+      packet.flags[i] = 0;
+    }
+    rtcOccluded16(valid, scene, &context, &packet);
+    // Embree sets tfar to -inf for occluded rays.
+    for (int i = 0; i < n; ++i) occluded[first + std::size_t(i)] = packet.tfar[i] < 0.0f ? 1 : 0;
+  }
+}
+
+/// The closest hit of a ray (unit direction, valid input) in `scene`; hit.geomID is
+/// RTC_INVALID_GEOMETRY_ID on a miss.
+RTCRayHit cast_ray(RTCScene scene, const glm::vec3& origin, const glm::vec3& direction,
+                   float tmax) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh{};
+  rh.ray.org_x = origin.x;
+  rh.ray.org_y = origin.y;
+  rh.ray.org_z = origin.z;
+  rh.ray.dir_x = direction.x;
+  rh.ray.dir_y = direction.y;
+  rh.ray.dir_z = direction.z;
+  rh.ray.tnear = 0.0f;
+  rh.ray.tfar = tmax;
+  rh.ray.mask = 0xffffffffu;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(scene, &context, &rh);
+  return rh;
+}
+
+/// Unit direction from a surface point towards a light and the distance to it (infinite for
+/// directional lights); distance 0 when the point sits on the light.
+struct ToLight {
+  glm::vec3 direction{0.0f};
+  float distance = 0.0f;
+};
+ToLight to_light(const glm::vec3& position, const ReferenceLight& light) {
+  if (light.type == LightType::directional) return {-light.direction, kInfinity};
+  const glm::vec3 d = light.position - position;
+  const float dist = glm::length(d);
+  if (!(dist > 0.0f)) return {};
+  return {d / dist, dist};
+}
+
+/// The shadow ray of a punctual light from a surface point, or false when no ray is needed
+/// (facing away from the light, on the light, or invalid input); `lit_without_ray` then says the
+/// visibility.
+bool hard_shadow_ray(const glm::vec3& position, const glm::vec3& n, const ReferenceLight& light,
+                     float offset, ShadowRay& ray, bool& lit_without_ray) {
+  lit_without_ray = false;
+  const ToLight tl = to_light(position, light);
+  if (tl.distance == 0.0f || !(glm::dot(n, tl.direction) > 0.0f)) return false;
+  ray.origin = position + offset * n;
+  if (light.type == LightType::directional) {
+    ray.direction = tl.direction;
+    ray.tmax = kInfinity;
+  } else {
+    // From the offset origin to the light, stopping `offset` short of it (a caster exactly at
+    // the light does not shadow).
+    const glm::vec3 d = light.position - ray.origin;
+    const float dist = glm::length(d);
+    if (!(dist > offset)) {
+      lit_without_ray = true;
+      return false;
+    }
+    ray.direction = d / dist;
+    ray.tmax = dist - offset;
+  }
+  if (!finite(ray.origin) || !finite(ray.direction)) return false;
+  return true;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix) {
+  ReferenceLight r;
+  r.type = light.type;
+  r.position = glm::vec3(world_matrix[3]);
+  // Same as systems/shadow_map_system.cpp light_direction() (the runtime does not link systems).
+  const glm::vec3 d = glm::vec3(world_matrix * glm::vec4(0.0f, 0.0f, -1.0f, 0.0f));
+  const float len = glm::length(d);
+  r.direction = len > 0.0f ? d / len : glm::vec3(0.0f, -1.0f, 0.0f);
+  r.right = perpendicular(r.direction, glm::vec3(world_matrix[0]));
+  r.outer_cone_deg = light.type == LightType::spot ? light.outer_cone_deg : 180.0f;
+  r.range = light.type == LightType::directional ? 0.0f : light.range;
+  return r;
+}
+
+RayTracer::RayTracer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+RayTracer::RayTracer(RayTracer&&) noexcept = default;
+RayTracer& RayTracer::operator=(RayTracer&&) noexcept = default;
+RayTracer::~RayTracer() = default;
+
+Result<RayTracer> RayTracer::build(const Scene& scene) { return build(scene.world, scene.assets); }
+
+Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& assets) {
+  auto impl = std::make_unique<Impl>();
+  impl->device = rtcNewDevice(nullptr);
+  if (!impl->device) {
+    return Error{"", "rtcNewDevice",
+                 std::string("Embree: ") + error_name(rtcGetDeviceError(nullptr))};
+  }
+  rtcSetDeviceErrorFunction(impl->device, on_embree_error, &impl->errors);
+  impl->occluders = rtcNewScene(impl->device);
+  impl->surfaces = rtcNewScene(impl->device);
+  // The error of a call that returned null: the device's, else a generic one.
+  auto embree_error = [&](const std::string& what) -> Error {
+    Status st = check_device(impl->device, impl->errors, what);
+    return st.ok() ? Error{"", what, "Embree: the call failed"} : st.error();
+  };
+  KASKAD_TRY(check_device(impl->device, impl->errors, "rtcNewScene"));
+  for (RTCScene s : {impl->occluders, impl->surfaces}) {
+    // Robust: watertight traversal, no hits lost on shared edges (what a reference needs);
+    // high quality: SAH spatial splits, built once, traced millions of times.
+    rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
+  }
+
+  // 1. Collect the drawn meshes (views cannot return errors from inside `each`).
+  struct Item {
+    ecs::Entity entity;
+    MeshRenderer renderer;
+    glm::mat4 matrix;
+  };
+  std::vector<Item> items;
+  world.view<MeshRenderer, WorldTransform>().each(
+      [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
+        if (mr.mesh != kNoMesh) items.push_back({e, mr, wt.matrix});
+      });
+
+  // 2. One world-space triangle geometry per entity.
+  std::vector<glm::vec3> world_positions;
+  std::vector<std::uint32_t> kept;
+  for (const Item& item : items) {
+    const std::string where = "entity " + std::to_string(item.entity.index);
+    if (item.renderer.mesh >= assets.meshes.size()) {
+      return Error{"", where,
+                   "MeshRenderer names mesh " + std::to_string(item.renderer.mesh) +
+                       " but the asset store has " + std::to_string(assets.meshes.size())};
+    }
+    const MeshData& mesh = assets.meshes[item.renderer.mesh];
+    world_positions.resize(mesh.positions.size());
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+      const glm::vec3 p = glm::vec3(item.matrix * glm::vec4(mesh.positions[i], 1.0f));
+      world_positions[i] = p;
+    }
+    kept.clear();
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+      bool ok = true;
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::uint32_t index = mesh.indices[t + k];
+        if (index >= mesh.positions.size()) {
+          return Error{"", where + ", mesh '" + mesh.name + "'",
+                       "index " + std::to_string(index) + " at " + std::to_string(t + k) +
+                           " is out of range (" + std::to_string(mesh.positions.size()) +
+                           " vertices)"};
+        }
+        ok = ok && finite(world_positions[index]);
+      }
+      // Embree needs finite vertices (its invalid-ray/primitive filters are compiled out here);
+      // degenerate triangles are fine, they are never hit.
+      if (ok) kept.insert(kept.end(), mesh.indices.begin() + std::ptrdiff_t(t),
+                          mesh.indices.begin() + std::ptrdiff_t(t + 3));
+    }
+    if (kept.empty()) continue;
+    for (const std::uint32_t index : kept) impl->bounds.expand(world_positions[index]);
+
+    RTCGeometry geometry = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!geometry) return embree_error(where + ": rtcNewGeometry");
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                3 * sizeof(float), world_positions.size()));
+    auto* indices = static_cast<std::uint32_t*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(std::uint32_t), kept.size() / 3));
+    if (!vertices || !indices) {
+      rtcReleaseGeometry(geometry);
+      return embree_error(where + ": rtcSetNewGeometryBuffer");
+    }
+    for (std::size_t i = 0; i < world_positions.size(); ++i) {
+      // Unreferenced non-finite vertices are zeroed so that nothing non-finite reaches Embree.
+      const glm::vec3 p = finite(world_positions[i]) ? world_positions[i] : glm::vec3(0.0f);
+      vertices[3 * i + 0] = p.x;
+      vertices[3 * i + 1] = p.y;
+      vertices[3 * i + 2] = p.z;
+    }
+    std::copy(kept.begin(), kept.end(), indices);
+    rtcCommitGeometry(geometry);
+    const unsigned id = rtcAttachGeometry(impl->surfaces, geometry);
+    if (item.renderer.cast_shadows) {
+      rtcAttachGeometry(impl->occluders, geometry);  // a geometry may live in several scenes
+      impl->occluder_triangles += kept.size() / 3;
+    }
+    rtcReleaseGeometry(geometry);  // the scenes hold their own references
+    KASKAD_TRY(check_device(impl->device, impl->errors, where + ": building its Embree geometry"));
+    if (id >= impl->surface_entity.size()) {
+      impl->surface_entity.resize(id + 1);
+      impl->surface_receives.resize(id + 1, true);
+    }
+    impl->surface_entity[id] = item.entity;
+    impl->surface_receives[id] = item.renderer.receive_shadows;
+    impl->surface_triangles += kept.size() / 3;
+  }
+
+  // 3. The BVHs.
+  rtcCommitScene(impl->occluders);
+  rtcCommitScene(impl->surfaces);
+  KASKAD_TRY(check_device(impl->device, impl->errors, "rtcCommitScene"));
+
+  // 4. The origin offset, scaled to the scene (see ray_offset()).
+  if (!impl->bounds.empty()) {
+    const glm::vec3 a = glm::max(glm::abs(impl->bounds.min), glm::abs(impl->bounds.max));
+    const float extent =
+        std::max(glm::length(impl->bounds.extent()), std::max(a.x, std::max(a.y, a.z)));
+    if (extent > 0.0f && std::isfinite(extent)) impl->offset = kRayOffsetScale * extent;
+  }
+  return RayTracer(std::move(impl));
+}
+
+bool RayTracer::occluded(const glm::vec3& origin, const glm::vec3& direction, float tmax) const {
+  KASKAD_CHECK(impl_, "RayTracer used after being moved from");
+  if (!finite(origin) || !finite(direction) || glm::dot(direction, direction) == 0.0f ||
+      !(tmax > 0.0f)) {
+    return false;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay ray{};
+  ray.org_x = origin.x;
+  ray.org_y = origin.y;
+  ray.org_z = origin.z;
+  ray.dir_x = direction.x;
+  ray.dir_y = direction.y;
+  ray.dir_z = direction.z;
+  ray.tnear = 0.0f;
+  ray.tfar = tmax;
+  ray.mask = 0xffffffffu;
+  rtcOccluded1(impl_->occluders, &context, &ray);
+  return ray.tfar < 0.0f;
+}
+
+std::optional<SurfaceHit> RayTracer::intersect(const glm::vec3& origin,
+                                               const glm::vec3& direction, float tmax) const {
+  KASKAD_CHECK(impl_, "RayTracer used after being moved from");
+  const float len = glm::length(direction);
+  if (!finite(origin) || !(len > 0.0f) || !std::isfinite(len) || !(tmax > 0.0f)) {
+    return std::nullopt;
+  }
+  const glm::vec3 dir = direction / len;
+  // tmax is in units of the given direction's length.
+  const RTCRayHit rh = cast_ray(impl_->surfaces, origin, dir, tmax * len);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+
+  SurfaceHit hit;
+  hit.entity = rh.hit.geomID < impl_->surface_entity.size() ? impl_->surface_entity[rh.hit.geomID]
+                                                            : ecs::kNullEntity;
+  hit.distance = rh.ray.tfar;
+  hit.position = origin + hit.distance * dir;
+  glm::vec3 n{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+  const float nl = glm::length(n);
+  n = nl > 0.0f ? n / nl : -dir;
+  hit.normal = glm::dot(n, dir) > 0.0f ? -n : n;
+  return hit;
+}
+
+float RayTracer::hard_visibility(const glm::vec3& position, const glm::vec3& n,
+                                 const ReferenceLight& light) const {
+  KASKAD_CHECK(impl_, "RayTracer used after being moved from");
+  ShadowRay ray;
+  bool lit = false;
+  if (!hard_shadow_ray(position, n, light, impl_->offset, ray, lit)) return lit ? 1.0f : 0.0f;
+  return occluded(ray.origin, ray.direction, ray.tmax) ? 0.0f : 1.0f;
+}
+
+namespace {
+
+/// The area-light estimator shared by area_light_visibility() and shadow_reference(); returns the
+/// visible fraction and adds the rays traced to `rays`.
+float area_visibility(RTCScene occluders, float offset, const glm::vec3& position,
+                      const glm::vec3& n, const ReferenceLight& light, int strata,
+                      std::uint64_t seed, std::uint64_t& rays) {
+  const glm::vec3 origin = position + offset * n;
+  if (!finite(origin) || !finite(n)) return 0.0f;
+  const glm::vec3 axis = light.direction;  // unit
+  const glm::vec3 t1 = perpendicular(axis, light.right);
+  const glm::vec3 t2 = glm::cross(axis, t1);
+  // Directional: uniform over the cone's solid angle, cos(theta) uniform in [cos(half), 1].
+  const float half_angle = 0.5f * glm::radians(light.angular_size_deg);
+  const float one_minus_cos_max = 1.0f - std::cos(half_angle);
+
+  Pcg32 rng(seed);
+  const int total = strata * strata;
+  std::array<ShadowRay, kPacket> batch;
+  std::array<std::uint8_t, kPacket> hit{};
+  int pending = 0;
+  int visible = 0;
+  auto flush = [&] {
+    trace_occluded(occluders, std::span(batch.data(), std::size_t(pending)), hit.data());
+    for (int i = 0; i < pending; ++i) visible += hit[std::size_t(i)] ? 0 : 1;
+    rays += std::uint64_t(pending);
+    pending = 0;
+  };
+  for (int j = 0; j < strata; ++j) {
+    for (int i = 0; i < strata; ++i) {
+      // Jittered stratum (i, j) of the unit square.
+      const float su = (float(i) + rng.uniform()) / float(strata);
+      const float sv = (float(j) + rng.uniform()) / float(strata);
+      ShadowRay ray;
+      ray.origin = origin;
+      if (light.type == LightType::directional) {
+        const float cos_t = 1.0f - su * one_minus_cos_max;
+        const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
+        const float phi = 2.0f * std::numbers::pi_v<float> * sv;
+        ray.direction = glm::normalize(cos_t * -axis +
+                                       sin_t * (std::cos(phi) * t1 + std::sin(phi) * t2));
+        ray.tmax = kInfinity;
+      } else {
+        // Point on the square emitter (S1), edges along t1 and t2, centred at the light.
+        const glm::vec3 s =
+            light.position + light.size * ((su - 0.5f) * t1 + (sv - 0.5f) * t2);
+        const glm::vec3 d = s - origin;
+        const float dist = glm::length(d);
+        if (!(dist > offset)) {  // the sample is at the surface point: nothing in between
+          ++visible;
+          continue;
+        }
+        ray.direction = d / dist;
+        ray.tmax = dist - offset;
+      }
+      // Below the tangent plane: the surface itself blocks this part of the emitter.
+      if (!(glm::dot(n, ray.direction) > 0.0f) || !finite(ray.direction)) continue;
+      batch[std::size_t(pending++)] = ray;
+      if (pending == kPacket) flush();
+    }
+  }
+  if (pending > 0) flush();
+  return float(visible) / float(total);
+}
+
+int strata_of(int samples, const char* function) {
+  const int strata = int(std::lround(std::sqrt(double(std::max(samples, 0)))));
+  if (samples < 1 || strata * strata != samples) {
+    precondition_failed(function, "samples must be a perfect square >= 1 (sqrt(M) x sqrt(M) "
+                                  "strata), was " + std::to_string(samples));
+  }
+  return strata;
+}
+
+}  // namespace
+
+float RayTracer::area_light_visibility(const glm::vec3& position, const glm::vec3& n,
+                                       const ReferenceLight& light, int samples,
+                                       std::uint32_t seed) const {
+  KASKAD_CHECK(impl_, "RayTracer used after being moved from");
+  const int strata = strata_of(samples, __func__);
+  if (!light.is_area()) return hard_visibility(position, n, light);
+  std::uint64_t rays = 0;
+  return area_visibility(impl_->occluders, impl_->offset, position, n, light, strata,
+                         pixel_seed(0, seed), rays);
+}
+
+std::optional<SurfaceHit> RayTracer::trace_mirror(const glm::vec3& position, const glm::vec3& n,
+                                                  const glm::vec3& incident) const {
+  KASKAD_CHECK(impl_, "RayTracer used after being moved from");
+  const float ul = glm::length(incident);
+  if (!(ul > 0.0f) || !finite(n)) return std::nullopt;
+  const glm::vec3 u = incident / ul;
+  const glm::vec3 nf = glm::dot(n, u) > 0.0f ? -n : n;  // the side the eye is on
+  const glm::vec3 r = u - 2.0f * glm::dot(nf, u) * nf;
+  return intersect(position + impl_->offset * nf, r);
+}
+
+Result<ShadowReference> RayTracer::shadow_reference(const Image& aov, const ReferenceLight& light,
+                                                    const ReferenceOptions& options) const {
+  KASKAD_CHECK(impl_, "RayTracer used after being moved from");
+  const int strata = strata_of(options.area_samples, __func__);
+  KASKAD_CHECK(options.threads >= 0,
+               "threads must be >= 0 (0 = all cores), was " + std::to_string(options.threads));
+
+  // Channels by name (EXR files may come back reordered); canonical order when unnamed.
+  constexpr std::array<const char*, 7> kNames = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z", "mask"};
+  constexpr std::array<int, 7> kCanonical = {0, 1, 2, 3, 4, 5, 8};
+  std::array<int, 7> ch{};
+  if (aov.width <= 0 || aov.height <= 0 || aov.channels <= 0 ||
+      aov.pixels.size() != std::size_t(aov.width) * std::size_t(aov.height) *
+                               std::size_t(aov.channels)) {
+    return Error{"", "AOV image",
+                 "size " + std::to_string(aov.width) + "x" + std::to_string(aov.height) + "x" +
+                     std::to_string(aov.channels) + " does not match its " +
+                     std::to_string(aov.pixels.size()) + " values"};
+  }
+  if (aov.channel_names.empty()) {
+    if (aov.channels != 9) {
+      return Error{"", "AOV image",
+                   "has no channel names and " + std::to_string(aov.channels) +
+                       " channels, not the 9 of Renderer::read_aovs()"};
+    }
+    ch = kCanonical;
+  } else {
+    for (std::size_t i = 0; i < kNames.size(); ++i) {
+      const auto it = std::find(aov.channel_names.begin(), aov.channel_names.end(), kNames[i]);
+      if (it == aov.channel_names.end() || it - aov.channel_names.begin() >= aov.channels) {
+        return Error{"", "AOV image", std::string("has no channel '") + kNames[i] + "'"};
+      }
+      ch[i] = int(it - aov.channel_names.begin());
+    }
+  }
+
+  ShadowReference out;
+  out.image.width = aov.width;
+  out.image.height = aov.height;
+  out.image.channels = 2;
+  out.image.channel_names = {"visibility", "receiver"};
+  out.image.pixels.assign(std::size_t(aov.width) * std::size_t(aov.height) * 2, 0.0f);
+
+  const Impl& im = *impl_;
+  const bool area = light.is_area();
+  const float cos_outer = std::cos(glm::radians(std::min(light.outer_cone_deg, 180.0f)));
+  const bool spot = light.type == LightType::spot;
+  std::atomic<int> next_row{0};
+  std::atomic<std::uint64_t> total_rays{0};
+
+  // One image row: steps 2 and 3 of the file comment.
+  auto trace_row = [&](int y, std::vector<ShadowRay>& rays, std::vector<int>& ray_x,
+                       std::vector<std::uint8_t>& occluded) -> std::uint64_t {
+    std::uint64_t count = 0;
+    rays.clear();
+    ray_x.clear();
+    for (int x = 0; x < aov.width; ++x) {
+      float& vis = out.image.at(x, y, 0);
+      float& receiver = out.image.at(x, y, 1);
+      vis = 1.0f;
+      receiver = 0.0f;
+      if (!(aov.at(x, y, ch[6]) >= 0.5f)) continue;  // background (or NaN mask): skipped
+      const glm::vec3 p{aov.at(x, y, ch[0]), aov.at(x, y, ch[1]), aov.at(x, y, ch[2])};
+      glm::vec3 n{aov.at(x, y, ch[3]), aov.at(x, y, ch[4]), aov.at(x, y, ch[5])};
+      const float nl = glm::length(n);
+      if (!finite(p) || !(nl > 0.0f) || !std::isfinite(nl)) continue;
+      n /= nl;
+
+      // Does the pixel count for the metrics (ReferenceOptions::facing_threshold)?
+      const ToLight tl = to_light(p, light);
+      bool receives = tl.distance > 0.0f && glm::dot(n, tl.direction) > options.facing_threshold;
+      if (receives && spot) receives = glm::dot(light.direction, -tl.direction) >= cos_outer;
+      if (receives && light.range > 0.0f && light.type != LightType::directional)
+        receives = tl.distance <= light.range;
+      if (receives && options.respect_receive_shadows) {
+        // The entity under the pixel: a short ray down the normal onto the surface.
+        // A miss (should not happen) keeps the pixel.
+        const unsigned g =
+            cast_ray(im.surfaces, p + 2.0f * im.offset * n, -n, 4.0f * im.offset).hit.geomID;
+        ++count;
+        if (g < im.surface_receives.size()) receives = im.surface_receives[g];
+      }
+      receiver = receives ? 1.0f : 0.0f;
+
+      if (area) {
+        const std::size_t pixel = std::size_t(y) * std::size_t(aov.width) + std::size_t(x);
+        vis = area_visibility(im.occluders, im.offset, p, n, light, strata,
+                              pixel_seed(pixel, options.seed), count);
+      } else {
+        ShadowRay ray;
+        bool lit = false;
+        if (hard_shadow_ray(p, n, light, im.offset, ray, lit)) {
+          rays.push_back(ray);
+          ray_x.push_back(x);
+        } else {
+          vis = lit ? 1.0f : 0.0f;
+        }
+      }
+    }
+    if (!rays.empty()) {
+      occluded.resize(rays.size());
+      trace_occluded(im.occluders, rays, occluded.data());
+      for (std::size_t i = 0; i < rays.size(); ++i)
+        out.image.at(ray_x[i], y, 0) = occluded[i] ? 0.0f : 1.0f;
+      count += rays.size();
+    }
+    return count;
+  };
+
+  auto worker = [&] {
+    std::vector<ShadowRay> rays;
+    std::vector<int> ray_x;
+    std::vector<std::uint8_t> occluded;
+    std::uint64_t count = 0;
+    for (int y = next_row.fetch_add(1); y < aov.height; y = next_row.fetch_add(1))
+      count += trace_row(y, rays, ray_x, occluded);
+    total_rays.fetch_add(count);
+  };
+
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const int thread_count =
+      std::min(aov.height, options.threads > 0 ? options.threads : int(hw));
+  const auto start = std::chrono::steady_clock::now();
+  {
+    std::vector<std::jthread> pool;
+    for (int i = 1; i < thread_count; ++i) pool.emplace_back(worker);
+    worker();  // the calling thread works too
+  }  // joins
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.rays = total_rays.load();
+  return out;
+}
+
+float RayTracer::ray_offset() const {
+  KASKAD_CHECK(impl_, "RayTracer used after being moved from");
+  return impl_->offset;
+}
+Aabb RayTracer::bounds() const {
+  KASKAD_CHECK(impl_, "RayTracer used after being moved from");
+  return impl_->bounds;
+}
+std::size_t RayTracer::occluder_triangles() const {
+  KASKAD_CHECK(impl_, "RayTracer used after being moved from");
+  return impl_->occluder_triangles;
+}
+std::size_t RayTracer::surface_triangles() const {
+  KASKAD_CHECK(impl_, "RayTracer used after being moved from");
+  return impl_->surface_triangles;
+}
+
+}  // namespace kaskad::reference

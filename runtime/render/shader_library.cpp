@@ -1,0 +1,246 @@
+#include "runtime/render/shader_library.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+
+#include "runtime/core/log.h"
+#include "runtime/gpu/shader.h"
+
+namespace kaskad::render {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr char kMagic[4] = {'K', 'S', 'K', 'B'};
+constexpr std::uint32_t kCacheVersion = 1;
+
+struct PassFiles {
+  const char* vertex;
+  const char* fragment;
+};
+PassFiles files_for(Pass pass) {
+  return pass == Pass::depth ? PassFiles{"shadow_depth.vert", "shadow_depth.frag"}
+                             : PassFiles{"forward.vert", "forward.frag"};
+}
+
+std::uint64_t map_key(Pass pass, VariantKey key) {
+  return (std::uint64_t(pass) << 32) | key.bits();
+}
+
+std::string hex(std::uint64_t v) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+bool read_cache(const fs::path& file, std::uint64_t hash, GLenum& format,
+                std::vector<std::uint8_t>& binary) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return false;
+  char magic[4];
+  std::uint32_t version = 0, fmt = 0;
+  std::uint64_t stored = 0, size = 0;
+  in.read(magic, 4);
+  in.read(reinterpret_cast<char*>(&version), 4);
+  in.read(reinterpret_cast<char*>(&fmt), 4);
+  in.read(reinterpret_cast<char*>(&stored), 8);
+  in.read(reinterpret_cast<char*>(&size), 8);
+  if (!in || std::memcmp(magic, kMagic, 4) != 0 || version != kCacheVersion || stored != hash ||
+      size > (std::uint64_t(1) << 30))
+    return false;
+  binary.resize(std::size_t(size));
+  in.read(reinterpret_cast<char*>(binary.data()), std::streamsize(size));
+  format = fmt;
+  return bool(in);
+}
+
+void write_cache(const fs::path& file, std::uint64_t hash, GLenum format,
+                 const std::vector<std::uint8_t>& binary) {
+  std::error_code ec;
+  fs::create_directories(file.parent_path(), ec);
+  fs::path tmp = file;
+  tmp += ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) return;  // a cache that cannot be written is not an error, just slower next time
+    const std::uint32_t fmt = format;
+    const std::uint64_t size = binary.size();
+    out.write(kMagic, 4);
+    out.write(reinterpret_cast<const char*>(&kCacheVersion), 4);
+    out.write(reinterpret_cast<const char*>(&fmt), 4);
+    out.write(reinterpret_cast<const char*>(&hash), 8);
+    out.write(reinterpret_cast<const char*>(&size), 8);
+    out.write(reinterpret_cast<const char*>(binary.data()), std::streamsize(binary.size()));
+    if (!out) return;
+  }
+  fs::rename(tmp, file, ec);
+  if (ec) fs::remove(tmp, ec);
+}
+
+}  // namespace
+
+std::uint64_t fnv1a64(std::string_view data, std::uint64_t h) {
+  for (unsigned char c : data) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+fs::path default_shader_cache_dir() {
+  if (const char* env = std::getenv("KASKAD_SHADER_CACHE"); env && *env)
+    return std::string(env) == "off" ? fs::path() : fs::path(env);
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+    return fs::path(xdg) / "kaskad" / "shaders";
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return fs::path(home) / ".cache" / "kaskad" / "shaders";
+  return {};
+}
+
+Result<std::unique_ptr<ShaderLibrary>> ShaderLibrary::create(const fs::path& shader_dir,
+                                                             const fs::path& cache_dir,
+                                                             bool oracle) {
+  std::unique_ptr<ShaderLibrary> lib(new ShaderLibrary());
+  lib->dir_ = shader_dir;
+  lib->cache_dir_ = cache_dir;
+  lib->oracle_ = oracle;
+  auto manifest = FeatureManifest::load(shader_dir / "features.json");
+  if (!manifest) return manifest.error();
+  lib->manifest_ = std::move(manifest.value());
+  auto str = [](GLenum name) {
+    const GLubyte* s = glGetString(name);
+    return s ? std::string(reinterpret_cast<const char*>(s)) : std::string();
+  };
+  lib->driver_ = str(GL_VENDOR) + "|" + str(GL_RENDERER) + "|" + str(GL_VERSION);
+  glGetIntegerv(GL_NUM_PROGRAM_BINARY_FORMATS, &lib->binary_formats_);
+  if (lib->binary_formats_ == 0 && !cache_dir.empty())
+    log::info("the driver offers no program binary formats: shader binary cache off");
+  return lib;
+}
+
+ShaderLibrary::~ShaderLibrary() = default;
+
+Result<ShaderLibrary::Entry> ShaderLibrary::build(Pass pass, VariantKey key, bool reload) {
+  const auto t0 = Clock::now();
+  const PassFiles pf = files_for(pass);
+  // The oracle compiles every material feature in and selects them by uniform (features.glsl).
+  const VariantKey effective =
+      oracle_ ? VariantKey(key.frame().bits() | VariantKey::kMaterialMask) : key;
+  auto defines_for = [&](ShaderStage stage) {
+    auto d = manifest_.defines(effective, stage);
+    if (oracle_) {
+      for (auto& [name, value] : d)
+        if (name.rfind("MATERIAL_", 0) == 0 && name.find("HAS_") != std::string::npos) value = "1";
+      d.emplace_back("KASKAD_UBER_ORACLE", "1");
+    }
+    return d;
+  };
+  auto vs = gpu::preprocess_shader(dir_, pf.vertex, defines_for(ShaderStage::vertex));
+  if (!vs) return vs.error();
+  auto fs_src = gpu::preprocess_shader(dir_, pf.fragment, defines_for(ShaderStage::fragment));
+  if (!fs_src) return fs_src.error();
+
+  Entry entry;
+  for (const auto* src : {&vs.value(), &fs_src.value()})
+    for (const auto& f : src->files) {
+      entry.files.push_back(dir_ / f);
+      std::error_code ec;
+      entry.newest = std::max(entry.newest, fs::last_write_time(dir_ / f, ec));
+    }
+
+  // Cache key: driver + both preprocessed sources. Editing any included file changes the text,
+  // so stale binaries are never used (they are simply not found).
+  const std::uint64_t hash =
+      fnv1a64(fs_src->text, fnv1a64(vs->text, fnv1a64(driver_)));
+  const bool use_cache = !cache_dir_.empty() && binary_formats_ > 0;
+  const fs::path cache_file = cache_dir_ / (hex(hash) + ".bin");
+  if (use_cache) {
+    GLenum format = 0;
+    std::vector<std::uint8_t> binary;
+    if (read_cache(cache_file, hash, format, binary)) {
+      auto p = gpu::program_from_binary(format, binary);
+      if (p) {
+        entry.program = std::move(p.value());
+        ++stats_.cache_hits;
+        stats_.compile_ms += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+        return entry;
+      }
+      log::debug("shader cache %s: %s; rebuilding", cache_file.string().c_str(),
+                 p.error().message.c_str());
+    }
+  }
+  auto program = gpu::build_program(*vs, *fs_src, use_cache);
+  if (!program) return program.error();
+  entry.program = std::move(program.value());
+  ++stats_.programs_compiled;
+  if (first_frame_done_ && !reload) ++stats_.runtime_compiles;
+  if (use_cache) {
+    GLenum format = 0;
+    const auto binary = gpu::program_binary(entry.program, format);
+    if (!binary.empty()) write_cache(cache_file, hash, format, binary);
+  }
+  stats_.compile_ms += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  return entry;
+}
+
+Result<GLuint> ShaderLibrary::program(Pass pass, VariantKey key) {
+  key = key.filtered_for(pass);
+  // Hot path: one hash probe; a miss builds the program (and is counted).
+  const std::uint64_t k = map_key(pass, key);
+  if (auto it = programs_.find(k); it != programs_.end()) return it->second.program.id();
+  if (!oracle_) {
+    const std::string bad = manifest_.check(key);
+    KASKAD_CHECK(bad.empty(), "invalid variant key " + manifest_.describe(key) + ": " + bad);
+  }
+  auto entry = build(pass, key, false);
+  if (!entry) return entry.error();
+  const GLuint id = entry->program.id();
+  programs_.emplace(k, std::move(entry.value()));
+  return id;
+}
+
+Status ShaderLibrary::prewarm(std::span<const ProgramRequest> requests) {
+  for (const ProgramRequest& r : requests) {
+    auto p = program(r.pass, r.key);
+    if (!p) return p.error();
+  }
+  return {};
+}
+
+std::vector<Error> ShaderLibrary::reload_changed() {
+  std::vector<Error> errors;
+  for (auto& [k, entry] : programs_) {
+    fs::file_time_type newest{};
+    for (const auto& f : entry.files) {
+      std::error_code ec;
+      newest = std::max(newest, fs::last_write_time(f, ec));
+    }
+    if (newest <= entry.newest) continue;
+    const Pass pass = Pass(k >> 32);
+    auto rebuilt = build(pass, VariantKey(std::uint32_t(k & 0xffffffffu)), true);
+    if (!rebuilt) {
+      entry.newest = newest;  // report once per change, keep the last good program
+      errors.push_back(rebuilt.error());
+      continue;
+    }
+    entry = std::move(rebuilt.value());
+    ++stats_.reloads;
+  }
+  return errors;
+}
+
+std::vector<VariantKey> ShaderLibrary::built_keys(Pass pass) const {
+  std::vector<VariantKey> keys;
+  for (const auto& [k, e] : programs_)
+    if (Pass(k >> 32) == pass) keys.push_back(VariantKey(std::uint32_t(k & 0xffffffffu)));
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
+}  // namespace kaskad::render
