@@ -35,27 +35,37 @@ enum class CascadeSelection {
 };
 
 struct CascadeSettings {
-  int cascade_count = 4;  ///< N, in [1, 8]. 4: S0 recommends 3..5 (fewer is barely better than one
-                          ///< map, each more costs a scene render)
-  SplitScheme split_scheme = SplitScheme::mixed;  ///< S0 eq. (3), the paper's choice
-  float lambda = 0.5f;         ///< mixed-split weight of the log scheme, in [0, 1]; 0.5: S0's default
-  float max_distance = 100.0f; ///< metres from the camera where the last cascade ends; 0 = the
-                               ///< camera's far plane. 100: engine choice, half the default camera
-                               ///< far (components/camera.h), so resolution is not spent on the horizon
-  int map_size = 2048;         ///< texels per side of each cascade map; power of two in [64, 16384].
-                               ///< 2048: the basic map's default (shadow_settings.h)
-  DepthFormat depth_format = DepthFormat::d24;  ///< S2: 16 bits suffice when near/far are tight;
-                                                ///< 24 because S0 step 3 pulls the near plane back to
-                                                ///< distant casters, which loosens the range
-  FitMode fit_mode = FitMode::stable;  ///< S2: stabilised cascades do not shimmer as the camera moves
-  float beam_radius = 0.0f;    ///< metres, >= 0: S0's searchlight cylinder radius R around the light
-                               ///< axis (through the light entity's position); 0 = fit to the scene
-  float normal_offset_bias = 1.0f;  ///< texels of the cascade, >= 0: shading points move this far
-                                    ///< along the normal before the lookup; 1 texel as in MJP's 2015
-                                    ///< shadow sample update (normal offset scaled by the texel size)
-  float blend_band = 0.1f;     ///< fraction of a cascade's depth range, in [0, 1], over which it
-                               ///< fades into the next one; 0 = hard seams. 0.1: engine choice
-  CascadeSelection selection = CascadeSelection::depth;  ///< S0's D array
+  /// N, in [1, 8]. 4: S0 recommends 3..5 (fewer is barely better than one map; each more costs
+  /// a scene render).
+  int cascade_count = 4;
+  /// S0 eq. (3), the paper's choice.
+  SplitScheme split_scheme = SplitScheme::mixed;
+  /// Mixed-split weight of the log scheme, in [0, 1]. 0.5: S0's default.
+  float lambda = 0.5f;
+  /// Metres from the camera where the last cascade ends; 0 = the camera's far plane. 100: engine
+  /// choice, half the default camera far (components/camera.h), so resolution is not spent on
+  /// the horizon.
+  float max_distance = 100.0f;
+  /// Texels per side of each cascade map; power of two in [64, 16384]. 2048: the basic map's
+  /// default (shadow_settings.h).
+  int map_size = 2048;
+  /// S2: 16 bits suffice when near/far are tight; 24 because S0 step 3 pulls the near plane back
+  /// to distant casters, which loosens the range.
+  DepthFormat depth_format = DepthFormat::d24;
+  /// S2: stabilised cascades do not shimmer as the camera moves.
+  FitMode fit_mode = FitMode::stable;
+  /// Metres, >= 0: S0's searchlight cylinder radius R around the light axis (through the light
+  /// entity's position); 0 = fit to the scene. Used by FitMode::crop only.
+  float beam_radius = 0.0f;
+  /// Texels of the cascade, in [0, 16]: shading points move this far along the normal before
+  /// the lookup. 1 texel as in MJP's 2015 shadow sample update (offset scaled by texel size).
+  float normal_offset_bias = 1.0f;
+  /// Fraction of a cascade's depth range, in [0, 1], over which it fades into the next one
+  /// (with map_bounds selection: fraction of the map's half-width); 0 = hard seams. 0.1: engine
+  /// choice.
+  float blend_band = 0.1f;
+  /// S0's D array by default.
+  CascadeSelection selection = CascadeSelection::depth;
 };
 
 namespace cascade_settings_detail {
@@ -79,8 +89,7 @@ inline std::string validate_cascade_settings(const CascadeSettings& s) {
   if (!(s.lambda >= 0.0f && s.lambda <= 1.0f))  // also rejects NaN
     return "lambda must be in [0, 1], was " + str(s.lambda);
   if (!(s.max_distance >= 0.0f && std::isfinite(s.max_distance)))
-    return "max_distance must be finite and >= 0 (0 = camera far), was " +
-           str(s.max_distance);
+    return "max_distance must be finite and >= 0 (0 = camera far), was " + str(s.max_distance);
   if (s.map_size < 64 || s.map_size > 16384 || (s.map_size & (s.map_size - 1)) != 0)
     return "map_size must be a power of two in [64, 16384], was " + std::to_string(s.map_size);
   const int format = static_cast<int>(s.depth_format);
@@ -90,11 +99,9 @@ inline std::string validate_cascade_settings(const CascadeSettings& s) {
   if (fit < 0 || fit > static_cast<int>(FitMode::stable))
     return "fit_mode must be crop or stable, was " + std::to_string(fit);
   if (!(s.beam_radius >= 0.0f && std::isfinite(s.beam_radius)))
-    return "beam_radius must be finite and >= 0 (0 = fit to the scene), was " +
-           str(s.beam_radius);
+    return "beam_radius must be finite and >= 0 (0 = fit to the scene), was " + str(s.beam_radius);
   if (!(s.normal_offset_bias >= 0.0f && s.normal_offset_bias <= 16.0f))
-    return "normal_offset_bias must be in [0, 16] texels, was " +
-           str(s.normal_offset_bias);
+    return "normal_offset_bias must be in [0, 16] texels, was " + str(s.normal_offset_bias);
   if (!(s.blend_band >= 0.0f && s.blend_band <= 1.0f))
     return "blend_band must be in [0, 1], was " + str(s.blend_band);
   const int selection = static_cast<int>(s.selection);

@@ -23,6 +23,12 @@ struct ModelRef {
   std::string path;
 };
 
+/// A material file (content/materials/*.json) used by this entity; path relative to the scene.
+/// The scene loader fills the entity's Material from it.
+struct MaterialRef {
+  std::string path;
+};
+
 /// Marks entities created from a ModelRef (or a built-in default); they are not written back
 /// to scene files, since loading the reference recreates them.
 struct Imported {

@@ -1,9 +1,13 @@
+// Cascaded shadow map maths: see cascade_math.h for the contracts; the fit is written as a
+// numbered procedure above fit_cascade().
 #include "systems/cascade_math.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "runtime/core/result.h"
 
@@ -55,16 +59,20 @@ dmat4 light_view_d(const glm::vec3& direction, const glm::vec3& origin) {
   const dvec3 u = glm::cross(s, f);
   const dvec3 o(origin);
   dmat4 m(1.0);  // rows s, u, -f: glm::lookAt's layout
-  m[0][0] = s.x, m[1][0] = s.y, m[2][0] = s.z;
-  m[0][1] = u.x, m[1][1] = u.y, m[2][1] = u.z;
-  m[0][2] = -f.x, m[1][2] = -f.y, m[2][2] = -f.z;
+  for (int c = 0; c < 3; ++c) {
+    m[c][0] = s[c];
+    m[c][1] = u[c];
+    m[c][2] = -f[c];
+  }
   m[3][0] = -glm::dot(s, o);
   m[3][1] = -glm::dot(u, o);
   m[3][2] = glm::dot(f, o);
   return m;
 }
 
-dvec3 transform_point(const dmat4& m, const dvec3& p) { return dvec3(m * dvec4(p, 1.0)); }
+dvec3 transform_point(const dmat4& m, const dvec3& p) {
+  return dvec3(m * dvec4(p, 1.0));
+}
 
 // S0 step 1 in view space (P0..P3 at d_near, P4..P7 at d_far), then M_cam.
 std::array<dvec3, 8> corners_world_d(const glm::mat4& camera_world, double half_h_near,
@@ -97,11 +105,12 @@ std::array<glm::vec3, 8> to_float(const std::array<dvec3, 8>& c) {
   return out;
 }
 
-// Sphere of the slice in double. Perspective: the 8 corners lie on two circles around the view
-// axis, radius a_n = d_n k at depth d_n and a_f = d_f k at d_f, k = tan(fov/2) sqrt(1 + aspect^2).
-// The sphere through both circles is centred at depth c with (c - d_n)^2 + a_n^2 = (d_f - c)^2 +
-// a_f^2, i.e. c = (d_n + d_f)(1 + k^2) / 2; when c > d_f the far circle alone bounds the slice
-// (c = d_f, r = a_f). Only shape parameters enter r (see the header).
+// The bounding sphere of the slice, in double. Perspective: the 8 corners lie on two circles
+// around the view axis, radius a_n = d_n k at depth d_n and a_f = d_f k at d_f, with
+// k = tan(fov/2) sqrt(1 + aspect^2). The sphere through both circles is centred at depth c with
+//   (c - d_n)^2 + a_n^2 = (d_f - c)^2 + a_f^2,  i.e.  c = (d_n + d_f)(1 + k^2) / 2;
+// when c > d_f the far circle alone bounds the slice (c = d_f, r = a_f). Only shape parameters
+// enter r (see the header).
 void sphere_d(const CameraSlice& s, dvec3& center, double& radius) {
   const double dn = s.near, df = s.far, a = s.aspect;
   double c;
@@ -163,7 +172,10 @@ Range box_range_in_rect(const dmat4& light_view, const Aabb& box, const Rect& r)
   }
   // Quick reject: the light-space box of the corners misses the rectangle.
   dvec3 lo = c[0], hi = c[0];
-  for (const dvec3& p : c) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  for (const dvec3& p : c) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
   if (hi.x < r.min_x || lo.x > r.max_x || hi.y < r.min_y || lo.y > r.max_y) return out;
   // 2. The 6 faces as 12 triangles, each clipped against the 4 side planes; 3. min/max z of the
   //    clipped vertices (depth = -z).
@@ -237,8 +249,8 @@ std::vector<float> split_distances(SplitScheme scheme, int count, float near, fl
   d.front() = near;  // exact ends, no rounding drift
   d.back() = far;
   for (int i = 1; i < count; ++i) {
-    const double uniform = dn + (df - dn) * (i / n);      // S0 eq. (1)
-    const double log = dn * std::pow(df / dn, i / n);     // S0 eq. (2)
+    const double uniform = dn + (df - dn) * (i / n);   // S0 eq. (1)
+    const double log = dn * std::pow(df / dn, i / n);  // S0 eq. (2)
     double v = uniform;
     if (scheme == SplitScheme::log) v = log;
     if (scheme == SplitScheme::mixed) v = lambda * log + (1.0 - lambda) * uniform;  // S0 eq. (3)
@@ -271,7 +283,7 @@ std::array<glm::vec3, 8> slice_corners_world(const CameraSlice& slice) {
   return to_float(corners_world_d(slice));
 }
 
-Sphere slice_bounding_sphere(const CameraSlice& slice) {
+BoundingSphere slice_bounding_sphere(const CameraSlice& slice) {
   dvec3 c;
   double r;
   sphere_d(slice, c, r);
@@ -488,7 +500,7 @@ float cascade_blend_weight_map(const glm::vec3& ndc, float blend_band) {
 }
 
 glm::mat4 shadow_bias_matrix() {
-  glm::mat4 m(0.5f);  // diagonal 0.5, 0.5, 0.5, 0.5
+  glm::mat4 m(0.5f);                         // diagonal 0.5, 0.5, 0.5, 0.5
   m[3] = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);  // S0: last column (.5, .5, .5, 1)
   return m;
 }
@@ -517,8 +529,7 @@ std::string validate_camera_slice(const CameraSlice& s) {
   for (int c = 0; c < 3; ++c) {
     const float len = glm::length(glm::vec3(m[c]));
     if (std::abs(len - 1.0f) > 1e-3f)
-      return "camera_world is not rigid: column " + std::to_string(c) + " has length " +
-             num(len);
+      return "camera_world is not rigid: column " + std::to_string(c) + " has length " + num(len);
     for (int o = c + 1; o < 3; ++o)
       if (std::abs(glm::dot(glm::vec3(m[c]), glm::vec3(m[o]))) > 1e-3f)
         return "camera_world is not rigid: columns " + std::to_string(c) + " and " +

@@ -67,11 +67,11 @@ std::array<glm::vec3, 8> slice_corners_world(const CameraSlice& slice);
 /// while the camera moves and turns (S2). It is the smallest sphere through the slice's corners:
 /// centred on the view axis where the near and far corner circles are equidistant, or at the far
 /// rectangle's centre when that circle alone dominates (wide slices).
-struct Sphere {
+struct BoundingSphere {
   glm::vec3 center{0.0f};  ///< world space
   float radius = 0.0f;     ///< metres
 };
-Sphere slice_bounding_sphere(const CameraSlice& slice);
+BoundingSphere slice_bounding_sphere(const CameraSlice& slice);
 
 // ---- The light ----------------------------------------------------------------------------------
 
@@ -111,7 +111,7 @@ struct NearFar {
 /// S2's ComputeNearAndFar: the 12 triangles of `scene_bounds` (world space), taken to light view
 /// space, clipped against the 4 side planes x = min_x, x = max_x, y = min_y, y = max_y of the light
 /// frustum; near/far are the min/max depth of what remains. This is exactly the depth range of
-/// the box inside the prism (every vertex of box ∩ prism lies on the box's surface). Empty when
+/// the box inside the prism (every vertex of the box-prism intersection lies on the box's surface). Empty when
 /// the box misses the rectangle or is empty.
 NearFar compute_near_far(const glm::mat4& light_view, const Aabb& scene_bounds, float min_x,
                          float max_x, float min_y, float max_y);
@@ -119,9 +119,9 @@ NearFar compute_near_far(const glm::mat4& light_view, const Aabb& scene_bounds, 
 /// Tighter depth range from per-object boxes (world space), for a slice covering the light-space
 /// rectangle and the depths [slice_near, slice_far]:
 ///  - far: the farthest point of any receiver inside the slice volume (rectangle x depths);
-///  - near: the nearest receiver point in that volume, pulled back (S0 step 3) to the nearest caster
-///    inside the rectangle that lies in front of that far (so it can shadow a receiver), even when
-///    the caster is outside the camera's view.
+///  - near: the nearest receiver point in that volume, pulled back (S0 step 3) to the nearest
+///    caster inside the rectangle that lies in front of that far (so it can shadow a receiver),
+///    even when the caster is outside the camera's view.
 /// Each box's range inside the rectangle is exact (compute_near_far per box). Empty when no
 /// receiver overlaps the slice volume: the cascade has nothing to shadow.
 NearFar tighten_near_far(const glm::mat4& light_view, std::span<const Aabb> casters,
@@ -134,9 +134,9 @@ NearFar tighten_near_far(const glm::mat4& light_view, std::span<const Aabb> cast
 /// given, tighten_near_far() is used; else the scene box through compute_near_far(); else the
 /// slice's own depth range.
 struct ShadowGeometry {
-  Aabb scene;                      ///< world bounds of everything (S2's scene AABB)
-  std::span<const Aabb> casters;   ///< world bounds of each shadow caster
-  std::span<const Aabb> receivers; ///< world bounds of each shadow receiver
+  Aabb scene;                       ///< world bounds of everything (S2's scene AABB)
+  std::span<const Aabb> casters;    ///< world bounds of each shadow caster
+  std::span<const Aabb> receivers;  ///< world bounds of each shadow receiver
 };
 
 /// How far the depth range is tightened.
@@ -158,14 +158,15 @@ struct CascadeFitOptions {
 };
 
 /// One cascade's light camera. view_proj() maps every point of the slice into [-1, 1]^3 (with
-/// DepthFit::enclose_slice and clip_to_light_bounds off).
+/// DepthFit::enclose_slice and clip_to_light_bounds off), up to float resolution: a cascade only
+/// millimetres wide, far from the world origin, is placed to about 1e-7 x |coordinates|.
 struct CascadeFit {
   glm::mat4 view{1.0f};  ///< world -> light view (M_light)
   glm::mat4 proj{1.0f};  ///< light view -> clip (M_proj,i = M_crop,i * M_Lprj,i for crop)
   float near = 0.0f;     ///< depth of the near plane along the light, metres
   float far = 1.0f;      ///< depth of the far plane, metres
   float world_units_per_texel = 0.0f;  ///< metres per texel (the larger of x and y for crop)
-  glm::vec2 ortho_min{0.0f};  ///< light-view x/y of the map's lower-left edge, metres
+  glm::vec2 ortho_min{0.0f};           ///< light-view x/y of the map's lower-left edge, metres
   glm::vec2 ortho_max{0.0f};  ///< upper-right edge; the map spans exactly ortho_max - ortho_min
   bool empty = false;  ///< nothing to shadow (no receiver in the slice, or the slice is outside
                        ///< the clipped beam); the matrices are still valid

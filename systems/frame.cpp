@@ -63,11 +63,15 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   return in;
 }
 
-Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx) {
+render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx) {
   update_transforms(scene.world, scene.assets);
   const CameraState camera = select_camera(scene.world, float(ctx.width) / float(ctx.height));
   const ShadowData shadow = update_basic_shadow(scene.world);
-  return renderer.prewarm(build_frame_input(scene, ctx, camera, shadow));
+  return build_frame_input(scene, ctx, camera, shadow);
+}
+
+Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx) {
+  return renderer.prewarm(plan_frame(scene, ctx));
 }
 
 Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,

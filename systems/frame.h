@@ -37,6 +37,9 @@ struct FrameReport {
 Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
                  FrameReport& report);
 
+/// Phases 1-4 without GL: the renderer input a frame of this scene would get.
+render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx);
+
 /// Phases 1-4, then compiles every program the frame will use (scene load: no compiles later).
 Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx);
 

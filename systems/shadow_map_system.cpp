@@ -7,6 +7,7 @@
 #include "components/light.h"
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
+#include "systems/cascade_math.h"
 
 namespace kaskad {
 
@@ -18,11 +19,9 @@ glm::vec3 light_direction(const glm::mat4& world_matrix) {
 
 LightProjection fit_ortho_light_to_bounds(const glm::vec3& direction, const Aabb& bounds) {
   const glm::vec3 dir = glm::normalize(direction);
-  // Up = the world axis least parallel to the light, so lookAt never degenerates.
-  const glm::vec3 a = glm::abs(dir);
-  const glm::vec3 up = (a.y <= a.x && a.y <= a.z) ? glm::vec3(0, 1, 0)
-                       : (a.x <= a.z)             ? glm::vec3(1, 0, 0)
-                                                  : glm::vec3(0, 0, 1);
+  // Up = the world axis least parallel to the light, so lookAt never degenerates (shared with
+  // the cascades' light view).
+  const glm::vec3 up = light_up_vector(dir);
   const glm::vec3 center = bounds.center();
   LightProjection out;
   out.view = glm::lookAt(center - dir, center, up);

@@ -19,6 +19,7 @@
 #include "components/name.h"
 #include "components/transform.h"
 #include "runtime/assets/gltf_loader.h"
+#include "runtime/assets/material_file.h"
 #include "runtime/assets/primitives.h"
 #include "runtime/core/json_reader.h"
 #include "runtime/core/log.h"
@@ -116,6 +117,19 @@ void read_rotation(ObjectReader& r, Transform& t) {
   }
 }
 
+// An inline material block: the built-in parameters, features derived from the values.
+Material read_inline_material(ObjectReader& mr) {
+  Material m;
+  mr.vector<4>("base_color", m.base_color, 0.0f, 1.0e4f);
+  mr.number("metallic", m.metallic, 0.0f, 1.0f);
+  mr.number("roughness", m.roughness, 0.0f, 1.0f);
+  mr.vector<3>("emissive", m.emissive, 0.0f, 1.0e6f);
+  mr.boolean("double_sided", m.double_sided);
+  mr.finish();
+  m.features = derive_material_features(m);
+  return m;
+}
+
 struct Pending {
   ecs::Entity entity;
   std::string parent;
@@ -182,15 +196,19 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
     if (!has_primitive)
       fail(r.at("material"), has_model ? "models use their glTF materials; remove this block"
                                        : "material needs a primitive");
-    Material m;
-    ObjectReader mr(r.raw("material"), r.at("material"));
-    mr.vector<4>("base_color", m.base_color, 0.0f, 1.0e4f);
-    mr.number("metallic", m.metallic, 0.0f, 1.0f);
-    mr.number("roughness", m.roughness, 0.0f, 1.0f);
-    mr.vector<3>("emissive", m.emissive, 0.0f, 1.0e6f);
-    mr.boolean("double_sided", m.double_sided);
-    mr.finish();
-    w.emplace<Material>(e, m);
+    const json& mj = r.raw("material");
+    if (mj.is_object() && mj.contains("file")) {
+      ObjectReader fr(mj, r.at("material"));
+      MaterialRef ref;
+      fr.string("file", ref.path);
+      fr.finish();  // a file reference stands alone: no inline fields beside it
+      if (ref.path.empty()) fail(fr.at("file"), "empty material file path");
+      w.emplace<MaterialRef>(e, ref);
+      w.emplace<Material>(e);
+    } else {
+      ObjectReader mr(mj, r.at("material"));
+      w.emplace<Material>(e, read_inline_material(mr));
+    }
   } else if (has_primitive) {
     w.emplace<Material>(e);
   }
@@ -250,18 +268,18 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
   }
   if (const auto* p = w.try_get<PrimitiveMesh>(e))
     j["primitive"] = {{"shape", enum_name(p->shape, kShapes)}, {"segments", p->segments}};
-  if (const auto* m = w.try_get<ModelRef>(e)) {
-    // Model paths are relative to the scene file: rebase them when writing somewhere else.
-    std::string path = m->path;
-    if (!base.empty() && fs::path(path).is_relative()) {
-      const fs::path abs = fs::absolute(scene.file.parent_path() / path).lexically_normal();
-      path = abs.lexically_relative(fs::absolute(base).lexically_normal()).generic_string();
-    }
-    j["model"] = {{"path", path}};
-  }
+  // Paths are relative to the scene file: rebase them when writing somewhere else.
+  auto rebase = [&](const std::string& path) {
+    if (base.empty() || !fs::path(path).is_relative()) return path;
+    const fs::path abs = fs::absolute(scene.file.parent_path() / path).lexically_normal();
+    return abs.lexically_relative(fs::absolute(base).lexically_normal()).generic_string();
+  };
+  if (const auto* m = w.try_get<ModelRef>(e)) j["model"] = {{"path", rebase(m->path)}};
   if (const auto* mr = w.try_get<MeshRenderer>(e))
     j["renderer"] = {{"cast_shadows", mr->cast_shadows}, {"receive_shadows", mr->receive_shadows}};
-  if (const auto* m = w.try_get<Material>(e)) {
+  if (const auto* ref = w.try_get<MaterialRef>(e)) {
+    j["material"] = {{"file", rebase(ref->path)}};
+  } else if (const auto* m = w.try_get<Material>(e)) {
     j["material"] = {{"base_color", vec(m->base_color)},
                      {"metallic", num(m->metallic)},
                      {"roughness", num(m->roughness)},
@@ -432,8 +450,17 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
   return scene;
 }
 
-Status instantiate_scene(Scene& scene) {
+Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) {
   ecs::World& w = scene.world;
+  std::vector<std::pair<ecs::Entity, MaterialRef>> material_refs;
+  w.view<MaterialRef>().each([&](ecs::Entity e, MaterialRef& r) { material_refs.emplace_back(e, r); });
+  for (auto& [e, ref] : material_refs) {
+    if (!manifest)
+      return Error{scene.file.string(), "", "material files need the feature manifest"};
+    auto m = load_material_file(scene.file.parent_path() / ref.path, *manifest, scene.assets);
+    if (!m) return m.error();
+    w.emplace<Material>(e, *m);
+  }
   std::vector<std::pair<ecs::Entity, PrimitiveMesh>> prims;
   std::vector<std::pair<ecs::Entity, ModelRef>> models;
   w.view<PrimitiveMesh>().each([&](ecs::Entity e, PrimitiveMesh& p) { prims.emplace_back(e, p); });

@@ -17,6 +17,7 @@
 
 #include "runtime/assets/scene.h"
 #include "runtime/core/result.h"
+#include "runtime/render/feature_manifest.h"
 
 namespace kaskad {
 
@@ -38,9 +39,10 @@ Result<Scene> parse_scene(const nlohmann::json& document, const std::filesystem:
 Result<Scene> read_scene(const std::filesystem::path& file,
                          const std::vector<std::string>& overrides = {});
 
-/// Creates meshes for primitives and imports glTF references (paths relative to scene.file).
-/// Cameras with auto_frame are framed by the load phase (load_scene in runtime/cli/player.h).
-Status instantiate_scene(Scene& scene);
+/// Loads material files (validated against `manifest`; required when the scene has any), creates
+/// meshes for primitives and imports glTF references (paths relative to scene.file). Cameras with
+/// auto_frame are framed by the load phase (load_scene in runtime/cli/player.h).
+Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest = nullptr);
 
 /// The canonical document of the authored entities and settings (imported entities excluded).
 /// With a `base_dir`, model paths are rewritten relative to it (for a file written there);

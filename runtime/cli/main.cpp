@@ -27,6 +27,8 @@ usage:
   kaskad render [SCENE] [options]   render a scene (default: content/scenes/default.json)
   kaskad save SCENE -o OUT.json [--set key=value]...
                                     write the canonical scene file (after overrides)
+  kaskad variants [SCENE] [--set key=value]... [--aov]
+                                    list the shader variants (pass, key, defines) the scene needs
   kaskad info                       print the OpenGL context kaskad gets on this machine
 
 render options:
@@ -78,7 +80,7 @@ Args parse_args(int argc, char** argv) {
     std::fputs(kUsage, stdout);
     std::exit(0);
   }
-  if (a.command != "render" && a.command != "save" && a.command != "info")
+  if (a.command != "render" && a.command != "save" && a.command != "info" && a.command != "variants")
     usage_error("unknown command '" + a.command + "'");
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -91,6 +93,8 @@ Args parse_args(int argc, char** argv) {
       std::exit(0);
     } else if (arg == "-o" || arg == "--output") {
       a.output = value();
+    } else if (arg == "--aov" && a.command == "variants") {
+      a.aov = "yes";
     } else if (arg == "--aov") {
       a.aov = value();
     } else if (arg == "--shadow-map") {
@@ -148,6 +152,31 @@ int run_save(const Args& a) {
   if (!scene) return fail(scene.error());
   if (auto st = save_scene(a.output, *scene); !st) return fail(st.error());
   std::printf("wrote %s\n", a.output.c_str());
+  return 0;
+}
+
+int run_variants(const Args& a) {
+  const fs::path scene_path =
+      a.scene.empty() ? content_dir() / "scenes" / "default.json" : fs::path(a.scene);
+  auto scene = load_scene(scene_path, a.sets);
+  if (!scene) return fail(scene.error());
+  auto manifest = render::FeatureManifest::load(content_dir() / "shaders" / "features.json");
+  if (!manifest) return fail(manifest.error());
+  FrameContext ctx;
+  ctx.width = scene->render.width;
+  ctx.height = scene->render.height;
+  ctx.write_aovs = !a.aov.empty();
+  const auto requests = render::required_programs(plan_frame(*scene, ctx));
+  std::printf("%s: %zu programs (%s AOVs)\n", scene_path.string().c_str(), requests.size(),
+              ctx.write_aovs ? "with" : "without");
+  for (const auto& r : requests) {
+    std::printf("\n%-7s key 0x%08x  %s\n", r.pass == render::Pass::depth ? "depth" : "forward",
+                r.key.bits(), manifest->describe(r.key).c_str());
+    std::string defs;
+    for (const auto& f : manifest->features())
+      defs += " " + f.define + "=" + std::to_string(manifest->value(f, r.key));
+    std::printf("        defines:%s\n", defs.c_str());
+  }
   return 0;
 }
 
@@ -235,5 +264,6 @@ int main(int argc, char** argv) {
   const Args a = parse_args(argc, argv);
   if (a.command == "info") return run_info(a);
   if (a.command == "save") return run_save(a);
+  if (a.command == "variants") return run_variants(a);
   return run_render(a);
 }

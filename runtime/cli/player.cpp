@@ -23,7 +23,9 @@ Result<Scene> load_scene(const std::filesystem::path& file,
                          const std::vector<std::string>& overrides) {
   auto scene = read_scene(file, overrides);
   if (!scene) return scene.error();
-  KASKAD_TRY(instantiate_scene(*scene));
+  auto manifest = render::FeatureManifest::load(content_dir() / "shaders" / "features.json");
+  if (!manifest) return manifest.error();
+  KASKAD_TRY(instantiate_scene(*scene, &manifest.value()));
   update_transforms(scene->world, scene->assets);
   frame_auto_cameras(scene->world, scene_bounds(scene->world),
                      float(scene->render.width) / float(scene->render.height));

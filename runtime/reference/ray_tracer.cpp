@@ -43,6 +43,7 @@ struct RayTracer::Impl {
   RTCScene surfaces = nullptr;   // every MeshRenderer
   std::vector<ecs::Entity> surface_entity;  // by geometry ID in `surfaces`
   std::vector<bool> surface_receives;       // MeshRenderer::receive_shadows, by geometry ID
+  bool all_receive = true;                  // every surface receives: no receiver look-ups
   Aabb bounds;
   float offset = RayTracer::kRayOffsetScale;
   std::size_t occluder_triangles = 0;
@@ -389,6 +390,7 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
     }
     impl->surface_entity[id] = item.entity;
     impl->surface_receives[id] = item.renderer.receive_shadows;
+    impl->all_receive = impl->all_receive && item.renderer.receive_shadows;
     impl->surface_triangles += kept.size() / 3;
   }
 
@@ -634,7 +636,7 @@ Result<ShadowReference> RayTracer::shadow_reference(const Image& aov, const Refe
       if (receives && spot) receives = glm::dot(light.direction, -tl.direction) >= cos_outer;
       if (receives && light.range > 0.0f && light.type != LightType::directional)
         receives = tl.distance <= light.range;
-      if (receives && options.respect_receive_shadows) {
+      if (receives && options.respect_receive_shadows && !im.all_receive) {
         // The entity under the pixel: a short ray down the normal onto the surface.
         // A miss (should not happen) keeps the pixel.
         const unsigned g =

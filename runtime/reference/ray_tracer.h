@@ -73,7 +73,8 @@ struct ReferenceOptions {
   /// disagree) stays out of the metrics.
   float facing_threshold = 0.05f;
   /// Pixels of MeshRenderers with receive_shadows = false are not receivers (the AOV writes 1
-  /// there). Costs one short ray per pixel to find the surface's entity.
+  /// there). Costs one short ray per pixel to find the surface's entity, when any surface has
+  /// receive_shadows = false.
   bool respect_receive_shadows = true;
   /// Worker threads over image rows; 0 = std::thread::hardware_concurrency().
   int threads = 0;

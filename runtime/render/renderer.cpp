@@ -235,13 +235,8 @@ VariantKey frame_variant(const FrameInput& frame) {
 }
 
 VariantKey material_variant(const DrawItem& d) {
-  const Material& m = d.material;
-  VariantKey k;
-  if (m.base_color_texture != kNoTexture) k.set(VariantKey::kBaseColorTexture, 1);
-  if (m.normal_texture != kNoTexture) k.set(VariantKey::kNormalMap, 1);
-  if (m.alpha_mask) k.set(VariantKey::kAlphaMask, 1);
-  if (m.emissive.r > 0.0f || m.emissive.g > 0.0f || m.emissive.b > 0.0f)
-    k.set(VariantKey::kEmissive, 1);
+  // receive_shadows is a per-object flag, but it selects code like a material feature.
+  VariantKey k = VariantKey(d.material.features & VariantKey::kMaterialMask & ~VariantKey::kReceiveShadows.mask());
   if (d.receive_shadows) k.set(VariantKey::kReceiveShadows, 1);
   return k;
 }

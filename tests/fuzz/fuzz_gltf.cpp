@@ -17,13 +17,6 @@
 
 #include "runtime/assets/gltf_loader.h"
 
-/// See tests/unit/assets/asset_test_util.h: OIIO's PNG reader leaks an error string whenever
-/// libpng longjmps out of a truncated image.
-extern "C" __attribute__((weak)) const char* __lsan_default_suppressions() {
-  return "leak:PNGInput::PngReadCallback\n"
-         "leak:ImageInput::geterror\n";
-}
-
 namespace {
 
 /// Per-process directory for the input file (and, standalone, the seeds' .bin and image files,

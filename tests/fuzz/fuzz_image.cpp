@@ -14,13 +14,6 @@
 
 #include "runtime/assets/image_io.h"
 
-/// See tests/unit/assets/asset_test_util.h: OIIO's PNG reader leaks an error string whenever
-/// libpng longjmps out of a truncated image.
-extern "C" __attribute__((weak)) const char* __lsan_default_suppressions() {
-  return "leak:PNGInput::PngReadCallback\n"
-         "leak:ImageInput::geterror\n";
-}
-
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   auto image = kaskad::load_image_from_memory(data, size, "fuzz input");
   // KASKAD_FUZZ_VERBOSE=1 prints each outcome: shows how deep the inputs get.

@@ -13,15 +13,6 @@
 #error "KASKAD_CONTENT_DIR must be defined (a string: the path of the repository's content/)"
 #endif
 
-/// LeakSanitizer suppressions, read by the sanitizer runtime when the tests run under
-/// -fsanitize=address (unused otherwise). OpenImageIO 2.4's PNG reader builds an error string
-/// (ImageInput::geterror) in its libpng read callback and then png_error() longjmps over it, so
-/// every truncated PNG leaks a few bytes inside OIIO. Weak: several test files may include this.
-extern "C" __attribute__((weak)) const char* __lsan_default_suppressions() {
-  return "leak:PNGInput::PngReadCallback\n"
-         "leak:ImageInput::geterror\n";
-}
-
 namespace kaskad::test {
 
 /// Path of a file under content/, e.g. content_path("models/Box/glTF-Binary/Box.glb").
