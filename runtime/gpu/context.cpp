@@ -36,6 +36,8 @@ void GLAPIENTRY on_debug_message(GLenum source, GLenum type, GLuint id, GLenum s
   if (type == GL_DEBUG_TYPE_ERROR && source != GL_DEBUG_SOURCE_SHADER_COMPILER) {
     ++g_debug_errors;
     log::error("GL error (%s, id %u): %s", debug_source(source), id, message);
+  } else if (source == GL_DEBUG_SOURCE_SHADER_COMPILER) {
+    log::debug("GL (%s, id %u): %s", debug_source(source), id, message);
   } else if (severity == GL_DEBUG_SEVERITY_HIGH || severity == GL_DEBUG_SEVERITY_MEDIUM) {
     log::warn("GL (%s, id %u): %s", debug_source(source), id, message);
   } else {

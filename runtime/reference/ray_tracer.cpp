@@ -39,8 +39,8 @@ struct ErrorLog {
 
 struct RayTracer::Impl {
   RTCDevice device = nullptr;
-  RTCScene occluders = nullptr;  // cast_shadows = true
-  RTCScene surfaces = nullptr;   // every MeshRenderer
+  RTCScene occluders = nullptr;             // cast_shadows = true
+  RTCScene surfaces = nullptr;              // every MeshRenderer
   std::vector<ecs::Entity> surface_entity;  // by geometry ID in `surfaces`
   std::vector<bool> surface_receives;       // MeshRenderer::receive_shadows, by geometry ID
   bool all_receive = true;                  // every surface receives: no receiver look-ups
@@ -115,11 +115,21 @@ glm::vec3 perpendicular(const glm::vec3& axis, const glm::vec3& hint) {
     // hint parallel to axis: the world axis least parallel to it.
     const glm::vec3 a = glm::abs(axis);
     const glm::vec3 other = (a.x <= a.y && a.x <= a.z) ? glm::vec3(1, 0, 0)
-                            : (a.y <= a.z)              ? glm::vec3(0, 1, 0)
-                                                        : glm::vec3(0, 0, 1);
+                            : (a.y <= a.z)             ? glm::vec3(0, 1, 0)
+                                                       : glm::vec3(0, 0, 1);
     r = other - glm::dot(other, axis) * axis;
   }
   return glm::normalize(r);
+}
+
+/// The light with a unit direction (straight down when it has none) and a unit `right`
+/// perpendicular to it, whatever the caller filled in.
+ReferenceLight prepared(const ReferenceLight& light) {
+  ReferenceLight l = light;
+  const float len = glm::length(l.direction);
+  l.direction = len > 0.0f && std::isfinite(len) ? l.direction / len : glm::vec3(0.0f, -1.0f, 0.0f);
+  l.right = perpendicular(l.direction, finite(l.right) ? l.right : glm::vec3(1.0f, 0.0f, 0.0f));
+  return l;
 }
 
 /// PCG32 (O'Neill 2014, "PCG: a family of simple fast space-efficient statistically good
@@ -164,8 +174,8 @@ struct ShadowRay {
   float tmax;
 };
 
-/// occluded[i] (0 or 1) for each ray, traced in packets of 16 (rtcOccluded16). Rays must be valid (finite,
-/// tmax > 0): Embree is built without its invalid-ray filter.
+/// occluded[i] (0 or 1) for each ray, traced in packets of 16 (rtcOccluded16). Rays must be valid
+/// (finite, tmax > 0): Embree is built without its invalid-ray filter.
 void trace_occluded(RTCScene scene, std::span<const ShadowRay> rays, std::uint8_t* occluded) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
@@ -282,7 +292,9 @@ RayTracer::RayTracer(RayTracer&&) noexcept = default;
 RayTracer& RayTracer::operator=(RayTracer&&) noexcept = default;
 RayTracer::~RayTracer() = default;
 
-Result<RayTracer> RayTracer::build(const Scene& scene) { return build(scene.world, scene.assets); }
+Result<RayTracer> RayTracer::build(const Scene& scene) {
+  return build(scene.world, scene.assets);
+}
 
 Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& assets) {
   auto impl = std::make_unique<Impl>();
@@ -350,8 +362,9 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
       }
       // Embree needs finite vertices (its invalid-ray/primitive filters are compiled out here);
       // degenerate triangles are fine, they are never hit.
-      if (ok) kept.insert(kept.end(), mesh.indices.begin() + std::ptrdiff_t(t),
-                          mesh.indices.begin() + std::ptrdiff_t(t + 3));
+      if (ok)
+        kept.insert(kept.end(), mesh.indices.begin() + std::ptrdiff_t(t),
+                    mesh.indices.begin() + std::ptrdiff_t(t + 3));
     }
     if (kept.empty()) continue;
     for (const std::uint32_t index : kept) impl->bounds.expand(world_positions[index]);
@@ -431,8 +444,8 @@ bool RayTracer::occluded(const glm::vec3& origin, const glm::vec3& direction, fl
   return ray.tfar < 0.0f;
 }
 
-std::optional<SurfaceHit> RayTracer::intersect(const glm::vec3& origin,
-                                               const glm::vec3& direction, float tmax) const {
+std::optional<SurfaceHit> RayTracer::intersect(const glm::vec3& origin, const glm::vec3& direction,
+                                               float tmax) const {
   KASKAD_CHECK(impl_, "RayTracer used after being moved from");
   const float len = glm::length(direction);
   if (!finite(origin) || !(len > 0.0f) || !std::isfinite(len) || !(tmax > 0.0f)) {
@@ -460,7 +473,8 @@ float RayTracer::hard_visibility(const glm::vec3& position, const glm::vec3& n,
   KASKAD_CHECK(impl_, "RayTracer used after being moved from");
   ShadowRay ray;
   bool lit = false;
-  if (!hard_shadow_ray(position, n, light, impl_->offset, ray, lit)) return lit ? 1.0f : 0.0f;
+  if (!hard_shadow_ray(position, n, prepared(light), impl_->offset, ray, lit))
+    return lit ? 1.0f : 0.0f;
   return occluded(ray.origin, ray.direction, ray.tmax) ? 0.0f : 1.0f;
 }
 
@@ -473,8 +487,8 @@ float area_visibility(RTCScene occluders, float offset, const glm::vec3& positio
                       std::uint64_t seed, std::uint64_t& rays) {
   const glm::vec3 origin = position + offset * n;
   if (!finite(origin) || !finite(n)) return 0.0f;
-  const glm::vec3 axis = light.direction;  // unit
-  const glm::vec3 t1 = perpendicular(axis, light.right);
+  const glm::vec3 axis = light.direction;  // prepared(): unit, and right is perpendicular
+  const glm::vec3 t1 = light.right;
   const glm::vec3 t2 = glm::cross(axis, t1);
   // Directional: uniform over the cone's solid angle, cos(theta) uniform in [cos(half), 1].
   const float half_angle = 0.5f * glm::radians(light.angular_size_deg);
@@ -503,13 +517,12 @@ float area_visibility(RTCScene occluders, float offset, const glm::vec3& positio
         const float cos_t = 1.0f - su * one_minus_cos_max;
         const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
         const float phi = 2.0f * std::numbers::pi_v<float> * sv;
-        ray.direction = glm::normalize(cos_t * -axis +
-                                       sin_t * (std::cos(phi) * t1 + std::sin(phi) * t2));
+        ray.direction =
+            glm::normalize(cos_t * -axis + sin_t * (std::cos(phi) * t1 + std::sin(phi) * t2));
         ray.tmax = kInfinity;
       } else {
         // Point on the square emitter (S1), edges along t1 and t2, centred at the light.
-        const glm::vec3 s =
-            light.position + light.size * ((su - 0.5f) * t1 + (sv - 0.5f) * t2);
+        const glm::vec3 s = light.position + light.size * ((su - 0.5f) * t1 + (sv - 0.5f) * t2);
         const glm::vec3 d = s - origin;
         const float dist = glm::length(d);
         if (!(dist > offset)) {  // the sample is at the surface point: nothing in between
@@ -532,8 +545,8 @@ float area_visibility(RTCScene occluders, float offset, const glm::vec3& positio
 int strata_of(int samples, const char* function) {
   const int strata = int(std::lround(std::sqrt(double(std::max(samples, 0)))));
   if (samples < 1 || strata * strata != samples) {
-    precondition_failed(function, "samples must be a perfect square >= 1 (sqrt(M) x sqrt(M) "
-                                  "strata), was " + std::to_string(samples));
+    const std::string value = std::to_string(samples);
+    precondition_failed(function, "samples must be a perfect square >= 1, was " + value);
   }
   return strata;
 }
@@ -547,24 +560,27 @@ float RayTracer::area_light_visibility(const glm::vec3& position, const glm::vec
   const int strata = strata_of(samples, __func__);
   if (!light.is_area()) return hard_visibility(position, n, light);
   std::uint64_t rays = 0;
-  return area_visibility(impl_->occluders, impl_->offset, position, n, light, strata,
+  return area_visibility(impl_->occluders, impl_->offset, position, n, prepared(light), strata,
                          pixel_seed(0, seed), rays);
 }
 
 std::optional<SurfaceHit> RayTracer::trace_mirror(const glm::vec3& position, const glm::vec3& n,
                                                   const glm::vec3& incident) const {
   KASKAD_CHECK(impl_, "RayTracer used after being moved from");
-  const float ul = glm::length(incident);
-  if (!(ul > 0.0f) || !finite(n)) return std::nullopt;
+  const float ul = glm::length(incident), nl = glm::length(n);
+  if (!(ul > 0.0f) || !(nl > 0.0f) || !std::isfinite(nl)) return std::nullopt;
   const glm::vec3 u = incident / ul;
-  const glm::vec3 nf = glm::dot(n, u) > 0.0f ? -n : n;  // the side the eye is on
+  const glm::vec3 nu = n / nl;
+  const glm::vec3 nf = glm::dot(nu, u) > 0.0f ? -nu : nu;  // the side the eye is on
   const glm::vec3 r = u - 2.0f * glm::dot(nf, u) * nf;
   return intersect(position + impl_->offset * nf, r);
 }
 
-Result<ShadowReference> RayTracer::shadow_reference(const Image& aov, const ReferenceLight& light,
+Result<ShadowReference> RayTracer::shadow_reference(const Image& aov,
+                                                    const ReferenceLight& authored_light,
                                                     const ReferenceOptions& options) const {
   KASKAD_CHECK(impl_, "RayTracer used after being moved from");
+  const ReferenceLight light = prepared(authored_light);
   const int strata = strata_of(options.area_samples, __func__);
   KASKAD_CHECK(options.threads >= 0,
                "threads must be >= 0 (0 = all cores), was " + std::to_string(options.threads));
@@ -574,8 +590,8 @@ Result<ShadowReference> RayTracer::shadow_reference(const Image& aov, const Refe
   constexpr std::array<int, 7> kCanonical = {0, 1, 2, 3, 4, 5, 8};
   std::array<int, 7> ch{};
   if (aov.width <= 0 || aov.height <= 0 || aov.channels <= 0 ||
-      aov.pixels.size() != std::size_t(aov.width) * std::size_t(aov.height) *
-                               std::size_t(aov.channels)) {
+      aov.pixels.size() !=
+          std::size_t(aov.width) * std::size_t(aov.height) * std::size_t(aov.channels)) {
     return Error{"", "AOV image",
                  "size " + std::to_string(aov.width) + "x" + std::to_string(aov.height) + "x" +
                      std::to_string(aov.channels) + " does not match its " +
@@ -682,14 +698,13 @@ Result<ShadowReference> RayTracer::shadow_reference(const Image& aov, const Refe
   };
 
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const int thread_count =
-      std::min(aov.height, options.threads > 0 ? options.threads : int(hw));
+  const int thread_count = std::min(aov.height, options.threads > 0 ? options.threads : int(hw));
   const auto start = std::chrono::steady_clock::now();
-  {
+  {  // the pool joins at the end of this block
     std::vector<std::jthread> pool;
     for (int i = 1; i < thread_count; ++i) pool.emplace_back(worker);
     worker();  // the calling thread works too
-  }  // joins
+  }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.rays = total_rays.load();
   return out;

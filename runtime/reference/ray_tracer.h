@@ -27,10 +27,12 @@ namespace kaskad::reference {
 /// reference_light(), or by hand in tests.
 struct ReferenceLight {
   LightType type = LightType::directional;
-  glm::vec3 position{0.0f};             ///< spot/point: world position, metres
-  glm::vec3 direction{0.0f, -1.0f, 0.0f};  ///< unit; the way light travels (the entity's -Z)
-  glm::vec3 right{1.0f, 0.0f, 0.0f};    ///< spot/point area light: first edge of the square (the
-                                        ///< entity's +X); made perpendicular to `direction`
+  glm::vec3 position{0.0f};                ///< spot/point: world position, metres
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};  ///< the way light travels (the entity's -Z);
+                                           ///< normalised by the tracer
+  glm::vec3 right{1.0f, 0.0f, 0.0f};       ///< area light: the square's first edge, or the cone's
+                                      ///< azimuth origin (the entity's +X); the tracer makes it
+                                      ///< unit and perpendicular to `direction`
   /// Spot/point: side of the square emitter in metres (perpendicular to `direction`, centred at
   /// `position`, edges along `right` and direction x right; S1's 2 x 2 light has size 2).
   /// 0 = punctual.
@@ -57,8 +59,8 @@ ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix
 struct SurfaceHit {
   ecs::Entity entity = ecs::kNullEntity;  ///< the MeshRenderer entity hit
   glm::vec3 position{0.0f};               ///< world position of the hit, metres
-  glm::vec3 normal{0.0f, 1.0f, 0.0f};     ///< unit geometric (triangle) normal, facing the ray origin
-  float distance = 0.0f;                  ///< along the unit ray direction, metres
+  glm::vec3 normal{0.0f, 1.0f, 0.0f};  ///< unit geometric (triangle) normal, facing the ray origin
+  float distance = 0.0f;               ///< along the unit ray direction, metres
 };
 
 struct ReferenceOptions {
@@ -82,9 +84,9 @@ struct ReferenceOptions {
 
 /// shadow_reference()'s output and what it cost.
 struct ShadowReference {
-  /// Same size as the AOV; channels "visibility" (reference visibility in [0, 1]: 1 lit, 0 shadowed,
-  /// fractions for area lights; 1 where mask = 0; 0 where the surface faces away from the light)
-  /// and "receiver" (1 where the pixel counts for the metrics: mask = 1, finite position and
+  /// Same size as the AOV; channels "visibility" (reference visibility in [0, 1]: 1 lit, 0
+  /// shadowed, fractions for area lights; 1 where mask = 0; 0 where the surface faces away from the
+  /// light) and "receiver" (1 where the pixel counts for the metrics: mask = 1, finite position and
   /// normal, facing the light by facing_threshold, inside a spot's cone and the light's range,
   /// and, with respect_receive_shadows, a surface that receives shadows; else 0).
   Image image;
@@ -155,7 +157,7 @@ class RayTracer {
   float ray_offset() const;
   static constexpr float kRayOffsetScale = 1e-5f;
 
-  Aabb bounds() const;                    ///< of every surface triangle kept
+  Aabb bounds() const;                     ///< of every surface triangle kept
   std::size_t occluder_triangles() const;  ///< triangles in the occluder BVH
   std::size_t surface_triangles() const;   ///< triangles in the all-surfaces BVH
 

@@ -62,14 +62,13 @@ bool consistent(const Image& image) {
 ShadowMetrics compare_shadows(int width, int height, std::span<const float> method,
                               std::span<const float> reference,
                               std::span<const std::uint8_t> receiver) {
-  KASKAD_CHECK(width >= 0 && height >= 0,
-               "image size must be >= 0, was " + std::to_string(width) + "x" +
-                   std::to_string(height));
+  KASKAD_CHECK(width >= 0 && height >= 0, "image size must be >= 0, was " + std::to_string(width) +
+                                              "x" + std::to_string(height));
   const std::size_t count = std::size_t(width) * std::size_t(height);
   KASKAD_CHECK(method.size() == count && reference.size() == count && receiver.size() == count,
-               "arrays must hold width * height = " + std::to_string(count) +
-                   " values, were " + std::to_string(method.size()) + ", " +
-                   std::to_string(reference.size()) + ", " + std::to_string(receiver.size()));
+               "arrays must hold width * height = " + std::to_string(count) + " values, were " +
+                   std::to_string(method.size()) + ", " + std::to_string(reference.size()) + ", " +
+                   std::to_string(receiver.size()));
 
   // A pixel takes part when it is a receiver with finite values on both sides.
   auto counted = [&](std::size_t i) {

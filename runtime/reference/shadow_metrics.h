@@ -19,26 +19,26 @@ inline constexpr float kShadowThreshold = 0.5f;
 /// Errors of a method's visibility against the reference over a set of receiver pixels.
 /// Percentages are of `pixels` (0 when there are none).
 struct ShadowErrorStats {
-  std::size_t pixels = 0;          ///< receiver pixels counted
-  std::size_t misclassified = 0;   ///< binary method != binary reference
-  std::size_t false_shadow = 0;    ///< reference lit, method shadowed: acne, over-darkening
-  std::size_t false_light = 0;     ///< reference shadowed, method lit: Peter Panning, leaks, lost
-                                   ///< casters
+  std::size_t pixels = 0;         ///< receiver pixels counted
+  std::size_t misclassified = 0;  ///< binary method != binary reference
+  std::size_t false_shadow = 0;   ///< reference lit, method shadowed: acne, over-darkening
+  std::size_t false_light = 0;    ///< reference shadowed, method lit: Peter Panning, leaks, lost
+                                  ///< casters
   double misclassified_pct = 0.0;
   double false_shadow_pct = 0.0;
   double false_light_pct = 0.0;
-  double rmse = 0.0;               ///< sqrt(mean((method - reference)^2)) of visibility
-  double mean_abs_error = 0.0;     ///< mean(|method - reference|) of visibility
+  double rmse = 0.0;            ///< sqrt(mean((method - reference)^2)) of visibility
+  double mean_abs_error = 0.0;  ///< mean(|method - reference|) of visibility
 };
 
 struct ShadowMetrics {
-  ShadowErrorStats all;            ///< every receiver pixel
+  ShadowErrorStats all;  ///< every receiver pixel
   /// Receiver pixels outside the 1-pixel band around reference shadow edges: a pixel is in the
   /// band when any of its 8 neighbours that is a receiver has the other binary reference value.
   /// The band holds the pixels whose classification depends on sub-pixel edge placement.
   ShadowErrorStats outside_edges;
-  std::size_t edge_pixels = 0;     ///< receiver pixels in the band (all.pixels - outside_edges.pixels)
-  std::size_t non_finite = 0;      ///< receiver pixels skipped: method or reference not finite
+  std::size_t edge_pixels = 0;  ///< receiver pixels in the band (all.pixels - outside_edges.pixels)
+  std::size_t non_finite = 0;   ///< receiver pixels skipped: method or reference not finite
 };
 
 /// Metrics from per-pixel arrays (row-major, width * height each): the method's visibility, the
@@ -61,9 +61,9 @@ inline constexpr float kStabilityChangeThreshold = 1.0f / 255.0f;
 struct StabilityStats {
   std::size_t frames = 0;
   std::size_t points = 0;
-  std::size_t samples = 0;      ///< (point, consecutive frame pair) samples with finite values
-  double flicker = 0.0;         ///< mean |v[f+1][p] - v[f][p]| over all samples
-  double changed_pct = 0.0;     ///< % of samples with |v[f+1][p] - v[f][p]| > change threshold
+  std::size_t samples = 0;   ///< (point, consecutive frame pair) samples with finite values
+  double flicker = 0.0;      ///< mean |v[f+1][p] - v[f][p]| over all samples
+  double changed_pct = 0.0;  ///< % of samples with |v[f+1][p] - v[f][p]| > change threshold
   std::vector<double> flicker_per_frame;  ///< mean |delta| of each frame pair (frames - 1 values)
 };
 

@@ -79,6 +79,7 @@ struct Renderer::Impl {
 
   std::array<gpu::Query, 2> timers;
   bool timers_pending = false;
+  std::uint64_t frames_rendered = 0;
   bool aovs_written = false;
 
   const GpuMesh& mesh(MeshId id, const AssetStore& assets) {
@@ -460,7 +461,9 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.shaders = im.shaders->stats();
   glDisable(GL_FRAMEBUFFER_SRGB);
   glEndQuery(GL_TIME_ELAPSED);
-  im.timers_pending = true;
+  // llvmpipe returns garbage for the very first GL_TIME_ELAPSED queries of a context (seen:
+  // 3.4e6 ms), and frame 0 times uploads anyway: results are read from frame 1's queries on.
+  im.timers_pending = im.frames_rendered++ > 0;
   glBindVertexArray(0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return {};

@@ -77,6 +77,7 @@ struct FrameStats {
   std::size_t triangles = 0;          ///< submitted in the forward pass
   int shadow_draw_calls = 0;
   std::size_t shadow_triangles = 0;   ///< submitted to the shadow map
+  /// GPU times are the previous frame's (queries are read a frame late); 0 until frame 3.
   double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
   double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)
   int program_switches = 0;           ///< glUseProgram calls in the frame (draws are sorted)

@@ -191,6 +191,7 @@ Result<ShaderLibrary::Entry> ShaderLibrary::build(Pass pass, VariantKey key, boo
 
 Result<GLuint> ShaderLibrary::program(Pass pass, VariantKey key) {
   key = key.filtered_for(pass);
+  if (oracle_) key = key.frame();  // one über-program per frame configuration
   // Hot path: one hash probe; a miss builds the program (and is counted).
   const std::uint64_t k = map_key(pass, key);
   if (auto it = programs_.find(k); it != programs_.end()) return it->second.program.id();
@@ -216,7 +217,7 @@ Status ShaderLibrary::prewarm(std::span<const ProgramRequest> requests) {
 std::vector<Error> ShaderLibrary::reload_changed() {
   std::vector<Error> errors;
   for (auto& [k, entry] : programs_) {
-    fs::file_time_type newest{};
+    fs::file_time_type newest = fs::file_time_type::min();
     for (const auto& f : entry.files) {
       std::error_code ec;
       newest = std::max(newest, fs::last_write_time(f, ec));

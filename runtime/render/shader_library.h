@@ -68,7 +68,8 @@ class ShaderLibrary {
   struct Entry {
     gpu::Program program;
     std::vector<std::filesystem::path> files;  // every source file, for hot reload
-    std::filesystem::file_time_type newest{};
+    // min(), not {}: libstdc++'s file clock epoch is in 2174, so real times are negative.
+    std::filesystem::file_time_type newest = std::filesystem::file_time_type::min();
   };
   Result<Entry> build(Pass pass, VariantKey key, bool reload);
 

@@ -191,9 +191,12 @@ TEST(RayTracer, SphereAbovePlaneUnderDirectionalLightCastsTheAnalyticEllipse) {
   // The tessellated sphere lies between the analytic sphere and one shrunk by the chord sag
   // r (1 - cos(pi / segments)) (inscribed vertices); plus a float margin.
   const float band = radius * (1.0f - std::cos(3.14159265f / segments)) + 2e-3f;
-  const int shadowed = expect_matches_analytic(ref, aov, [&](glm::vec3 p, float grow) {
-    return ray_hits_sphere(p, -light.direction, 1e30f, centre, radius + grow);
-  }, band);
+  const int shadowed = expect_matches_analytic(
+      ref, aov,
+      [&](glm::vec3 p, float grow) {
+        return ray_hits_sphere(p, -light.direction, 1e30f, centre, radius + grow);
+      },
+      band);
   // The ellipse: area pi r^2 / cos(angle to the vertical), 1/20 of the grid spacing squared.
   const float cos_theta = -light.direction.y;
   const float cell = 6.0f / 120.0f;
@@ -215,10 +218,13 @@ TEST(RayTracer, BoxUnderPointLightCastsTheAnalyticShadow) {
   const ReferenceLight light = positional(LightType::point, light_pos);
   const Image aov = ground_aov(101, 4.0f);
   const ShadowReference ref = reference(tracer, aov, light);
-  const int shadowed = expect_matches_analytic(ref, aov, [&](glm::vec3 p, float grow) {
-    const glm::vec3 d = light_pos - p;
-    return ray_hits_box(p, glm::normalize(d), glm::length(d), lo - grow, hi + grow);
-  }, 2e-3f);
+  const int shadowed = expect_matches_analytic(
+      ref, aov,
+      [&](glm::vec3 p, float grow) {
+        const glm::vec3 d = light_pos - p;
+        return ray_hits_box(p, glm::normalize(d), glm::length(d), lo - grow, hi + grow);
+      },
+      2e-3f);
   EXPECT_GT(shadowed, 100);
   // The caster's own top face sees the light.
   EXPECT_EQ(tracer.hard_visibility({0, 1.5f + 1e-3f, 0.2f}, {0, 1, 0}, light), 1.0f);
@@ -234,10 +240,13 @@ TEST(RayTracer, SpotLightShadowAndCone) {
   light.outer_cone_deg = 30.0f;
   const Image aov = ground_aov(81, 4.0f);
   const ShadowReference ref = reference(tracer, aov, light);
-  const int shadowed = expect_matches_analytic(ref, aov, [&](glm::vec3 p, float grow) {
-    const glm::vec3 d = light.position - p;
-    return ray_hits_box(p, glm::normalize(d), glm::length(d), lo - grow, hi + grow);
-  }, 2e-3f);
+  const int shadowed = expect_matches_analytic(
+      ref, aov,
+      [&](glm::vec3 p, float grow) {
+        const glm::vec3 d = light.position - p;
+        return ray_hits_box(p, glm::normalize(d), glm::length(d), lo - grow, hi + grow);
+      },
+      2e-3f);
   EXPECT_GT(shadowed, 20);
   // Receivers: inside the 30 degree cone (radius 5 tan 30 = 2.89 around (0.5, 0)) only.
   const float cone_radius = 5.0f * std::tan(glm::radians(30.0f));
@@ -312,14 +321,32 @@ TEST(RayTracer, FacingAwayIsShadowedAndGrazingIsNoReceiver) {
   EXPECT_EQ(high.image.at(1, 0, 1), 0.0f);
 }
 
+TEST(RayTracer, LightAndNormalVectorsNeedNotBeUnit) {
+  Scene scene;
+  add(scene, PrimitiveShape::box, trs({0, 2, 0}));
+  const RayTracer tracer = build(scene);
+  ReferenceLight sun;
+  sun.direction = {0, -5, 0};
+  sun.right = {3, 1, 0};  // not perpendicular either
+  EXPECT_EQ(tracer.hard_visibility({0, 0, 0}, {0, 1, 0}, sun), 0.0f);
+  EXPECT_EQ(tracer.hard_visibility({3, 0, 0}, {0, 1, 0}, sun), 1.0f);
+  sun.angular_size_deg = 4.0f;
+  EXPECT_EQ(tracer.area_light_visibility({0, 0, 0}, {0, 1, 0}, sun, 16, 1), 0.0f);
+  sun.direction = {0, 0, 0};  // no direction at all: straight down
+  EXPECT_EQ(tracer.area_light_visibility({0, 0, 0}, {0, 1, 0}, sun, 16, 1), 0.0f);
+  const auto hit = tracer.trace_mirror({0, 0, 0}, {0, 10, 0}, {0, -1, 0});
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->distance, 1.5f, 1e-3f);
+}
+
 TEST(RayTracer, DegenerateTrianglesAndNonFiniteInputNeverCrash) {
   Scene scene;
   MeshData mesh;
   mesh.name = "broken";
-  mesh.positions = {{0, 1, 0}, {0, 1, 0}, {0, 1, 0},     // degenerate: one point
-                    {-1, 1, 0}, {1, 1, 0}, {3, 1, 0},    // degenerate: collinear
-                    {0, 1, 0}, {kNaN, 1, 0}, {0, 1, 1},  // non-finite vertex
-                    {-1, 2, -1}, {-1, 2, 1}, {1, 2, 0}};  // a proper triangle
+  mesh.positions = {{0, 1, 0},   {0, 1, 0},    {0, 1, 0},   // degenerate: one point
+                    {-1, 1, 0},  {1, 1, 0},    {3, 1, 0},   // degenerate: collinear
+                    {0, 1, 0},   {kNaN, 1, 0}, {0, 1, 1},   // non-finite vertex
+                    {-1, 2, -1}, {-1, 2, 1},   {1, 2, 0}};  // a proper triangle
   mesh.indices = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11};
   const MeshId id = scene.assets.add_mesh(mesh);
   const ecs::Entity e = scene.world.create();
@@ -329,7 +356,7 @@ TEST(RayTracer, DegenerateTrianglesAndNonFiniteInputNeverCrash) {
   scene.world.emplace<MeshRenderer>(no_mesh, MeshRenderer{});
   scene.world.emplace<WorldTransform>(no_mesh, WorldTransform{});
   const RayTracer tracer = build(scene);
-  EXPECT_EQ(tracer.occluder_triangles(), 3u);  // the non-finite one is dropped
+  EXPECT_EQ(tracer.occluder_triangles(), 3u);                 // the non-finite one is dropped
   EXPECT_TRUE(tracer.occluded({0, 0, 0}, {0, 1, 0}, 10.0f));  // the proper triangle at y = 2
   EXPECT_FALSE(tracer.occluded({0, 0, 0}, {kNaN, 1, 0}, 10.0f));
   EXPECT_FALSE(tracer.occluded({0, 0, 0}, {0, 0, 0}, 10.0f));
@@ -411,8 +438,8 @@ TEST(RayTracer, ReferenceLightFromAComponent) {
   spot.outer_cone_deg = 25.0f;
   spot.range = 12.0f;
   // Rotated -90 degrees about +X: local -Z turns to world -Y (a spot pointing down), +X stays.
-  const glm::mat4 m = glm::rotate(glm::translate(glm::mat4(1.0f), {1, 5, 2}),
-                                  glm::radians(-90.0f), glm::vec3(1, 0, 0));
+  const glm::mat4 m = glm::rotate(glm::translate(glm::mat4(1.0f), {1, 5, 2}), glm::radians(-90.0f),
+                                  glm::vec3(1, 0, 0));
   const ReferenceLight l = reference_light(spot, m);
   EXPECT_EQ(l.type, LightType::spot);
   EXPECT_NEAR(glm::length(l.position - glm::vec3(1, 5, 2)), 0.0f, 1e-6f);
@@ -443,8 +470,8 @@ float parallel_square_visibility(glm::vec2 p, float size, float light_h, glm::ve
   auto overlap = [&](float c0, float h0, float c1, float h1) {
     return std::max(0.0f, std::min(c0 + h0, c1 + h1) - std::max(c0 - h0, c1 - h1));
   };
-  const float blocked = overlap(centre.x, half, 0.0f, 0.5f * size) *
-                        overlap(centre.y, half, 0.0f, 0.5f * size);
+  const float blocked =
+      overlap(centre.x, half, 0.0f, 0.5f * size) * overlap(centre.y, half, 0.0f, 0.5f * size);
   return 1.0f - blocked / (size * size);
 }
 
@@ -517,7 +544,8 @@ TEST(RayTracer, AreaSamplesBelowTheHorizonAreBlocked) {
   ReferenceLight sun = directional({0, 0, -1});
   sun.angular_size_deg = 10.0f;
   EXPECT_NEAR(tracer.area_light_visibility({0, 0, 0}, {1, 0, 0}, sun, 256, 1), 0.5f, 1e-6f);
-  EXPECT_EQ(tracer.area_light_visibility({0, 0, 0}, {0, 0, -1}, square, 256, 1), 0.0f);  // faces away
+  EXPECT_EQ(tracer.area_light_visibility({0, 0, 0}, {0, 0, -1}, square, 256, 1),
+            0.0f);  // faces away
   EXPECT_EQ(tracer.area_light_visibility({0, 0, 0}, {0, 0, 1}, square, 256, 1), 1.0f);
 }
 

@@ -1,0 +1,214 @@
+// The shader permutation system on the GPU: only used variants are compiled, variants match the
+// uniform-driven über-shader oracle, pre-warm leaves nothing to compile, the binary cache is hit,
+// and hot reload keeps the last good program.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "runtime/cli/player.h"
+#include "runtime/gpu/context.h"
+#include "systems/frame.h"
+
+namespace kaskad {
+namespace {
+
+namespace fs = std::filesystem;
+using render::Pass;
+using render::VariantKey;
+
+class PermutationTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    gpu::ContextOptions opt;
+    opt.headless = true;
+    auto ctx = gpu::Context::create(opt);
+    ASSERT_TRUE(ctx.ok()) << ctx.error().to_string();
+    context_ = ctx.value().release();
+  }
+  static void TearDownTestSuite() {
+    delete context_;
+    context_ = nullptr;
+  }
+  void SetUp() override { gpu::reset_debug_error_count(); }
+  void TearDown() override { EXPECT_EQ(gpu::debug_error_count(), 0) << "GL errors were logged"; }
+
+  static std::unique_ptr<render::Renderer> make_renderer(const fs::path& cache = {},
+                                                         bool oracle = false,
+                                                         const fs::path& shaders = content_dir() / "shaders") {
+    render::RendererOptions o;
+    o.shader_cache_dir = cache;
+    o.uber_oracle = oracle;
+    auto r = render::Renderer::create(shaders, o);
+    EXPECT_TRUE(r.ok()) << r.error().to_string();
+    return r.ok() ? std::move(r.value()) : nullptr;
+  }
+  static Scene scene(const std::string& name, std::vector<std::string> sets = {}) {
+    sets.push_back("render.width=320");
+    sets.push_back("render.height=180");
+    auto s = load_scene(content_dir() / "scenes" / name, sets);
+    EXPECT_TRUE(s.ok()) << s.error().to_string();
+    return std::move(s.value());
+  }
+  // Renders `frames` frames with a bare renderer (no player) and returns the last colour image.
+  static Image render(render::Renderer& r, Scene& s, int frames = 1, bool prewarm = false,
+                      bool aovs = false, Image* aov = nullptr) {
+    FrameContext ctx;
+    ctx.width = s.render.width;
+    ctx.height = s.render.height;
+    ctx.write_aovs = aovs;
+    if (prewarm) {
+      EXPECT_TRUE(prewarm_frame(s, r, ctx).ok());
+    }
+    FrameReport report;
+    for (int i = 0; i < frames; ++i) {
+      ctx.index = std::uint64_t(i);
+      Status st = run_frame(s, r, ctx, report);
+      EXPECT_TRUE(st.ok()) << st.error().to_string();
+      if (i == 0) r.shaders().first_frame_done();
+    }
+    r.finish();
+    if (aov) *aov = r.read_aovs();
+    return r.read_color();
+  }
+  static gpu::Context* context_;
+};
+gpu::Context* PermutationTest::context_ = nullptr;
+
+TEST_F(PermutationTest, CompilesExactlyTheCombinationsTheSceneUses) {
+  Scene s = scene("materials.json");
+  FrameContext ctx{320, 180, 0, false};
+  const auto requests = render::required_programs(plan_frame(s, ctx));
+  std::set<std::uint32_t> forward, depth;
+  for (const auto& r : requests) (r.pass == Pass::forward ? forward : depth).insert(r.key.bits());
+  // materials.json: ground (none), checker, bumpy metal, glow, foliage (alpha), textured+bumpy,
+  // plain cone (no shadow receiving): 7 distinct forward keys; depth: opaque + alpha mask.
+  EXPECT_EQ(forward.size(), 7u);
+  EXPECT_EQ(depth.size(), 2u);
+
+  auto r = make_renderer();
+  render(*r, s);
+  EXPECT_EQ(r->shaders().built_keys(Pass::forward).size(), forward.size());
+  EXPECT_EQ(r->shaders().built_keys(Pass::depth).size(), depth.size());
+  EXPECT_EQ(r->stats().shaders.programs_compiled, int(forward.size() + depth.size()));
+  for (VariantKey k : r->shaders().built_keys(Pass::forward)) EXPECT_TRUE(forward.count(k.bits()));
+}
+
+TEST_F(PermutationTest, UnusedFeaturesAreNeverCompiled) {
+  Scene s = scene("default.json");
+  auto r = make_renderer();
+  render(*r, s, 3);
+  for (Pass pass : {Pass::forward, Pass::depth})
+    for (VariantKey k : r->shaders().built_keys(pass)) {
+      EXPECT_FALSE(k.has(VariantKey::kBaseColorTexture));
+      EXPECT_FALSE(k.has(VariantKey::kNormalMap));
+      EXPECT_FALSE(k.has(VariantKey::kEmissive));
+      EXPECT_FALSE(k.has(VariantKey::kAlphaMask));
+      EXPECT_FALSE(k.has(VariantKey::kReflectionCube));
+      EXPECT_FALSE(k.has(VariantKey::kAovs));  // not asked for
+    }
+  EXPECT_EQ(r->stats().shaders.programs_compiled, 2);  // one forward, one depth
+}
+
+TEST_F(PermutationTest, EveryVariantMatchesTheUberShaderOracle) {
+  for (const char* filter : {"pcf3x3", "none"}) {
+    Scene a = scene("materials.json", {std::string("shadow.filter=") + filter});
+    Scene b = scene("materials.json", {std::string("shadow.filter=") + filter});
+    auto variants = make_renderer();
+    auto oracle = make_renderer({}, true);
+    Image aov_v, aov_o;
+    const Image v = render(*variants, a, 1, false, true, &aov_v);
+    const Image o = render(*oracle, b, 1, false, true, &aov_o);
+    ASSERT_EQ(v.pixels.size(), o.pixels.size());
+    double worst = 0;
+    for (std::size_t i = 0; i < v.pixels.size(); ++i) worst = std::max(worst, double(std::abs(v.pixels[i] - o.pixels[i])));
+    EXPECT_LE(worst, 1.0 / 255.0 + 1e-6) << filter;
+    float worst_vis = 0;
+    for (int y = 0; y < aov_v.height; ++y)
+      for (int x = 0; x < aov_v.width; ++x) worst_vis = std::max(worst_vis, std::abs(aov_v.at(x, y, 7) - aov_o.at(x, y, 7)));
+    EXPECT_LE(worst_vis, 1e-6f) << filter;
+    // The oracle is one program per pass; the variants are many.
+    EXPECT_EQ(oracle->shaders().built_keys(Pass::forward).size(), 1u);
+    EXPECT_GT(variants->shaders().built_keys(Pass::forward).size(), 5u);
+  }
+}
+
+TEST_F(PermutationTest, PrewarmLeavesNothingToCompileAndTheCacheIsHit) {
+  const fs::path cache = fs::path(KASKAD_TEST_TMP) / "perm_cache";
+  fs::remove_all(cache);
+  Scene s = scene("materials.json");
+  auto cold = make_renderer(cache);
+  ASSERT_TRUE(cold->shaders().binary_cache_supported());
+  render(*cold, s, 20, /*prewarm=*/true);
+  const auto& st = cold->stats().shaders;
+  EXPECT_GT(st.programs_compiled, 0);
+  EXPECT_EQ(st.runtime_compiles, 0);
+  EXPECT_EQ(st.cache_hits, 0);
+
+  Scene s2 = scene("materials.json");
+  auto warm = make_renderer(cache);
+  render(*warm, s2, 2, true);
+  EXPECT_EQ(warm->stats().shaders.programs_compiled, 0);
+  EXPECT_EQ(warm->stats().shaders.cache_hits, st.programs_compiled);
+  EXPECT_EQ(warm->stats().shaders.runtime_compiles, 0);
+
+  // A corrupt cache file is rebuilt from source, not trusted.
+  for (const auto& f : fs::directory_iterator(cache)) std::ofstream(f.path(), std::ios::binary | std::ios::trunc) << "junk";
+  Scene s3 = scene("materials.json");
+  auto rebuilt = make_renderer(cache);
+  render(*rebuilt, s3, 1, true);
+  EXPECT_EQ(rebuilt->stats().shaders.cache_hits, 0);
+  EXPECT_EQ(rebuilt->stats().shaders.programs_compiled, st.programs_compiled);
+}
+
+TEST_F(PermutationTest, HotReloadKeepsTheLastGoodProgramAndMapsErrors) {
+  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "hot_shaders";
+  fs::remove_all(dir);
+  fs::copy(content_dir() / "shaders", dir, fs::copy_options::recursive);
+  Scene s = scene("default.json");
+  auto r = make_renderer({}, false, dir);
+  const Image before = render(*r, s);
+
+  // Break common.glsl (included by every program): each program reports the included file.
+  const fs::path common = dir / "common.glsl";
+  std::string text;
+  {
+    std::ifstream in(common);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const int lines = int(std::count(text.begin(), text.end(), '\n'));
+  std::ofstream(common, std::ios::app) << "this is not glsl;\n";
+  fs::last_write_time(common, fs::last_write_time(common) + std::chrono::seconds(2));
+  const auto errors = r->shaders().reload_changed();
+  ASSERT_EQ(errors.size(), r->shaders().program_count());
+  for (const auto& e : errors)
+    EXPECT_NE(e.to_string().find("common.glsl:" + std::to_string(lines + 1)), std::string::npos) << e.to_string();
+  // Still renders, with the last good programs.
+  const Image during = render(*r, s);
+  EXPECT_EQ(during.pixels, before.pixels);
+
+  // Fix it, with a visible change: everything gets brighter.
+  std::ofstream(common, std::ios::trunc) << text;
+  std::ofstream(dir / "forward.frag", std::ios::app) << "\n";
+  {
+    std::ifstream in(dir / "forward.frag");
+    std::string f((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string from = "o_color = vec4(color * u_ambient.w, 1.0);";
+    ASSERT_NE(f.find(from), std::string::npos);
+    f.replace(f.find(from), from.size(), "o_color = vec4(color * u_ambient.w + 0.2, 1.0);");
+    std::ofstream(dir / "forward.frag", std::ios::trunc) << f;
+  }
+  for (const char* name : {"common.glsl", "forward.frag"})
+    fs::last_write_time(dir / name, fs::last_write_time(dir / name) + std::chrono::seconds(4));
+  EXPECT_TRUE(r->shaders().reload_changed().empty());
+  EXPECT_EQ(r->stats().shaders.runtime_compiles, 0);  // reloads are not runtime compiles
+  const Image after = render(*r, s);
+  EXPECT_GT(r->shaders().stats().reloads, 0);
+  // The ground at the bottom centre is drawn by the reloaded program (the sky is a clear colour).
+  const int x = after.width / 2, y = after.height - 1;
+  EXPECT_GT(after.at(x, y, 0), before.at(x, y, 0) + 0.05f);
+}
+
+}  // namespace
+}  // namespace kaskad

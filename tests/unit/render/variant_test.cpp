@@ -1,0 +1,157 @@
+// Variant keys, the feature manifest and material files: no GL needed.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "runtime/assets/material_file.h"
+#include "runtime/render/feature_manifest.h"
+#include "runtime/render/variant_key.h"
+
+namespace kaskad::render {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kShaders = fs::path(KASKAD_CONTENT_DIR) / "shaders";
+
+FeatureManifest manifest() {
+  auto m = FeatureManifest::load(kShaders / "features.json");
+  EXPECT_TRUE(m.ok()) << m.error().to_string();
+  return m.ok() ? std::move(m.value()) : FeatureManifest();
+}
+
+fs::path temp(const std::string& name, const std::string& text) {
+  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "variants";
+  fs::create_directories(dir);
+  std::ofstream(dir / name, std::ios::binary) << text;
+  return dir / name;
+}
+
+TEST(VariantKey, ManifestRulesAgreeWithTheConstexprRules) {
+  const FeatureManifest m = manifest();
+  std::uint32_t used = 0;
+  for (const auto& f : m.features()) used |= f.field.mask();
+  // Every key over the used bits: both rule sets give the same verdict, and a valid key
+  // filters to itself for the forward pass (it reads everything).
+  int valid = 0;
+  for (std::uint32_t bits = 0; bits < (1u << 24); bits = ((bits | ~used) + 1) & used) {
+    const VariantKey k(bits);
+    EXPECT_EQ(k.valid(), m.check(k).empty()) << std::hex << bits << ": " << m.check(k);
+    if (k.valid()) {
+      ++valid;
+      EXPECT_EQ(k.filtered_for(Pass::forward), k);
+      EXPECT_TRUE(k.filtered_for(Pass::depth).valid());
+    }
+    if (bits == used) break;
+  }
+  EXPECT_GT(valid, 100);
+}
+
+TEST(VariantKey, DefinesComeFromOneFunctionForBothKinds) {
+  const FeatureManifest m = manifest();
+  VariantKey k;
+  k = m.with(k, *m.find("normal_map"), 1);
+  k = m.with(k, *m.find("shadow"), 1);
+  k = m.with(k, *m.find("shadow_filter"), 2);
+  k = m.with(k, *m.find("cascade_count"), 4);
+  const auto defs = m.defines(k, ShaderStage::fragment);
+  auto value = [&](const std::string& name) {
+    for (const auto& [n, v] : defs)
+      if (n == name) return v;
+    return std::string("missing");
+  };
+  EXPECT_EQ(value("MATERIAL_HAS_NORMAL_MAP"), "1");
+  EXPECT_EQ(value("MATERIAL_HAS_EMISSIVE"), "0");
+  EXPECT_EQ(value("VARIANT_HAS_SHADOW"), "1");
+  EXPECT_EQ(value("VARIANT_SHADOW_FILTER"), "2");
+  EXPECT_EQ(value("VARIANT_SHADOW_FILTER_PCF3X3"), "2");
+  EXPECT_EQ(value("VARIANT_CASCADE_COUNT"), "4");
+  EXPECT_EQ(m.describe(k), "normal_map shadow shadow_filter=pcf3x3 cascade_count=4");
+  // Stages: normal_map is fragment-only.
+  for (const auto& [n, v] : m.defines(k, ShaderStage::vertex)) EXPECT_NE(n, "MATERIAL_HAS_NORMAL_MAP");
+}
+
+TEST(VariantKey, InvalidCombinationsAreNamed) {
+  const FeatureManifest m = manifest();
+  VariantKey k;
+  k = m.with(k, *m.find("reflection_cube"), 1);
+  k = m.with(k, *m.find("reflection_sphere"), 1);
+  EXPECT_NE(m.check(k).find("excludes"), std::string::npos) << m.check(k);
+  VariantKey f = m.with(VariantKey(), *m.find("shadow_filter"), 1);
+  EXPECT_NE(m.check(f).find("shadow_filter requires shadow"), std::string::npos) << m.check(f);
+}
+
+TEST(FeatureManifest, BadManifestsAreRejected) {
+  auto bad = [](const std::string& text) { return FeatureManifest::load(temp("features.json", text)); };
+  auto r1 = bad(R"({"features": [{"name": "sparkles", "kind": "material", "define": "MATERIAL_HAS_SPARKLES", "stages": ["fragment"]}]})");
+  ASSERT_FALSE(r1.ok());
+  EXPECT_NE(r1.error().to_string().find("sparkles"), std::string::npos) << r1.error().to_string();
+  auto r2 = bad(R"({"features": [{"name": "normal_map", "kind": "material", "define": "VARIANT_X", "stages": ["fragment"]}]})");
+  ASSERT_FALSE(r2.ok());
+  EXPECT_NE(r2.error().to_string().find("MATERIAL_"), std::string::npos);
+  auto r3 = bad("{ not json");
+  ASSERT_FALSE(r3.ok());
+  EXPECT_NE(r3.error().to_string().find("features.json"), std::string::npos);
+  // A manifest missing a feature the key layout has.
+  auto real = manifest();
+  std::ifstream in(kShaders / "features.json");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto pos = text.find("    { \"name\": \"debug_cascades\"");
+  ASSERT_NE(pos, std::string::npos);
+  std::string cut = text;
+  cut.erase(text.rfind(",\n", pos), text.find('\n', pos) - text.rfind(",\n", pos));
+  auto r4 = bad(cut);
+  ASSERT_FALSE(r4.ok());
+  EXPECT_NE(r4.error().to_string().find("debug_cascades"), std::string::npos) << r4.error().to_string();
+}
+
+struct BadMaterial {
+  const char* name;
+  const char* text;
+  std::vector<const char*> expect;
+};
+
+TEST(MaterialFile, MalformedFilesGiveErrorsNamingFileAndKey) {
+  const FeatureManifest m = manifest();
+  const BadMaterial cases[] = {
+      {"unknown_feature", R"({"features": ["sparkles"]})", {"/features/0", "sparkles", "normal_map"}},
+      {"frame_feature", R"({"features": ["shadow"]})", {"/features/0", "not a material feature"}},
+      {"contradiction", R"({"features": ["reflection_cube", "reflection_sphere"]})", {"/features/0", "exclude each other"}},
+      {"wrong_type", R"({"parameters": {"roughness": "rough"}})", {"/parameters/roughness", "expected a number"}},
+      {"out_of_range", R"({"parameters": {"metallic": 1.5}})", {"/parameters/metallic", "[0, 1]", "1.5"}},
+      {"unknown_param", R"({"parameters": {"shininess": 3}})", {"/parameters/shininess", "roughness"}},
+      {"param_needs_feature", R"({"parameters": {"normal_scale": 2}})", {"/parameters/normal_scale", "normal_map"}},
+      {"texture_needs_feature", R"({"textures": {"normal": "n.png"}})", {"/textures/normal", "normal_map"}},
+      {"feature_needs_texture", R"({"features": ["base_color_texture"]})", {"/textures", "base_color"}},
+      {"missing_texture_file", R"({"features": ["normal_map"], "textures": {"normal": "nope.png"}})", {"/textures/normal", "nope.png"}},
+      {"unknown_key", R"({"feature": []})", {"unknown key 'feature'", "features"}},
+      {"vec_size", R"({"parameters": {"base_color": [1, 1, 1]}})", {"/parameters/base_color", "4 numbers"}},
+      {"malformed", "{\"features\": [", {"line 1", "malformed JSON"}},
+  };
+  for (const auto& c : cases) {
+    AssetStore assets;
+    const fs::path file = temp(std::string(c.name) + ".json", c.text);
+    auto r = load_material_file(file, m, assets);
+    ASSERT_FALSE(r.ok()) << c.name;
+    const std::string msg = r.error().to_string();
+    EXPECT_NE(msg.find(c.name), std::string::npos) << c.name << ": file not named in " << msg;
+    for (const char* e : c.expect) EXPECT_NE(msg.find(e), std::string::npos) << c.name << ": '" << e << "' not in " << msg;
+  }
+}
+
+TEST(MaterialFile, ShippedMaterialsLoad) {
+  const FeatureManifest m = manifest();
+  int loaded = 0;
+  for (const auto& f : fs::directory_iterator(fs::path(KASKAD_CONTENT_DIR) / "materials")) {
+    if (f.path().extension() != ".json") continue;
+    AssetStore assets;
+    auto r = load_material_file(f.path(), m, assets);
+    ASSERT_TRUE(r.ok()) << r.error().to_string();
+    EXPECT_TRUE(VariantKey(r->features).valid());
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 4);
+}
+
+}  // namespace
+}  // namespace kaskad::render
