@@ -3,6 +3,7 @@
 // settings between frames.  usage: kaskad_editor [SCENE] [--set key=value]...
 #include <epoxy/gl.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -93,6 +94,8 @@ int main(int argc, char** argv) {
   ImGui_ImplOpenGL3_Init("#version 450 core");
 
   std::uint64_t frame = 0;
+  auto last_reload_check = std::chrono::steady_clock::now();
+  std::string shader_error;  // last hot-reload failure, shown in the panel until fixed
   int max_frames = -1;  // KASKAD_EDITOR_FRAMES limits the run (for automated screenshots)
   if (const char* f = std::getenv("KASKAD_EDITOR_FRAMES")) max_frames = std::atoi(f);
   while (!glfwWindowShouldClose(window) && (max_frames < 0 || int(frame) < max_frames)) {
@@ -100,7 +103,19 @@ int main(int argc, char** argv) {
     int w = 0, h = 0;
     glfwGetFramebufferSize(window, &w, &h);
     if (w <= 0 || h <= 0) continue;
+    // Hot reload: poll the shader files twice a second. A failed compile keeps the last good
+    // program; its log (mapped to file:line) is shown until a later save fixes it.
+    if (std::chrono::steady_clock::now() - last_reload_check > std::chrono::milliseconds(500)) {
+      last_reload_check = std::chrono::steady_clock::now();
+      const auto before = player->renderer->shaders().stats().reloads;
+      for (const auto& e : player->renderer->shaders().reload_changed()) {
+        shader_error = e.to_string();
+        std::fprintf(stderr, "kaskad_editor: shader reload failed: %s\n", shader_error.c_str());
+      }
+      if (player->renderer->shaders().stats().reloads > before) shader_error.clear();
+    }
     RenderRun run;
+    run.prewarm = frame == 0;
     run.width = w;
     run.height = h;
     run.write_aovs = false;
@@ -122,6 +137,9 @@ int main(int argc, char** argv) {
                 t->last.stats.shadow_gpu_ms, t->last.stats.forward_gpu_ms);
     ImGui::Text("%d draws, %zu shadow triangles", t->last.stats.draw_calls,
                 t->last.stats.shadow_triangles);
+    ImGui::Text("%d programs, %d reloads", int(player->renderer->shaders().program_count()),
+                player->renderer->shaders().stats().reloads);
+    if (!shader_error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", shader_error.c_str());
     scene->world.view<Light, ShadowSettings>().each(
         [&](ecs::Entity e, Light& light, ShadowSettings& s) {
           const Name* n = scene->world.try_get<Name>(e);
