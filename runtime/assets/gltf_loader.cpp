@@ -139,29 +139,6 @@ struct ImageLoadState {
   std::map<int, std::string> failures;  ///< image index -> why it has no pixels
 };
 
-/// TextureData's layout: 8-bit RGBA, grey expanded to RGB, alpha 1 when the image has none.
-std::vector<std::uint8_t> to_rgba8(const Image& image) {
-  auto q = [](float v) -> std::uint8_t {
-    if (!(v > 0.0f)) return 0;
-    if (v >= 1.0f) return 255;
-    return std::uint8_t(std::lround(v * 255.0f));
-  };
-  const std::size_t n = std::size_t(image.width) * std::size_t(image.height);
-  std::vector<std::uint8_t> out(n * 4);
-  for (std::size_t p = 0; p < n; ++p) {
-    const float* s = &image.pixels[p * image.channels];
-    const int c = image.channels;
-    const float r = s[0];
-    const float g = c >= 3 ? s[1] : s[0];
-    const float b = c >= 3 ? s[2] : s[0];
-    const float a = c == 2 ? s[1] : c >= 4 ? s[3] : 1.0f;
-    out[p * 4 + 0] = q(r);
-    out[p * 4 + 1] = q(g);
-    out[p * 4 + 2] = q(b);
-    out[p * 4 + 3] = q(a);
-  }
-  return out;
-}
 
 /// tinygltf image callback: decodes images given by URI (external files, data URIs) through
 /// OIIO. Failures are recorded, not returned: a missing texture should not fail the import.
@@ -1005,8 +982,15 @@ Result<Material> read_material(Importer& im, int index) {
   if (pbr.metallicRoughnessTexture.index >= 0) ignored += " metallicRoughnessTexture";
   if (g.occlusionTexture.index >= 0) ignored += " occlusionTexture";
   if (g.emissiveTexture.index >= 0) ignored += " emissiveTexture";
-  if (g.alphaMode == "MASK" || g.alphaMode == "BLEND") ignored += " alphaMode " + g.alphaMode;
+  if (g.alphaMode == "MASK") {
+    m.alpha_mask = true;
+    m.alpha_cutoff = float(std::clamp(g.alphaCutoff, 0.0, 1.0));
+  } else if (g.alphaMode == "BLEND") {
+    ignored += " alphaMode BLEND (drawn opaque)";
+  }
   if (!ignored.empty()) im.report.warnings.push_back(where + ": not imported:" + ignored);
+  // glTF materials map onto the same feature model as material files.
+  m.features = derive_material_features(m);
 
   im.materials[index] = m;
   return m;

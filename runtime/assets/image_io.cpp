@@ -374,4 +374,18 @@ Status save_image(const std::filesystem::path& path, const Image& image) {
   return {};
 }
 
+std::vector<std::uint8_t> to_rgba8(const Image& image) {
+  const std::size_t n = std::size_t(image.width) * std::size_t(image.height);
+  std::vector<std::uint8_t> out(n * 4);
+  const int c = image.channels;
+  for (std::size_t p = 0; p < n; ++p) {
+    const float* s = &image.pixels[p * std::size_t(c)];
+    out[p * 4 + 0] = to_unorm8(s[0]);
+    out[p * 4 + 1] = to_unorm8(c >= 3 ? s[1] : s[0]);
+    out[p * 4 + 2] = to_unorm8(c >= 3 ? s[2] : s[0]);
+    out[p * 4 + 3] = to_unorm8(c == 2 ? s[1] : c >= 4 ? s[3] : 1.0f);
+  }
+  return out;
+}
+
 }  // namespace kaskad

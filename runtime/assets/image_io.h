@@ -34,6 +34,10 @@ Result<Image> load_image(const std::filesystem::path& path);
 Result<Image> load_image_from_memory(const void* data, std::size_t size, const std::string& name,
                                      const std::string& mime_type = {});
 
+/// 8-bit RGBA (TextureData's layout): grey expands to RGB, a missing alpha is 1, values are clamped
+/// to [0,1] and rounded.
+std::vector<std::uint8_t> to_rgba8(const Image& image);
+
 /// Writes an image; the format follows the extension. 8-bit formats (PNG, JPEG) get values clamped
 /// to [0,1] and quantised; EXR keeps 32-bit float and channel_names. Reading an EXR back may
 /// reorder its channels (OIIO puts R, G, B, A first): look channels up by name.

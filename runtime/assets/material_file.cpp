@@ -23,16 +23,7 @@ Result<TextureId> load_texture(const std::filesystem::path& path, bool srgb, Ass
   t.width = image->width;
   t.height = image->height;
   t.srgb = srgb;
-  t.rgba8.resize(std::size_t(t.width) * t.height * 4);
-  // Grey (+alpha) expands to RGB (+alpha); a missing alpha is 1.
-  const int ch = image->channels;
-  for (std::size_t p = 0; p < std::size_t(t.width) * t.height; ++p) {
-    const float* src = &image->pixels[p * std::size_t(ch)];
-    const float rgba[4] = {src[0], ch >= 3 ? src[1] : src[0], ch >= 3 ? src[2] : src[0],
-                           ch == 4 ? src[3] : (ch == 2 ? src[1] : 1.0f)};
-    for (int c = 0; c < 4; ++c)
-      t.rgba8[p * 4 + std::size_t(c)] = std::uint8_t(std::clamp(rgba[c], 0.0f, 1.0f) * 255.0f + 0.5f);
-  }
+  t.rgba8 = to_rgba8(*image);
   return assets.add_texture(std::move(t));
 }
 

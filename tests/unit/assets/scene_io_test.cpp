@@ -6,6 +6,7 @@
 
 #include "components/camera.h"
 #include "components/light.h"
+#include "components/material.h"
 #include "components/model.h"
 #include "components/name.h"
 #include "components/transform.h"
@@ -183,6 +184,30 @@ TEST(SceneIo, SaveToUnwritablePlaceFailsCleanly) {
   Status st = save_scene(temp_dir() / "no" / "such" / "dir" / "x.json", *s);
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.error().to_string().find("x.json"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace kaskad
+
+namespace kaskad {
+namespace {
+
+TEST(SceneIo, GltfMaterialsMapOntoFeatureBits) {
+  auto s = read_scene(kContent / "models/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf");
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  ASSERT_TRUE(instantiate_scene(*s).ok());
+  int textured = 0, plain = 0;
+  s->world.view<Material>().each([&](ecs::Entity, const Material& m) {
+    EXPECT_EQ(m.features, derive_material_features(m));
+    if (m.base_color_texture != kNoTexture) {
+      EXPECT_TRUE(m.features & 1u);  // VariantKey::kBaseColorTexture
+      ++textured;
+    } else {
+      ++plain;
+    }
+  });
+  EXPECT_GT(textured, 0);
+  EXPECT_GT(plain, 0);
 }
 
 }  // namespace
