@@ -10,35 +10,20 @@
 #include "runtime/gpu/context.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/gpu/shader.h"
+#include "tests/render/headless_gl.h"
 
 namespace kaskad {
 namespace {
 
-class GlTest : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    gpu::ContextOptions opt;
-    opt.headless = true;
-    auto ctx = gpu::Context::create(opt);
-    ASSERT_TRUE(ctx.ok()) << ctx.error().to_string();
-    context_ = std::move(ctx.value()).release();
-  }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
-  void SetUp() override { gpu::reset_debug_error_count(); }
-  static gpu::Context* context_;
-};
-gpu::Context* GlTest::context_ = nullptr;
+using GlTest = HeadlessGlTest;
 
 TEST_F(GlTest, ContextIsOpenGL45Core) {
   EXPECT_GE(epoxy_gl_version(), 45);
   GLint mask = 0;
   glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &mask);
   EXPECT_TRUE(mask & GL_CONTEXT_CORE_PROFILE_BIT);
-  EXPECT_FALSE(context_->description().empty());
-  EXPECT_TRUE(context_->headless());
+  EXPECT_FALSE(context()->description().empty());
+  EXPECT_TRUE(context()->headless());
 }
 
 TEST_F(GlTest, DebugOutputCountsGlErrors) {

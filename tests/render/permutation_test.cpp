@@ -10,6 +10,7 @@
 #include "runtime/cli/player.h"
 #include "runtime/gpu/context.h"
 #include "systems/frame.h"
+#include "tests/render/headless_gl.h"
 
 namespace kaskad {
 namespace {
@@ -18,21 +19,8 @@ namespace fs = std::filesystem;
 using render::Pass;
 using render::VariantKey;
 
-class PermutationTest : public ::testing::Test {
+class PermutationTest : public HeadlessGlTest {
  protected:
-  static void SetUpTestSuite() {
-    gpu::ContextOptions opt;
-    opt.headless = true;
-    auto ctx = gpu::Context::create(opt);
-    ASSERT_TRUE(ctx.ok()) << ctx.error().to_string();
-    context_ = ctx.value().release();
-  }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
-  void SetUp() override { gpu::reset_debug_error_count(); }
-  void TearDown() override { EXPECT_EQ(gpu::debug_error_count(), 0) << "GL errors were logged"; }
 
   static std::unique_ptr<render::Renderer> make_renderer(const fs::path& cache = {},
                                                          bool oracle = false,
@@ -72,9 +60,7 @@ class PermutationTest : public ::testing::Test {
     if (aov) *aov = r.read_aovs();
     return r.read_color();
   }
-  static gpu::Context* context_;
 };
-gpu::Context* PermutationTest::context_ = nullptr;
 
 TEST_F(PermutationTest, CompilesExactlyTheCombinationsTheSceneUses) {
   Scene s = scene("materials.json");
