@@ -11,6 +11,7 @@
 //   4. validate the node hierarchy (indices, single parent) and pick the root nodes;
 //   5. walk the hierarchy parents-first, creating node entities, primitive child entities (meshes
 //      and materials are converted once, on first use) and lights and cameras.
+#include "runtime/core/file_io.h"
 #include "runtime/assets/gltf_loader.h"
 
 #include <draco/compression/decode.h>
@@ -168,23 +169,6 @@ bool load_image_callback(tinygltf::Image* image, const int index, std::string* /
 
 // ---- Reading and parsing the file -----------------------------------------------------------
 
-Result<std::vector<std::uint8_t>> read_whole_file(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(status)) return Error{file, "", "file not found"};
-  if (std::filesystem::is_directory(status)) return Error{file, "", "is a directory, not a file"};
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) return Error{file, "", "cannot read file size: " + ec.message()};
-  if (size == 0) return Error{file, "", "empty file (0 bytes)"};
-  if (size > kMaxFileBytes) return Error{file, "", "file larger than 1 GiB"};
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{file, "", "cannot open file for reading"};
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
-  in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size()));
-  if (std::size_t(in.gcount()) != bytes.size()) return Error{file, "", "short read"};
-  return bytes;
-}
 
 /// Refuses JSON nested deeper than kMaxJsonDepth (brackets outside strings are counted).
 Status check_json_depth(const std::uint8_t* json, std::size_t size, const std::string& file) {
@@ -262,7 +246,7 @@ std::vector<std::uint8_t> replace_glb_json(const std::vector<std::uint8_t>& glb,
 Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadState& images,
                                    std::vector<std::string>& warnings) {
   const std::string file = path.string();
-  auto bytes = read_whole_file(path);
+  auto bytes = read_file_bytes(path, kMaxFileBytes);
   if (!bytes) return bytes.error();
   std::vector<std::uint8_t>& data = bytes.value();
 

@@ -4,6 +4,7 @@
 // format comes from the file's magic bytes, then the MIME type, then the extension. We never let
 // OIIO "try every reader in turn" on unknown bytes (what ImageInput::open(filename) does when the
 // extension does not match), so corrupt or hostile data reaches at most one decoder.
+#include "runtime/core/file_io.h"
 #include "runtime/assets/image_io.h"
 
 #include <OpenImageIO/filesystem.h>
@@ -251,25 +252,6 @@ Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::stri
   return image;
 }
 
-/// Reads a whole file, with messages for the common ways this fails.
-Result<std::vector<std::uint8_t>> read_file(const std::filesystem::path& path) {
-  const std::string name = path.string();
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(status)) return Error{name, "", "file not found"};
-  if (std::filesystem::is_directory(status)) return Error{name, "", "is a directory, not a file"};
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) return Error{name, "", "cannot read file size: " + ec.message()};
-  if (size == 0) return Error{name, "", "empty file (0 bytes)"};
-  if (size > kMaxFileBytes) return Error{name, "", "file larger than 2 GiB"};
-
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return Error{name, "", "cannot open file for reading"};
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
-  file.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size()));
-  if (std::size_t(file.gcount()) != bytes.size()) return Error{name, "", "short read"};
-  return bytes;
-}
 
 /// Formats written as 32-bit float; everything else is written as 8 bits per channel.
 bool is_float_format(const std::string& ext) {
@@ -287,7 +269,7 @@ std::uint8_t to_unorm8(float v) {
 
 Result<Image> load_image(const std::filesystem::path& path) {
   try {
-    auto bytes = read_file(path);
+    auto bytes = read_file_bytes(path, kMaxFileBytes);
     if (!bytes) return bytes.error();
     const auto& b = bytes.value();
     return decode(b.data(), b.size(), path.string(),

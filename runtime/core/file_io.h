@@ -1,0 +1,36 @@
+// Whole-file reads with messages for the common ways they fail.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "runtime/core/result.h"
+
+namespace kaskad {
+
+/// The bytes of a file. Errors name the file: missing, a directory, empty, larger than
+/// `max_bytes`, unreadable, or shorter than its size said.
+inline Result<std::vector<std::uint8_t>> read_file_bytes(const std::filesystem::path& path,
+                                                         std::uintmax_t max_bytes) {
+  const std::string name = path.string();
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) return Error{name, "", "file not found"};
+  if (std::filesystem::is_directory(status)) return Error{name, "", "is a directory, not a file"};
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return Error{name, "", "cannot read file size: " + ec.message()};
+  if (size == 0) return Error{name, "", "empty file (0 bytes)"};
+  if (size > max_bytes)
+    return Error{name, "", "file larger than " + std::to_string(max_bytes >> 20) + " MiB"};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{name, "", "cannot open file for reading"};
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
+  in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size()));
+  if (std::size_t(in.gcount()) != bytes.size()) return Error{name, "", "short read"};
+  return bytes;
+}
+
+}  // namespace kaskad
