@@ -9,6 +9,7 @@
 
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
+#include "runtime/cli/bench.h"
 #include "runtime/cli/player.h"
 #include "runtime/core/log.h"
 #include "runtime/gpu/context.h"
@@ -29,6 +30,9 @@ usage:
                                     write the canonical scene file (after overrides)
   kaskad variants [SCENE] [--set key=value]... [--aov]
                                     list the shader variants (pass, key, defines) the scene needs
+  kaskad bench [SCENE]... [--sweep SPEC] [--out DIR] [--frames N] [--size WxH] [--no-chart]
+                                    sweep settings, write DIR/bench.csv and one speed-vs-accuracy
+                                    chart per scene (default sweep: see README)
   kaskad info                       print the OpenGL context kaskad gets on this machine
 
 render options:
@@ -47,6 +51,10 @@ render options:
 struct Args {
   std::string command;
   std::string scene;
+  std::vector<std::string> more_scenes;  ///< bench: every SCENE after the first
+  std::string sweep;
+  std::string out_dir;
+  bool chart = true;
   std::string output;
   std::string aov;
   std::string shadow_map;
@@ -80,7 +88,8 @@ Args parse_args(int argc, char** argv) {
     std::fputs(kUsage, stdout);
     std::exit(0);
   }
-  if (a.command != "render" && a.command != "save" && a.command != "info" && a.command != "variants")
+  if (a.command != "render" && a.command != "save" && a.command != "info" &&
+      a.command != "variants" && a.command != "bench")
     usage_error("unknown command '" + a.command + "'");
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -99,6 +108,12 @@ Args parse_args(int argc, char** argv) {
       a.aov = value();
     } else if (arg == "--shadow-map") {
       a.shadow_map = value();
+    } else if (arg == "--sweep") {
+      a.sweep = value();
+    } else if (arg == "--out") {
+      a.out_dir = value();
+    } else if (arg == "--no-chart") {
+      a.chart = false;
     } else if (arg == "--set") {
       a.sets.push_back(value());
     } else if (arg == "--frames") {
@@ -119,6 +134,8 @@ Args parse_args(int argc, char** argv) {
       usage_error("unknown option '" + arg + "'");
     } else if (a.scene.empty()) {
       a.scene = arg;
+    } else if (a.command == "bench") {
+      a.more_scenes.push_back(arg);
     } else {
       usage_error("unexpected argument '" + arg + "'");
     }
@@ -177,6 +194,22 @@ int run_variants(const Args& a) {
       defs += " " + f.define + "=" + std::to_string(manifest->value(f, r.key));
     std::printf("        defines:%s\n", defs.c_str());
   }
+  return 0;
+}
+
+int run_bench_command(const Args& a, bool frames_given) {
+  BenchOptions o;
+  if (!a.scene.empty()) o.scenes.push_back(a.scene);
+  for (const auto& s : a.more_scenes) o.scenes.push_back(s);
+  o.sweep = a.sweep;
+  if (!a.out_dir.empty()) o.out_dir = a.out_dir;
+  if (frames_given) o.frames = a.frames;
+  if (a.width > 0) {
+    o.width = a.width;
+    o.height = a.height;
+  }
+  o.chart = a.chart;
+  if (auto st = run_bench(o); !st) return fail(st.error());
   return 0;
 }
 
@@ -265,5 +298,10 @@ int main(int argc, char** argv) {
   if (a.command == "info") return run_info(a);
   if (a.command == "save") return run_save(a);
   if (a.command == "variants") return run_variants(a);
+  if (a.command == "bench") {
+    bool frames_given = false;
+    for (int i = 2; i < argc; ++i) frames_given |= std::strcmp(argv[i], "--frames") == 0;
+    return run_bench_command(a, frames_given);
+  }
   return run_render(a);
 }

@@ -62,5 +62,31 @@ printf '{ "entities": [ { "name": "b", "primitive": { "shape": "box" } } ] }' >"
 check no_camera nonzero "no camera" -- "$KASKAD" render "$tmp/nocam.json" --headless
 check unwritable_output nonzero "cannot|could not|error" -- "$KASKAD" render --headless --size 32x32 --frames 1 -o /proc/nope/x.png
 
+# kaskad bench: CSV with the documented columns, a chart, and a bad configuration (256^2 map, no
+# bias) scoring worse than the default one on misclassified pixels.
+check bench_runs 0 "wrote .*bench.csv \(8 rows\)" -- "$KASKAD" bench --size 200x112 --frames 2 --out "$tmp/bench" \
+  --sweep "shadow.map_size=256,2048;shadow.slope_bias=0,3;shadow.constant_bias=0,2"
+if [ -s "$tmp/bench/default.png" ]; then echo "ok   bench_chart"; passed=$((passed + 1)); else echo "FAIL bench_chart: no default.png"; failed=$((failed + 1)); fi
+check bench_csv 0 "bad worse than default" -- /usr/bin/python3 -c '
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+need = ["scene", "config", "frame_ms", "gpu_shadow_ms", "shadow_triangles", "misclassified_pct",
+        "false_shadow_pct", "false_light_pct", "rmse", "mae", "misclassified_pct_noedge"]
+missing = [c for c in need if c not in rows[0]]
+assert not missing, missing
+for r in rows:
+    for c in need[2:]:
+        float(r[c])
+pick = lambda s: [r for r in rows if r["settings"] == s][0]
+bad = pick("shadow.map_size=256;shadow.slope_bias=0;shadow.constant_bias=0")
+good = pick("shadow.map_size=2048;shadow.slope_bias=3;shadow.constant_bias=2")
+b, g = float(bad["misclassified_pct"]), float(good["misclassified_pct"])
+print("misclassified bad %.3f%% good %.3f%%" % (b, g))
+assert b > g
+print("bad worse than default")
+' "$tmp/bench/bench.csv"
+check bench_bad_sweep nonzero "--sweep.*expected key=value" -- "$KASKAD" bench --sweep "shadow.map_size" --no-chart --out "$tmp/bench2"
+check bench_bad_value nonzero "map_size.*power of two" -- "$KASKAD" bench --sweep "shadow.map_size=100" --no-chart --out "$tmp/bench3"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -1,0 +1,264 @@
+#include "runtime/cli/bench.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "components/light.h"
+#include "components/shadow_settings.h"
+#include "components/transform.h"
+#include "runtime/cli/player.h"
+#include "runtime/reference/ray_tracer.h"
+#include "runtime/reference/shadow_metrics.h"
+
+namespace kaskad {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_sigint(int) { g_interrupted = true; }
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::string cur;
+  std::istringstream in(s);
+  while (std::getline(in, cur, sep)) out.push_back(cur);
+  if (!s.empty() && s.back() == sep) out.push_back("");
+  return out;
+}
+
+std::string trim(std::string s) {
+  const auto b = s.find_first_not_of(" \t");
+  const auto e = s.find_last_not_of(" \t");
+  return b == std::string::npos ? "" : s.substr(b, e - b + 1);
+}
+
+std::string csv_quote(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string clock_text(double seconds) {
+  const int s = int(seconds + 0.5);
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "%02d:%02d", s / 60, s % 60);
+  return buf;
+}
+
+void progress(std::size_t done, std::size_t total, double elapsed_s, const std::string& what) {
+  const int width = 28;
+  const int filled = total ? int(double(done) / double(total) * width) : width;
+  const double eta = done ? elapsed_s / double(done) * double(total - done) : 0.0;
+  std::fprintf(stderr, "\r[%s%s] %zu/%zu  elapsed %s  ETA %s  %-40.40s", std::string(std::size_t(filled), '#').c_str(),
+               std::string(std::size_t(width - filled), '-').c_str(), done, total,
+               clock_text(elapsed_s).c_str(), done ? clock_text(eta).c_str() : "--:--", what.c_str());
+  std::fflush(stderr);
+}
+
+}  // namespace
+
+std::string default_sweep() {
+  return "shadow.map_size=1024,2048,4096;shadow.filter=none,pcf3x3";
+}
+
+Result<std::vector<BenchConfig>> parse_sweep(const std::string& spec) {
+  std::vector<BenchConfig> configs{{"", {}}};
+  std::set<std::string> keys;
+  for (const std::string& part_raw : split(spec, ';')) {
+    const std::string part = trim(part_raw);
+    if (part.empty()) continue;
+    const auto eq = part.find('=');
+    if (eq == std::string::npos || eq == 0)
+      return Error{"--sweep", part, "expected key=value1,value2,... (e.g. shadow.map_size=1024,2048)"};
+    const std::string key = trim(part.substr(0, eq));
+    if (!keys.insert(key).second) return Error{"--sweep", key, "key given twice"};
+    std::vector<std::string> values;
+    for (const auto& v : split(part.substr(eq + 1), ','))
+      if (!trim(v).empty()) values.push_back(trim(v));
+    if (values.empty()) return Error{"--sweep", key, "no values"};
+    std::vector<BenchConfig> next;
+    for (const auto& c : configs)
+      for (const auto& v : values) {
+        BenchConfig n = c;
+        n.sets.push_back(key + "=" + v);
+        // Appended piecewise: `a + b + c` on strings trips GCC 12's false -Wrestrict (PR 105651).
+        if (!n.label.empty()) n.label += ' ';
+        n.label += key.substr(key.rfind('.') + 1);
+        n.label += '=';
+        n.label += v;
+        next.push_back(std::move(n));
+      }
+    configs = std::move(next);
+  }
+  if (configs.size() == 1 && configs[0].label.empty()) configs[0].label = "scene settings";
+  return configs;
+}
+
+std::vector<std::string> bench_csv_columns() {
+  return {"scene", "config", "settings", "width", "height", "frames", "frame_ms", "frame_ms_min",
+          "frame_ms_max", "cpu_transforms_ms", "cpu_camera_ms", "cpu_shadows_ms",
+          "cpu_draw_list_ms", "cpu_render_ms", "gpu_shadow_ms", "gpu_forward_ms", "draw_calls",
+          "shadow_draw_calls", "shadow_triangles", "scene_triangles", "shadow_map_mib",
+          "receiver_pixels", "misclassified_pct", "false_shadow_pct", "false_light_pct", "rmse",
+          "mae", "misclassified_pct_noedge", "false_shadow_pct_noedge", "false_light_pct_noedge",
+          "rmse_noedge", "mae_noedge", "reference_mrays_per_s"};
+}
+
+Status run_bench(const BenchOptions& options) {
+  auto configs = parse_sweep(options.sweep.empty() ? default_sweep() : options.sweep);
+  if (!configs) return configs.error();
+  std::vector<fs::path> scenes = options.scenes;
+  if (scenes.empty()) scenes.push_back(content_dir() / "scenes" / "default.json");
+  std::error_code ec;
+  fs::create_directories(options.out_dir, ec);
+  if (ec) return Error{options.out_dir.string(), "", "cannot create the output folder: " + ec.message()};
+  const fs::path csv_path = options.out_dir / "bench.csv";
+  std::ofstream csv(csv_path, std::ios::trunc);
+  if (!csv) return Error{csv_path.string(), "", "cannot write"};
+  const auto columns = bench_csv_columns();
+  for (std::size_t i = 0; i < columns.size(); ++i) csv << (i ? "," : "") << columns[i];
+  csv << "\n";
+  csv.flush();
+
+  gpu::ContextOptions copt;
+  copt.headless = true;
+  auto player = Player::create(copt);
+  if (!player) return player.error();
+
+  g_interrupted = false;
+  auto previous = std::signal(SIGINT, on_sigint);
+  const std::size_t total = scenes.size() * configs->size();
+  std::size_t done = 0;
+  const auto t0 = Clock::now();
+  std::fprintf(stderr, "kaskad bench: %zu scene(s) x %zu configuration(s), %d frames each at %dx%d -> %s\n",
+               scenes.size(), configs->size(), options.frames, options.width, options.height,
+               csv_path.string().c_str());
+  Status result;
+  for (const fs::path& scene_path : scenes) {
+    for (const BenchConfig& config : *configs) {
+      if (g_interrupted) break;
+      progress(done, total, std::chrono::duration<double>(Clock::now() - t0).count(),
+               scene_path.stem().string() + ": " + config.label);
+      std::vector<std::string> sets = config.sets;
+      sets.push_back("render.width=" + std::to_string(options.width));
+      sets.push_back("render.height=" + std::to_string(options.height));
+      auto scene = load_scene(scene_path, sets);
+      if (!scene) {
+        result = scene.error();
+        break;
+      }
+      // 1. Timing: warm-up frame + `frames` timed frames, AOVs off (as a game would render).
+      RenderRun run;
+      run.frames = options.frames + 1;
+      run.write_aovs = false;
+      auto timing = render_frames(*player, *scene, run);
+      if (!timing) {
+        result = timing.error();
+        break;
+      }
+      // 2. Accuracy: one more frame with AOVs, against the Embree reference.
+      RenderRun aov_run;
+      aov_run.frames = 1;
+      aov_run.prewarm = true;
+      auto with_aovs = render_frames(*player, *scene, aov_run);
+      if (!with_aovs) {
+        result = with_aovs.error();
+        break;
+      }
+      const Image aov = player->renderer->read_aovs();
+      const FrameReport& rep = timing->last;
+      std::size_t scene_triangles = 0;
+      for (const auto& m : scene->assets.meshes) scene_triangles += m.triangle_count();
+      double map_mib = 0.0;
+      reference::ShadowMetrics metrics;
+      double mrays = 0.0;
+      const ecs::Entity light = with_aovs->last.shadow.light;
+      if (light.valid()) {
+        if (const auto* s = scene->world.try_get<ShadowSettings>(light))
+          map_mib = double(s->map_size) * s->map_size * 4.0 / (1024.0 * 1024.0);
+        auto tracer = reference::RayTracer::build(*scene);
+        if (!tracer) {
+          result = tracer.error();
+          break;
+        }
+        const auto rlight = reference::reference_light(scene->world.get<Light>(light),
+                                                       scene->world.get<WorldTransform>(light).matrix);
+        auto ref = tracer->shadow_reference(aov, rlight, {});
+        if (!ref) {
+          result = ref.error();
+          break;
+        }
+        mrays = ref->rays_per_second() * 1e-6;
+        auto m = reference::compare_shadows(aov, ref->image);
+        if (!m) {
+          result = m.error();
+          break;
+        }
+        metrics = *m;
+      }
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      auto metric = [&](double v) { return light.valid() ? fmt(v) : fmt(nan); };
+      std::string settings;
+      for (const auto& s : config.sets) {
+        if (!settings.empty()) settings += ';';
+        settings += s;
+      }
+      const auto& st = rep.stats;
+      std::vector<std::string> row = {
+          scene_path.stem().string(), config.label, settings, std::to_string(options.width),
+          std::to_string(options.height), std::to_string(options.frames),
+          fmt(timing->median_ms()),
+          fmt(*std::min_element(timing->frame_ms.begin(), timing->frame_ms.end())),
+          fmt(*std::max_element(timing->frame_ms.begin(), timing->frame_ms.end())),
+          fmt(rep.transforms_ms), fmt(rep.camera_ms), fmt(rep.shadows_ms), fmt(rep.draw_list_ms),
+          fmt(rep.render_ms), fmt(st.shadow_gpu_ms), fmt(st.forward_gpu_ms),
+          std::to_string(st.draw_calls), std::to_string(st.shadow_draw_calls),
+          std::to_string(st.shadow_triangles), std::to_string(scene_triangles), fmt(map_mib),
+          std::to_string(metrics.all.pixels), metric(metrics.all.misclassified_pct),
+          metric(metrics.all.false_shadow_pct), metric(metrics.all.false_light_pct),
+          metric(metrics.all.rmse), metric(metrics.all.mean_abs_error),
+          metric(metrics.outside_edges.misclassified_pct),
+          metric(metrics.outside_edges.false_shadow_pct),
+          metric(metrics.outside_edges.false_light_pct), metric(metrics.outside_edges.rmse),
+          metric(metrics.outside_edges.mean_abs_error), fmt(mrays)};
+      for (std::size_t i = 0; i < row.size(); ++i) csv << (i ? "," : "") << csv_quote(row[i]);
+      csv << "\n";
+      csv.flush();  // rows survive Ctrl-C and crashes
+      ++done;
+    }
+    if (!result.ok() || g_interrupted) break;
+  }
+  std::signal(SIGINT, previous);
+  progress(done, total, std::chrono::duration<double>(Clock::now() - t0).count(),
+           g_interrupted ? "interrupted" : "done");
+  std::fprintf(stderr, "\n");
+  if (!result.ok()) return result;
+  std::printf("wrote     %s (%zu rows%s)\n", fs::absolute(csv_path).string().c_str(), done,
+              g_interrupted ? ", interrupted" : "");
+  if (options.chart && done > 0) {
+    const fs::path script = content_dir().parent_path() / "scripts" / "bench_chart.py";
+    const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + csv_path.string() +
+                            "' '" + options.out_dir.string() + "'";
+    if (std::system(cmd.c_str()) != 0)
+      return Error{script.string(), "", "chart script failed (is python3-matplotlib installed?)"};
+  }
+  return {};
+}
+
+}  // namespace kaskad

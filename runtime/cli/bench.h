@@ -1,0 +1,47 @@
+// `kaskad bench`: sweeps render settings over scenes and charts speed against accuracy.
+// For every scene x configuration: frame time (median of N frames after warm-up, AOVs off), CPU
+// time per phase, GPU time per pass, counters, and shadow accuracy against the Embree reference
+// (runtime/reference) on the AOVs of one more frame. Rows go to a CSV as they finish (Ctrl-C keeps
+// them); a matplotlib script (scripts/bench_chart.py, run with /usr/bin/python3) draws one chart per
+// scene: frame ms on x, error on y, the Pareto front highlighted.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "runtime/core/result.h"
+
+namespace kaskad {
+
+struct BenchOptions {
+  std::vector<std::filesystem::path> scenes;  ///< empty: the default scene
+  std::string sweep;                          ///< "key=a,b;key2=c,d" (empty: default_sweep())
+  std::filesystem::path out_dir = "out/bench";
+  int frames = 10;  ///< timed frames per configuration (after one warm-up frame)
+  int width = 640;
+  int height = 360;
+  bool chart = true;  ///< run scripts/bench_chart.py after the sweep
+};
+
+/// One configuration: a label and its --set overrides.
+struct BenchConfig {
+  std::string label;
+  std::vector<std::string> sets;
+};
+
+/// The sweep used when none is given: the settings whose speed/accuracy trade-off matters.
+std::string default_sweep();
+
+/// Parses "key=v1,v2;key2=w1,w2" into the cartesian product, in order. Errors: empty keys,
+/// missing '=', empty value lists, a key given twice.
+Result<std::vector<BenchConfig>> parse_sweep(const std::string& spec);
+
+/// The CSV header, one name per column (documented in README.md "kaskad bench").
+std::vector<std::string> bench_csv_columns();
+
+/// Runs the sweep. Prints a progress bar with ETA on stderr; SIGINT stops after the current
+/// configuration, keeping the rows written so far. Writes OUT/bench.csv and OUT/<scene>.png.
+Status run_bench(const BenchOptions& options);
+
+}  // namespace kaskad

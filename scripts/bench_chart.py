@@ -1,0 +1,73 @@
+#!/usr/bin/python3
+"""Speed against accuracy charts for `kaskad bench`: one PNG per scene from bench.csv.
+
+usage: /usr/bin/python3 scripts/bench_chart.py BENCH.csv OUT_DIR [ERROR_COLUMN]
+x: median frame ms; y: ERROR_COLUMN (default misclassified_pct); the Pareto front (no other
+configuration is both faster and more accurate) is highlighted and every point is labelled.
+"""
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def pareto(points):
+    """Indices of points not dominated in (x, y), both minimised."""
+    front = []
+    for i, (x, y) in enumerate(points):
+        dominated = any(
+            (x2 <= x and y2 <= y) and (x2 < x or y2 < y) for j, (x2, y2) in enumerate(points) if j != i
+        )
+        if not dominated:
+            front.append(i)
+    return sorted(front, key=lambda i: points[i][0])
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit(__doc__)
+    path, out_dir = sys.argv[1], sys.argv[2]
+    column = sys.argv[3] if len(sys.argv) > 3 else "misclassified_pct"
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        sys.exit(f"{path}: no rows")
+    if column not in rows[0]:
+        sys.exit(f"{path}: no column '{column}'")
+    by_scene = {}
+    for r in rows:
+        by_scene.setdefault(r["scene"], []).append(r)
+    for scene, rs in by_scene.items():
+        pts, labels = [], []
+        for r in rs:
+            x, y = float(r["frame_ms"]), float(r[column])
+            if math.isfinite(x) and math.isfinite(y):
+                pts.append((x, y))
+                labels.append(r["config"])
+        fig, ax = plt.subplots(figsize=(9, 6), dpi=110)
+        if pts:
+            front = pareto(pts)
+            ax.scatter([p[0] for p in pts], [p[1] for p in pts], color="#8899aa", label="configuration")
+            ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "-o", color="#d04020",
+                    label="Pareto front")
+            for (x, y), text in zip(pts, labels):
+                ax.annotate(text, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+        ax.set_xlabel("frame time, median (ms)")
+        ax.set_ylabel(column.replace("_", " "))
+        ax.set_title(f"{scene}: speed against accuracy")
+        ax.grid(True, alpha=0.3)
+        ax.legend()
+        out = os.path.join(out_dir, f"{scene}.png")
+        fig.tight_layout()
+        fig.savefig(out)
+        plt.close(fig)
+        print(f"wrote     {os.path.abspath(out)}")
+
+
+if __name__ == "__main__":
+    main()
