@@ -37,7 +37,7 @@ render options:
   --frames N             frames to render; times are the median of frames 2..N (default 10)
   --set KEY=VALUE        override a setting or component field, e.g. shadow.map_size=4096,
                          sun.light.intensity=3, camera.camera.fov_y_deg=40 (repeatable)
-  --aov FILE.exr         write the AOVs of the last frame (P, N, Z, visibility, mask)
+  --aov FILE.exr         write the AOVs of the last frame (P, N, Z, visibility, mask, cascade)
   --shadow-map FILE      write the shadow map depth of the last frame
   --headless             never open a window (default when there is no display)
   --window               open a window even if --headless would be the default
@@ -242,7 +242,7 @@ int run_render(Args a) {
   std::printf("wrote     %s\n", fs::absolute(out).string().c_str());
   if (!a.aov.empty()) {
     if (auto s = save_image(a.aov, player->renderer->read_aovs()); !s) return fail(s.error());
-    std::printf("wrote     %s (AOVs: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask)\n",
+    std::printf("wrote     %s (AOVs: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade)\n",
                 fs::absolute(a.aov).string().c_str());
   }
   if (!a.shadow_map.empty()) {

@@ -190,7 +190,8 @@ INSTANTIATE_TEST_SUITE_P(
 TEST_F(DefaultSceneTest, BadConfigurationIsCaughtByTheSameCheck) {
   // No bias and a tiny map: acne and blocky edges. The check above must be able to fail.
   const Agreement a = render_and_compare(
-      {"shadow.map_size=64", "shadow.constant_bias=0", "shadow.slope_bias=0", "shadow.filter=none"});
+      {"shadow.map_size=64", "shadow.constant_bias=0", "shadow.slope_bias=0",
+       "shadow.normal_offset_bias=0", "shadow.filter=none"});
   std::printf("[ bad config ] %.3f%% agree\n", 100.0 * a.ratio());
   EXPECT_LT(a.ratio(), 0.99);
 }
@@ -198,7 +199,8 @@ TEST_F(DefaultSceneTest, BadConfigurationIsCaughtByTheSameCheck) {
 TEST_F(DefaultSceneTest, AovChannelsFollowTheContract) {
   Image aov;
   render_and_compare({}, &aov);
-  ASSERT_EQ(aov.channels, 9);
+  ASSERT_EQ(aov.channels, 10);
+  ASSERT_EQ(aov.channel_names[9], "cascade");
   ASSERT_EQ(aov.channel_names[7], "visibility");
   int drawn = 0, background = 0;
   for (int y = 0; y < aov.height; ++y)
