@@ -801,6 +801,11 @@ TEST(ShadowSettingsValidate, DefaultsAreValidAndBadValuesNamed) {
   s = ShadowSettings{};
   s.fit_mode = static_cast<FitMode>(7);
   EXPECT_NE(validate_shadow_settings(s).find("fit_mode"), std::string::npos);
+  s = ShadowSettings{};
+  s.fit_mode = FitMode::scene;
+  EXPECT_EQ(validate_shadow_settings(s), "fit_mode scene needs cascade_count 1, was 4");
+  s.cascade_count = 1;
+  EXPECT_EQ(validate_shadow_settings(s), "");
 }
 
 }  // namespace
