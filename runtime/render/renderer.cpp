@@ -426,13 +426,13 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(s.slope_bias, s.constant_bias);
     const std::vector<std::uint32_t> order = sorted_by(Pass::depth);
+    GLuint current = 0;  // kept across layers: the light matrix is a per-draw uniform
     for (int c = 0; c < cascades; ++c) {
       glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0,
                                      c);
       glClear(GL_DEPTH_BUFFER_BIT);
       if (frame.shadow.skipped[std::size_t(c)]) continue;
       const glm::mat4& light_vp = frame.shadow.view_proj[std::size_t(c)];
-      GLuint current = 0;
       for (std::uint32_t i : order) {
         const DrawItem& d = frame.draws[i];
         if (!d.cast_shadows || !(d.cascade_mask & (1u << c))) continue;
