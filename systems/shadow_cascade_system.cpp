@@ -148,10 +148,11 @@ ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& ca
   // 3. FitMode::scene: the basic map, one cascade around the whole scene at every depth.
   if (s.fit_mode == FitMode::scene) {
     out.cascade_count = 1;
-    out.view_proj[0] = fit_ortho_light_to_bounds(light.direction, scene).view_proj();
+    const LightProjection basic = fit_ortho_light_to_bounds(light.direction, scene);
+    out.view_proj[0] = basic.view_proj();
     out.splits[0] = 0.0f;
     out.splits[1] = std::numeric_limits<float>::max();
-    const Aabb ls = scene.transformed(fit_ortho_light_to_bounds(light.direction, scene).view);
+    const Aabb ls = scene.transformed(basic.view);
     out.texel_size[0] = std::max(ls.max.x - ls.min.x, ls.max.y - ls.min.y) / float(s.map_size);
     out.casters[0] = caster_entities;
     std::sort(out.casters[0].begin(), out.casters[0].end(), entity_less);
