@@ -286,6 +286,38 @@ TEST_F(DefaultSceneTest, StableCascadesDoNotShimmerUnderSubTexelCameraMoves) {
   std::printf("[ crop, for contrast ] %d of %d world points changed visibility\n", crop, compared);
 }
 
+// Per-cascade stats: each layer draws exactly the casters the system kept for it; layers without
+// receivers draw nothing; the farthest receiver pulls the last split in from max_distance.
+TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
+  auto scene = load_scene(content_dir() / "scenes" / "default.json",
+                          {"render.width=160", "render.height=90", "shadow.cascade_count=8"});
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  auto t = render_frames(*player_, *scene, {});
+  ASSERT_TRUE(t.ok()) << t.error().to_string();
+  const render::FrameStats& st = t->last.stats;
+  const ShadowData& sh = t->last.shadow;
+  ASSERT_EQ(st.cascades, 8);
+  int draws = 0, culled = 0;
+  std::size_t triangles = 0;
+  for (std::size_t i = 0; i < 8; ++i) {
+    EXPECT_EQ(st.cascade_draw_calls[i], int(sh.casters[i].size())) << "cascade " << i;
+    if (sh.skipped[i]) {
+      EXPECT_EQ(st.cascade_draw_calls[i], 0) << "cascade " << i;
+    }
+    draws += st.cascade_draw_calls[i];
+    triangles += st.cascade_triangles[i];
+    culled += 8 - st.cascade_draw_calls[i];  // the default scene has 8 casters
+  }
+  EXPECT_EQ(draws, st.shadow_draw_calls);
+  EXPECT_EQ(triangles, st.shadow_triangles);
+  EXPECT_GT(culled, 0);  // the near cascades do not see every caster
+  EXPECT_FLOAT_EQ(sh.far_requested, 100.0f);
+  EXPECT_LT(sh.far_used, 60.0f);  // the ground ends about 40 m from the camera
+  EXPECT_FLOAT_EQ(sh.splits[8], sh.far_used);
+  std::printf("[ 8 cascades ] last split pulled in from %.1f to %.1f m; %d of 64 caster draws culled\n",
+              double(sh.far_requested), double(sh.far_used), culled);
+}
+
 // Set-ups that used to be degenerate for one part or another: each renders without GL errors
 // (TearDown) and with finite visibility in [0, 1].
 class DegenerateSetups : public DefaultSceneTest,
