@@ -52,6 +52,41 @@ bool shadow_panel(ShadowSettings& s) {
   }
   changed |= ImGui::SliderFloat("constant bias", &s.constant_bias, 0.0f, 50.0f);
   changed |= ImGui::SliderFloat("slope bias", &s.slope_bias, 0.0f, 10.0f);
+  // Cascades (S0, S2). Edits keep the settings valid: fit "scene" is the one-map basic fit.
+  int fit = int(s.fit_mode);
+  const char* fits[] = {"crop (S0)", "stable (S2)", "scene (basic map)"};
+  if (ImGui::Combo("fit", &fit, fits, 3)) {
+    s.fit_mode = FitMode(fit);
+    if (s.fit_mode == FitMode::scene) s.cascade_count = 1;
+    changed = true;
+  }
+  if (ImGui::SliderInt("cascades", &s.cascade_count, 1, 8)) {
+    if (s.cascade_count > 1 && s.fit_mode == FitMode::scene) s.fit_mode = FitMode::stable;
+    changed = true;
+  }
+  int scheme = int(s.split_scheme);
+  const char* schemes[] = {"uniform (S0 eq. 1)", "log (S0 eq. 2)", "mixed (S0 eq. 3)"};
+  if (ImGui::Combo("splits", &scheme, schemes, 3)) {
+    s.split_scheme = SplitScheme(scheme);
+    changed = true;
+  }
+  changed |= ImGui::SliderFloat("lambda", &s.lambda, 0.0f, 1.0f);
+  changed |= ImGui::SliderFloat("max distance (0 = far)", &s.max_distance, 0.0f, 500.0f);
+  changed |= ImGui::SliderFloat("normal offset (texels)", &s.normal_offset_bias, 0.0f, 4.0f);
+  changed |= ImGui::SliderFloat("blend band", &s.blend_band, 0.0f, 1.0f);
+  int selection = int(s.selection);
+  const char* selections[] = {"view depth (S0)", "map bounds"};
+  if (ImGui::Combo("selection", &selection, selections, 2)) {
+    s.selection = CascadeSelection(selection);
+    changed = true;
+  }
+  int format = int(s.depth_format);
+  const char* formats[] = {"16", "24", "32F"};
+  if (ImGui::Combo("depth bits", &format, formats, 3)) {
+    s.depth_format = DepthFormat(format);
+    changed = true;
+  }
+  changed |= ImGui::Checkbox("debug: colour cascades", &s.debug_cascades);
   return changed;
 }
 

@@ -19,7 +19,7 @@
 
 #include "components/bounds.h"
 #include "components/camera.h"
-#include "components/cascade_settings.h"
+#include "components/shadow_settings.h"
 
 namespace kaskad {
 

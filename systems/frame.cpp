@@ -40,7 +40,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         if (mr.mesh == kNoMesh) return;
         const Material* mat = world.try_get<Material>(e);
         in.draws.push_back({mr.mesh, wt.matrix, mat ? *mat : default_material, mr.cast_shadows,
-                            mr.receive_shadows});
+                            mr.receive_shadows, shadow.cascade_mask(e)});
       });
 
   world.view<Light, WorldTransform>().each(
@@ -54,20 +54,31 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         item.cos_inner = std::cos(glm::radians(l.inner_cone_deg));
         item.cos_outer = std::cos(glm::radians(l.outer_cone_deg));
         if (e == shadow.light) {
-          in.shadow.light_index = int(in.lights.size());
-          in.shadow.view_proj = shadow.projection.view_proj();
-          in.shadow.settings = shadow.settings;
+          render::ShadowPass& sp = in.shadow;
+          sp.light_index = int(in.lights.size());
+          sp.settings = shadow.settings;
+          sp.cascade_count = shadow.cascade_count;
+          sp.view_proj = shadow.view_proj;
+          sp.splits = shadow.splits;
+          sp.texel_size = shadow.texel_size;
+          sp.skipped = shadow.skipped;
         }
         in.lights.push_back(item);
       });
   return in;
 }
 
-render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx) {
+render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx, ShadowData& shadow) {
   update_transforms(scene.world, scene.assets);
   const CameraState camera = select_camera(scene.world, float(ctx.width) / float(ctx.height));
-  const ShadowData shadow = update_basic_shadow(scene.world);
+  ShadowCascadeState state;
+  shadow = update_shadow_cascades(scene.world, camera, state);
   return build_frame_input(scene, ctx, camera, shadow);
+}
+
+render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx) {
+  ShadowData shadow;
+  return plan_frame(scene, ctx, shadow);
 }
 
 Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx) {
@@ -87,7 +98,7 @@ Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& c
     return Error{scene.file.string(), "", "the scene has no camera"};
 
   t = Clock::now();
-  report.shadow = update_basic_shadow(scene.world);
+  report.shadow = update_shadow_cascades(scene.world, report.camera, report.shadow_state);
   report.shadows_ms = ms_since(t);
 
   t = Clock::now();

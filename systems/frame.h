@@ -3,7 +3,8 @@
 //   1. Transforms  after it: every Transform has a current WorldTransform and every MeshRenderer
 //                  a current WorldBounds.
 //   2. Camera      after it: the active camera's view/projection for this frame's aspect.
-//   3. Shadows     after it: the shadowed light (if any) has a projection fitted to the scene.
+//   3. Cascades    after it: the shadowed directional light (if any) has current splits, one
+//                  light matrix per cascade and the casters drawn into each (ShadowData).
 //   4. DrawList    after it: the renderer's FrameInput holds every drawable, light and setting.
 //   5. Render      after it: shadow and forward passes are submitted (not necessarily finished).
 #pragma once
@@ -14,7 +15,7 @@
 #include "runtime/core/result.h"
 #include "runtime/render/renderer.h"
 #include "systems/camera_system.h"
-#include "systems/shadow_map_system.h"
+#include "systems/shadow_cascade_system.h"
 
 namespace kaskad {
 
@@ -31,6 +32,8 @@ struct FrameReport {
   CameraState camera;
   ShadowData shadow;
   render::FrameStats stats;
+  /// Carried from frame to frame when the caller reuses its report (the player does).
+  ShadowCascadeState shadow_state;
 };
 
 /// Runs phases 1-5. Errors: no camera in the scene, shader build failures.
@@ -39,6 +42,8 @@ Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& c
 
 /// Phases 1-4 without GL: the renderer input a frame of this scene would get.
 render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx);
+/// The same, also returning the frame's ShadowData (tests).
+render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx, ShadowData& shadow);
 
 /// Phases 1-4, then compiles every program the frame will use (scene load: no compiles later).
 Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx);

@@ -43,8 +43,8 @@ LightProjection fit_ortho_light_to_bounds(const glm::vec3& direction, const Aabb
   return out;
 }
 
-ShadowData update_basic_shadow(const ecs::World& world) {
-  ShadowData out;
+BasicShadow update_basic_shadow(const ecs::World& world) {
+  BasicShadow out;
   glm::mat4 light_matrix(1.0f);
   world.view<Light, WorldTransform>().each(
       [&](ecs::Entity e, const Light& light, const WorldTransform& wt) {
@@ -54,7 +54,6 @@ ShadowData update_basic_shadow(const ecs::World& world) {
         light_matrix = wt.matrix;
       });
   if (!out.light.valid()) return out;
-  if (const auto* s = world.try_get<ShadowSettings>(out.light)) out.settings = *s;
   const glm::vec3 dir = light_direction(light_matrix);
   Aabb bounds;
   world.view<MeshRenderer, WorldBounds>().each(

@@ -6,7 +6,6 @@
 #include <glm/glm.hpp>
 
 #include "components/bounds.h"
-#include "components/shadow_settings.h"
 #include "runtime/ecs/world.h"
 
 namespace kaskad {
@@ -24,16 +23,13 @@ struct LightProjection {
 /// lights work.
 LightProjection fit_ortho_light_to_bounds(const glm::vec3& direction, const Aabb& bounds);
 
-/// Result of the shadow phase for the renderer.
-struct ShadowData {
-  ecs::Entity light = ecs::kNullEntity;  ///< the shadowed light, null when there is none
+/// The basic map's projection: fits the first directional Light with cast_shadows (entity order)
+/// to the bounds of all mesh renderers, or nothing (light null). The baseline of FitMode::scene.
+struct BasicShadow {
+  ecs::Entity light = ecs::kNullEntity;
   LightProjection projection;
-  ShadowSettings settings;
 };
-
-/// Picks the first directional Light with cast_shadows (entity order), fits its projection to
-/// the bounds of all shadow casters and receivers. Needs current WorldTransform/WorldBounds.
-ShadowData update_basic_shadow(const ecs::World& world);
+BasicShadow update_basic_shadow(const ecs::World& world);
 
 /// World-space direction a light entity shines along: rotation * (0, 0, -1), normalised.
 glm::vec3 light_direction(const glm::mat4& world_matrix);

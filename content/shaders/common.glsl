@@ -1,5 +1,6 @@
 // Shared declarations. Change together with FrameBlock in runtime/render/renderer.cpp.
 #define MAX_LIGHTS 8
+#define MAX_CASCADES 8
 #define LIGHT_DIRECTIONAL 0
 #define LIGHT_SPOT 1
 #define LIGHT_POINT 2
@@ -7,15 +8,22 @@
 layout(std140, binding = 0) uniform FrameBlock {
   mat4 u_view_proj;
   mat4 u_view;
-  mat4 u_light_view_proj;          // world -> shadow clip space of the shadowed light
   vec4 u_camera_pos;               // xyz: world position
   vec4 u_ambient;                  // rgb: linear ambient radiance, w: exposure
-  ivec4 u_counts;                  // x: light count, y: shadowed light index (-1: none)
+  ivec4 u_counts;                  // x: light count, y: shadowed light index (-1: none),
+                                   // z: cascade count
+  vec4 u_shadow_params;            // x: normal offset (texels), y: blend band, z: map size
+  mat4 u_cascade_view_proj[MAX_CASCADES];  // world -> shadow clip space per cascade
+  vec4 u_cascade_splits[3];        // S0's D[0..8], four per vec4: cascade_split(i)
+  vec4 u_cascade_texel[2];         // metres per texel per cascade: cascade_texel(i)
   vec4 u_light_color[MAX_LIGHTS];  // rgb: colour * intensity, w: type
   vec4 u_light_dir[MAX_LIGHTS];    // xyz: direction the light travels, w: range (0 = infinite)
   vec4 u_light_pos[MAX_LIGHTS];    // xyz: world position, w: cos(outer cone)
   vec4 u_light_cone[MAX_LIGHTS];   // x: cos(inner cone)
 };
+
+float cascade_split(int i) { return u_cascade_splits[i >> 2][i & 3]; }
+float cascade_texel(int i) { return u_cascade_texel[i >> 2][i & 3]; }
 
 // Per-draw uniforms (explicit locations: no name look-ups at draw time).
 layout(location = 0) uniform mat4 u_model;

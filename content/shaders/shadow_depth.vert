@@ -1,5 +1,8 @@
 #include "common.glsl"
 
+// World -> light clip space of the cascade being drawn (set per layer by the renderer).
+layout(location = 12) uniform mat4 u_light_view_proj;
+
 layout(location = 0) in vec3 a_position;
 #if MATERIAL_HAS_ALPHA_MASK
 layout(location = 2) in vec2 a_uv;

@@ -55,14 +55,37 @@ const std::vector<std::pair<const char*, PrimitiveShape>> kShapes = {
 
 constexpr float kBig = 1.0e7f;  // |coordinate| limit: beyond it float precision is meaningless
 
+const std::vector<std::pair<const char*, SplitScheme>> kSplitSchemes = {
+    {"uniform", SplitScheme::uniform}, {"log", SplitScheme::log}, {"mixed", SplitScheme::mixed}};
+const std::vector<std::pair<const char*, DepthFormat>> kDepthFormats = {
+    {"d16", DepthFormat::d16}, {"d24", DepthFormat::d24}, {"d32f", DepthFormat::d32f}};
+const std::vector<std::pair<const char*, FitMode>> kFitModes = {
+    {"crop", FitMode::crop}, {"stable", FitMode::stable}, {"scene", FitMode::scene}};
+const std::vector<std::pair<const char*, CascadeSelection>> kSelections = {
+    {"depth", CascadeSelection::depth}, {"map_bounds", CascadeSelection::map_bounds}};
+
+// Range checks here; combinations (fit_mode scene with several cascades) by
+// validate_shadow_settings(), whose message starts with the bad key.
 void read_shadow(ObjectReader& r, ShadowSettings& s) {
   r.integer("map_size", s.map_size, 64, 16384);
   r.number("constant_bias", s.constant_bias, 0.0f, 1.0e4f);
   r.number("slope_bias", s.slope_bias, 0.0f, 100.0f);
   r.enumeration("cull", s.cull, kCullModes);
   r.enumeration("filter", s.filter, kFilters);
+  r.integer("cascade_count", s.cascade_count, 1, 8);
+  r.enumeration("split_scheme", s.split_scheme, kSplitSchemes);
+  r.number("lambda", s.lambda, 0.0f, 1.0f);
+  r.number("max_distance", s.max_distance, 0.0f, kBig);
+  r.enumeration("depth_format", s.depth_format, kDepthFormats);
+  r.enumeration("fit_mode", s.fit_mode, kFitModes);
+  r.number("beam_radius", s.beam_radius, 0.0f, kBig);
+  r.number("normal_offset_bias", s.normal_offset_bias, 0.0f, 16.0f);
+  r.number("blend_band", s.blend_band, 0.0f, 1.0f);
+  r.enumeration("selection", s.selection, kSelections);
+  r.boolean("debug_cascades", s.debug_cascades);
   r.finish();
-  if (std::string bad = validate_shadow_settings(s); !bad.empty()) fail(r.at("map_size"), bad);
+  if (std::string bad = validate_shadow_settings(s); !bad.empty())
+    fail(r.at(bad.substr(0, bad.find(' ')).c_str()), bad);
 }
 
 json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
@@ -70,11 +93,24 @@ json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
   auto put = [&](const char* key, json value, bool differs) {
     if (!defaults || differs) j[key] = std::move(value);
   };
-  put("map_size", s.map_size, defaults && s.map_size != defaults->map_size);
-  put("constant_bias", num(s.constant_bias), defaults && s.constant_bias != defaults->constant_bias);
-  put("slope_bias", num(s.slope_bias), defaults && s.slope_bias != defaults->slope_bias);
-  put("cull", enum_name(s.cull, kCullModes), defaults && s.cull != defaults->cull);
-  put("filter", enum_name(s.filter, kFilters), defaults && s.filter != defaults->filter);
+  const ShadowSettings& d = defaults ? *defaults : s;
+  put("map_size", s.map_size, s.map_size != d.map_size);
+  put("constant_bias", num(s.constant_bias), s.constant_bias != d.constant_bias);
+  put("slope_bias", num(s.slope_bias), s.slope_bias != d.slope_bias);
+  put("cull", enum_name(s.cull, kCullModes), s.cull != d.cull);
+  put("filter", enum_name(s.filter, kFilters), s.filter != d.filter);
+  put("cascade_count", s.cascade_count, s.cascade_count != d.cascade_count);
+  put("split_scheme", enum_name(s.split_scheme, kSplitSchemes), s.split_scheme != d.split_scheme);
+  put("lambda", num(s.lambda), s.lambda != d.lambda);
+  put("max_distance", num(s.max_distance), s.max_distance != d.max_distance);
+  put("depth_format", enum_name(s.depth_format, kDepthFormats), s.depth_format != d.depth_format);
+  put("fit_mode", enum_name(s.fit_mode, kFitModes), s.fit_mode != d.fit_mode);
+  put("beam_radius", num(s.beam_radius), s.beam_radius != d.beam_radius);
+  put("normal_offset_bias", num(s.normal_offset_bias),
+      s.normal_offset_bias != d.normal_offset_bias);
+  put("blend_band", num(s.blend_band), s.blend_band != d.blend_band);
+  put("selection", enum_name(s.selection, kSelections), s.selection != d.selection);
+  put("debug_cascades", s.debug_cascades, s.debug_cascades != d.debug_cascades);
   return j;
 }
 

@@ -41,7 +41,7 @@ render options:
   --frames N             frames to render; times are the median of frames 2..N (default 10)
   --set KEY=VALUE        override a setting or component field, e.g. shadow.map_size=4096,
                          sun.light.intensity=3, camera.camera.fov_y_deg=40 (repeatable)
-  --aov FILE.exr         write the AOVs of the last frame (P, N, Z, visibility, mask)
+  --aov FILE.exr         write the AOVs of the last frame (P, N, Z, visibility, mask, cascade)
   --shadow-map FILE      write the shadow map depth of the last frame
   --headless             never open a window (default when there is no display)
   --window               open a window even if --headless would be the default
@@ -259,6 +259,22 @@ int run_render(Args a) {
               "GPU shadow %.2f ms, forward %.2f ms; %d program and %d material switches\n",
               st.draw_calls, st.triangles, st.shadow_draw_calls, st.shadow_triangles,
               st.shadow_gpu_ms, st.forward_gpu_ms, st.program_switches, st.material_switches);
+  if (const ShadowData& sh = timings->last.shadow; sh.light.valid() && st.cascades > 0) {
+    const char* fits[] = {"crop", "stable", "scene"};
+    std::printf("cascades  %d (%s fit, %d^2 each)", st.cascades, fits[int(sh.settings.fit_mode)],
+                sh.settings.map_size);
+    if (sh.settings.fit_mode != FitMode::scene) {
+      std::printf("; splits");
+      for (int i = 0; i <= sh.cascade_count; ++i) std::printf(" %.3g", double(sh.splits[std::size_t(i)]));
+      std::printf(" m; last split at %.3g m, pulled in from %.3g m by the farthest visible receiver",
+                  double(sh.far_used), double(sh.far_requested));
+    }
+    std::printf("\n          per cascade draws/triangles:");
+    for (int i = 0; i < st.cascades; ++i)
+      std::printf(" %d/%zu%s", st.cascade_draw_calls[std::size_t(i)],
+                  st.cascade_triangles[std::size_t(i)], sh.skipped[std::size_t(i)] ? " (skipped)" : "");
+    std::printf("\n");
+  }
   std::printf("shaders   %d compiled, %d from the binary cache, %.1f ms (prewarm %.1f ms); "
               "%d compiled after the first frame\n",
               st.shaders.programs_compiled, st.shaders.cache_hits, st.shaders.compile_ms,
@@ -275,7 +291,7 @@ int run_render(Args a) {
   std::printf("wrote     %s\n", fs::absolute(out).string().c_str());
   if (!a.aov.empty()) {
     if (auto s = save_image(a.aov, player->renderer->read_aovs()); !s) return fail(s.error());
-    std::printf("wrote     %s (AOVs: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask)\n",
+    std::printf("wrote     %s (AOVs: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade)\n",
                 fs::absolute(a.aov).string().c_str());
   }
   if (!a.shadow_map.empty()) {

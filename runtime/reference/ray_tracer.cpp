@@ -598,10 +598,10 @@ Result<ShadowReference> RayTracer::shadow_reference(const Image& aov,
                      std::to_string(aov.pixels.size()) + " values"};
   }
   if (aov.channel_names.empty()) {
-    if (aov.channels != 9) {
+    if (aov.channels != 9 && aov.channels != 10) {  // 10 with the cascade channel
       return Error{"", "AOV image",
                    "has no channel names and " + std::to_string(aov.channels) +
-                       " channels, not the 9 of Renderer::read_aovs()"};
+                       " channels, not the 9 or 10 of Renderer::read_aovs()"};
     }
     ch = kCanonical;
   } else {

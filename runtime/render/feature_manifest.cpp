@@ -32,6 +32,7 @@ constexpr LayoutEntry kLayout[] = {
     {"shadow_filter", VariantKey::kShadowFilter, 0},
     {"cascade_count", VariantKey::kCascadeCountMinus1, 1},
     {"aovs", VariantKey::kAovs, 0},
+    {"cascade_selection", VariantKey::kCascadeSelection, 0},
     {"debug_cascades", VariantKey::kDebugCascades, 0},
 };
 

@@ -19,21 +19,34 @@ namespace {
 struct alignas(16) FrameBlock {
   glm::mat4 view_proj;
   glm::mat4 view;
-  glm::mat4 light_view_proj;
   glm::vec4 camera_pos;
   glm::vec4 ambient;
   glm::ivec4 counts;
+  glm::vec4 shadow_params;
+  glm::mat4 cascade_view_proj[kMaxCascades];
+  glm::vec4 cascade_splits[3];  // D[0..8], four per vec4 (std140 pads float arrays to vec4)
+  glm::vec4 cascade_texel[2];   // metres per texel, four per vec4
   glm::vec4 light_color[kMaxLights];
   glm::vec4 light_dir[kMaxLights];
   glm::vec4 light_pos[kMaxLights];
   glm::vec4 light_cone[kMaxLights];
 };
-static_assert(sizeof(FrameBlock) == 3 * 64 + 3 * 16 + 4 * kMaxLights * 16);
+static_assert(sizeof(FrameBlock) ==
+              2 * 64 + 4 * 16 + kMaxCascades * 64 + 5 * 16 + 4 * kMaxLights * 16);
+
+GLenum depth_internal_format(DepthFormat f) {
+  switch (f) {
+    case DepthFormat::d16: return GL_DEPTH_COMPONENT16;
+    case DepthFormat::d32f: return GL_DEPTH_COMPONENT32F;
+    case DepthFormat::d24: break;
+  }
+  return GL_DEPTH_COMPONENT24;
+}
 
 // Fixed attribute and uniform locations (see the shaders).
 constexpr GLuint kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
 constexpr GLint kUniModel = 0, kUniNormalMatrix = 4, kUniBaseColor = 8, kUniMaterial = 9,
-                kUniEmissive = 10, kUniOracleFeatures = 11;
+                kUniEmissive = 10, kUniOracleFeatures = 11, kUniLightViewProj = 12;
 constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2;
 
 struct GpuMesh {
@@ -70,8 +83,9 @@ struct Renderer::Impl {
   gpu::Framebuffer fbo;
   gpu::Texture color, position, normal, visibility, depth;
 
-  // Shadow map.
-  int shadow_size = 0;
+  // Shadow map: a depth texture array, one layer per cascade.
+  int shadow_size = 0, shadow_layers = 0;
+  DepthFormat shadow_format = DepthFormat::d24;
   ShadowFilter shadow_filter = ShadowFilter::none;
   gpu::Framebuffer shadow_fbo;
   gpu::Texture shadow_map;
@@ -160,7 +174,7 @@ struct Renderer::Impl {
     make(color, GL_SRGB8_ALPHA8);
     make(position, GL_RGBA32F);
     make(normal, GL_RGBA32F);
-    make(visibility, GL_R32F);
+    make(visibility, GL_RG32F);  // r visibility, g cascade index
     make(depth, GL_DEPTH_COMPONENT32F);
     fbo = gpu::make_framebuffer();
     glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0, color.id(), 0);
@@ -170,12 +184,16 @@ struct Renderer::Impl {
     glNamedFramebufferTexture(fbo.id(), GL_DEPTH_ATTACHMENT, depth.id(), 0);
   }
 
-  void ensure_shadow_map(int size, ShadowFilter filter) {
-    if (shadow_fbo && size == shadow_size && filter == shadow_filter) return;
-    if (!shadow_fbo || size != shadow_size) {
+  void ensure_shadow_map(int size, int layers, DepthFormat format, ShadowFilter filter) {
+    if (shadow_fbo && size == shadow_size && layers == shadow_layers && format == shadow_format &&
+        filter == shadow_filter)
+      return;
+    if (!shadow_fbo || size != shadow_size || layers != shadow_layers || format != shadow_format) {
       shadow_size = size;
-      shadow_map = gpu::make_texture(GL_TEXTURE_2D);
-      glTextureStorage2D(shadow_map.id(), 1, GL_DEPTH_COMPONENT24, size, size);
+      shadow_layers = layers;
+      shadow_format = format;
+      shadow_map = gpu::make_texture(GL_TEXTURE_2D_ARRAY);
+      glTextureStorage3D(shadow_map.id(), 1, depth_internal_format(format), size, size, layers);
       // S4: clamp to border with border depth 1, so lookups outside the map compare as lit.
       glTextureParameteri(shadow_map.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
       glTextureParameteri(shadow_map.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
@@ -184,7 +202,7 @@ struct Renderer::Impl {
       glTextureParameteri(shadow_map.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
       glTextureParameteri(shadow_map.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
       shadow_fbo = gpu::make_framebuffer();
-      glNamedFramebufferTexture(shadow_fbo.id(), GL_DEPTH_ATTACHMENT, shadow_map.id(), 0);
+      glNamedFramebufferTextureLayer(shadow_fbo.id(), GL_DEPTH_ATTACHMENT, shadow_map.id(), 0, 0);
       glNamedFramebufferDrawBuffer(shadow_fbo.id(), GL_NONE);
       glNamedFramebufferReadBuffer(shadow_fbo.id(), GL_NONE);
     }
@@ -215,7 +233,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
   im.timers[0] = gpu::make_query(GL_TIME_ELAPSED);
   im.timers[1] = gpu::make_query(GL_TIME_ELAPSED);
   // Empty shadow map so the sampler is complete even in frames without a shadow pass.
-  im.ensure_shadow_map(64, ShadowFilter::none);
+  im.ensure_shadow_map(64, 1, DepthFormat::d24, ShadowFilter::none);
   return r;
 }
 
@@ -223,13 +241,21 @@ Renderer::~Renderer() = default;
 
 ShaderLibrary& Renderer::shaders() { return *impl_->shaders; }
 
+namespace {
+int cascade_layers(const ShadowPass& p) { return std::clamp(p.cascade_count, 1, kMaxCascades); }
+}  // namespace
+
 VariantKey frame_variant(const FrameInput& frame) {
   VariantKey k;
   const bool shadowed = frame.shadow.light_index >= 0 &&
                         frame.shadow.light_index < std::min<int>(int(frame.lights.size()), kMaxLights);
   if (shadowed) {
+    const ShadowSettings& s = frame.shadow.settings;
     k.set(VariantKey::kShadow, 1);
-    k.set(VariantKey::kShadowFilter, std::uint32_t(frame.shadow.settings.filter));
+    k.set(VariantKey::kShadowFilter, std::uint32_t(s.filter));
+    k.set(VariantKey::kCascadeCountMinus1, std::uint32_t(cascade_layers(frame.shadow) - 1));
+    k.set(VariantKey::kCascadeSelection, s.selection == CascadeSelection::map_bounds ? 1u : 0u);
+    k.set(VariantKey::kDebugCascades, s.debug_cascades ? 1u : 0u);
   }
   if (frame.write_aovs) k.set(VariantKey::kAovs, 1);
   return k;
@@ -291,14 +317,26 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   FrameBlock fb{};
   fb.view_proj = frame.camera.proj * frame.camera.view;
   fb.view = frame.camera.view;
-  fb.light_view_proj = frame.shadow.view_proj;
   fb.camera_pos = glm::vec4(frame.camera.position, 1.0f);
   fb.ambient = glm::vec4(frame.ambient, frame.exposure);
   const int light_count = std::min<int>(int(frame.lights.size()), kMaxLights);
   if (int(frame.lights.size()) > kMaxLights)
     log::warn("%zu lights; only the first %d are shaded", frame.lights.size(), kMaxLights);
   const bool shadowed = frame.shadow.light_index >= 0 && frame.shadow.light_index < light_count;
-  fb.counts = glm::ivec4(light_count, shadowed ? frame.shadow.light_index : -1, 0, 0);
+  const int cascades = shadowed ? cascade_layers(frame.shadow) : 0;
+  fb.counts = glm::ivec4(light_count, shadowed ? frame.shadow.light_index : -1, cascades, 0);
+  if (shadowed) {
+    const ShadowPass& sp = frame.shadow;
+    // The basic map (fit scene) is biased by polygon offset alone, as before the cascades.
+    const float normal_offset =
+        sp.settings.fit_mode == FitMode::scene ? 0.0f : sp.settings.normal_offset_bias;
+    fb.shadow_params = glm::vec4(normal_offset, sp.settings.blend_band, float(sp.settings.map_size), 0);
+    for (int i = 0; i < cascades; ++i) {
+      fb.cascade_view_proj[i] = sp.view_proj[std::size_t(i)];
+      fb.cascade_texel[i / 4][i % 4] = sp.texel_size[std::size_t(i)];
+    }
+    for (int i = 0; i <= cascades; ++i) fb.cascade_splits[i / 4][i % 4] = sp.splits[std::size_t(i)];
+  }
   for (int i = 0; i < light_count; ++i) {
     const LightItem& l = frame.lights[std::size_t(i)];
     fb.light_color[i] = glm::vec4(l.color, float(int(l.type)));
@@ -364,18 +402,21 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     return {};
   };
 
-  // Pass 1: shadow map (S4): depth only, light viewport, bias by polygon offset, chosen culling.
+  // Pass 1: shadow maps (S4, S0 step 6): depth only, one layer per cascade, light viewport, bias
+  // by polygon offset, chosen culling. Each layer gets only the casters overlapping its cascade.
   glBeginQuery(GL_TIME_ELAPSED, im.timers[0].id());
+  stats_.cascades = cascades;
+  stats_.cascade_draw_calls.fill(0);
+  stats_.cascade_triangles.fill(0);
   if (shadowed) {
     const ShadowSettings& s = frame.shadow.settings;
-    im.ensure_shadow_map(s.map_size, s.filter);
+    im.ensure_shadow_map(s.map_size, cascades, s.depth_format, s.filter);
     glBindFramebuffer(GL_FRAMEBUFFER, im.shadow_fbo.id());
     glViewport(0, 0, s.map_size, s.map_size);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     glClearDepth(1.0);
-    glClear(GL_DEPTH_BUFFER_BIT);
     if (s.cull == CullMode::none) {
       glDisable(GL_CULL_FACE);
     } else {
@@ -384,23 +425,36 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     }
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(s.slope_bias, s.constant_bias);
-    GLuint current = 0;
-    for (std::uint32_t i : sorted_by(Pass::depth)) {
-      const DrawItem& d = frame.draws[i];
-      if (!d.cast_shadows) continue;
-      const GpuMesh& m = im.mesh(d.mesh, assets);
-      if (m.index_count == 0) continue;
-      if (Status st = use_program(Pass::depth, keys[i], current); !st) {
-        glDisable(GL_POLYGON_OFFSET_FILL);
-        glEndQuery(GL_TIME_ELAPSED);
-        return st;
+    const std::vector<std::uint32_t> order = sorted_by(Pass::depth);
+    GLuint current = 0;  // kept across layers: the light matrix is a per-draw uniform
+    for (int c = 0; c < cascades; ++c) {
+      glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0,
+                                     c);
+      glClear(GL_DEPTH_BUFFER_BIT);
+      if (frame.shadow.skipped[std::size_t(c)]) continue;
+      const glm::mat4& light_vp = frame.shadow.view_proj[std::size_t(c)];
+      for (std::uint32_t i : order) {
+        const DrawItem& d = frame.draws[i];
+        if (!d.cast_shadows || !(d.cascade_mask & (1u << c))) continue;
+        const GpuMesh& m = im.mesh(d.mesh, assets);
+        if (m.index_count == 0) continue;
+        if (Status st = use_program(Pass::depth, keys[i], current); !st) {
+          glDisable(GL_POLYGON_OFFSET_FILL);
+          glEndQuery(GL_TIME_ELAPSED);
+          return st;
+        }
+        // The oracle's one depth program reads the material bits from a uniform: set it for
+        // every draw, or an alpha-masked draw's bits leak into the next layer's opaque draws.
+        if (keys[i].has(VariantKey::kAlphaMask) || im.oracle) bind_material(current, d, keys[i]);
+        glProgramUniformMatrix4fv(current, kUniLightViewProj, 1, GL_FALSE, &light_vp[0][0]);
+        glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+        glBindVertexArray(m.vao.id());
+        glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+        ++stats_.shadow_draw_calls;
+        stats_.shadow_triangles += std::size_t(m.index_count / 3);
+        ++stats_.cascade_draw_calls[std::size_t(c)];
+        stats_.cascade_triangles[std::size_t(c)] += std::size_t(m.index_count / 3);
       }
-      if (keys[i].has(VariantKey::kAlphaMask)) bind_material(current, d, keys[i]);
-      glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-      glBindVertexArray(m.vao.id());
-      glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
-      ++stats_.shadow_draw_calls;
-      stats_.shadow_triangles += std::size_t(m.index_count / 3);
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
     im.shadow_valid = true;
@@ -515,11 +569,11 @@ Image Renderer::read_aovs() const {
   const int w = im.width, h = im.height;
   const auto pos = read_texture(im.position.id(), w, h, GL_RGBA, 4);
   const auto nrm = read_texture(im.normal.id(), w, h, GL_RGBA, 4);
-  const auto vis = read_texture(im.visibility.id(), w, h, GL_RED, 1);
+  const auto vis = read_texture(im.visibility.id(), w, h, GL_RG, 2);
   Image img;
   img.width = w;
   img.height = h;
-  img.channel_names = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z", "Z", "visibility", "mask"};
+  img.channel_names = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z", "Z", "visibility", "mask", "cascade"};
   img.channels = int(img.channel_names.size());
   img.pixels.resize(std::size_t(w) * h * img.channels);
   for (std::size_t i = 0; i < std::size_t(w) * h; ++i) {
@@ -531,8 +585,9 @@ Image Renderer::read_aovs() const {
     o[4] = nrm[i * 4 + 1];
     o[5] = nrm[i * 4 + 2];
     o[6] = nrm[i * 4 + 3];
-    o[7] = vis[i];
+    o[7] = vis[i * 2];
     o[8] = pos[i * 4 + 3];
+    o[9] = vis[i * 2 + 1];
   }
   return img;
 }
@@ -540,11 +595,18 @@ Image Renderer::read_aovs() const {
 Image Renderer::read_shadow_map() const {
   const Impl& im = *impl_;
   Image img;
-  img.width = img.height = im.shadow_size;
+  img.width = im.shadow_size;
+  img.height = im.shadow_size * im.shadow_layers;
   img.channels = 1;
   img.channel_names = {"Y"};
-  img.pixels = read_texture(im.shadow_map.id(), im.shadow_size, im.shadow_size,
-                            GL_DEPTH_COMPONENT, 1);
+  // All layers in one read; read_texture flips the whole stack, so flip the layer order back.
+  const std::size_t layer = std::size_t(im.shadow_size) * im.shadow_size;
+  const auto stack = read_texture(im.shadow_map.id(), im.shadow_size, img.height,
+                                  GL_DEPTH_COMPONENT, 1);
+  img.pixels.resize(stack.size());
+  for (int l = 0; l < im.shadow_layers; ++l)
+    std::memcpy(&img.pixels[std::size_t(l) * layer],
+                &stack[std::size_t(im.shadow_layers - 1 - l) * layer], layer * sizeof(float));
   return img;
 }
 

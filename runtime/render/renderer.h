@@ -1,9 +1,12 @@
-// The forward renderer: a depth-only shadow pass for one shadowed light, then one forward pass
-// that writes colour and the AOVs (world position + mask, facing normal + view depth, shadow
-// visibility) into an offscreen framebuffer. Headless and windowed use the same passes; a window
+// The forward renderer: a depth-only shadow pass per cascade of one shadowed light (one layer of
+// a depth texture array each), then one forward pass that writes colour and the AOVs (world
+// position + mask, facing normal + view depth, shadow visibility + cascade) into an offscreen
+// framebuffer. Headless and windowed use the same passes; a window
 // only adds present().
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -36,6 +39,7 @@ struct DrawItem {
   Material material;
   bool cast_shadows = true;
   bool receive_shadows = true;
+  std::uint8_t cascade_mask = 0xff;  ///< bit i: drawn into cascade i (when cast_shadows)
 };
 
 /// A light as the shaders see it. `color` already includes the intensity.
@@ -49,10 +53,18 @@ struct LightItem {
   float cos_outer = 0.7f;
 };
 
+inline constexpr int kMaxCascades = 8;  // change together with systems/cascade_math.h and
+                                        // MAX_CASCADES in common.glsl
+
+/// The shadowed light's cascades (systems/shadow_cascade_system.h, ShadowData).
 struct ShadowPass {
   int light_index = -1;          ///< index into FrameInput::lights; -1: no shadow pass
-  glm::mat4 view_proj{1.0f};     ///< world -> light clip space
   ShadowSettings settings;
+  int cascade_count = 0;         ///< layers drawn; 0 with light_index >= 0 is treated as 1
+  std::array<glm::mat4, kMaxCascades> view_proj{};  ///< world -> light clip space per cascade
+  std::array<float, kMaxCascades + 1> splits{};     ///< S0's D, metres of view depth
+  std::array<float, kMaxCascades> texel_size{};     ///< metres per texel per cascade
+  std::array<bool, kMaxCascades> skipped{};         ///< no receivers: cleared, nothing drawn
 };
 
 struct FrameInput {
@@ -76,7 +88,10 @@ struct FrameStats {
   int draw_calls = 0;
   std::size_t triangles = 0;          ///< submitted in the forward pass
   int shadow_draw_calls = 0;
-  std::size_t shadow_triangles = 0;   ///< submitted to the shadow map
+  std::size_t shadow_triangles = 0;   ///< submitted to the shadow map (all cascades)
+  int cascades = 0;                   ///< cascade layers of the shadow map this frame
+  std::array<int, kMaxCascades> cascade_draw_calls{};         ///< casters drawn per cascade
+  std::array<std::size_t, kMaxCascades> cascade_triangles{};  ///< their triangles
   /// GPU times are the previous frame's (queries are read a frame late); 0 until frame 3.
   double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
   double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)
@@ -119,10 +134,11 @@ class Renderer {
 
   /// sRGB-encoded colour of the last frame, RGBA in [0,1], rows top to bottom.
   Image read_color() const;
-  /// AOVs of the last frame: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask (see README).
+  /// AOVs of the last frame: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade (see README).
   /// Precondition: the last frame was rendered with write_aovs.
   Image read_aovs() const;
-  /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom.
+  /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom; with
+  /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;
 
   /// Copies the colour target to the default framebuffer (windowed mode).

@@ -9,7 +9,7 @@
 // Valid combinations (valid()):
 //   reflection_cube and reflection_sphere exclude each other
 //   shadow_filter != 0 and cascade_count != 1 need shadow
-//   debug_cascades needs shadow
+//   debug_cascades and cascade_selection need shadow
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask), so every material
 // shares one or two shadow programs.
 #pragma once
@@ -45,6 +45,7 @@ class VariantKey {
   static constexpr Field kCascadeCountMinus1{19, 3};  ///< cascade count - 1 (1..8 cascades)
   static constexpr Field kAovs{22, 1};
   static constexpr Field kDebugCascades{23, 1};
+  static constexpr Field kCascadeSelection{24, 1};  ///< 0 depth (S0's D), 1 map bounds
   static constexpr std::uint32_t kFrameMask = 0xffff0000u;
 
   constexpr VariantKey() = default;
@@ -71,11 +72,12 @@ class VariantKey {
                                    kReflectionSphere.mask() | kReceiveShadows.mask() |
                                    kShadow.mask() | kShadowFilter.mask() |
                                    kCascadeCountMinus1.mask() | kAovs.mask() |
-                                   kDebugCascades.mask();
+                                   kDebugCascades.mask() | kCascadeSelection.mask();
     if (bits_ & ~used) return false;
     if (has(kReflectionCube) && has(kReflectionSphere)) return false;
     if (get(kShadowFilter) > 2) return false;
-    if (!has(kShadow) && (has(kShadowFilter) || has(kCascadeCountMinus1) || has(kDebugCascades)))
+    if (!has(kShadow) && (has(kShadowFilter) || has(kCascadeCountMinus1) || has(kDebugCascades) ||
+                        has(kCascadeSelection)))
       return false;
     return true;
   }

@@ -33,7 +33,7 @@ check render_default 0 "median .* ms" -- "$KASKAD" render --headless --size 160x
 [ -s "$tmp/default.png" ] && [ -s "$tmp/default.exr" ] || { echo "FAIL render_default: no files"; failed=$((failed + 1)); }
 if command -v oiiotool >/dev/null; then
   # EXR stores channels sorted by name; the contract is the set of names.
-  for ch in P.X P.Y P.Z N.X N.Y N.Z Z visibility mask; do
+  for ch in P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade; do
     check "aov_channel_$ch" 0 "channel list:.*(^|[ ,])$ch(,|$)" -- oiiotool --info -v "$tmp/default.exr"
   done
 fi

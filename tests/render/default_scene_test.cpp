@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 
 #include "components/light.h"
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
+#include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
 #include "runtime/cli/player.h"
 #include "runtime/gpu/context.h"
@@ -187,10 +189,223 @@ INSTANTIATE_TEST_SUITE_P(
                       Config{"map_1024", {"shadow.map_size=1024"}}),
     [](const auto& info) { return std::string(info.param.name); });
 
+// Cascades: every count in both fits (and map-bounds selection) must agree with the ray cast.
+INSTANTIATE_TEST_SUITE_P(
+    Cascades, DefaultSceneVisibility,
+    ::testing::Values(
+        Config{"stable_1", {"shadow.cascade_count=1", "shadow.fit_mode=stable"}},
+        Config{"stable_2", {"shadow.cascade_count=2", "shadow.fit_mode=stable"}},
+        Config{"stable_4", {"shadow.cascade_count=4", "shadow.fit_mode=stable"}},
+        Config{"stable_8", {"shadow.cascade_count=8", "shadow.fit_mode=stable"}},
+        Config{"crop_1", {"shadow.cascade_count=1", "shadow.fit_mode=crop"}},
+        Config{"crop_2", {"shadow.cascade_count=2", "shadow.fit_mode=crop"}},
+        Config{"crop_4", {"shadow.cascade_count=4", "shadow.fit_mode=crop"}},
+        Config{"crop_8", {"shadow.cascade_count=8", "shadow.fit_mode=crop"}},
+        Config{"scene_1", {"shadow.cascade_count=1", "shadow.fit_mode=scene"}},
+        Config{"stable_4_map_bounds", {"shadow.cascade_count=4", "shadow.selection=map_bounds"}},
+        Config{"stable_4_d16", {"shadow.cascade_count=4", "shadow.depth_format=d16"}},
+        Config{"stable_4_d32f", {"shadow.cascade_count=4", "shadow.depth_format=d32f"}}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+// One cascade fitted to the scene is the basic map from before the cascades: its visibility AOV
+// (default scene, 400x225, pcf3x3, 2048^2, d24) was rendered by the basic renderer at commit
+// 25fd79d and stored as 8-bit (tests/render/data/basic_map_visibility_400x225.png).
+TEST_F(DefaultSceneTest, SceneFitReproducesTheBasicMap) {
+  Image aov;
+  render_and_compare({"shadow.cascade_count=1", "shadow.fit_mode=scene"}, &aov);
+  auto golden = load_image(std::filesystem::path(KASKAD_TEST_DATA) / "basic_map_visibility_400x225.png");
+  ASSERT_TRUE(golden.ok()) << golden.error().to_string();
+  ASSERT_EQ(golden->width, aov.width);
+  ASSERT_EQ(golden->height, aov.height);
+  int differ = 0;
+  float worst = 0.0f;
+  for (int y = 0; y < aov.height; ++y)
+    for (int x = 0; x < aov.width; ++x) {
+      const float d = std::abs(aov.at(x, y, 7) - golden->at(x, y, 0));
+      worst = std::max(worst, d);
+      differ += d > 0.5f / 255.0f + 1e-5f;  // beyond the golden's 8-bit rounding
+    }
+  std::printf("[ scene fit vs basic map ] %d pixels differ, worst %.5f\n", differ, worst);
+  EXPECT_EQ(differ, 0);
+  for (int y = 0; y < aov.height; ++y)
+    for (int x = 0; x < aov.width; ++x)
+      if (aov.at(x, y, 8) > 0.5f) {
+        ASSERT_EQ(aov.at(x, y, 9), 0.0f);  // all in cascade 0
+      }
+}
+
+// S2's stabilisation: with the stable fit the cascades' texel grid is fixed in the world, so
+// moving the camera by less than a texel leaves the visibility at every world point unchanged.
+// A top-down orthographic camera moved by whole screen pixels (1/16 m; the cascade texels are
+// about 0.1 m) sees the same world points at shifted pixels; their visibility must be identical.
+TEST_F(DefaultSceneTest, StableCascadesDoNotShimmerUnderSubTexelCameraMoves) {
+  auto render_at = [&](float x, const char* fit, ShadowData* shadow) {
+    const std::string tx = "camera.transform.translation=[" + std::to_string(x) + ",20,0]";
+    auto scene = load_scene(content_dir() / "scenes" / "default.json",
+                            {"render.width=256", "render.height=256",
+                             "camera.camera.projection=orthographic", "camera.camera.ortho_height=16",
+                             tx, "camera.transform.rotation=[-0.70710678,0,0,0.70710678]",
+                             "shadow.map_size=256", "shadow.cascade_count=4",
+                             std::string("shadow.fit_mode=") + fit});
+    EXPECT_TRUE(scene.ok()) << scene.error().to_string();
+    auto t = render_frames(*player_, *scene, {});
+    EXPECT_TRUE(t.ok()) << t.error().to_string();
+    if (shadow && t.ok()) *shadow = t->last.shadow;
+    return player_->renderer->read_aovs();
+  };
+  auto count_changes = [&](const char* fit, int& compared, float& texel) {
+    ShadowData shadow;
+    const Image a = render_at(0.0f, fit, &shadow);
+    texel = shadow.texel_size[3];
+    int changed = 0;
+    compared = 0;
+    for (int k = 1; k <= 3; ++k) {
+      const Image b = render_at(float(k) / 16.0f, fit, nullptr);
+      for (int y = 0; y < b.height; ++y)
+        for (int x = 0; x + k < b.width; ++x) {
+          if (a.at(x + k, y, 8) < 0.5f || b.at(x, y, 8) < 0.5f) continue;
+          bool same_point = true;
+          for (int c = 0; c < 3; ++c)
+            same_point = same_point && std::abs(a.at(x + k, y, c) - b.at(x, y, c)) < 1e-4f;
+          if (!same_point) continue;
+          ++compared;
+          changed += a.at(x + k, y, 7) != b.at(x, y, 7);
+        }
+    }
+    return changed;
+  };
+  int compared = 0;
+  float texel = 0.0f;
+  const int stable = count_changes("stable", compared, texel);
+  std::printf("[ stable ] %d of %d world points changed visibility (last cascade texel %.4f m)\n",
+              stable, compared, texel);
+  EXPECT_GT(compared, 100000);
+  EXPECT_GT(texel, 1.0f / 16.0f);  // the one-pixel move is a sub-texel move
+  EXPECT_EQ(stable, 0);
+  const int crop = count_changes("crop", compared, texel);
+  std::printf("[ crop, for contrast ] %d of %d world points changed visibility\n", crop, compared);
+}
+
+// Per-cascade stats: each layer draws exactly the casters the system kept for it; layers without
+// receivers draw nothing; the farthest receiver pulls the last split in from max_distance.
+TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
+  auto scene = load_scene(content_dir() / "scenes" / "default.json",
+                          {"render.width=160", "render.height=90", "shadow.cascade_count=8"});
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  auto t = render_frames(*player_, *scene, {});
+  ASSERT_TRUE(t.ok()) << t.error().to_string();
+  const render::FrameStats& st = t->last.stats;
+  const ShadowData& sh = t->last.shadow;
+  ASSERT_EQ(st.cascades, 8);
+  int draws = 0, culled = 0;
+  std::size_t triangles = 0;
+  for (std::size_t i = 0; i < 8; ++i) {
+    EXPECT_EQ(st.cascade_draw_calls[i], int(sh.casters[i].size())) << "cascade " << i;
+    if (sh.skipped[i]) {
+      EXPECT_EQ(st.cascade_draw_calls[i], 0) << "cascade " << i;
+    }
+    draws += st.cascade_draw_calls[i];
+    triangles += st.cascade_triangles[i];
+    culled += 8 - st.cascade_draw_calls[i];  // the default scene has 8 casters
+  }
+  EXPECT_EQ(draws, st.shadow_draw_calls);
+  EXPECT_EQ(triangles, st.shadow_triangles);
+  EXPECT_GT(culled, 0);  // the near cascades do not see every caster
+  EXPECT_FLOAT_EQ(sh.far_requested, 100.0f);
+  EXPECT_LT(sh.far_used, 60.0f);  // the ground ends about 40 m from the camera
+  EXPECT_FLOAT_EQ(sh.splits[8], sh.far_used);
+  std::printf("[ 8 cascades ] last split pulled in from %.1f to %.1f m; %d of 64 caster draws culled\n",
+              double(sh.far_requested), double(sh.far_used), culled);
+}
+
+// Set-ups that used to be degenerate for one part or another: each renders without GL errors
+// (TearDown) and with finite visibility in [0, 1].
+class DegenerateSetups : public DefaultSceneTest,
+                         public ::testing::WithParamInterface<Config> {};
+
+void expect_sane_visibility(const Image& aov) {
+  for (int y = 0; y < aov.height; ++y)
+    for (int x = 0; x < aov.width; ++x) {
+      const float v = aov.at(x, y, 7);
+      ASSERT_TRUE(v >= 0.0f && v <= 1.0f) << x << "," << y << ": " << v;
+      const float c = aov.at(x, y, 9);
+      ASSERT_TRUE(c >= -1.0f && c < 8.0f) << c;
+    }
+}
+
+TEST_P(DegenerateSetups, RenderWithoutErrors) {
+  std::vector<std::string> sets = GetParam().sets;
+  sets.push_back("render.width=160");
+  sets.push_back("render.height=90");
+  auto scene = load_scene(content_dir() / "scenes" / "default.json", sets);
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  auto t = render_frames(*player_, *scene, {});
+  ASSERT_TRUE(t.ok()) << t.error().to_string();
+  expect_sane_visibility(player_->renderer->read_aovs());
+}
+
+constexpr const char* kDown = "[-0.70710678,0,0,0.70710678]";  // local -Z to world -Y
+INSTANTIATE_TEST_SUITE_P(
+    Cascades, DegenerateSetups,
+    ::testing::Values(
+        Config{"light_straight_down", {std::string("sun.transform.rotation=") + kDown}},
+        Config{"light_along_view", {std::string("sun.transform.rotation=") + kDown,
+                                    std::string("camera.transform.rotation=") + kDown,
+                                    "camera.transform.translation=[0,20,0]"}},
+        Config{"light_along_view_crop", {std::string("sun.transform.rotation=") + kDown,
+                                         std::string("camera.transform.rotation=") + kDown,
+                                         "camera.transform.translation=[0,20,0]",
+                                         "shadow.fit_mode=crop"}},
+        Config{"near_1e-4_far_1e4", {"camera.camera.near=0.0001", "camera.camera.far=10000",
+                                     "shadow.max_distance=0", "shadow.cascade_count=8"}},
+        Config{"near_1e-4_far_1e4_crop", {"camera.camera.near=0.0001", "camera.camera.far=10000",
+                                          "shadow.max_distance=0", "shadow.fit_mode=crop"}},
+        Config{"camera_below_ground", {"camera.transform.translation=[0,-5,0]"}}),
+    [](const auto& info) {
+      std::string n = info.param.name;
+      std::replace(n.begin(), n.end(), '-', '_');
+      std::replace(n.begin(), n.end(), '.', '_');
+      return n;
+    });
+
+// Scenes written on the fly: no geometry at all, and geometry that casts nothing.
+TEST_F(DefaultSceneTest, EmptySceneAndSceneWithoutCastersRender) {
+  const std::filesystem::path dir = std::filesystem::path(KASKAD_TEST_TMP) / "cascade_scenes";
+  std::filesystem::create_directories(dir);
+  const std::string light_and_camera = R"(
+    { "name": "sun", "transform": { "direction": [0.5, -0.6, -0.45] },
+      "light": { "type": "directional", "cast_shadows": true } },
+    { "name": "camera", "transform": { "translation": [6, 4, 8], "look_at": [0, 0, 0] },
+      "camera": { "near": 0.1, "far": 100 } })";
+  const std::pair<const char*, std::string> scenes[] = {
+      {"empty.json", R"({ "kaskad_scene": 1, "entities": [)" + light_and_camera + "] }"},
+      {"no_casters.json", R"({ "kaskad_scene": 1, "entities": [
+        { "name": "ground", "transform": { "scale": [20, 1, 20] }, "primitive": { "shape": "plane" },
+          "renderer": { "cast_shadows": false } },
+        { "name": "box", "transform": { "translation": [0, 0.5, 0] }, "primitive": { "shape": "box" },
+          "renderer": { "cast_shadows": false } },)" + light_and_camera + "] }"}};
+  for (const auto& [name, text] : scenes) {
+    std::ofstream(dir / name) << text;
+    auto scene = load_scene(dir / name, {"render.width=160", "render.height=90"});
+    ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+    auto t = render_frames(*player_, *scene, {});
+    ASSERT_TRUE(t.ok()) << name << ": " << t.error().to_string();
+    const Image aov = player_->renderer->read_aovs();
+    expect_sane_visibility(aov);
+    for (int y = 0; y < aov.height; ++y)
+      for (int x = 0; x < aov.width; ++x)
+        if (aov.at(x, y, 8) > 0.5f) {
+          ASSERT_EQ(aov.at(x, y, 7), 1.0f) << name;  // nothing casts
+        }
+    EXPECT_EQ(t->last.stats.shadow_draw_calls, 0) << name;
+  }
+}
+
 TEST_F(DefaultSceneTest, BadConfigurationIsCaughtByTheSameCheck) {
   // No bias and a tiny map: acne and blocky edges. The check above must be able to fail.
   const Agreement a = render_and_compare(
-      {"shadow.map_size=64", "shadow.constant_bias=0", "shadow.slope_bias=0", "shadow.filter=none"});
+      {"shadow.map_size=64", "shadow.constant_bias=0", "shadow.slope_bias=0",
+       "shadow.normal_offset_bias=0", "shadow.filter=none"});
   std::printf("[ bad config ] %.3f%% agree\n", 100.0 * a.ratio());
   EXPECT_LT(a.ratio(), 0.99);
 }
@@ -198,7 +413,8 @@ TEST_F(DefaultSceneTest, BadConfigurationIsCaughtByTheSameCheck) {
 TEST_F(DefaultSceneTest, AovChannelsFollowTheContract) {
   Image aov;
   render_and_compare({}, &aov);
-  ASSERT_EQ(aov.channels, 9);
+  ASSERT_EQ(aov.channels, 10);
+  ASSERT_EQ(aov.channel_names[9], "cascade");
   ASSERT_EQ(aov.channel_names[7], "visibility");
   int drawn = 0, background = 0;
   for (int y = 0; y < aov.height; ++y)

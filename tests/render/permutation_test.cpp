@@ -1,3 +1,5 @@
+
+
 // The shader permutation system on the GPU: only used variants are compiled, variants match the
 // uniform-driven über-shader oracle, pre-warm leaves nothing to compile, the binary cache is hit,
 // and hot reload keeps the last good program.

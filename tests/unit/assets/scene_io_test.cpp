@@ -121,6 +121,49 @@ void expect_error(const Result<Scene>& r, const std::vector<std::string>& parts)
   for (const auto& p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
 }
 
+TEST(SceneIo, CascadeFieldsLoadWithRangeChecksAndPerLightOverrides) {
+  const fs::path p = temp_dir() / "cascades.json";
+  std::ofstream(p) << R"({ "shadow": { "cascade_count": 3, "fit_mode": "crop", "lambda": 0.8,
+      "split_scheme": "log", "max_distance": 60, "depth_format": "d32f", "normal_offset_bias": 2,
+      "blend_band": 0.2, "selection": "map_bounds", "debug_cascades": true, "beam_radius": 5 },
+    "entities": [
+      { "name": "sun", "transform": { "direction": [0, -1, 0] },
+        "light": { "type": "directional", "cast_shadows": true },
+        "shadow": { "cascade_count": 1, "fit_mode": "scene" } } ] })";
+  auto s = read_scene(p);
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  const ShadowSettings& d = s->shadow_defaults;
+  EXPECT_EQ(d.cascade_count, 3);
+  EXPECT_EQ(d.fit_mode, FitMode::crop);
+  EXPECT_EQ(d.split_scheme, SplitScheme::log);
+  EXPECT_FLOAT_EQ(d.lambda, 0.8f);
+  EXPECT_FLOAT_EQ(d.max_distance, 60.0f);
+  EXPECT_EQ(d.depth_format, DepthFormat::d32f);
+  EXPECT_EQ(d.selection, CascadeSelection::map_bounds);
+  EXPECT_TRUE(d.debug_cascades);
+  const ShadowSettings& l = s->world.get<ShadowSettings>(find(*s, "sun"));
+  EXPECT_EQ(l.cascade_count, 1);
+  EXPECT_EQ(l.fit_mode, FitMode::scene);
+  EXPECT_FLOAT_EQ(l.lambda, 0.8f);  // the rest from the scene-wide defaults
+  // Saved and read again: the same settings (per light only what differs).
+  const fs::path out = temp_dir() / "cascades_saved.json";
+  ASSERT_TRUE(save_scene(out, *s).ok());
+  auto again = read_scene(out);
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_EQ(again->world.get<ShadowSettings>(find(*again, "sun")).fit_mode, FitMode::scene);
+  EXPECT_EQ(again->shadow_defaults.depth_format, DepthFormat::d32f);
+
+  const fs::path def = kContent / "scenes" / "default.json";
+  expect_error(read_scene(def, {"shadow.cascade_count=9"}), {"/shadow/cascade_count", "9"});
+  expect_error(read_scene(def, {"shadow.lambda=1.5"}), {"/shadow/lambda", "1.5"});
+  expect_error(read_scene(def, {"shadow.fit_mode=tight"}), {"tight", "stable", "scene"});
+  expect_error(read_scene(def, {"shadow.fit_mode=scene"}),
+               {"/shadow/fit_mode", "needs cascade_count 1, was 4"});
+  expect_error(read_scene(def, {"shadow.blend_band=-0.1"}), {"/shadow/blend_band"});
+  expect_error(read_scene(def, {"shadow.normal_offset_bias=17"}), {"/shadow/normal_offset_bias"});
+  expect_error(read_scene(def, {"shadow.depth_format=d8"}), {"d8", "d16", "d24", "d32f"});
+}
+
 TEST(SceneIo, OverrideErrorsListValidKeys) {
   const fs::path def = kContent / "scenes" / "default.json";
   expect_error(read_scene(def, {"shadow.map_sise=4"}), {"map_sise", "map_size", "filter"});

@@ -15,7 +15,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "components/cascade_settings.h"
+#include "components/shadow_settings.h"
 #include "systems/cascade_math.h"
 
 namespace kaskad {
@@ -772,35 +772,40 @@ TEST(CascadeValidateDeathTest, FitRejectsBadInputWithAMessage) {
   EXPECT_DEATH(fit_cascade(CameraSlice{}, LightFrame{}, o), "map_size");
 }
 
-TEST(CascadeSettingsValidate, DefaultsAreValidAndBadValuesNamed) {
-  EXPECT_EQ(validate_cascade_settings(CascadeSettings{}), "");
-  CascadeSettings s;
+TEST(ShadowSettingsValidate, DefaultsAreValidAndBadValuesNamed) {
+  EXPECT_EQ(validate_shadow_settings(ShadowSettings{}), "");
+  ShadowSettings s;
   s.lambda = 1.2f;
-  EXPECT_EQ(validate_cascade_settings(s), "lambda must be in [0, 1], was 1.2");
-  s = CascadeSettings{};
+  EXPECT_EQ(validate_shadow_settings(s), "lambda must be in [0, 1], was 1.2");
+  s = ShadowSettings{};
   s.lambda = NAN;
-  EXPECT_NE(validate_cascade_settings(s).find("lambda"), std::string::npos);
-  s = CascadeSettings{};
+  EXPECT_NE(validate_shadow_settings(s).find("lambda"), std::string::npos);
+  s = ShadowSettings{};
   s.cascade_count = 9;
-  EXPECT_EQ(validate_cascade_settings(s), "cascade_count must be in [1, 8], was 9");
-  s = CascadeSettings{};
+  EXPECT_EQ(validate_shadow_settings(s), "cascade_count must be in [1, 8], was 9");
+  s = ShadowSettings{};
   s.map_size = 1000;
-  EXPECT_NE(validate_cascade_settings(s).find("was 1000"), std::string::npos);
-  s = CascadeSettings{};
+  EXPECT_NE(validate_shadow_settings(s).find("was 1000"), std::string::npos);
+  s = ShadowSettings{};
   s.max_distance = -1.0f;
-  EXPECT_NE(validate_cascade_settings(s).find("max_distance"), std::string::npos);
-  s = CascadeSettings{};
+  EXPECT_NE(validate_shadow_settings(s).find("max_distance"), std::string::npos);
+  s = ShadowSettings{};
   s.beam_radius = INFINITY;
-  EXPECT_NE(validate_cascade_settings(s).find("beam_radius"), std::string::npos);
-  s = CascadeSettings{};
+  EXPECT_NE(validate_shadow_settings(s).find("beam_radius"), std::string::npos);
+  s = ShadowSettings{};
   s.blend_band = 1.5f;
-  EXPECT_EQ(validate_cascade_settings(s), "blend_band must be in [0, 1], was 1.5");
-  s = CascadeSettings{};
+  EXPECT_EQ(validate_shadow_settings(s), "blend_band must be in [0, 1], was 1.5");
+  s = ShadowSettings{};
   s.normal_offset_bias = -1.0f;
-  EXPECT_NE(validate_cascade_settings(s).find("normal_offset_bias"), std::string::npos);
-  s = CascadeSettings{};
+  EXPECT_NE(validate_shadow_settings(s).find("normal_offset_bias"), std::string::npos);
+  s = ShadowSettings{};
   s.fit_mode = static_cast<FitMode>(7);
-  EXPECT_NE(validate_cascade_settings(s).find("fit_mode"), std::string::npos);
+  EXPECT_NE(validate_shadow_settings(s).find("fit_mode"), std::string::npos);
+  s = ShadowSettings{};
+  s.fit_mode = FitMode::scene;
+  EXPECT_EQ(validate_shadow_settings(s), "fit_mode scene needs cascade_count 1, was 4");
+  s.cascade_count = 1;
+  EXPECT_EQ(validate_shadow_settings(s), "");
 }
 
 }  // namespace

@@ -1,0 +1,225 @@
+#include "systems/shadow_cascade_system.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "components/light.h"
+#include "components/mesh_renderer.h"
+#include "components/transform.h"
+#include "runtime/core/log.h"
+
+namespace kaskad {
+namespace {
+
+bool finite_box(const Aabb& b) {
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(b.min[a]) || !std::isfinite(b.max[a])) return false;
+  return true;
+}
+
+// The 8 corners of a box in clip space (homogeneous, not divided: points behind a perspective
+// camera keep their sign).
+std::array<glm::vec4, 8> clip_corners(const glm::mat4& m, const Aabb& b) {
+  std::array<glm::vec4, 8> out;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 c{(i & 1) ? b.max.x : b.min.x, (i & 2) ? b.max.y : b.min.y,
+                      (i & 4) ? b.max.z : b.min.z};
+    out[std::size_t(i)] = m * glm::vec4(c, 1.0f);
+  }
+  return out;
+}
+
+// False when all corners lie outside one of the 6 clip planes (-w <= x, y, z <= w): the box is
+// certainly outside. True may be a false positive near frustum corners (conservative).
+bool maybe_inside(const std::array<glm::vec4, 8>& c) {
+  for (int axis = 0; axis < 3; ++axis)
+    for (float sign : {-1.0f, 1.0f}) {
+      bool all_out = true;
+      for (const glm::vec4& p : c)
+        if (sign * p[axis] <= p.w) {
+          all_out = false;
+          break;
+        }
+      if (all_out) return false;
+    }
+  return true;
+}
+
+bool entity_less(ecs::Entity a, ecs::Entity b) {
+  return a.index != b.index ? a.index < b.index : a.generation < b.generation;
+}
+
+void set_error(ShadowData& out, const std::string& message) {
+  if (out.error.empty()) out.error = message;
+}
+
+}  // namespace
+
+std::uint8_t ShadowData::cascade_mask(ecs::Entity e) const {
+  std::uint8_t mask = 0;
+  for (int i = 0; i < cascade_count; ++i) {
+    const auto& list = casters[std::size_t(i)];
+    if (std::binary_search(list.begin(), list.end(), e, entity_less)) mask |= std::uint8_t(1u << i);
+  }
+  return mask;
+}
+
+float farthest_visible_receiver(const glm::mat4& view, const glm::mat4& view_proj, float near,
+                                float far, std::span<const Aabb> receivers) {
+  float out = 0.0f;
+  for (const Aabb& b : receivers) {
+    if (b.empty() || !maybe_inside(clip_corners(view_proj, b))) continue;
+    const Aabb v = b.transformed(view);
+    out = std::max(out, std::clamp(-v.min.z, near, far));  // view space looks down -z
+  }
+  return out;
+}
+
+std::vector<std::uint32_t> cull_casters(const glm::mat4& light_view_proj,
+                                        std::span<const Aabb> casters) {
+  std::vector<std::uint32_t> out;
+  for (std::size_t i = 0; i < casters.size(); ++i)
+    if (!casters[i].empty() && maybe_inside(clip_corners(light_view_proj, casters[i])))
+      out.push_back(std::uint32_t(i));
+  return out;
+}
+
+ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& camera,
+                                  ShadowCascadeState& state) {
+  ShadowData out;
+  // 1. The light: the first shadowed directional light, its settings and a finite transform.
+  glm::mat4 light_matrix(1.0f);
+  world.view<Light, WorldTransform>().each(
+      [&](ecs::Entity e, const Light& light, const WorldTransform& wt) {
+        if (out.light.valid() || !light.cast_shadows || light.type != LightType::directional)
+          return;
+        out.light = e;
+        light_matrix = wt.matrix;
+      });
+  auto finish = [&]() -> ShadowData {
+    if (out.error != state.last_error) {
+      if (!out.error.empty()) log::error("shadows: %s", out.error.c_str());
+      state.last_error = out.error;
+    }
+    return std::move(out);
+  };
+  if (!out.light.valid()) return finish();
+  if (const auto* s = world.try_get<ShadowSettings>(out.light)) out.settings = *s;
+  const ShadowSettings& s = out.settings;
+  if (std::string bad = validate_shadow_settings(s); !bad.empty()) {
+    set_error(out, "light " + std::to_string(out.light.index) + ": " + bad);
+    out.light = ecs::kNullEntity;
+    return finish();
+  }
+  if (std::string bad = validate_transform(light_matrix); !bad.empty()) {
+    set_error(out, "light " + std::to_string(out.light.index) + " transform: " + bad);
+    out.light = ecs::kNullEntity;
+    return finish();
+  }
+  LightFrame light;
+  light.direction = light_direction(light_matrix);
+  light.origin = glm::vec3(light_matrix[3]);
+
+  // 2. Casters, receivers and the scene box; entities with non-finite bounds are left out.
+  Aabb scene;
+  std::vector<Aabb> caster_boxes, receiver_boxes;
+  std::vector<ecs::Entity> caster_entities;
+  world.view<MeshRenderer, WorldBounds>().each(
+      [&](ecs::Entity e, const MeshRenderer& mr, const WorldBounds& b) {
+        if (b.box.empty()) return;
+        if (!finite_box(b.box)) {
+          set_error(out, "entity " + std::to_string(e.index) +
+                             " has non-finite bounds (NaN or inf transform); left out");
+          return;
+        }
+        scene.expand(b.box);
+        if (mr.cast_shadows) {
+          caster_boxes.push_back(b.box);
+          caster_entities.push_back(e);
+        }
+        if (mr.receive_shadows) receiver_boxes.push_back(b.box);
+      });
+  if (scene.empty()) {
+    out.light = ecs::kNullEntity;  // nothing to shadow
+    return finish();
+  }
+
+  // 3. FitMode::scene: the basic map, one cascade around the whole scene at every depth.
+  if (s.fit_mode == FitMode::scene) {
+    out.cascade_count = 1;
+    const LightProjection basic = fit_ortho_light_to_bounds(light.direction, scene);
+    out.view_proj[0] = basic.view_proj();
+    out.splits[0] = 0.0f;
+    out.splits[1] = std::numeric_limits<float>::max();
+    const Aabb ls = scene.transformed(basic.view);
+    out.texel_size[0] = std::max(ls.max.x - ls.min.x, ls.max.y - ls.min.y) / float(s.map_size);
+    out.casters[0] = caster_entities;
+    std::sort(out.casters[0].begin(), out.casters[0].end(), entity_less);
+    return finish();
+  }
+
+  // 4. The camera slice shape; a non-finite or degenerate camera gives no shadow.
+  if (!camera.entity.valid()) {
+    out.light = ecs::kNullEntity;
+    return finish();
+  }
+  CameraSlice slice;
+  slice.camera_world = glm::inverse(camera.view);
+  slice.projection = camera.camera.projection;
+  slice.fov_y_rad = glm::radians(camera.camera.fov_y_deg);
+  slice.ortho_height = camera.camera.ortho_height;
+  slice.aspect = camera.aspect;
+  slice.near = camera.camera.near;
+  slice.far = camera.camera.far;
+  if (std::string bad = validate_transform(camera.view); !bad.empty()) {
+    set_error(out, "camera transform: " + bad);
+    out.light = ecs::kNullEntity;
+    return finish();
+  }
+  if (std::string bad = validate_camera_slice(slice); !bad.empty() || !(slice.near > 0.0f)) {
+    set_error(out, "camera: " + (bad.empty() ? std::string("near must be > 0") : bad));
+    out.light = ecs::kNullEntity;
+    return finish();
+  }
+
+  // 5. Where the last split ends: min(camera far, max_distance, farthest visible receiver).
+  const float near = slice.near;
+  float far = slice.far;
+  if (s.max_distance > 0.0f) far = std::min(far, s.max_distance);
+  out.far_requested = far;
+  const float receiver_far = farthest_visible_receiver(camera.view, camera.proj * camera.view,
+                                                       near, far, receiver_boxes);
+  if (receiver_far > 0.0f) far = std::min(far, receiver_far);
+  // N distinct splits need some room (split_distances' precondition).
+  far = std::max(far, near * (1.0f + 1e-3f * float(s.cascade_count)) + 1e-6f);
+  out.far_used = far;
+  const std::vector<float> D =
+      split_distances(s.split_scheme, s.cascade_count, near, far, s.lambda);
+
+  // 6. Per cascade (S0 steps 1-5, or S2's stable fit): fit, skip when no receiver, cull casters.
+  out.cascade_count = s.cascade_count;
+  CascadeFitOptions options;
+  options.mode = s.fit_mode;
+  options.map_size = s.map_size;
+  options.beam_radius = s.beam_radius;
+  options.depth = DepthFit::enclose_slice;
+  const ShadowGeometry geometry{scene, caster_boxes, receiver_boxes};
+  for (int i = 0; i <= s.cascade_count; ++i) out.splits[std::size_t(i)] = D[std::size_t(i)];
+  for (int i = 0; i < s.cascade_count; ++i) {
+    const auto c = std::size_t(i);
+    slice.near = D[c];
+    slice.far = D[c + 1];
+    const CascadeFit fit = fit_cascade(slice, light, options, geometry);
+    out.view_proj[c] = fit.view_proj();
+    out.texel_size[c] = fit.world_units_per_texel;
+    out.skipped[c] = fit.empty || receiver_boxes.empty();
+    if (out.skipped[c]) continue;
+    for (std::uint32_t k : cull_casters(out.view_proj[c], caster_boxes))
+      out.casters[c].push_back(caster_entities[k]);
+    std::sort(out.casters[c].begin(), out.casters[c].end(), entity_less);
+  }
+  return finish();
+}
+
+}  // namespace kaskad

@@ -1,0 +1,79 @@
+// Cascaded shadow maps of the first shadowed directional light (S0 with S2's stabilisation), the
+// frame's Cascades phase. Maths on the CPU only (cascade_math.h); the renderer draws one depth
+// layer per cascade from the ShadowData published here.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "components/bounds.h"
+#include "components/shadow_settings.h"
+#include "runtime/ecs/world.h"
+#include "systems/camera_system.h"
+#include "systems/cascade_math.h"
+#include "systems/shadow_map_system.h"
+
+namespace kaskad {
+
+/// What the renderer and the stats need of the shadowed light this frame.
+struct ShadowData {
+  ecs::Entity light = ecs::kNullEntity;  ///< the shadowed light, null when there is none
+  ShadowSettings settings;               ///< the light's own, else defaults
+  int cascade_count = 0;                 ///< cascades published (settings.cascade_count), 0: none
+  /// World -> light clip space per cascade (cascade 0 is the basic map with FitMode::scene).
+  std::array<glm::mat4, kMaxCascades> view_proj{};
+  /// S0's D: D[0] = camera near .. D[count] = the end of the last cascade, metres of view depth.
+  /// FitMode::scene: [0, 3.4e38] (one map covers every depth).
+  std::array<float, kMaxCascades + 1> splits{};
+  /// Metres per shadow-map texel of each cascade (the larger of x and y).
+  std::array<float, kMaxCascades> texel_size{};
+  /// No receiver lies in the cascade's volume: its layer is cleared, nothing drawn.
+  std::array<bool, kMaxCascades> skipped{};
+  /// Shadow casters overlapping each cascade's light volume, sorted: only these are drawn into
+  /// that layer.
+  std::array<std::vector<ecs::Entity>, kMaxCascades> casters{};
+  /// The end of the last split before and after clamping to the farthest visible receiver:
+  /// min(camera far, max_distance) and min(that, farthest receiver). Equal when nothing moved it.
+  float far_requested = 0.0f, far_used = 0.0f;
+  /// Why there is no shadow (a non-finite transform, a bad camera), or an entity left out; empty
+  /// when all is well.
+  std::string error;
+
+  /// Bit i set when `e` is drawn into cascade i.
+  std::uint8_t cascade_mask(ecs::Entity e) const;
+};
+
+/// State the system owns between frames: the last error, so it is logged once, not every frame.
+struct ShadowCascadeState {
+  std::string last_error;
+};
+
+/// Phase 3. Picks the first directional Light with cast_shadows (entity order) and fits its
+/// cascades to `camera`: splits (S0 eq. (1)-(3)) between the camera near and min(camera far,
+/// max_distance, farthest visible receiver), each cascade by fit_cascade() (crop or stable) with
+/// the near plane pulled back to the casters; cascades without receivers are skipped; casters are
+/// culled per cascade. FitMode::scene reproduces the basic map (fit_ortho_light_to_bounds).
+/// A non-finite light or camera transform gives no shadow and an error, never a crash; entities
+/// with non-finite bounds are left out. Needs current WorldTransform/WorldBounds.
+ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& camera,
+                                  ShadowCascadeState& state);
+
+// ---- Pure parts, exposed for tests -------------------------------------------------------------
+
+/// The largest view depth (metres, -z of view space) of any box at least partly inside the
+/// frustum of `view_proj` (box corners against the 6 clip planes; conservative), clamped to
+/// [near, far]. 0 when no box is visible.
+float farthest_visible_receiver(const glm::mat4& view, const glm::mat4& view_proj, float near,
+                                float far, std::span<const Aabb> receivers);
+
+/// Indices of the boxes that overlap the clip volume [-1, 1]^3 of `light_view_proj` (corner test
+/// against each plane; conservative), in order.
+std::vector<std::uint32_t> cull_casters(const glm::mat4& light_view_proj,
+                                        std::span<const Aabb> casters);
+
+}  // namespace kaskad

@@ -1,0 +1,215 @@
+// ShadowCascadeSystem's CPU side: split end clamped to the farthest visible receiver, skipped
+// empty cascades, per-cascade caster lists, NaN transforms rejected, the basic fit reproduced.
+// No GL.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "components/light.h"
+#include "components/mesh_renderer.h"
+#include "components/transform.h"
+#include "systems/shadow_cascade_system.h"
+
+namespace kaskad {
+namespace {
+
+Aabb box(glm::vec3 lo, glm::vec3 hi) {
+  Aabb b;
+  b.expand(lo);
+  b.expand(hi);
+  return b;
+}
+
+// A camera at the origin looking down -z (fov 20 degrees, square), near 1, far 100.
+CameraState camera(ecs::World& w, float fov_deg = 20.0f) {
+  CameraState c;
+  c.entity = w.create();
+  c.camera.fov_y_deg = fov_deg;
+  c.camera.near = 1.0f;
+  c.camera.far = 100.0f;
+  c.aspect = 1.0f;
+  c.view = glm::mat4(1.0f);
+  c.proj = glm::perspective(glm::radians(fov_deg), 1.0f, 1.0f, 100.0f);
+  return c;
+}
+
+ecs::Entity sun(ecs::World& w, const ShadowSettings& s, glm::vec3 dir = {0.3f, -1.0f, -0.2f}) {
+  const ecs::Entity e = w.create();
+  Light l;
+  l.cast_shadows = true;
+  w.emplace<Light>(e, l);
+  // Local -z along dir: a rotation taking (0,0,-1) to dir.
+  const glm::vec3 d = glm::normalize(dir);
+  WorldTransform wt;
+  wt.matrix = glm::inverse(glm::lookAt(glm::vec3(0.0f), d, std::abs(d.y) > 0.99f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0)));
+  w.emplace<WorldTransform>(e, wt);
+  w.emplace<ShadowSettings>(e, s);
+  return e;
+}
+
+ecs::Entity mesh(ecs::World& w, const Aabb& b, bool cast = true, bool receive = true) {
+  const ecs::Entity e = w.create();
+  MeshRenderer mr;
+  mr.mesh = 0;
+  mr.cast_shadows = cast;
+  mr.receive_shadows = receive;
+  w.emplace<MeshRenderer>(e, mr);
+  w.emplace<WorldBounds>(e, WorldBounds{b});
+  return e;
+}
+
+bool contains(const std::vector<ecs::Entity>& v, ecs::Entity e) {
+  return std::find(v.begin(), v.end(), e) != v.end();
+}
+
+TEST(ShadowCascadeSystem, LastSplitEndsAtTheFarthestVisibleReceiver) {
+  ecs::World w;
+  ShadowSettings s;
+  s.max_distance = 100.0f;
+  sun(w, s);
+  // A receiver from 2 m to 20 m in front of the camera, and one far behind it (not visible).
+  mesh(w, box({-1, -1, -20}, {1, 0, -2}));
+  mesh(w, box({-1, -1, 40}, {1, 0, 60}));
+  ShadowCascadeState state;
+  const ShadowData d = update_shadow_cascades(w, camera(w), state);
+  ASSERT_TRUE(d.light.valid()) << d.error;
+  EXPECT_EQ(d.cascade_count, 4);
+  EXPECT_FLOAT_EQ(d.far_requested, 100.0f);
+  EXPECT_NEAR(d.far_used, 20.0f, 1e-4f);
+  EXPECT_FLOAT_EQ(d.splits[0], 1.0f);
+  EXPECT_FLOAT_EQ(d.splits[4], d.far_used);
+  for (int i = 0; i < 4; ++i) EXPECT_LT(d.splits[std::size_t(i)], d.splits[std::size_t(i) + 1]);
+  // max_distance still wins when it is nearer.
+  w.get<ShadowSettings>(d.light).max_distance = 10.0f;
+  const ShadowData d2 = update_shadow_cascades(w, camera(w), state);
+  EXPECT_FLOAT_EQ(d2.far_requested, 10.0f);
+  EXPECT_FLOAT_EQ(d2.far_used, 10.0f);
+}
+
+TEST(ShadowCascadeSystem, FarthestVisibleReceiverIgnoresBoxesOutsideTheFrustum) {
+  const glm::mat4 view(1.0f), proj = glm::perspective(glm::radians(20.0f), 1.0f, 1.0f, 100.0f);
+  const Aabb behind = box({-1, -1, 5}, {1, 1, 9});
+  const Aabb aside = box({50, -1, -30}, {52, 1, -20});
+  const Aabb front = box({-1, -1, -30}, {1, 1, -20});
+  EXPECT_EQ(farthest_visible_receiver(view, proj * view, 1, 100, std::array{behind, aside}), 0.0f);
+  EXPECT_FLOAT_EQ(farthest_visible_receiver(view, proj * view, 1, 100, std::array{behind, front}), 30.0f);
+  // Clamped to far.
+  const Aabb long_box = box({-1, -1, -300}, {1, 1, -20});
+  EXPECT_FLOAT_EQ(farthest_visible_receiver(view, proj * view, 1, 100, std::array{long_box}), 100.0f);
+}
+
+TEST(ShadowCascadeSystem, CascadesWithoutReceiversAreSkippedAndCastersCulledPerCascade) {
+  ecs::World w;
+  ShadowSettings s;
+  s.split_scheme = SplitScheme::uniform;  // 1, 13.25, 25.5, 37.75, 50
+  s.cascade_count = 4;
+  sun(w, s, {0.0f, -1.0f, 0.0f});
+  const ecs::Entity near_box = mesh(w, box({-0.3f, -0.3f, -2.0f}, {0.3f, 0.3f, -1.5f}));
+  const ecs::Entity far_box = mesh(w, box({-0.3f, -0.3f, -50.0f}, {0.3f, 0.3f, -49.0f}));
+  const ecs::Entity no_cast = mesh(w, box({-0.3f, -0.3f, -45.0f}, {0.3f, 0.3f, -44.0f}), false, true);
+  ShadowCascadeState state;
+  const ShadowData d = update_shadow_cascades(w, camera(w), state);
+  ASSERT_TRUE(d.light.valid()) << d.error;
+  EXPECT_NEAR(d.far_used, 50.0f, 1e-4f);
+  EXPECT_FALSE(d.skipped[0]);
+  EXPECT_TRUE(d.skipped[1]);
+  EXPECT_TRUE(d.skipped[2]);
+  EXPECT_FALSE(d.skipped[3]);
+  EXPECT_TRUE(d.casters[1].empty());
+  EXPECT_TRUE(d.casters[2].empty());
+  EXPECT_TRUE(contains(d.casters[0], near_box));
+  EXPECT_FALSE(contains(d.casters[0], far_box));
+  EXPECT_TRUE(contains(d.casters[3], far_box));
+  EXPECT_FALSE(contains(d.casters[3], near_box));
+  for (const auto& list : d.casters) EXPECT_FALSE(contains(list, no_cast));  // not a caster
+  EXPECT_EQ(d.cascade_mask(near_box), 0b0001);
+  EXPECT_EQ(d.cascade_mask(far_box), 0b1000);
+  for (int i = 0; i < 4; ++i) EXPECT_GT(d.texel_size[std::size_t(i)], 0.0f);
+}
+
+TEST(ShadowCascadeSystem, CullCastersKeepsBoxesOverlappingTheLightVolume) {
+  const glm::mat4 vp = glm::ortho(-1.0f, 1.0f, -1.0f, 1.0f, 0.0f, 10.0f);  // looks down -z
+  const std::array boxes{box({-0.5f, -0.5f, -2}, {0.5f, 0.5f, -1}),   // inside
+                         box({0.9f, 0.9f, -2}, {3, 3, -1}),            // straddles a corner
+                         box({2, -0.5f, -2}, {3, 0.5f, -1}),           // right of it
+                         box({-0.5f, -0.5f, -30}, {0.5f, 0.5f, -20}),  // beyond far
+                         Aabb{}};                                      // empty
+  EXPECT_EQ(cull_casters(vp, boxes), (std::vector<std::uint32_t>{0, 1}));
+}
+
+TEST(ShadowCascadeSystem, NanLightTransformIsRejectedWithAnError) {
+  ecs::World w;
+  const ecs::Entity l = sun(w, ShadowSettings{});
+  mesh(w, box({-1, -1, -20}, {1, 0, -2}));
+  w.get<WorldTransform>(l).matrix[1][2] = std::numeric_limits<float>::quiet_NaN();
+  ShadowCascadeState state;
+  const ShadowData d = update_shadow_cascades(w, camera(w), state);
+  EXPECT_FALSE(d.light.valid());
+  EXPECT_NE(d.error.find("NaN"), std::string::npos) << d.error;
+  EXPECT_EQ(state.last_error, d.error);
+}
+
+TEST(ShadowCascadeSystem, NonFiniteBoundsAreLeftOutAndTheRestShadowed) {
+  ecs::World w;
+  sun(w, ShadowSettings{});
+  const ecs::Entity good = mesh(w, box({-1, -1, -20}, {1, 0, -2}));
+  Aabb bad = box({-1, -1, -20}, {1, 0, -2});
+  bad.max.x = std::numeric_limits<float>::infinity();
+  const ecs::Entity broken = mesh(w, bad);
+  ShadowCascadeState state;
+  const ShadowData d = update_shadow_cascades(w, camera(w), state);
+  ASSERT_TRUE(d.light.valid());
+  EXPECT_NE(d.error.find("non-finite"), std::string::npos) << d.error;
+  EXPECT_TRUE(contains(d.casters[0], good));
+  for (const auto& list : d.casters) EXPECT_FALSE(contains(list, broken));
+  for (int i = 0; i < d.cascade_count; ++i)
+    EXPECT_TRUE(validate_transform(d.view_proj[std::size_t(i)]).empty());
+}
+
+TEST(ShadowCascadeSystem, NanCameraIsRejectedWithAnError) {
+  ecs::World w;
+  sun(w, ShadowSettings{});
+  mesh(w, box({-1, -1, -20}, {1, 0, -2}));
+  CameraState c = camera(w);
+  c.view[3][0] = std::numeric_limits<float>::infinity();
+  ShadowCascadeState state;
+  const ShadowData d = update_shadow_cascades(w, c, state);
+  EXPECT_FALSE(d.light.valid());
+  EXPECT_NE(d.error.find("camera"), std::string::npos) << d.error;
+}
+
+TEST(ShadowCascadeSystem, SceneFitIsTheBasicMap) {
+  ecs::World w;
+  ShadowSettings s;
+  s.cascade_count = 1;
+  s.fit_mode = FitMode::scene;
+  sun(w, s);
+  mesh(w, box({-20, 0, -20}, {20, 0, 20}));
+  mesh(w, box({-1, 0, -1}, {1, 2, 1}));
+  ShadowCascadeState state;
+  const ShadowData d = update_shadow_cascades(w, camera(w), state);
+  const BasicShadow basic = update_basic_shadow(w);
+  ASSERT_TRUE(d.light.valid());
+  EXPECT_EQ(d.cascade_count, 1);
+  EXPECT_EQ(d.view_proj[0], basic.projection.view_proj());  // bit-exact
+  EXPECT_EQ(d.splits[0], 0.0f);
+  EXPECT_EQ(d.splits[1], std::numeric_limits<float>::max());
+}
+
+TEST(ShadowCascadeSystem, NoShadowedLightOrNoGeometryGivesNoShadow) {
+  ecs::World w;
+  mesh(w, box({-1, -1, -20}, {1, 0, -2}));
+  ShadowCascadeState state;
+  EXPECT_FALSE(update_shadow_cascades(w, camera(w), state).light.valid());
+  ecs::World empty;
+  sun(empty, ShadowSettings{});
+  const ShadowData d = update_shadow_cascades(empty, camera(empty), state);
+  EXPECT_FALSE(d.light.valid());
+  EXPECT_TRUE(d.error.empty());
+}
+
+}  // namespace
+}  // namespace kaskad
