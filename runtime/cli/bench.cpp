@@ -74,7 +74,9 @@ void progress(std::size_t done, std::size_t total, double elapsed_s, const std::
 }  // namespace
 
 std::string default_sweep() {
-  return "shadow.map_size=1024,2048,4096;shadow.filter=none,pcf3x3";
+  // Cascade count x fit x map size x filter: 24 configurations, the trade-offs that matter most.
+  return "shadow.cascade_count=1,2,4;shadow.fit_mode=stable,crop;shadow.map_size=1024,2048;"
+         "shadow.filter=none,pcf3x3";
 }
 
 Result<std::vector<BenchConfig>> parse_sweep(const std::string& spec) {
@@ -190,8 +192,10 @@ Status run_bench(const BenchOptions& options) {
       double mrays = 0.0;
       const ecs::Entity light = with_aovs->last.shadow.light;
       if (light.valid()) {
-        if (const auto* s = scene->world.try_get<ShadowSettings>(light))
-          map_mib = double(s->map_size) * s->map_size * 4.0 / (1024.0 * 1024.0);
+        if (const auto* s = scene->world.try_get<ShadowSettings>(light)) {
+          const double bytes = s->depth_format == DepthFormat::d16 ? 2.0 : 4.0;
+          map_mib = double(s->map_size) * s->map_size * bytes * s->cascade_count / (1024.0 * 1024.0);
+        }
         auto tracer = reference::RayTracer::build(*scene);
         if (!tracer) {
           result = tracer.error();

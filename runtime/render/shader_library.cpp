@@ -133,12 +133,8 @@ Result<ShaderLibrary::Entry> ShaderLibrary::build(Pass pass, VariantKey key, boo
   const VariantKey effective =
       oracle_ ? VariantKey(key.frame().bits() | VariantKey::kMaterialMask) : key;
   auto defines_for = [&](ShaderStage stage) {
-    auto d = manifest_.defines(effective, stage);
-    if (oracle_) {
-      for (auto& [name, value] : d)
-        if (name.rfind("MATERIAL_", 0) == 0 && name.find("HAS_") != std::string::npos) value = "1";
-      d.emplace_back("KASKAD_UBER_ORACLE", "1");
-    }
+    auto d = manifest_.defines(effective, stage);  // oracle: every material define is 1
+    if (oracle_) d.emplace_back("KASKAD_UBER_ORACLE", "1");
     return d;
   };
   auto vs = gpu::preprocess_shader(dir_, pf.vertex, defines_for(ShaderStage::vertex));
