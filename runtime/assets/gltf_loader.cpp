@@ -11,7 +11,6 @@
 //   4. validate the node hierarchy (indices, single parent) and pick the root nodes;
 //   5. walk the hierarchy parents-first, creating node entities, primitive child entities (meshes
 //      and materials are converted once, on first use) and lights and cameras.
-#include "runtime/core/file_io.h"
 #include "runtime/assets/gltf_loader.h"
 
 #include <draco/compression/decode.h>
@@ -49,6 +48,7 @@
 #include "components/transform.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/tinygltf_config.h"
+#include "runtime/core/file_io.h"
 
 namespace kaskad {
 namespace {
@@ -140,7 +140,6 @@ struct ImageLoadState {
   std::map<int, std::string> failures;  ///< image index -> why it has no pixels
 };
 
-
 /// tinygltf image callback: decodes images given by URI (external files, data URIs) through
 /// OIIO. Failures are recorded, not returned: a missing texture should not fail the import.
 bool load_image_callback(tinygltf::Image* image, const int index, std::string* /*err*/,
@@ -168,7 +167,6 @@ bool load_image_callback(tinygltf::Image* image, const int index, std::string* /
 }
 
 // ---- Reading and parsing the file -----------------------------------------------------------
-
 
 /// Refuses JSON nested deeper than kMaxJsonDepth (brackets outside strings are counted).
 Status check_json_depth(const std::uint8_t* json, std::size_t size, const std::string& file) {

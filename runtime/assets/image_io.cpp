@@ -4,7 +4,6 @@
 // format comes from the file's magic bytes, then the MIME type, then the extension. We never let
 // OIIO "try every reader in turn" on unknown bytes (what ImageInput::open(filename) does when the
 // extension does not match), so corrupt or hostile data reaches at most one decoder.
-#include "runtime/core/file_io.h"
 #include "runtime/assets/image_io.h"
 
 #include <OpenImageIO/filesystem.h>
@@ -22,6 +21,8 @@
 #include <new>
 #include <string_view>
 #include <system_error>
+
+#include "runtime/core/file_io.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define KASKAD_LSAN 1
@@ -251,7 +252,6 @@ Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::stri
   if (!read) return Error{name, "", "corrupt or truncated image data: " + one_line(read_error)};
   return image;
 }
-
 
 /// Formats written as 32-bit float; everything else is written as 8 bits per channel.
 bool is_float_format(const std::string& ext) {
