@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 packages=(
   cmake g++ make pkg-config git
   libglfw3-dev libegl-dev libepoxy-dev libglm-dev libgl-dev
-  libegl-mesa0 libgl1-mesa-dri mesa-utils
+  libegl-mesa0 libgl1-mesa-dri libglx-mesa0 libgl1 mesa-utils
   libtinygltf-dev libdraco-dev draco
   libopenimageio-dev openimageio-tools
   nlohmann-json3-dev libimgui-dev libstb-dev libembree-dev
