@@ -511,10 +511,7 @@ class View<detail::TypeList<I...>, detail::TypeList<X...>> {
       // keep that path branch-light, it is the range-for equivalent of step 2.
       ++index_;
       if constexpr (sizeof...(X) == 0) {
-        if (index_ < cursor_.aligned) {
-          pos_.fill(static_cast<std::uint32_t>(index_));
-          return *this;
-        }
+        if (index_ < cursor_.aligned) return *this;  // deref uses index_ itself there
       }
       settle();
       return *this;
@@ -534,6 +531,10 @@ class View<detail::TypeList<I...>, detail::TypeList<X...>> {
     }
     template <std::size_t... K>
     value_type deref(std::index_sequence<K...>) const {
+      // Inside the aligned prefix every pool holds the entity at index_: no position look-up
+      // (pos_ is not even written there, see operator++).
+      if (index_ < cursor_.aligned)
+        return value_type(cursor_.entities[index_], std::get<K>(cursor_.data)[index_]...);
       return value_type(cursor_.entities[index_], std::get<K>(cursor_.data)[pos_[K]]...);
     }
 
