@@ -79,7 +79,10 @@ std::string default_sweep() {
          "shadow.filter=none,pcf3x3";
 }
 
-Result<std::vector<BenchConfig>> parse_sweep(const std::string& spec) {
+namespace {
+
+// One cartesian product: "key=v1,v2;key2=w1,w2".
+Result<std::vector<BenchConfig>> parse_product(const std::string& spec) {
   std::vector<BenchConfig> configs{{"", {}}};
   std::set<std::string> keys;
   for (const std::string& part_raw : split(spec, ';')) {
@@ -110,6 +113,19 @@ Result<std::vector<BenchConfig>> parse_sweep(const std::string& spec) {
   }
   if (configs.size() == 1 && configs[0].label.empty()) configs[0].label = "scene settings";
   return configs;
+}
+
+}  // namespace
+
+Result<std::vector<BenchConfig>> parse_sweep(const std::string& spec) {
+  // Alternatives separated by '|' are concatenated: "a=1;b=2 | a=0;b=0" is two configurations.
+  std::vector<BenchConfig> all;
+  for (const std::string& product : split(spec, '|')) {
+    auto configs = parse_product(product);
+    if (!configs) return configs.error();
+    all.insert(all.end(), configs->begin(), configs->end());
+  }
+  return all;
 }
 
 std::vector<std::string> bench_csv_columns() {

@@ -33,8 +33,9 @@ struct BenchConfig {
 /// The sweep used when none is given: the settings whose speed/accuracy trade-off matters.
 std::string default_sweep();
 
-/// Parses "key=v1,v2;key2=w1,w2" into the cartesian product, in order. Errors: empty keys,
-/// missing '=', empty value lists, a key given twice.
+/// Parses "key=v1,v2;key2=w1,w2" into the cartesian product, in order; products separated by
+/// '|' are concatenated ("a=1;b=2|a=0;b=0" is two configurations). Errors: empty keys, missing
+/// '=', empty value lists, a key given twice within one product.
 Result<std::vector<BenchConfig>> parse_sweep(const std::string& spec);
 
 /// The CSV header, one name per column (documented in README.md "kaskad bench").
