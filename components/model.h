@@ -10,8 +10,9 @@ namespace kaskad {
 
 /// Built-in unit primitives, centred at the origin; size them with Transform::scale.
 /// plane: 1 x 1 in XZ facing +Y; box: 1 x 1 x 1; sphere: diameter 1; cylinder and cone: diameter 1,
-/// height 1 along Y.
-enum class PrimitiveShape { plane, box, sphere, cylinder, cone };
+/// height 1 along Y; terrain: a 1 x 1 heightfield in XZ with heights in [0, 1] (deterministic
+/// fractal noise; `segments` x `segments` cells, 2 triangles each).
+enum class PrimitiveShape { plane, box, sphere, cylinder, cone, terrain };
 
 struct PrimitiveMesh {
   PrimitiveShape shape = PrimitiveShape::box;

@@ -199,6 +199,63 @@ MeshData make_cone(int segments) {
 
 }  // namespace
 
+// Value noise on the integer lattice, hashed (no tables: the same heights on every machine).
+float lattice(int x, int z) {
+  std::uint32_t h = std::uint32_t(x) * 0x8da6b343u ^ std::uint32_t(z) * 0xd8163841u;
+  h ^= h >> 13;
+  h *= 0x5bd1e995u;
+  h ^= h >> 15;
+  return float(h & 0xffffffu) / float(0xffffff);
+}
+
+float value_noise(float x, float z) {
+  const float fx = std::floor(x), fz = std::floor(z);
+  const int ix = int(fx), iz = int(fz);
+  float tx = x - fx, tz = z - fz;
+  tx = tx * tx * (3.0f - 2.0f * tx);  // smoothstep fade
+  tz = tz * tz * (3.0f - 2.0f * tz);
+  const float a = lattice(ix, iz), b = lattice(ix + 1, iz);
+  const float c = lattice(ix, iz + 1), d = lattice(ix + 1, iz + 1);
+  return (a + (b - a) * tx) + ((c + (d - c) * tx) - (a + (b - a) * tx)) * tz;
+}
+
+/// Height in [0, 1] at (u, v) in [0, 1]^2: six octaves of value noise (fBm).
+float terrain_height(float u, float v) {
+  float sum = 0.0f, amplitude = 0.5f, frequency = 4.0f, norm = 0.0f;
+  for (int octave = 0; octave < 6; ++octave) {
+    sum += amplitude * value_noise(u * frequency + 17.0f * float(octave), v * frequency);
+    norm += amplitude;
+    amplitude *= 0.5f;
+    frequency *= 2.0f;
+  }
+  return sum / norm;
+}
+
+MeshData make_terrain(int segments) {
+  MeshData m;
+  m.name = "terrain";
+  const int n = segments;
+  const float step = 1.0f / float(n);
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      const float u = float(i) * step, v = float(j) * step;
+      // Normal from central differences of the height (local space; the normal matrix handles
+      // the transform's non-uniform scale).
+      const float dx = terrain_height(u + step, v) - terrain_height(u - step, v);
+      const float dz = terrain_height(u, v + step) - terrain_height(u, v - step);
+      const glm::vec3 normal = glm::normalize(glm::vec3(-dx, 2.0f * step, -dz));
+      add_vertex(m, {u - 0.5f, terrain_height(u, v), v - 0.5f}, normal, {u, v});
+    }
+  }
+  const auto at = [n](int i, int j) { return std::uint32_t(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {  // counter-clockwise seen from +Y, as the plane
+      add_triangle(m, at(i, j), at(i, j + 1), at(i + 1, j + 1));
+      add_triangle(m, at(i, j), at(i + 1, j + 1), at(i + 1, j));
+    }
+  return m;
+}
+
 MeshData make_primitive(PrimitiveShape shape, int segments) {
   KASKAD_CHECK(segments >= 3 && segments <= 1024,
                "segments must be in [3, 1024], was " + std::to_string(segments));
@@ -218,6 +275,9 @@ MeshData make_primitive(PrimitiveShape shape, int segments) {
       break;
     case PrimitiveShape::cone:
       mesh = make_cone(segments);
+      break;
+    case PrimitiveShape::terrain:
+      mesh = make_terrain(segments);
       break;
   }
   mesh.compute_bounds();

@@ -51,7 +51,8 @@ const std::vector<std::pair<const char*, Projection>> kProjections = {
     {"perspective", Projection::perspective}, {"orthographic", Projection::orthographic}};
 const std::vector<std::pair<const char*, PrimitiveShape>> kShapes = {
     {"plane", PrimitiveShape::plane}, {"box", PrimitiveShape::box}, {"sphere", PrimitiveShape::sphere},
-    {"cylinder", PrimitiveShape::cylinder}, {"cone", PrimitiveShape::cone}};
+    {"cylinder", PrimitiveShape::cylinder}, {"cone", PrimitiveShape::cone},
+    {"terrain", PrimitiveShape::terrain}};
 
 constexpr float kBig = 1.0e7f;  // |coordinate| limit: beyond it float precision is meaningless
 

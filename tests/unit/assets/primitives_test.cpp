@@ -30,6 +30,8 @@ std::string shape_name(PrimitiveShape s) {
       return "cylinder";
     case PrimitiveShape::cone:
       return "cone";
+    case PrimitiveShape::terrain:
+      return "terrain";
   }
   return "?";
 }
@@ -173,6 +175,35 @@ TEST(Primitives, SegmentsOutsideTheRangeAreAPreconditionFailure) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   EXPECT_DEATH((void)make_primitive(PrimitiveShape::sphere, 2), "segments must be in");
   EXPECT_DEATH((void)make_primitive(PrimitiveShape::cone, 1025), "segments must be in");
+}
+
+}  // namespace
+}  // namespace kaskad
+
+namespace kaskad {
+namespace {
+
+TEST(Primitives, TerrainIsADeterministicUnitHeightfield) {
+  const MeshData a = make_primitive(PrimitiveShape::terrain, 64);
+  const MeshData b = make_primitive(PrimitiveShape::terrain, 64);
+  EXPECT_EQ(a.positions, b.positions);  // same heights every time, on every machine
+  EXPECT_EQ(a.triangle_count(), 2u * 64u * 64u);
+  EXPECT_EQ(a.positions.size(), 65u * 65u);
+  EXPECT_NEAR(a.bounds.min.x, -0.5f, 1e-6f);
+  EXPECT_NEAR(a.bounds.max.z, 0.5f, 1e-6f);
+  EXPECT_GE(a.bounds.min.y, 0.0f);
+  EXPECT_LE(a.bounds.max.y, 1.0f);
+  EXPECT_GT(a.bounds.max.y - a.bounds.min.y, 0.2f);  // not flat
+  for (const auto& n : a.normals) {
+    EXPECT_NEAR(glm::length(n), 1.0f, 1e-4f);
+    EXPECT_GT(n.y, 0.0f);  // a heightfield's normals point up
+  }
+  // Faces wind counter-clockwise seen from above: geometric normals agree with vertex normals.
+  for (std::size_t t = 0; t < a.indices.size(); t += 3) {
+    const glm::vec3 p0 = a.positions[a.indices[t]], p1 = a.positions[a.indices[t + 1]],
+                    p2 = a.positions[a.indices[t + 2]];
+    ASSERT_GT(glm::cross(p1 - p0, p2 - p0).y, 0.0f) << t;
+  }
 }
 
 }  // namespace
