@@ -2,6 +2,7 @@
 // TextureId); the renderer uploads them to the GPU on first use.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -43,6 +44,9 @@ struct TextureData {
 struct AssetStore {
   std::vector<MeshData> meshes;
   std::vector<TextureData> textures;
+  /// Identifies this store's contents for GPU caches (MeshId 0 of another scene is another
+  /// mesh): unique per constructed store, kept when the store is moved.
+  std::uint64_t uid = next_uid();
 
   MeshId add_mesh(MeshData mesh) {
     meshes.push_back(std::move(mesh));
@@ -51,6 +55,12 @@ struct AssetStore {
   TextureId add_texture(TextureData texture) {
     textures.push_back(std::move(texture));
     return TextureId(textures.size() - 1);
+  }
+
+ private:
+  static std::uint64_t next_uid() {
+    static std::atomic<std::uint64_t> counter{1};
+    return counter.fetch_add(1, std::memory_order_relaxed);
   }
 };
 

@@ -73,6 +73,7 @@ gpu::Texture make_solid_texture(const std::array<float, 4>& rgba, GLenum interna
 struct Renderer::Impl {
   std::unique_ptr<ShaderLibrary> shaders;
   bool oracle = false;
+  std::uint64_t assets_uid = 0;                            // whose ids the caches below hold
   std::vector<GpuMesh> meshes;                             // indexed by MeshId
   std::vector<std::unique_ptr<GpuTexture>> textures;       // indexed by TextureId
   gpu::Texture white, flat_normal;
@@ -347,6 +348,12 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   glNamedBufferSubData(im.frame_ubo.id(), 0, sizeof fb, &fb);
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
 
+  // GPU meshes and textures are cached by id; ids of another AssetStore are other assets.
+  if (assets.uid != im.assets_uid) {
+    im.meshes.clear();
+    im.textures.clear();
+    im.assets_uid = assets.uid;
+  }
   for (const DrawItem& d : frame.draws)
     if (d.mesh >= assets.meshes.size())
       return Error{"", "draw list", "mesh id " + std::to_string(d.mesh) + " is out of range"};

@@ -200,3 +200,23 @@ TEST_F(PermutationTest, HotReloadKeepsTheLastGoodProgramAndMapsErrors) {
 
 }  // namespace
 }  // namespace kaskad
+
+namespace kaskad {
+namespace {
+
+// One renderer drawing two scenes in turn (as `kaskad bench` and the editor do) must not reuse
+// the first scene's GPU meshes for the second scene's mesh ids.
+TEST_F(PermutationTest, ARendererDrawsEachSceneWithItsOwnMeshes) {
+  Scene first = PermutationTest::scene("terrain.json");  // mesh 0: a heightfield, not a plane
+  Scene def_a = PermutationTest::scene("default.json");
+  auto fresh = make_renderer();
+  const Image expected = render(*fresh, def_a);
+  auto shared = make_renderer();
+  render(*shared, first);
+  Scene def_b = PermutationTest::scene("default.json");
+  const Image got = render(*shared, def_b);
+  EXPECT_EQ(got.pixels, expected.pixels);
+}
+
+}  // namespace
+}  // namespace kaskad
