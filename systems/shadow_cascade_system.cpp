@@ -90,13 +90,7 @@ ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& ca
   ShadowData out;
   // 1. The light: the first shadowed directional light, its settings and a finite transform.
   glm::mat4 light_matrix(1.0f);
-  world.view<Light, WorldTransform>().each(
-      [&](ecs::Entity e, const Light& light, const WorldTransform& wt) {
-        if (out.light.valid() || !light.cast_shadows || light.type != LightType::directional)
-          return;
-        out.light = e;
-        light_matrix = wt.matrix;
-      });
+  out.light = first_shadowed_directional_light(world, light_matrix);
   auto finish = [&]() -> ShadowData {
     if (out.error != state.last_error) {
       if (!out.error.empty()) log::error("shadows: %s", out.error.c_str());

@@ -43,16 +43,21 @@ LightProjection fit_ortho_light_to_bounds(const glm::vec3& direction, const Aabb
   return out;
 }
 
+ecs::Entity first_shadowed_directional_light(const ecs::World& world, glm::mat4& world_matrix) {
+  ecs::Entity found;
+  world.view<Light, WorldTransform>().each(
+      [&](ecs::Entity e, const Light& light, const WorldTransform& wt) {
+        if (found.valid() || !light.cast_shadows || light.type != LightType::directional) return;
+        found = e;
+        world_matrix = wt.matrix;
+      });
+  return found;
+}
+
 BasicShadow update_basic_shadow(const ecs::World& world) {
   BasicShadow out;
   glm::mat4 light_matrix(1.0f);
-  world.view<Light, WorldTransform>().each(
-      [&](ecs::Entity e, const Light& light, const WorldTransform& wt) {
-        if (out.light.valid() || !light.cast_shadows || light.type != LightType::directional)
-          return;
-        out.light = e;
-        light_matrix = wt.matrix;
-      });
+  out.light = first_shadowed_directional_light(world, light_matrix);
   if (!out.light.valid()) return out;
   const glm::vec3 dir = light_direction(light_matrix);
   Aabb bounds;

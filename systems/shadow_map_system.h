@@ -31,6 +31,10 @@ struct BasicShadow {
 };
 BasicShadow update_basic_shadow(const ecs::World& world);
 
+/// The first directional Light with cast_shadows (entity order) and its world matrix; a null
+/// entity when there is none. Both shadow systems shadow this light.
+ecs::Entity first_shadowed_directional_light(const ecs::World& world, glm::mat4& world_matrix);
+
 /// World-space direction a light entity shines along: rotation * (0, 0, -1), normalised.
 glm::vec3 light_direction(const glm::mat4& world_matrix);
 
