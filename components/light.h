@@ -19,4 +19,13 @@ struct Light {
   bool cast_shadows = false;    ///< only shadowed lights get shadow maps
 };
 
+/// World-space direction a light shines along: its world matrix applied to local (0, 0, -1),
+/// normalised (straight down when the matrix collapses the axis). The one definition of the
+/// convention above, shared by the shadow systems and the ray-traced reference.
+inline glm::vec3 light_direction(const glm::mat4& world_matrix) {
+  const glm::vec3 d = glm::vec3(world_matrix * glm::vec4(0.0f, 0.0f, -1.0f, 0.0f));
+  const float len = glm::length(d);
+  return len > 0.0f ? d / len : glm::vec3(0.0f, -1.0f, 0.0f);
+}
+
 }  // namespace kaskad

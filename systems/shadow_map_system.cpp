@@ -11,12 +11,6 @@
 
 namespace kaskad {
 
-glm::vec3 light_direction(const glm::mat4& world_matrix) {
-  const glm::vec3 d = glm::vec3(world_matrix * glm::vec4(0.0f, 0.0f, -1.0f, 0.0f));
-  const float len = glm::length(d);
-  return len > 0.0f ? d / len : glm::vec3(0.0f, -1.0f, 0.0f);
-}
-
 LightProjection fit_ortho_light_to_bounds(const glm::vec3& direction, const Aabb& bounds) {
   const glm::vec3 dir = glm::normalize(direction);
   // Up = the world axis least parallel to the light, so lookAt never degenerates (shared with

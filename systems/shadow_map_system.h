@@ -6,6 +6,7 @@
 #include <glm/glm.hpp>
 
 #include "components/bounds.h"
+#include "components/light.h"  // light_direction()
 #include "runtime/ecs/world.h"
 
 namespace kaskad {
@@ -35,7 +36,5 @@ BasicShadow update_basic_shadow(const ecs::World& world);
 /// entity when there is none. Both shadow systems shadow this light.
 ecs::Entity first_shadowed_directional_light(const ecs::World& world, glm::mat4& world_matrix);
 
-/// World-space direction a light entity shines along: rotation * (0, 0, -1), normalised.
-glm::vec3 light_direction(const glm::mat4& world_matrix);
 
 }  // namespace kaskad

@@ -277,10 +277,7 @@ ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix
   ReferenceLight r;
   r.type = light.type;
   r.position = glm::vec3(world_matrix[3]);
-  // Same as systems/shadow_map_system.cpp light_direction() (the runtime does not link systems).
-  const glm::vec3 d = glm::vec3(world_matrix * glm::vec4(0.0f, 0.0f, -1.0f, 0.0f));
-  const float len = glm::length(d);
-  r.direction = len > 0.0f ? d / len : glm::vec3(0.0f, -1.0f, 0.0f);
+  r.direction = light_direction(world_matrix);
   r.right = perpendicular(r.direction, glm::vec3(world_matrix[0]));
   r.outer_cone_deg = light.type == LightType::spot ? light.outer_cone_deg : 180.0f;
   r.range = light.type == LightType::directional ? 0.0f : light.range;
