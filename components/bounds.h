@@ -13,6 +13,14 @@ struct Aabb {
   glm::vec3 min{std::numeric_limits<float>::max()};
   glm::vec3 max{-std::numeric_limits<float>::max()};
 
+  /// The box spanned by two opposite corners (in any order).
+  static Aabb from_corners(const glm::vec3& a, const glm::vec3& b) {
+    Aabb box;
+    box.expand(a);
+    box.expand(b);
+    return box;
+  }
+
   bool empty() const { return min.x > max.x || min.y > max.y || min.z > max.z; }
   glm::vec3 center() const { return 0.5f * (min + max); }
   glm::vec3 extent() const { return max - min; }

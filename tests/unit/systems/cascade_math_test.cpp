@@ -23,13 +23,6 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 
-Aabb box(glm::vec3 lo, glm::vec3 hi) {
-  Aabb b;
-  b.expand(lo);
-  b.expand(hi);
-  return b;
-}
-
 glm::mat4 pose(const glm::vec3& position, const glm::quat& rotation) {
   return glm::translate(glm::mat4(1.0f), position) * glm::mat4_cast(rotation);
 }
@@ -314,7 +307,7 @@ TEST(CascadeFit, SliceCornersInsideLightClipVolumeRandom) {
     Aabb scene;
     for (int k = 0; k < 6; ++k) {
       const glm::vec3 c = rng.point(80.0f);
-      objects.push_back(box(c, c + glm::vec3(rng.uniform(0.1f, 20.0f), rng.uniform(0.1f, 20.0f),
+      objects.push_back(Aabb::from_corners(c, c + glm::vec3(rng.uniform(0.1f, 20.0f), rng.uniform(0.1f, 20.0f),
                                              rng.uniform(0.1f, 20.0f))));
       scene.expand(objects.back());
     }
@@ -332,8 +325,8 @@ TEST(CascadeFit, SliceCornersInsideLightClipVolumeDegenerate) {
   CameraSetup cam;
   cam.world = look(eye, eye + forward, up_hint);
   const glm::vec3 cam_up = glm::vec3(cam.world[1]);
-  const Aabb ground = box({-100, -1, -100}, {100, 0, 100});
-  const std::vector<Aabb> objects = {ground, box({0, 0, -10}, {2, 5, -8})};
+  const Aabb ground = Aabb::from_corners({-100, -1, -100}, {100, 0, 100});
+  const std::vector<Aabb> objects = {ground, Aabb::from_corners({0, 0, -10}, {2, 5, -8})};
   const ShadowGeometry geometry{ground, objects, objects};
   struct Case {
     const char* name;
@@ -433,8 +426,8 @@ TEST(CascadeFit, CasterOutsideTheViewIsPulledIntoTheDepthRange) {
   cam.world = look({0, 1, 0}, {0, 1, -1}, {0, 1, 0});
   cam.fov_y_rad = glm::radians(40.0f);
   const CameraSlice s = cam.slice(10.0f, 20.0f);
-  const Aabb caster = box({-1, 40, -16}, {1, 42, -14});
-  const Aabb ground = box({-50, -1, -50}, {50, 0, 50});
+  const Aabb caster = Aabb::from_corners({-1, 40, -16}, {1, 42, -14});
+  const Aabb ground = Aabb::from_corners({-50, -1, -50}, {50, 0, 50});
   for (const glm::vec3& p : slice_corners_world(s)) ASSERT_LT(p.y, 40.0f);  // outside the view
   const LightFrame light{{0, -1, 0.05f}, {0, 100, 0}};
   const std::vector<Aabb> casters = {caster, ground};
@@ -476,7 +469,7 @@ TEST(CascadeFit, TightDepthIsTighterAndEmptyWithoutReceivers) {
   cam.world = look({0, 30, 0}, {0, 0, -40}, {0, 1, 0});
   const CameraSlice s = cam.slice(10.0f, 50.0f);
   const LightFrame light{glm::normalize(glm::vec3(0.2f, -1, 0.1f)), {0, 100, 0}};
-  const Aabb ground = box({-200, -1, -200}, {200, 0, 200});
+  const Aabb ground = Aabb::from_corners({-200, -1, -200}, {200, 0, 200});
   const std::vector<Aabb> objects = {ground};
   CascadeFitOptions o;
   const CascadeFit loose = fit_cascade(s, light, o, {ground, objects, objects});
@@ -490,10 +483,10 @@ TEST(CascadeFit, TightDepthIsTighterAndEmptyWithoutReceivers) {
   EXPECT_LE(tight.near, g.near);
   EXPECT_GE(tight.far, g.far);
   // Only a caster, nothing receives: empty.
-  const std::vector<Aabb> casters = {box({0, 5, -20}, {1, 6, -19})};
+  const std::vector<Aabb> casters = {Aabb::from_corners({0, 5, -20}, {1, 6, -19})};
   EXPECT_TRUE(fit_cascade(s, light, o, {Aabb{}, casters, {}}).empty);
   // Receivers far behind the slice only: empty too.
-  const std::vector<Aabb> far_away = {box({0, -500, 0}, {1, -499, 1})};
+  const std::vector<Aabb> far_away = {Aabb::from_corners({0, -500, 0}, {1, -499, 1})};
   EXPECT_TRUE(fit_cascade(s, light, o, {Aabb{}, far_away, far_away}).empty);
 }
 
@@ -583,7 +576,7 @@ TEST(CascadeNearFar, MatchesBruteForceSurfaceSampling) {
   int non_empty = 0;
   for (int trial = 0; trial < 60; ++trial) {
     const glm::vec3 lo = rng.point(20.0f);
-    const Aabb b = box(lo, lo + glm::vec3(rng.uniform(0.5f, 10.0f), rng.uniform(0.5f, 10.0f),
+    const Aabb b = Aabb::from_corners(lo, lo + glm::vec3(rng.uniform(0.5f, 10.0f), rng.uniform(0.5f, 10.0f),
                                           rng.uniform(0.0f, 10.0f)));  // may be flat
     const glm::vec3 dir = trial % 10 == 0 ? glm::vec3(0, -1, 0) : rng.unit();
     const glm::mat4 v = light_view_matrix(dir, rng.point(30.0f));
@@ -633,7 +626,7 @@ TEST(CascadeNearFar, MatchesBruteForceSurfaceSampling) {
 
 TEST(CascadeNearFar, EmptyWhenTheRectangleMissesTheBox) {
   const glm::mat4 v = light_view_matrix({0, -1, 0}, {0, 10, 0});
-  const Aabb b = box({-1, 0, -1}, {1, 1, 1});
+  const Aabb b = Aabb::from_corners({-1, 0, -1}, {1, 1, 1});
   EXPECT_TRUE(compute_near_far(v, b, 5, 6, 5, 6).empty);
   EXPECT_TRUE(compute_near_far(v, Aabb{}, -1, 1, -1, 1).empty);
   const NearFar nf = compute_near_far(v, b, -0.5f, 0.5f, -0.5f, 0.5f);
@@ -644,10 +637,10 @@ TEST(CascadeNearFar, EmptyWhenTheRectangleMissesTheBox) {
 
 TEST(CascadeNearFar, TightenUsesReceiversInTheSliceAndCastersInFront) {
   const glm::mat4 v = light_view_matrix({0, -1, 0}, {0, 100, 0});       // depth = 100 - y
-  const std::vector<Aabb> receivers = {box({-5, 0, -5}, {5, 1, 5})};    // depths 99..100
-  const std::vector<Aabb> casters = {box({-1, 50, -1}, {1, 51, 1}),     // 49..50, in front
-                                     box({-1, -20, -1}, {1, -19, 1}),   // behind the receiver
-                                     box({30, 60, 30}, {31, 61, 31})};  // outside the rectangle
+  const std::vector<Aabb> receivers = {Aabb::from_corners({-5, 0, -5}, {5, 1, 5})};    // depths 99..100
+  const std::vector<Aabb> casters = {Aabb::from_corners({-1, 50, -1}, {1, 51, 1}),     // 49..50, in front
+                                     Aabb::from_corners({-1, -20, -1}, {1, -19, 1}),   // behind the receiver
+                                     Aabb::from_corners({30, 60, 30}, {31, 61, 31})};  // outside the rectangle
   const NearFar nf = tighten_near_far(v, casters, receivers, -10, 10, -10, 10, 90.0f, 110.0f);
   ASSERT_FALSE(nf.empty);
   EXPECT_NEAR(nf.near, 49.0f, 1e-4f);

@@ -16,13 +16,6 @@
 namespace kaskad {
 namespace {
 
-Aabb box(glm::vec3 lo, glm::vec3 hi) {
-  Aabb b;
-  b.expand(lo);
-  b.expand(hi);
-  return b;
-}
-
 // A camera at the origin looking down -z (fov 20 degrees, square), near 1, far 100.
 CameraState camera(ecs::World& w, float fov_deg = 20.0f) {
   CameraState c;
@@ -71,8 +64,8 @@ TEST(ShadowCascadeSystem, LastSplitEndsAtTheFarthestVisibleReceiver) {
   s.max_distance = 100.0f;
   sun(w, s);
   // A receiver from 2 m to 20 m in front of the camera, and one far behind it (not visible).
-  mesh(w, box({-1, -1, -20}, {1, 0, -2}));
-  mesh(w, box({-1, -1, 40}, {1, 0, 60}));
+  mesh(w, Aabb::from_corners({-1, -1, -20}, {1, 0, -2}));
+  mesh(w, Aabb::from_corners({-1, -1, 40}, {1, 0, 60}));
   ShadowCascadeState state;
   const ShadowData d = update_shadow_cascades(w, camera(w), state);
   ASSERT_TRUE(d.light.valid()) << d.error;
@@ -91,13 +84,13 @@ TEST(ShadowCascadeSystem, LastSplitEndsAtTheFarthestVisibleReceiver) {
 
 TEST(ShadowCascadeSystem, FarthestVisibleReceiverIgnoresBoxesOutsideTheFrustum) {
   const glm::mat4 view(1.0f), proj = glm::perspective(glm::radians(20.0f), 1.0f, 1.0f, 100.0f);
-  const Aabb behind = box({-1, -1, 5}, {1, 1, 9});
-  const Aabb aside = box({50, -1, -30}, {52, 1, -20});
-  const Aabb front = box({-1, -1, -30}, {1, 1, -20});
+  const Aabb behind = Aabb::from_corners({-1, -1, 5}, {1, 1, 9});
+  const Aabb aside = Aabb::from_corners({50, -1, -30}, {52, 1, -20});
+  const Aabb front = Aabb::from_corners({-1, -1, -30}, {1, 1, -20});
   EXPECT_EQ(farthest_visible_receiver(view, proj * view, 1, 100, std::array{behind, aside}), 0.0f);
   EXPECT_FLOAT_EQ(farthest_visible_receiver(view, proj * view, 1, 100, std::array{behind, front}), 30.0f);
   // Clamped to far.
-  const Aabb long_box = box({-1, -1, -300}, {1, 1, -20});
+  const Aabb long_box = Aabb::from_corners({-1, -1, -300}, {1, 1, -20});
   EXPECT_FLOAT_EQ(farthest_visible_receiver(view, proj * view, 1, 100, std::array{long_box}), 100.0f);
 }
 
@@ -107,9 +100,9 @@ TEST(ShadowCascadeSystem, CascadesWithoutReceiversAreSkippedAndCastersCulledPerC
   s.split_scheme = SplitScheme::uniform;  // 1, 13.25, 25.5, 37.75, 50
   s.cascade_count = 4;
   sun(w, s, {0.0f, -1.0f, 0.0f});
-  const ecs::Entity near_box = mesh(w, box({-0.3f, -0.3f, -2.0f}, {0.3f, 0.3f, -1.5f}));
-  const ecs::Entity far_box = mesh(w, box({-0.3f, -0.3f, -50.0f}, {0.3f, 0.3f, -49.0f}));
-  const ecs::Entity no_cast = mesh(w, box({-0.3f, -0.3f, -45.0f}, {0.3f, 0.3f, -44.0f}), false, true);
+  const ecs::Entity near_box = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -2.0f}, {0.3f, 0.3f, -1.5f}));
+  const ecs::Entity far_box = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -50.0f}, {0.3f, 0.3f, -49.0f}));
+  const ecs::Entity no_cast = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -45.0f}, {0.3f, 0.3f, -44.0f}), false, true);
   ShadowCascadeState state;
   const ShadowData d = update_shadow_cascades(w, camera(w), state);
   ASSERT_TRUE(d.light.valid()) << d.error;
@@ -132,10 +125,10 @@ TEST(ShadowCascadeSystem, CascadesWithoutReceiversAreSkippedAndCastersCulledPerC
 
 TEST(ShadowCascadeSystem, CullCastersKeepsBoxesOverlappingTheLightVolume) {
   const glm::mat4 vp = glm::ortho(-1.0f, 1.0f, -1.0f, 1.0f, 0.0f, 10.0f);  // looks down -z
-  const std::array boxes{box({-0.5f, -0.5f, -2}, {0.5f, 0.5f, -1}),   // inside
-                         box({0.9f, 0.9f, -2}, {3, 3, -1}),            // straddles a corner
-                         box({2, -0.5f, -2}, {3, 0.5f, -1}),           // right of it
-                         box({-0.5f, -0.5f, -30}, {0.5f, 0.5f, -20}),  // beyond far
+  const std::array boxes{Aabb::from_corners({-0.5f, -0.5f, -2}, {0.5f, 0.5f, -1}),   // inside
+                         Aabb::from_corners({0.9f, 0.9f, -2}, {3, 3, -1}),            // straddles a corner
+                         Aabb::from_corners({2, -0.5f, -2}, {3, 0.5f, -1}),           // right of it
+                         Aabb::from_corners({-0.5f, -0.5f, -30}, {0.5f, 0.5f, -20}),  // beyond far
                          Aabb{}};                                      // empty
   EXPECT_EQ(cull_casters(vp, boxes), (std::vector<std::uint32_t>{0, 1}));
 }
@@ -143,7 +136,7 @@ TEST(ShadowCascadeSystem, CullCastersKeepsBoxesOverlappingTheLightVolume) {
 TEST(ShadowCascadeSystem, NanLightTransformIsRejectedWithAnError) {
   ecs::World w;
   const ecs::Entity l = sun(w, ShadowSettings{});
-  mesh(w, box({-1, -1, -20}, {1, 0, -2}));
+  mesh(w, Aabb::from_corners({-1, -1, -20}, {1, 0, -2}));
   w.get<WorldTransform>(l).matrix[1][2] = std::numeric_limits<float>::quiet_NaN();
   ShadowCascadeState state;
   const ShadowData d = update_shadow_cascades(w, camera(w), state);
@@ -155,8 +148,8 @@ TEST(ShadowCascadeSystem, NanLightTransformIsRejectedWithAnError) {
 TEST(ShadowCascadeSystem, NonFiniteBoundsAreLeftOutAndTheRestShadowed) {
   ecs::World w;
   sun(w, ShadowSettings{});
-  const ecs::Entity good = mesh(w, box({-1, -1, -20}, {1, 0, -2}));
-  Aabb bad = box({-1, -1, -20}, {1, 0, -2});
+  const ecs::Entity good = mesh(w, Aabb::from_corners({-1, -1, -20}, {1, 0, -2}));
+  Aabb bad = Aabb::from_corners({-1, -1, -20}, {1, 0, -2});
   bad.max.x = std::numeric_limits<float>::infinity();
   const ecs::Entity broken = mesh(w, bad);
   ShadowCascadeState state;
@@ -172,7 +165,7 @@ TEST(ShadowCascadeSystem, NonFiniteBoundsAreLeftOutAndTheRestShadowed) {
 TEST(ShadowCascadeSystem, NanCameraIsRejectedWithAnError) {
   ecs::World w;
   sun(w, ShadowSettings{});
-  mesh(w, box({-1, -1, -20}, {1, 0, -2}));
+  mesh(w, Aabb::from_corners({-1, -1, -20}, {1, 0, -2}));
   CameraState c = camera(w);
   c.view[3][0] = std::numeric_limits<float>::infinity();
   ShadowCascadeState state;
@@ -187,8 +180,8 @@ TEST(ShadowCascadeSystem, SceneFitIsTheBasicMap) {
   s.cascade_count = 1;
   s.fit_mode = FitMode::scene;
   sun(w, s);
-  mesh(w, box({-20, 0, -20}, {20, 0, 20}));
-  mesh(w, box({-1, 0, -1}, {1, 2, 1}));
+  mesh(w, Aabb::from_corners({-20, 0, -20}, {20, 0, 20}));
+  mesh(w, Aabb::from_corners({-1, 0, -1}, {1, 2, 1}));
   ShadowCascadeState state;
   const ShadowData d = update_shadow_cascades(w, camera(w), state);
   const BasicShadow basic = update_basic_shadow(w);
@@ -201,7 +194,7 @@ TEST(ShadowCascadeSystem, SceneFitIsTheBasicMap) {
 
 TEST(ShadowCascadeSystem, NoShadowedLightOrNoGeometryGivesNoShadow) {
   ecs::World w;
-  mesh(w, box({-1, -1, -20}, {1, 0, -2}));
+  mesh(w, Aabb::from_corners({-1, -1, -20}, {1, 0, -2}));
   ShadowCascadeState state;
   EXPECT_FALSE(update_shadow_cascades(w, camera(w), state).light.valid());
   ecs::World empty;

@@ -10,13 +10,6 @@
 namespace kaskad {
 namespace {
 
-Aabb box(glm::vec3 lo, glm::vec3 hi) {
-  Aabb b;
-  b.expand(lo);
-  b.expand(hi);
-  return b;
-}
-
 void expect_encloses(const LightProjection& lp, const Aabb& b) {
   const glm::mat4 m = lp.view_proj();
   for (float v : {m[0][0], m[1][1], m[2][2], m[3][0], m[3][1], m[3][2]}) ASSERT_TRUE(std::isfinite(v));
@@ -32,7 +25,7 @@ void expect_encloses(const LightProjection& lp, const Aabb& b) {
 }
 
 TEST(BasicShadow, FitEnclosesTheBoundsTightly) {
-  const Aabb b = box({-20, 0, -20}, {20, 3, 20});
+  const Aabb b = Aabb::from_corners({-20, 0, -20}, {20, 3, 20});
   const LightProjection lp = fit_ortho_light_to_bounds(glm::normalize(glm::vec3(-0.45f, -0.65f, -0.6f)), b);
   expect_encloses(lp, b);
   // Tight: some corner touches the x and y borders.
@@ -48,14 +41,14 @@ TEST(BasicShadow, FitEnclosesTheBoundsTightly) {
 }
 
 TEST(BasicShadow, DegenerateDirectionsGiveValidMatrices) {
-  const Aabb b = box({-5, 0, -5}, {5, 2, 5});
+  const Aabb b = Aabb::from_corners({-5, 0, -5}, {5, 2, 5});
   for (glm::vec3 d : {glm::vec3(0, -1, 0), glm::vec3(0, 1, 0), glm::vec3(1, 0, 0), glm::vec3(0, 0, -1),
                       glm::vec3(1e-7f, -1, 0)})
     expect_encloses(fit_ortho_light_to_bounds(d, b), b);
 }
 
 TEST(BasicShadow, FlatBoundsStayInvertible) {
-  const Aabb plane = box({-5, 0, -5}, {5, 0, 5});
+  const Aabb plane = Aabb::from_corners({-5, 0, -5}, {5, 0, 5});
   expect_encloses(fit_ortho_light_to_bounds(glm::vec3(0, -1, 0), plane), plane);
   expect_encloses(fit_ortho_light_to_bounds(glm::vec3(1, 0, 0), plane), plane);  // edge-on
 }
