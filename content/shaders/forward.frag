@@ -3,14 +3,11 @@
 // the preprocessor only; see README.md in this folder.
 #include "common.glsl"
 #include "features.glsl"
+#include "shadow.glsl"
 
 in vec3 v_world_pos;
 in vec3 v_world_normal;
 in vec2 v_uv;
-
-#if VARIANT_HAS_SHADOW
-layout(binding = 2) uniform sampler2DArrayShadow u_shadow_map;  // one layer per cascade
-#endif
 
 layout(location = 0) out vec4 o_color;
 #if VARIANT_HAS_AOVS
@@ -33,104 +30,6 @@ vec3 perturb_normal(vec3 n, vec3 p, vec2 uv, vec3 tangent_normal) {
   return normalize(mat3(t * inv, b * inv, n) * tangent_normal);
 }
 
-// Visibility of the shadowed light at world position p with geometric normal n: 1 lit, 0
-// shadowed (S4, with S0's cascades). Clamp-to-border with border depth 1 and the z > 1 test keep
-// everything outside a cascade's light frustum lit. Cascade selection and blending mirror
-// select_cascade_by_depth / select_cascade_by_map / cascade_blend_weight* in
-// systems/cascade_math.h (change together).
-#if VARIANT_HAS_SHADOW
-#define CASCADES VARIANT_CASCADE_COUNT
-
-// One cascade's lookup. The point moves along the normal by normal_offset texels of this
-// cascade (MJP's normal offset), so the bias follows each cascade's resolution.
-float cascade_visibility(int cascade, vec3 p, vec3 n) {
-  vec3 q = p + n * (u_shadow_params.x * cascade_texel(cascade));
-  vec4 clip = u_cascade_view_proj[cascade] * vec4(q, 1.0);
-  vec3 c = clip.xyz / clip.w * 0.5 + 0.5;  // S0's M_bias
-  if (c.z > 1.0) return 1.0;
-  vec4 tc = vec4(c.xy, float(cascade), c.z);
-#if VARIANT_SHADOW_FILTER == VARIANT_SHADOW_FILTER_PCF3X3
-  // textureOffset needs constant offsets: the 3x3 kernel is written out.
-  float sum = 0.0;
-  sum += textureOffset(u_shadow_map, tc, ivec2(-1, -1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(0, -1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(1, -1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(-1, 0));
-  sum += texture(u_shadow_map, tc);
-  sum += textureOffset(u_shadow_map, tc, ivec2(1, 0));
-  sum += textureOffset(u_shadow_map, tc, ivec2(-1, 1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(0, 1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(1, 1));
-  return sum / 9.0;
-#else
-  return texture(u_shadow_map, tc);  // filtering (nearest / linear) is set on the texture
-#endif
-}
-
-#if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
-// Border kept free in NDC: the PCF kernel's reach plus the normal offset, in texels.
-float map_border() { return 2.0 * (1.5 + u_shadow_params.x) / u_shadow_params.z; }
-#endif
-
-// The cascade of a point, -1 outside all. depth: view depth |z_view|.
-int select_cascade(vec3 p, float depth) {
-#if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
-  float limit = 1.0 - map_border();
-  for (int i = 0; i < CASCADES; ++i) {
-    vec4 clip = u_cascade_view_proj[i] * vec4(p, 1.0);
-    vec3 ndc = clip.xyz / clip.w;
-    if (abs(ndc.x) <= limit && abs(ndc.y) <= limit && abs(ndc.z) <= 1.0) return i;
-  }
-  return -1;
-#else
-  // S0: D[i] <= depth < D[i+1]; nearer than D[0] (the camera near plane) counts as cascade 0.
-  if (depth >= cascade_split(CASCADES)) return -1;
-  int cascade = 0;
-  for (int i = 1; i < CASCADES; ++i)
-    if (depth >= cascade_split(i)) cascade = i;
-  return cascade;
-#endif
-}
-
-// Weight of cascade + 1 in the blend band at the end of `cascade` (0 for the last one).
-float blend_weight(int cascade, vec3 p, float depth) {
-#if CASCADES > 1
-  float band = u_shadow_params.y;
-  if (cascade >= CASCADES - 1 || band <= 0.0) return 0.0;
-#if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
-  vec4 clip = u_cascade_view_proj[cascade] * vec4(p, 1.0);
-  vec2 ndc = abs(clip.xy / clip.w);
-  float edge = 1.0 - map_border();
-  return clamp((max(ndc.x, ndc.y) - (edge - band * edge)) / (band * edge), 0.0, 1.0);
-#else
-  float d0 = cascade_split(cascade), d1 = cascade_split(cascade + 1);
-  float width = band * (d1 - d0);
-  return clamp((depth - (d1 - width)) / width, 0.0, 1.0);
-#endif
-#else
-  return 0.0;
-#endif
-}
-
-float shadow_visibility(vec3 p, vec3 n, float depth, out int cascade) {
-  cascade = select_cascade(p, depth);
-  if (cascade < 0) return 1.0;
-  float v = cascade_visibility(cascade, p, n);
-  float w = blend_weight(cascade, p, depth);
-  if (w > 0.0) v = mix(v, cascade_visibility(cascade + 1, p, n), w);
-  return v;
-}
-
-#if VARIANT_DEBUG_CASCADES
-// Tints per cascade: red, green, blue, yellow, magenta, cyan, orange, violet.
-vec3 cascade_tint(int cascade) {
-  const vec3 tints[8] = vec3[8](vec3(1.0, 0.35, 0.35), vec3(0.35, 1.0, 0.35), vec3(0.4, 0.5, 1.0),
-                                vec3(1.0, 1.0, 0.3), vec3(1.0, 0.35, 1.0), vec3(0.3, 1.0, 1.0),
-                                vec3(1.0, 0.65, 0.25), vec3(0.65, 0.4, 1.0));
-  return cascade < 0 ? vec3(1.0) : tints[cascade];
-}
-#endif
-#endif
 
 void main() {
   vec4 base = u_base_color;
