@@ -7,13 +7,16 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "components/light.h"
 #include "components/shadow_settings.h"
 #include "components/transform.h"
+#include "components/mesh_renderer.h"
 #include "runtime/cli/player.h"
+#include "runtime/cli/stability.h"
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
 
@@ -69,6 +72,31 @@ void progress(std::size_t done, std::size_t total, double elapsed_s, const std::
                std::string(std::size_t(width - filled), '-').c_str(), done, total,
                clock_text(elapsed_s).c_str(), done ? clock_text(eta).c_str() : "--:--", what.c_str());
   std::fflush(stderr);
+}
+
+// What the reference BVH depends on: every MeshRenderer's mesh, flags and world matrix, and the
+// meshes' sizes. Configurations of one scene usually differ in settings only, so the BVH is
+// rebuilt only when this changes (a --set may move or hide geometry).
+std::uint64_t geometry_signature(const Scene& scene) {
+  std::uint64_t h = 1469598103934665603ull;
+  auto mix = [&](const void* data, std::size_t n) {
+    const auto* b = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+  };
+  scene.world.view<const MeshRenderer, const WorldTransform>().each(
+      [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
+        const std::uint32_t id = e.index;
+        const std::uint8_t flags = std::uint8_t(mr.cast_shadows) | std::uint8_t(mr.receive_shadows << 1);
+        mix(&id, sizeof id);
+        mix(&mr.mesh, sizeof mr.mesh);
+        mix(&flags, 1);
+        mix(&wt.matrix, sizeof wt.matrix);
+      });
+  for (const auto& m : scene.assets.meshes) {
+    const std::size_t sizes[2] = {m.positions.size(), m.indices.size()};
+    mix(sizes, sizeof sizes);
+  }
+  return h;
 }
 
 }  // namespace
@@ -135,7 +163,8 @@ std::vector<std::string> bench_csv_columns() {
           "shadow_draw_calls", "shadow_triangles", "scene_triangles", "shadow_map_mib",
           "receiver_pixels", "misclassified_pct", "false_shadow_pct", "false_light_pct", "rmse",
           "mae", "misclassified_pct_noedge", "false_shadow_pct_noedge", "false_light_pct_noedge",
-          "rmse_noedge", "mae_noedge", "reference_mrays_per_s"};
+          "rmse_noedge", "mae_noedge", "reference_mrays_per_s", "stability_points",
+          "stability_frames", "stability_step_m", "flicker", "flicker_changed_pct"};
 }
 
 Status run_bench(const BenchOptions& options) {
@@ -168,6 +197,8 @@ Status run_bench(const BenchOptions& options) {
                scenes.size(), configs->size(), options.frames, options.width, options.height,
                csv_path.string().c_str());
   Status result;
+  std::optional<reference::RayTracer> tracer;  // reused while the geometry stays the same
+  std::uint64_t tracer_signature = 0;
   for (const fs::path& scene_path : scenes) {
     for (const BenchConfig& config : *configs) {
       if (g_interrupted) break;
@@ -212,10 +243,16 @@ Status run_bench(const BenchOptions& options) {
           const double bytes = s->depth_format == DepthFormat::d16 ? 2.0 : 4.0;
           map_mib = double(s->map_size) * s->map_size * bytes * s->cascade_count / (1024.0 * 1024.0);
         }
-        auto tracer = reference::RayTracer::build(*scene);
-        if (!tracer) {
-          result = tracer.error();
-          break;
+        const std::uint64_t signature = geometry_signature(*scene);
+        if (!tracer || signature != tracer_signature) {
+          tracer.reset();
+          auto built = reference::RayTracer::build(*scene);
+          if (!built) {
+            result = built.error();
+            break;
+          }
+          tracer.emplace(std::move(built.value()));
+          tracer_signature = signature;
         }
         const auto rlight = reference::reference_light(scene->world.get<Light>(light),
                                                        scene->world.get<WorldTransform>(light).matrix);
@@ -232,6 +269,28 @@ Status run_bench(const BenchOptions& options) {
         }
         metrics = *m;
       }
+      // 3. Stability: fixed receiver points from that AOV, the camera on its path.
+      reference::StabilityStats stability;
+      StabilityRun stab_run;
+      std::size_t stab_points = 0;
+      if (options.stability_frames > 1) {
+        auto points = stability_points(aov, options.stability_points);
+        if (!points) {
+          result = points.error();
+          break;
+        }
+        stab_points = points->positions.size();
+        CameraPath path;
+        path.frames = options.stability_frames;
+        auto measured = measure_stability(*player, *scene, *points, path);
+        if (!measured) {
+          result = measured.error();
+          break;
+        }
+        stab_run = std::move(measured.value());
+        stability = stab_run.stats;
+      }
+      const bool has_stability = options.stability_frames > 1;
       const double nan = std::numeric_limits<double>::quiet_NaN();
       auto metric = [&](double v) { return light.valid() ? fmt(v) : fmt(nan); };
       std::string settings;
@@ -256,7 +315,11 @@ Status run_bench(const BenchOptions& options) {
           metric(metrics.outside_edges.misclassified_pct),
           metric(metrics.outside_edges.false_shadow_pct),
           metric(metrics.outside_edges.false_light_pct), metric(metrics.outside_edges.rmse),
-          metric(metrics.outside_edges.mean_abs_error), fmt(mrays)};
+          metric(metrics.outside_edges.mean_abs_error), fmt(mrays), std::to_string(stab_points),
+          std::to_string(has_stability ? options.stability_frames : 0),
+          has_stability ? fmt(stab_run.step) : fmt(nan),
+          has_stability ? fmt(stability.flicker) : fmt(nan),
+          has_stability ? fmt(stability.changed_pct) : fmt(nan)};
       for (std::size_t i = 0; i < row.size(); ++i) csv << (i ? "," : "") << csv_quote(row[i]);
       csv << "\n";
       csv.flush();  // rows survive Ctrl-C and crashes

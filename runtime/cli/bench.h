@@ -1,7 +1,8 @@
 // `kaskad bench`: sweeps render settings over scenes and charts speed against accuracy.
 // For every scene x configuration: frame time (median of N frames after warm-up, AOVs off), CPU
 // time per phase, GPU time per pass, counters, and shadow accuracy against the Embree reference
-// (runtime/reference) on the AOVs of one more frame. Rows go to a CSV as they finish (Ctrl-C keeps
+// (runtime/reference) on the AOVs of one more frame, and world-space flicker at fixed receiver
+// points while the camera moves (runtime/cli/stability.h). Rows go to a CSV as they finish (Ctrl-C keeps
 // them); a matplotlib script (scripts/bench_chart.py, run with /usr/bin/python3) draws one chart per
 // scene: frame ms on x, error on y, the Pareto front highlighted.
 #pragma once
@@ -22,6 +23,9 @@ struct BenchOptions {
   int width = 640;
   int height = 360;
   bool chart = true;  ///< run scripts/bench_chart.py after the sweep
+  /// Stability: frames of the camera path (runtime/cli/stability.h); 0 or 1 = skip.
+  int stability_frames = 16;
+  int stability_points = 4096;  ///< at most this many fixed receiver points
 };
 
 /// One configuration: a label and its --set overrides.

@@ -31,8 +31,10 @@ usage:
   kaskad variants [SCENE] [--set key=value]... [--aov]
                                     list the shader variants (pass, key, defines) the scene needs
   kaskad bench [SCENE]... [--sweep SPEC] [--out DIR] [--frames N] [--size WxH] [--no-chart]
+               [--stability-frames N]
                                     sweep settings, write DIR/bench.csv and one speed-vs-accuracy
-                                    chart per scene (default sweep: see README)
+                                    chart per scene (default sweep: see README); flicker at fixed
+                                    points over an N-frame camera path (default 16, 0 = off)
   kaskad info                       print the OpenGL context kaskad gets on this machine
 
 render options:
@@ -55,6 +57,7 @@ struct Args {
   std::string sweep;
   std::string out_dir;
   bool chart = true;
+  int stability_frames = -1;  ///< bench: -1 = default
   std::string output;
   std::string aov;
   std::string shadow_map;
@@ -112,6 +115,8 @@ Args parse_args(int argc, char** argv) {
       a.sweep = value();
     } else if (arg == "--out") {
       a.out_dir = value();
+    } else if (arg == "--stability-frames" && a.command == "bench") {
+      a.stability_frames = parse_int(arg, value(), 0, 10000);
     } else if (arg == "--no-chart") {
       a.chart = false;
     } else if (arg == "--set") {
@@ -187,7 +192,7 @@ int run_variants(const Args& a) {
   std::printf("%s: %zu programs (%s AOVs)\n", scene_path.string().c_str(), requests.size(),
               ctx.write_aovs ? "with" : "without");
   for (const auto& r : requests) {
-    std::printf("\n%-7s key 0x%08x  %s\n", r.pass == render::Pass::depth ? "depth" : "forward",
+    std::printf("\n%-7s key 0x%08x  %s\n", render::pass_name(r.pass),
                 r.key.bits(), manifest->describe(r.key).c_str());
     std::string defs;
     for (const auto& f : manifest->features())
@@ -209,6 +214,7 @@ int run_bench_command(const Args& a, bool frames_given) {
     o.height = a.height;
   }
   o.chart = a.chart;
+  if (a.stability_frames >= 0) o.stability_frames = a.stability_frames;
   if (auto st = run_bench(o); !st) return fail(st.error());
   return 0;
 }

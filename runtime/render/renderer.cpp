@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <numeric>
+#include <optional>
 #include <tuple>
 
 #include "runtime/core/log.h"
@@ -46,7 +47,8 @@ GLenum depth_internal_format(DepthFormat f) {
 // Fixed attribute and uniform locations (see the shaders).
 constexpr GLuint kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
 constexpr GLint kUniModel = 0, kUniNormalMatrix = 4, kUniBaseColor = 8, kUniMaterial = 9,
-                kUniEmissive = 10, kUniOracleFeatures = 11, kUniLightViewProj = 12;
+                kUniEmissive = 10, kUniOracleFeatures = 11, kUniLightViewProj = 12,
+                kUniTargetSize = 13;
 constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2;
 
 struct GpuMesh {
@@ -91,6 +93,13 @@ struct Renderer::Impl {
   gpu::Framebuffer shadow_fbo;
   gpu::Texture shadow_map;
   bool shadow_valid = false;
+
+  // Shadow-points pass target (one pixel per point) and its point buffer.
+  int points_width = 0, points_height = 0;
+  gpu::Framebuffer points_fbo;
+  gpu::Texture points_target;
+
+  std::optional<VariantKey> frame_key;  // frame features of the last render()
 
   std::array<gpu::Query, 2> timers;
   bool timers_pending = false;
@@ -361,6 +370,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   // Draw order: sorted by program (variant key), then by material, so program and material
   // state change as rarely as possible. Keys are computed once per draw.
   const VariantKey frame_key = frame_variant(frame);
+  im.frame_key = frame_key;
   std::vector<VariantKey> keys(frame.draws.size());
   for (std::size_t i = 0; i < frame.draws.size(); ++i)
     keys[i] = material_variant(frame.draws[i]) | frame_key;
@@ -528,6 +538,72 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   glBindVertexArray(0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return {};
+}
+
+Result<std::vector<glm::vec2>> Renderer::shadow_at_points(std::span<const glm::vec3> points,
+                                                          std::span<const glm::vec3> normals) {
+  Impl& im = *impl_;
+  if (points.size() != normals.size())
+    return Error{"", "shadow_at_points", std::to_string(points.size()) + " points but " +
+                                             std::to_string(normals.size()) + " normals"};
+  if (points.empty()) return std::vector<glm::vec2>{};
+  constexpr int kRow = 1024;
+  if (points.size() > std::size_t(kRow) * 16384)
+    return Error{"", "shadow_at_points", std::to_string(points.size()) +
+                                             " points; at most 16777216 per call"};
+  const int count = int(points.size());
+  const int w = std::min(count, kRow), h = (count + kRow - 1) / kRow;
+  if (!im.points_fbo || w != im.points_width || h != im.points_height) {
+    im.points_width = w;
+    im.points_height = h;
+    im.points_target = gpu::make_texture(GL_TEXTURE_2D);
+    glTextureStorage2D(im.points_target.id(), 1, GL_RG32F, w, h);
+    im.points_fbo = gpu::make_framebuffer();
+    glNamedFramebufferTexture(im.points_fbo.id(), GL_COLOR_ATTACHMENT0, im.points_target.id(), 0);
+  }
+  // Interleaved position | normal per point; a short-lived buffer (a metrics path, not a frame).
+  std::vector<glm::vec3> data(std::size_t(count) * 2);
+  for (int i = 0; i < count; ++i) {
+    data[std::size_t(i) * 2] = points[std::size_t(i)];
+    data[std::size_t(i) * 2 + 1] = normals[std::size_t(i)];
+  }
+  gpu::Buffer buffer = gpu::make_buffer();
+  glNamedBufferStorage(buffer.id(), GLsizeiptr(data.size() * sizeof(glm::vec3)), data.data(), 0);
+  gpu::VertexArray vao = gpu::make_vertex_array();
+  glVertexArrayVertexBuffer(vao.id(), 0, buffer.id(), 0, 2 * sizeof(glm::vec3));
+  for (GLuint attr : {kAttrPosition, kAttrNormal}) {
+    glEnableVertexArrayAttrib(vao.id(), attr);
+    glVertexArrayAttribFormat(vao.id(), attr, 3, GL_FLOAT, GL_FALSE,
+                              attr == kAttrNormal ? GLuint(sizeof(glm::vec3)) : 0);
+    glVertexArrayAttribBinding(vao.id(), attr, 0);
+  }
+  if (!im.frame_key) return Error{"", "shadow_at_points", "no frame rendered yet"};
+  auto program =
+      im.shaders->program(Pass::shadow_points, im.frame_key->filtered_for(Pass::shadow_points));
+  if (!program) return program.error();
+  glUseProgram(*program);
+  glProgramUniform2i(*program, kUniTargetSize, w, h);
+  // The frame block and shadow map are still those of the last render(); bind them again in
+  // case other GL work ran in between.
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
+  glBindTextureUnit(kTexShadow, im.shadow_map.id());
+  glBindFramebuffer(GL_FRAMEBUFFER, im.points_fbo.id());
+  glViewport(0, 0, w, h);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  const float clear[4] = {1.0f, -1.0f, 0.0f, 0.0f};
+  glClearBufferfv(GL_COLOR, 0, clear);
+  glBindVertexArray(vao.id());
+  glDrawArrays(GL_POINTS, 0, count);
+  glBindVertexArray(0);
+  std::vector<glm::vec2> out(std::size_t(w) * h);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(im.points_target.id(), 0, GL_RG, GL_FLOAT,
+                    GLsizei(out.size() * sizeof(glm::vec2)), out.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glEnable(GL_DEPTH_TEST);
+  out.resize(std::size_t(count));
+  return out;
 }
 
 void Renderer::finish() { glFinish(); }

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -140,6 +141,15 @@ class Renderer {
   /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom; with
   /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;
+
+  /// The shadowed light's visibility at fixed world points with unit normals (one per point),
+  /// evaluated by the forward pass's own shadow lookup (content/shaders/shadow.glsl) against the
+  /// shadow maps, camera and frame features of the last render(). One (visibility,
+  /// cascade) pair per point, as the forward pass would shade a surface there: (1, -1) without a
+  /// shadow pass. For stability metrics: the points stay put while the camera moves.
+  /// Errors: sizes differ, or the pass's program fails to build.
+  Result<std::vector<glm::vec2>> shadow_at_points(std::span<const glm::vec3> points,
+                                                  std::span<const glm::vec3> normals);
 
   /// Copies the colour target to the default framebuffer (windowed mode).
   void present(int window_width, int window_height) const;

@@ -25,8 +25,12 @@ struct PassFiles {
   const char* fragment;
 };
 PassFiles files_for(Pass pass) {
-  return pass == Pass::depth ? PassFiles{"shadow_depth.vert", "shadow_depth.frag"}
-                             : PassFiles{"forward.vert", "forward.frag"};
+  switch (pass) {
+    case Pass::depth: return {"shadow_depth.vert", "shadow_depth.frag"};
+    case Pass::shadow_points: return {"shadow_points.vert", "shadow_points.frag"};
+    case Pass::forward: break;
+  }
+  return {"forward.vert", "forward.frag"};
 }
 
 std::uint64_t map_key(Pass pass, VariantKey key) {

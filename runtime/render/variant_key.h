@@ -19,7 +19,18 @@
 
 namespace kaskad::render {
 
-enum class Pass : std::uint8_t { forward = 0, depth = 1 };
+/// forward: colour + AOVs; depth: shadow maps; shadow_points: the shadow lookup evaluated at given
+/// world points (Renderer::shadow_at_points(), the stability metrics).
+enum class Pass : std::uint8_t { forward = 0, depth = 1, shadow_points = 2 };
+
+constexpr const char* pass_name(Pass pass) {
+  switch (pass) {
+    case Pass::depth: return "depth";
+    case Pass::shadow_points: return "points";
+    case Pass::forward: break;
+  }
+  return "forward";
+}
 
 class VariantKey {
  public:
@@ -83,9 +94,13 @@ class VariantKey {
   }
 
   /// The part of the key a pass's shaders read. The depth pass only needs alpha masking; the
-  /// forward pass needs everything.
+  /// shadow-points pass only the shadow lookup's frame features (a receiver, without AOVs or the
+  /// debug tint); the forward pass needs everything.
   constexpr VariantKey filtered_for(Pass pass) const {
     if (pass == Pass::depth) return VariantKey(bits_ & kAlphaMask.mask());
+    if (pass == Pass::shadow_points)
+      return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask()) |
+                        kReceiveShadows.mask());
     return *this;
   }
 

@@ -85,6 +85,17 @@ print("misclassified bad %.3f%% good %.3f%%" % (b, g))
 assert b > g
 print("bad worse than default")
 ' "$tmp/bench/bench.csv"
+# Flicker at fixed world points while the camera moves: 0 for the stable fit, above 0 for crop.
+check bench_flicker 0 "wrote .*bench.csv \(2 rows\)" -- "$KASKAD" bench --size 200x112 --frames 1 --no-chart --out "$tmp/flicker" \
+  --stability-frames 8 --sweep "shadow.cascade_count=1;shadow.blend_band=0;shadow.fit_mode=stable,crop" 2>/dev/null
+check bench_flicker_csv 0 "flicker stable 0 crop" -- /usr/bin/python3 -c '
+import csv, sys
+rows = {r["settings"].split("fit_mode=")[1]: r for r in csv.DictReader(open(sys.argv[1]))}
+s, c = float(rows["stable"]["flicker"]), float(rows["crop"]["flicker"])
+assert int(rows["stable"]["stability_points"]) > 1000 and rows["stable"]["stability_frames"] == "8"
+assert s == 0.0 and c > 0.0, (s, c)
+print("flicker stable %g crop %g" % (s, c))
+' "$tmp/flicker/bench.csv"
 check bench_bad_sweep nonzero "--sweep.*expected key=value" -- "$KASKAD" bench --sweep "shadow.map_size" --no-chart --out "$tmp/bench2"
 check bench_bad_value nonzero "map_size.*power of two" -- "$KASKAD" bench --sweep "shadow.map_size=100" --no-chart --out "$tmp/bench3"
 
