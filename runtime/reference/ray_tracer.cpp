@@ -23,11 +23,65 @@
 #include <thread>
 #include <vector>
 
+#include "components/material.h"
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
 
 namespace kaskad::reference {
 namespace {
+
+/// An alpha-masked (glTF MASK) geometry's cut-out: what the forward and depth passes discard,
+/// alpha = base_color.a x texture alpha < cutoff. Hits there are rejected by Embree filter
+/// functions, so the reference sees the same holes as the rasteriser. The texture is sampled
+/// bilinearly at level 0 with repeat wrapping (the GPU may pick a coarser mip level: edges of
+/// cut-outs can differ by a texel there).
+struct AlphaCutout {
+  std::vector<glm::vec2> uvs;           // per vertex
+  std::vector<std::uint32_t> indices;   // 3 per kept triangle, by Embree primID
+  float factor = 1.0f;                  // base_color.a
+  float cutoff = 0.5f;
+  int width = 0, height = 0;            // 0: no texture
+  std::vector<std::uint8_t> alpha;      // width * height, rows top to bottom (uv (0,0) = row 0)
+
+  float texture_alpha(glm::vec2 uv) const {
+    if (width <= 0 || height <= 0) return 1.0f;
+    const float x = uv.x * float(width) - 0.5f, y = uv.y * float(height) - 0.5f;
+    if (!std::isfinite(x) || !std::isfinite(y)) return 1.0f;
+    const float fx = std::floor(x), fy = std::floor(y);
+    const float tx = x - fx, ty = y - fy;
+    auto texel = [&](float px, float py) {
+      const auto wrap = [](float v, int n) {
+        const double m = std::fmod(double(v), double(n));
+        return int(m < 0.0 ? m + n : m) % n;
+      };
+      return float(alpha[std::size_t(wrap(py, height)) * std::size_t(width) +
+                         std::size_t(wrap(px, width))]) / 255.0f;
+    };
+    const float top = texel(fx, fy) * (1.0f - tx) + texel(fx + 1.0f, fy) * tx;
+    const float bottom = texel(fx, fy + 1.0f) * (1.0f - tx) + texel(fx + 1.0f, fy + 1.0f) * tx;
+    return top * (1.0f - ty) + bottom * ty;
+  }
+
+  /// Whether the hit at Embree's barycentrics (u, v) on triangle `prim` is cut away.
+  bool cut(unsigned prim, float u, float v) const {
+    if (std::size_t(prim) * 3 + 2 >= indices.size()) return false;
+    const glm::vec2 a = uvs[indices[prim * 3]], b = uvs[indices[prim * 3 + 1]],
+                    c = uvs[indices[prim * 3 + 2]];
+    const glm::vec2 uv = (1.0f - u - v) * a + u * b + v * c;
+    return factor * texture_alpha(uv) < cutoff;
+  }
+};
+
+/// Embree filter function (intersection and occlusion): rejects hits in the cut-out.
+void alpha_cutout_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* cutout = static_cast<const AlphaCutout*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    if (cutout->cut(RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i),
+                    RTCHitN_v(args->hit, args->N, i)))
+      args->valid[i] = 0;
+  }
+}
 
 /// Where Embree's error callback leaves its message for check_device().
 struct ErrorLog {
@@ -50,6 +104,8 @@ struct RayTracer::Impl {
   std::size_t surface_triangles = 0;
 
   ErrorLog errors;  // filled by Embree's error callback
+  std::vector<std::unique_ptr<AlphaCutout>> cutouts;  // user data of alpha-masked geometries
+  std::size_t cutout_geometries = 0;
 
   Impl() = default;
   Impl(const Impl&) = delete;
@@ -321,11 +377,12 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
     ecs::Entity entity;
     MeshRenderer renderer;
     glm::mat4 matrix;
+    const Material* material;  // null: opaque
   };
   std::vector<Item> items;
   world.view<MeshRenderer, WorldTransform>().each(
       [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
-        if (mr.mesh != kNoMesh) items.push_back({e, mr, wt.matrix});
+        if (mr.mesh != kNoMesh) items.push_back({e, mr, wt.matrix, world.try_get<Material>(e)});
       });
 
   // 2. One world-space triangle geometry per entity.
@@ -386,6 +443,29 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
       vertices[3 * i + 2] = p.z;
     }
     std::copy(kept.begin(), kept.end(), indices);
+    if (item.material && item.material->alpha_mask && mesh.uvs.size() == mesh.positions.size()) {
+      auto cutout = std::make_unique<AlphaCutout>();
+      cutout->uvs = mesh.uvs;
+      cutout->indices = kept;
+      cutout->factor = item.material->base_color.a;
+      cutout->cutoff = item.material->alpha_cutoff;
+      const TextureId tex = item.material->base_color_texture;
+      if (tex != kNoTexture && tex < assets.textures.size()) {
+        const TextureData& t = assets.textures[tex];
+        if (t.width > 0 && t.height > 0 &&
+            t.rgba8.size() == std::size_t(t.width) * std::size_t(t.height) * 4) {
+          cutout->width = t.width;
+          cutout->height = t.height;
+          cutout->alpha.resize(std::size_t(t.width) * std::size_t(t.height));
+          for (std::size_t i = 0; i < cutout->alpha.size(); ++i) cutout->alpha[i] = t.rgba8[i * 4 + 3];
+        }
+      }
+      rtcSetGeometryUserData(geometry, cutout.get());
+      rtcSetGeometryIntersectFilterFunction(geometry, alpha_cutout_filter);
+      rtcSetGeometryOccludedFilterFunction(geometry, alpha_cutout_filter);
+      impl->cutouts.push_back(std::move(cutout));
+      ++impl->cutout_geometries;
+    }
     rtcCommitGeometry(geometry);
     const unsigned id = rtcAttachGeometry(impl->surfaces, geometry);
     if (item.renderer.cast_shadows) {
@@ -719,6 +799,8 @@ std::size_t RayTracer::occluder_triangles() const {
   KASKAD_CHECK(impl_, "RayTracer used after being moved from");
   return impl_->occluder_triangles;
 }
+std::size_t RayTracer::alpha_masked_geometries() const { return impl_->cutout_geometries; }
+
 std::size_t RayTracer::surface_triangles() const {
   KASKAD_CHECK(impl_, "RayTracer used after being moved from");
   return impl_->surface_triangles;

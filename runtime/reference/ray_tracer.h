@@ -96,8 +96,10 @@ struct ShadowReference {
 };
 
 /// Owns an Embree device and two scenes built from a Scene's MeshRenderers: the occluders
-/// (cast_shadows = true) and every surface (for mirror rays and receiver look-ups). Triangles are
-/// transformed to world space when built; later changes to the Scene are not seen. Move-only.
+/// (cast_shadows = true) and every surface (for mirror rays and receiver look-ups). Alpha-masked
+/// materials (glTF MASK) cut holes where the rasteriser discards (alpha_masked_geometries()).
+/// Triangles are transformed to world space when built; later changes to the Scene are not seen.
+/// Move-only.
 /// Thread safety: all const member functions may be called from any number of threads at once.
 class RayTracer {
  public:
@@ -160,6 +162,9 @@ class RayTracer {
   Aabb bounds() const;                     ///< of every surface triangle kept
   std::size_t occluder_triangles() const;  ///< triangles in the occluder BVH
   std::size_t surface_triangles() const;   ///< triangles in the all-surfaces BVH
+  /// Geometries with an alpha cut-out (Material::alpha_mask and uvs): rays pass through where
+  /// base_color.a x texture alpha < alpha_cutoff, as the rasteriser discards there.
+  std::size_t alpha_masked_geometries() const;
 
  private:
   struct Impl;

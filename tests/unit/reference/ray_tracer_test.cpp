@@ -12,6 +12,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "components/material.h"
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
 #include "runtime/assets/primitives.h"
@@ -674,6 +675,53 @@ TEST(RayTracer, ReferenceComparedWithItselfHasNoErrors) {
   ASSERT_TRUE(lost.ok());
   EXPECT_GT(lost->all.false_light, 100u);
   EXPECT_EQ(lost->all.false_shadow, 0u);
+}
+
+// Alpha cut-outs (glTF MASK): a card at y = 1 whose texture is transparent on its left half
+// (u < 0.5) and opaque on its right half; rays straight up from the ground pass through the left
+// half only. The base colour's alpha scales the texture's, as in forward.frag.
+TEST(RayTracerAlpha, CutOutsLetRaysThroughWhereTheRasteriserDiscards) {
+  auto card_scene = [](bool alpha_mask, float factor_alpha) {
+    Scene scene;
+    TextureData tex;
+    tex.name = "half";
+    tex.width = 4;
+    tex.height = 1;
+    tex.rgba8 = {255, 255, 255, 0, 255, 255, 255, 0, 255, 255, 255, 255, 255, 255, 255, 255};
+    scene.assets.textures.push_back(tex);
+    const ecs::Entity card = add(scene, PrimitiveShape::plane, trs({0, 1, 0}, {2, 1, 2}));
+    Material m;
+    m.alpha_mask = alpha_mask;
+    m.alpha_cutoff = 0.5f;
+    m.base_color = {1, 1, 1, factor_alpha};
+    m.base_color_texture = 0;
+    m.features = derive_material_features(m);
+    scene.world.emplace<Material>(card, m);
+    return scene;
+  };
+  ReferenceLight above;
+  above.direction = {0, -1, 0};  // shines down: shadow rays go up
+  const glm::vec3 up(0, 1, 0);
+  {
+    const Scene scene = card_scene(true, 1.0f);
+    const RayTracer tracer = build(scene);
+    EXPECT_EQ(tracer.alpha_masked_geometries(), 1u);
+    EXPECT_EQ(tracer.hard_visibility({-0.6f, 0, 0.3f}, up, above), 1.0f);  // u = 0.2: cut away
+    EXPECT_EQ(tracer.hard_visibility({0.6f, 0, -0.3f}, up, above), 0.0f);  // u = 0.8: opaque
+    EXPECT_FALSE(tracer.intersect({-0.6f, 0, 0}, up).has_value());
+    EXPECT_TRUE(tracer.intersect({0.6f, 0, 0}, up).has_value());
+  }
+  {
+    const Scene scene = card_scene(true, 0.4f);  // 0.4 x 1 < cutoff: the whole card is cut
+    const RayTracer tracer = build(scene);
+    EXPECT_EQ(tracer.hard_visibility({0.6f, 0, 0}, up, above), 1.0f);
+  }
+  {
+    const Scene scene = card_scene(false, 1.0f);  // opaque material: the texture's alpha is unused
+    const RayTracer tracer = build(scene);
+    EXPECT_EQ(tracer.alpha_masked_geometries(), 0u);
+    EXPECT_EQ(tracer.hard_visibility({-0.6f, 0, 0}, up, above), 0.0f);
+  }
 }
 
 }  // namespace
