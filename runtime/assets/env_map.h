@@ -127,16 +127,18 @@ struct EnvLoadOptions {
   /// The faces were authored in 3ds Max (Z up, front = -Y): convert with S3's face table and
   /// M_rot into the engine's Y-up convention. Only for layout faces / crosses.
   bool z_up_3dsmax = false;
-  /// Face size of the result in texels; 0 = from the image: the face images' size, the cross
-  /// width / 4 (horizontal) or / 3 (vertical), the equirect width / 4 (90 degrees of the 360
-  /// the width covers), the sphere map's size / 2. Another value resamples (bilinear).
+  /// Face size of the result in texels, at most 8192; 0 = from the image: the face images'
+  /// size, the cross width / 4 (horizontal) or / 3 (vertical), the equirect width / 4 (90
+  /// degrees of the 360 the width covers) and the sphere map's size / 2, those two at most 2048.
+  /// Another value resamples (bilinear).
   int face_size = 0;
 };
 
 /// Loads a cube map. Layouts (README "Environment maps"):
 ///   - faces: six images `<prefix>px<suffix>` ... `<prefix>nz<suffix>`; `path` is either a
-///     pattern with one `*` (e.g. "sky_*.png") or any one of the six files (e.g. "sky_px.png":
-///     the name's stem must end in one of the six face names). With z_up_3dsmax the names are
+///     pattern with one `*` (e.g. "sky_*.png"), any one of the six files (e.g. "sky_px.png":
+///     the name's stem must end in one of the six face names), or a folder holding px.<ext> ...
+///     nz.<ext>. With z_up_3dsmax the names are
 ///     3ds Max's axes (px = RIGHT, nx = LEFT, py = BACK, ny = FRONT, pz = UP, nz = DOWN), and
 ///     S3's face names right/left/back/front/up/down are accepted too.
 ///   - horizontal_cross (4:3):   . +Y  .  .        vertical_cross (3:4):   . +Y  .
@@ -150,10 +152,11 @@ struct EnvLoadOptions {
 ///     lat = pi (0.5 - v).
 ///   - sphere (1:1): a sphere-map image (see SphereMap) resampled into a cube with view space =
 ///     cube space (the -Z side comes from the rim, so it is poor there).
-///   - auto_detect: faces when the path contains `*` or its stem ends in a face name;
+///   - auto_detect: faces when the path contains `*`, its stem ends in a face name, or it is a
+///     folder of faces;
 ///     otherwise by the image's aspect ratio (4:3, 3:4, 2:1, 1:1).
 /// Errors name the file and the problem: unreadable images, missing face files, non-square or
-/// mismatched faces, a wrong aspect for the layout.
+/// mismatched faces, a wrong aspect for the layout, face_size out of range.
 Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOptions& options = {});
 
 /// Loads a sphere-map image (square; row 0 at the top, see SphereMap).
