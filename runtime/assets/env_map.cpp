@@ -459,7 +459,8 @@ CubeMap cube_from_3dsmax(const CubeMap& max_faces) {
   return out;
 }
 
-Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOptions& options) {
+Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOptions& options,
+                              EnvLayout* detected) {
   const std::string name = path.string();
   if (options.face_size < 0 || options.face_size > kMaxFaceSize) {
     return Error{name, "", "face_size must be in [0, " + std::to_string(kMaxFaceSize) +
@@ -469,6 +470,8 @@ Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOp
   if (layout == EnvLayout::auto_detect && face_pattern(path, options.z_up_3dsmax)) {
     layout = EnvLayout::faces;
   }
+
+  if (detected) *detected = layout;
 
   Result<CubeMap> cube = Error{};
   if (layout == EnvLayout::faces) {
@@ -487,6 +490,7 @@ Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOp
                                    " image: expected 4:3 or 3:4 (cross), 2:1 (equirect), 1:1 "
                                    "(sphere map), or six face files (a '*' pattern)"};
       }
+      if (detected) *detected = layout;
     }
     if (options.z_up_3dsmax && (layout == EnvLayout::equirect || layout == EnvLayout::sphere)) {
       return Error{name, "", std::string("the 3ds Max (Z-up) conversion applies to cube faces and "

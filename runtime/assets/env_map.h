@@ -157,7 +157,10 @@ struct EnvLoadOptions {
 ///     otherwise by the image's aspect ratio (4:3, 3:4, 2:1, 1:1).
 /// Errors name the file and the problem: unreadable images, missing face files, non-square or
 /// mismatched faces, a wrong aspect for the layout, face_size out of range.
-Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOptions& options = {});
+/// `detected`, when given, receives the layout used (auto_detect resolved), also on errors
+/// found after detection.
+Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOptions& options = {},
+                              EnvLayout* detected = nullptr);
 
 /// Loads a sphere-map image (square; row 0 at the top, see SphereMap).
 Result<SphereMap> load_sphere_map(const std::filesystem::path& path);
