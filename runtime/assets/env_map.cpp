@@ -388,7 +388,7 @@ glm::vec3 sphere_map_direction(int i, int j, int size) {
   return {2.0f * az * s, 2.0f * az * t, 2.0f * az * az - 1.0f};
 }
 
-SphereMap sphere_map_from_cube(const CubeMap& cube, int size) {
+SphereMap sphere_map_from_cube(const CubeMap& cube, int size, const glm::mat3& view_to_world) {
   KASKAD_CHECK(size >= 1, "size must be >= 1, was " + std::to_string(size));
   SphereMap map;
   map.size = size;
@@ -396,7 +396,7 @@ SphereMap sphere_map_from_cube(const CubeMap& cube, int size) {
   for (int j = 0; j < size; ++j) {
     for (int i = 0; i < size; ++i) {
       map.texels[std::size_t(j) * std::size_t(size) + std::size_t(i)] =
-          sample_cube(cube, sphere_map_direction(i, j, size));
+          sample_cube(cube, view_to_world * sphere_map_direction(i, j, size));
     }
   }
   return map;

@@ -100,10 +100,13 @@ struct SphereMap {
 /// view-space reflection direction stored there. Outside the unit circle: (0, 0, -1).
 glm::vec3 sphere_map_direction(int i, int j, int size);
 
-/// Sphere map from a cube map per S3 eq. (2), with view space = cube (world) space, i.e. as seen
-/// by a viewer looking down -Z with +Y up: the centre shows the cube's +Z direction, the rim its
-/// -Z direction. Each texel takes sample_cube() along R at its centre. Precondition: size >= 1.
-SphereMap sphere_map_from_cube(const CubeMap& cube, int size);
+/// Sphere map from a cube map per S3 eq. (2), for a viewer whose view-space directions turn into
+/// world (cube) directions by `view_to_world` (the rotation part of (MV)^-1, S3 eq. 6; the
+/// transpose of the view matrix's rotation). Identity: a viewer looking down world -Z with +Y up,
+/// so the centre shows the cube's +Z direction and the rim its -Z direction. Each texel takes
+/// sample_cube() along view_to_world * R at its centre. Precondition: size >= 1.
+SphereMap sphere_map_from_cube(const CubeMap& cube, int size,
+                               const glm::mat3& view_to_world = glm::mat3(1.0f));
 
 /// S3 eq. (4)-(5): the texture coordinate (s', t') in [0,1]^2 of a view-space reflection
 /// direction (need not be unit): A_z = sqrt((R_z + 1) / 2), s = R_x / (2 A_z), t = R_y / (2 A_z),

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -213,6 +215,24 @@ TEST(SphereMap, EveryTexelIsFormulaExact) {
     }
   }
   EXPECT_GT(checked, n * n / 2);
+}
+
+TEST(SphereMap, ViewRotationPicksWhatTheViewerFaces) {
+  // A camera looking down world +X (turned -90 degrees about Y): view -Z is world +X, so the rim
+  // shows +X and the centre (towards the eye) -X; view +Y stays world +Y.
+  const glm::mat4 camera_to_world = glm::rotate(glm::mat4(1.0f), glm::radians(-90.0f), glm::vec3(0, 1, 0));
+  const glm::mat3 view_to_world(camera_to_world);
+  ASSERT_LT(glm::length(view_to_world * glm::vec3(0, 0, -1) - glm::vec3(1, 0, 0)), 1e-6f);
+  const int n = 64;
+  const CubeMap cube = coloured_cube(8);
+  const SphereMap map = sphere_map_from_cube(cube, n, view_to_world);
+  EXPECT_EQ(map.at(n / 2, n / 2), kFaceColour[1]);  // centre: -X
+  EXPECT_EQ(map.at(0, n / 2), kFaceColour[0]);      // rim: +X
+  EXPECT_EQ(map.at(n / 2, n / 2 - int(0.7f * n / 2)), kFaceColour[2]);  // up: +Y
+  // Looking up a view-space direction gives the cube along its world direction.
+  const SphereMap smooth = sphere_map_from_cube(make_cube_map(64, smooth_env), 256, view_to_world);
+  const glm::vec3 r_view = glm::normalize(glm::vec3(0.3f, -0.4f, 0.6f));
+  EXPECT_LT(max_diff(sample_sphere(smooth, r_view), smooth_env(view_to_world * r_view)), 0.02f);
 }
 
 TEST(SphereMap, UvIsS3Eq4And5AndInvertsEq2) {
