@@ -128,7 +128,9 @@ const char* env_layout_name(EnvLayout layout);
 struct EnvLoadOptions {
   EnvLayout layout = EnvLayout::auto_detect;
   /// The faces were authored in 3ds Max (Z up, front = -Y): convert with S3's face table and
-  /// M_rot into the engine's Y-up convention. Only for layout faces / crosses.
+  /// M_rot into the engine's Y-up convention (cube_from_3dsmax). Faces and crosses only (an error
+  /// for equirect and sphere maps): face files are named, and cross cells placed, by 3ds Max's
+  /// axes (the cell drawn +Y below holds 3ds Max's +Y = BACK image, and so on).
   bool z_up_3dsmax = false;
   /// Face size of the result in texels, at most 8192; 0 = from the image: the face images'
   /// size, the cross width / 4 (horizontal) or / 3 (vertical), the equirect width / 4 (90
