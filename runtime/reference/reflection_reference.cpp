@@ -58,9 +58,61 @@ Status check_sizes(const Image& image, const char* what) {
 
 }  // namespace
 
+glm::vec4 sample_texture(const TextureData& texture, const glm::vec2& uv) {
+  const int w = texture.width, h = texture.height;
+  if (w <= 0 || h <= 0 || texture.rgba8.size() < std::size_t(w) * std::size_t(h) * 4)
+    return glm::vec4(1.0f);
+  if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return glm::vec4(1.0f);
+  // GL_REPEAT, GL_LINEAR: texel centres at integer + 0.5.
+  const float fx = (uv.x - std::floor(uv.x)) * float(w) - 0.5f;
+  const float fy = (uv.y - std::floor(uv.y)) * float(h) - 0.5f;
+  const float x0f = std::floor(fx), y0f = std::floor(fy);
+  const float ax = fx - x0f, ay = fy - y0f;
+  auto wrap = [](int i, int n) { return ((i % n) + n) % n; };
+  auto texel = [&](int x, int y) {
+    const std::uint8_t* t =
+        &texture.rgba8[(std::size_t(wrap(y, h)) * std::size_t(w) + std::size_t(wrap(x, w))) * 4];
+    glm::vec4 c(t[0], t[1], t[2], t[3]);
+    c /= 255.0f;
+    if (texture.srgb) {
+      for (int i = 0; i < 3; ++i)
+        c[i] = c[i] <= 0.04045f ? c[i] / 12.92f : std::pow((c[i] + 0.055f) / 1.055f, 2.4f);
+    }
+    return c;
+  };
+  const int x0 = int(x0f), y0 = int(y0f);
+  return glm::mix(glm::mix(texel(x0, y0), texel(x0 + 1, y0), ax),
+                  glm::mix(texel(x0, y0 + 1), texel(x0 + 1, y0 + 1), ax), ay);
+}
+
+glm::vec4 hit_base_color(const ReflectionScene& scene, const Material& material,
+                         const SurfaceHit& hit) {
+  if (material.base_color_texture == kNoTexture || !scene.assets || !scene.world ||
+      material.base_color_texture >= scene.assets->textures.size())
+    return material.base_color;
+  const auto* mr = scene.world->alive(hit.entity) ? scene.world->try_get<MeshRenderer>(hit.entity)
+                                                  : nullptr;
+  if (!mr || mr->mesh >= scene.assets->meshes.size()) return material.base_color;
+  const MeshData& mesh = scene.assets->meshes[mr->mesh];
+  const std::size_t first = 3 * std::size_t(hit.triangle);
+  if (mesh.uvs.size() != mesh.positions.size() || first + 2 >= mesh.indices.size())
+    return material.base_color;
+  std::array<glm::vec2, 3> uv;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const std::uint32_t i = mesh.indices[first + k];
+    if (i >= mesh.uvs.size()) return material.base_color;
+    uv[k] = mesh.uvs[i];
+  }
+  const glm::vec2 b = hit.barycentric;
+  const glm::vec2 at = (1.0f - b.x - b.y) * uv[0] + b.x * uv[1] + b.y * uv[2];
+  return material.base_color *
+         sample_texture(scene.assets->textures[material.base_color_texture], at);
+}
+
 ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment) {
   ReflectionScene out;
   out.world = &scene.world;
+  out.assets = &scene.assets;
   out.ambient = scene.render.ambient;
   out.clear_color = scene.render.clear_color;
   out.environment = environment;
@@ -165,9 +217,11 @@ glm::vec3 reflected_radiance(const RayTracer& tracer, const ReflectionScene& sce
     if (const auto* mr = scene.world->try_get<MeshRenderer>(surface->entity))
       receives = mr->receive_shadows;
   }
+  Material shaded = material ? *material : default_material;
+  shaded.base_color = hit_base_color(scene, shaded, *surface);
   const glm::vec3 to_mirror = glm::normalize(position - surface->position);
-  return shade_point(tracer, scene, material ? *material : default_material, surface->position,
-                     surface->normal, to_mirror, receives, rays);
+  return shade_point(tracer, scene, shaded, surface->position, surface->normal, to_mirror,
+                     receives, rays);
 }
 
 Result<ReflectionReference> reflection_reference(const RayTracer& tracer, const Image& aov,

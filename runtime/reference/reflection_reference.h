@@ -9,11 +9,11 @@
 // by u_ambient.w); environment cube texels are taken as they are.
 //
 // Differences from the rasteriser, by design or not yet done: the hit is shaded with the
-// triangle's geometric normal (flat primitives agree exactly, smooth meshes differ slightly), with
-// the base colour FACTOR only (no base colour texture: hits carry no uv yet) and without normal
-// maps or alpha cut-outs; the view vector at the hit points back along the mirror ray (a probe
-// captured at a centre sees it from there instead); every light with cast_shadows gets a hard
-// shadow ray (the engine shadows one light).
+// triangle's geometric normal (flat primitives agree exactly, smooth meshes differ slightly); the
+// base colour texture is sampled bilinearly from its top mip level (GL filters trilinearly over
+// mips); no normal maps or alpha cut-outs; the view vector at the hit points back along the
+// mirror ray (a probe captured at a centre sees it from there instead); every light with
+// cast_shadows gets a hard shadow ray (the engine shadows one light).
 #pragma once
 
 #include <cstdint>
@@ -49,6 +49,9 @@ struct ReflectionScene {
   /// the entities mirror rays hit. Not owned; must outlive the calls. May be null: every hit
   /// then has the default Material and receives shadows.
   const ecs::World* world = nullptr;
+  /// Meshes (uvs) and textures of the hit entities, for base colour textures. Not owned; may be
+  /// null: the base colour factor alone is used.
+  const AssetStore* assets = nullptr;
   std::vector<ShadingLight> lights;
   glm::vec3 ambient{0.05f};      ///< u_ambient.rgb: added as ambient * diffuse colour
   glm::vec3 clear_color{0.0f};   ///< returned on a miss when there is no environment
@@ -59,11 +62,23 @@ struct ReflectionScene {
 /// The ReflectionScene of a loaded scene (run the transform phase first): every Light with a
 /// WorldTransform, as systems/frame.cpp build_frame_input() turns them into LightItems (colour *
 /// intensity, direction from the matrix's -Z, cones as cosines), shadowed = cast_shadows; the
-/// render settings' ambient and clear colour.
+/// render settings' ambient and clear colour; world and assets point into `scene`.
 ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment = nullptr);
 
+/// A texture as a GL_LINEAR / GL_REPEAT sampler reads its top mip level at uv (glTF / GL
+/// convention: (0, 0) is the first texel of the first row), decoded from sRGB to linear first
+/// when texture.srgb (GL decodes sRGB texels before filtering). Empty texture: vec4(1).
+glm::vec4 sample_texture(const TextureData& texture, const glm::vec2& uv);
+
+/// The base colour a surface hit shows: Material::base_color times its base colour texture at
+/// the hit's uv (interpolated from the mesh's uvs with SurfaceHit::barycentric) when the material
+/// has a texture and `assets` has it and the mesh has uvs; else the factor alone.
+glm::vec4 hit_base_color(const ReflectionScene& scene, const Material& material,
+                         const SurfaceHit& hit);
+
 /// forward.frag's radiance (before exposure) leaving surface point `position` with unit normal
-/// `normal` (facing the viewer) towards the unit vector `to_eye`: ambient * diffuse + emissive +
+/// `normal` (facing the viewer) towards the unit vector `to_eye`, taking material.base_color as
+/// the base colour (multiply a texture sample in first): ambient * diffuse + emissive +
 /// sum over lights of (diffuse + normalised Blinn-Phong specular) * radiance * N.L * attenuation
 /// * visibility, with glTF metallic-roughness mapped as in forward.frag. Shadow rays (shadowed
 /// lights, when `receives_shadows`) start at position + ray_offset() * normal.

@@ -263,6 +263,93 @@ TEST(ReflectionReference, ImageAndMetric) {
   EXPECT_NE(bad.error().message.find("N.X"), std::string::npos);
 }
 
+TEST(ReflectionReference, SampleTextureIsGlLinearRepeat) {
+  TextureData t;
+  t.width = 2;
+  t.height = 2;
+  t.srgb = false;
+  // Row 0: red, green; row 1: blue, white.
+  t.rgba8 = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255};
+  auto near4 = [](glm::vec4 a, glm::vec4 b) { return glm::length(a - b) < 1e-5f; };
+  EXPECT_TRUE(near4(sample_texture(t, {0.25f, 0.25f}), {1, 0, 0, 1}));  // texel centres
+  EXPECT_TRUE(near4(sample_texture(t, {0.75f, 0.25f}), {0, 1, 0, 1}));
+  EXPECT_TRUE(near4(sample_texture(t, {0.25f, 0.75f}), {0, 0, 1, 1}));
+  EXPECT_TRUE(near4(sample_texture(t, {1.75f, -0.25f}), {1, 1, 1, 1}));  // repeat
+  // The corner (0, 0) lies between all four texels (wrapping): their mean.
+  EXPECT_TRUE(near4(sample_texture(t, {0.0f, 0.0f}), {0.5f, 0.5f, 0.5f, 1.0f}));
+  EXPECT_TRUE(near4(sample_texture(t, {0.5f, 0.25f}), {0.5f, 0.5f, 0, 1}));
+  // sRGB texels are decoded before filtering: 128 -> ((128/255 + 0.055) / 1.055)^2.4.
+  TextureData s;
+  s.width = s.height = 1;
+  s.rgba8 = {128, 0, 255, 128};
+  const glm::vec4 d = sample_texture(s, {0.3f, 0.6f});
+  EXPECT_NEAR(d.r, std::pow((128.0f / 255.0f + 0.055f) / 1.055f, 2.4f), 1e-6f);
+  EXPECT_EQ(d.g, 0.0f);
+  EXPECT_EQ(d.b, 1.0f);
+  EXPECT_NEAR(d.a, 128.0f / 255.0f, 1e-6f);  // alpha is linear
+  EXPECT_EQ(sample_texture(TextureData{}, {0.5f, 0.5f}), glm::vec4(1.0f));
+}
+
+TEST(ReflectionReference, HitsCarryTheirMeshTriangleAndBarycentrics) {
+  WallScene w = wall_scene(false, wall_material());
+  // A mesh whose first triangle has a non-finite vertex: Embree never sees it, and the hit
+  // triangle must still index the mesh (not Embree's primitive list).
+  MeshData mesh = make_primitive(PrimitiveShape::plane, 4);
+  mesh.positions.push_back(glm::vec3(NAN));
+  const std::uint32_t bad = std::uint32_t(mesh.positions.size() - 1);
+  mesh.indices.insert(mesh.indices.begin(), {bad, bad, bad});
+  mesh.normals.push_back(glm::vec3(0, 1, 0));
+  mesh.uvs.push_back(glm::vec2(0));
+  w.scene.world.get<MeshRenderer>(w.wall).mesh = w.scene.assets.add_mesh(mesh);
+  const RayTracer tracer = build(w.scene);
+  const auto hit = tracer.intersect(kMirror, glm::vec3(1, 1, 0));
+  ASSERT_TRUE(hit.has_value());
+  ASSERT_GE(hit->triangle, 1u);  // triangle 0 was dropped
+  ASSERT_LT(3 * hit->triangle + 2, mesh.indices.size());
+  const glm::mat4& m = w.scene.world.get<WorldTransform>(w.wall).matrix;
+  std::array<glm::vec3, 3> p;
+  for (std::size_t k = 0; k < 3; ++k)
+    p[k] = glm::vec3(m * glm::vec4(mesh.positions[mesh.indices[3 * hit->triangle + k]], 1.0f));
+  const glm::vec2 b = hit->barycentric;
+  expect_near((1 - b.x - b.y) * p[0] + b.x * p[1] + b.y * p[2], hit->position, 1e-4f);
+  expect_near(hit->position, kWallHit, 1e-4f);
+}
+
+TEST(ReflectionReference, HitsShowTheBaseColourTexture) {
+  // The wall's uv at (3, 3, 0): plane-local (0.3, 0, 0) -> uv (0.8, 0.5). A 4 x 4 texture whose
+  // right half is one colour: columns 2 and 3 are read there.
+  Material textured = wall_material();
+  WallScene w = wall_scene(false, textured);
+  TextureData t;
+  t.width = t.height = 4;
+  t.srgb = false;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) {
+      const std::array<std::uint8_t, 4> c =
+          x < 2 ? std::array<std::uint8_t, 4>{0, 0, 0, 255} : std::array<std::uint8_t, 4>{255, 128, 51, 255};
+      t.rgba8.insert(t.rgba8.end(), c.begin(), c.end());
+    }
+  textured.base_color_texture = w.scene.assets.add_texture(t);
+  w.scene.world.get<Material>(w.wall) = textured;
+  const RayTracer tracer = build(w.scene);
+  ReflectionScene rs = lit_by(w.scene, sun_along_x(false));
+  rs.assets = &w.scene.assets;
+  const auto hit = tracer.intersect(kMirror, glm::vec3(1, 1, 0));
+  ASSERT_TRUE(hit.has_value());
+  const glm::vec4 texel(1.0f, 128.0f / 255.0f, 51.0f / 255.0f, 1.0f);
+  const glm::vec4 base = hit_base_color(rs, textured, *hit);
+  EXPECT_LT(glm::length(base - textured.base_color * texel), 1e-5f);
+  // Shaded with that colour.
+  Material expected_material = textured;
+  expected_material.base_color = textured.base_color * texel;
+  const glm::vec3 v = glm::normalize(kMirror - hit->position);
+  expect_near(reflected_radiance(tracer, rs, kMirror, kMirrorNormal, kEye),
+              shade_point(tracer, rs, expected_material, hit->position, hit->normal, v, true));
+  // Without assets, the factor alone.
+  rs.assets = nullptr;
+  EXPECT_EQ(hit_base_color(rs, textured, *hit), textured.base_color);
+}
+
 TEST(ReflectionReference, SceneLightsAsTheFrameBuildsThem) {
   Scene scene;
   const ecs::Entity e = scene.world.create();
