@@ -17,7 +17,8 @@ namespace {
 constexpr std::array<const char*, 6> kFaceSuffix = {"px", "nx", "py", "ny", "pz", "nz"};
 /// S3's 3ds Max face names in CubeFace order of their 3ds Max axes (+X RIGHT, -X LEFT, +Y BACK,
 /// -Y FRONT, +Z UP, -Z DOWN; S3, Fig. 8).
-constexpr std::array<const char*, 6> kMaxFaceName = {"right", "left", "back", "front", "up", "down"};
+constexpr std::array<const char*, 6> kMaxFaceName = {"right", "left", "back",
+                                                     "front", "up",   "down"};
 
 bool finite(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -183,7 +184,8 @@ std::optional<FacePattern> face_pattern(const std::filesystem::path& path, bool 
   const std::string dir = path.has_parent_path() ? path.parent_path().string() + "/" : "";
   for (int f = 0; f < 6; ++f) {
     for (const std::string& name : face_names(f, max)) {
-      if (ends_with(stem, name)) return FacePattern{dir + stem.substr(0, stem.size() - name.size()), ext};
+      if (ends_with(stem, name))
+        return FacePattern{dir + stem.substr(0, stem.size() - name.size()), ext};
     }
   }
   return std::nullopt;
@@ -232,8 +234,9 @@ Result<CubeMap> load_faces(const std::filesystem::path& path, bool max) {
     auto image = load_image(file);
     if (!image) return image.error();
     if (image->width != image->height) {
-      return Error{file, "", "a cube face must be square, this one is " +
-                                 size_text(image->width, image->height)};
+      return Error{
+          file, "",
+          "a cube face must be square, this one is " + size_text(image->width, image->height)};
     }
     if (f == 0) {
       cube.size = image->width;
@@ -256,7 +259,8 @@ Result<CubeMap> cube_from_cross(const Image& image, const std::string& name, boo
   const int w = image.width, h = image.height;
   const int cols = vertical ? 3 : 4, rows = vertical ? 4 : 3;
   if (w % cols != 0 || h % rows != 0 || w / cols != h / rows) {
-    std::string message = vertical ? "a vertical cross must be 3:4" : "a horizontal cross must be 4:3";
+    std::string message =
+        vertical ? "a vertical cross must be 3:4" : "a horizontal cross must be 4:3";
     message += " with whole square faces (width divisible by ";
     message += std::to_string(cols);
     message += "), this image is ";
@@ -270,11 +274,18 @@ Result<CubeMap> cube_from_cross(const Image& image, const std::string& name, boo
     int col, row;
     bool rotate_180;
   };
-  const std::array<Cell, 6> cells =
-      vertical ? std::array<Cell, 6>{{{2, 1, false}, {0, 1, false}, {1, 0, false}, {1, 2, false},
-                                      {1, 1, false}, {1, 3, true}}}
-               : std::array<Cell, 6>{{{2, 1, false}, {0, 1, false}, {1, 0, false}, {1, 2, false},
-                                      {1, 1, false}, {3, 1, false}}};
+  const std::array<Cell, 6> cells = vertical ? std::array<Cell, 6>{{{2, 1, false},
+                                                                    {0, 1, false},
+                                                                    {1, 0, false},
+                                                                    {1, 2, false},
+                                                                    {1, 1, false},
+                                                                    {1, 3, true}}}
+                                             : std::array<Cell, 6>{{{2, 1, false},
+                                                                    {0, 1, false},
+                                                                    {1, 0, false},
+                                                                    {1, 2, false},
+                                                                    {1, 1, false},
+                                                                    {3, 1, false}}};
   CubeMap cube;
   cube.size = n;
   for (int f = 0; f < 6; ++f) {
@@ -287,8 +298,9 @@ Result<CubeMap> cube_from_cross(const Image& image, const std::string& name, boo
 Result<CubeMap> cube_from_equirect(const Image& image, const std::string& name, int face_size) {
   const int w = image.width, h = image.height;
   if (w != 2 * h) {
-    return Error{name, "", "an equirectangular map must be 2:1 (width = 2 x height), this image is " +
-                               size_text(w, h)};
+    return Error{name, "",
+                 "an equirectangular map must be 2:1 (width = 2 x height), this image is " +
+                     size_text(w, h)};
   }
   const std::vector<glm::vec4> texels = rgba_texels(image);
   const int size = face_size > 0 ? face_size : std::clamp(w / 4, 1, kMaxDerivedFaceSize);
@@ -305,8 +317,9 @@ Result<CubeMap> cube_from_equirect(const Image& image, const std::string& name, 
 
 Result<SphereMap> sphere_from_image(const Image& image, const std::string& name) {
   if (image.width != image.height) {
-    return Error{name, "", "a sphere map must be square, this image is " +
-                               size_text(image.width, image.height)};
+    return Error{
+        name, "",
+        "a sphere map must be square, this image is " + size_text(image.width, image.height)};
   }
   SphereMap map;
   map.size = image.width;
@@ -316,16 +329,24 @@ Result<SphereMap> sphere_from_image(const Image& image, const std::string& name)
 
 }  // namespace
 
-const char* cube_face_suffix(CubeFace face) { return kFaceSuffix[std::size_t(face)]; }
+const char* cube_face_suffix(CubeFace face) {
+  return kFaceSuffix[std::size_t(face)];
+}
 
 const char* env_layout_name(EnvLayout layout) {
   switch (layout) {
-    case EnvLayout::auto_detect: return "auto";
-    case EnvLayout::faces: return "faces";
-    case EnvLayout::horizontal_cross: return "horizontal_cross";
-    case EnvLayout::vertical_cross: return "vertical_cross";
-    case EnvLayout::equirect: return "equirect";
-    case EnvLayout::sphere: return "sphere";
+    case EnvLayout::auto_detect:
+      return "auto";
+    case EnvLayout::faces:
+      return "faces";
+    case EnvLayout::horizontal_cross:
+      return "horizontal_cross";
+    case EnvLayout::vertical_cross:
+      return "vertical_cross";
+    case EnvLayout::equirect:
+      return "equirect";
+    case EnvLayout::sphere:
+      return "sphere";
   }
   return "?";
 }
@@ -336,12 +357,24 @@ glm::vec3 cube_direction(CubeFace face, float s, float t) {
   const float tc = 2.0f * t - 1.0f;
   glm::vec3 d{0.0f};
   switch (face) {
-    case CubeFace::pos_x: d = {1.0f, -tc, -sc}; break;
-    case CubeFace::neg_x: d = {-1.0f, -tc, sc}; break;
-    case CubeFace::pos_y: d = {sc, 1.0f, tc}; break;
-    case CubeFace::neg_y: d = {sc, -1.0f, -tc}; break;
-    case CubeFace::pos_z: d = {sc, -tc, 1.0f}; break;
-    case CubeFace::neg_z: d = {-sc, -tc, -1.0f}; break;
+    case CubeFace::pos_x:
+      d = {1.0f, -tc, -sc};
+      break;
+    case CubeFace::neg_x:
+      d = {-1.0f, -tc, sc};
+      break;
+    case CubeFace::pos_y:
+      d = {sc, 1.0f, tc};
+      break;
+    case CubeFace::neg_y:
+      d = {sc, -1.0f, -tc};
+      break;
+    case CubeFace::pos_z:
+      d = {sc, -tc, 1.0f};
+      break;
+    case CubeFace::neg_z:
+      d = {-sc, -tc, -1.0f};
+      break;
   }
   return glm::normalize(d);
 }
@@ -422,7 +455,9 @@ glm::vec4 sample_sphere(const SphereMap& map, const glm::vec3& reflected_view) {
                   (1.0f - uv.y) * float(map.size));
 }
 
-glm::vec3 m_rot(const glm::vec3& v) { return {v.x, -v.z, v.y}; }
+glm::vec3 m_rot(const glm::vec3& v) {
+  return {v.x, -v.z, v.y};
+}
 
 CubeMap cube_from_3dsmax(const CubeMap& max_faces) {
   // Derivation. 3ds Max is Z-up with FRONT at -Y; the engine is Y-up. A Max scene exported to
@@ -463,8 +498,9 @@ Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOp
                               EnvLayout* detected) {
   const std::string name = path.string();
   if (options.face_size < 0 || options.face_size > kMaxFaceSize) {
-    return Error{name, "", "face_size must be in [0, " + std::to_string(kMaxFaceSize) +
-                               "] (0 = from the image), was " + std::to_string(options.face_size)};
+    return Error{name, "",
+                 "face_size must be in [0, " + std::to_string(kMaxFaceSize) +
+                     "] (0 = from the image), was " + std::to_string(options.face_size)};
   }
   EnvLayout layout = options.layout;
   if (layout == EnvLayout::auto_detect && face_pattern(path, options.z_up_3dsmax)) {
@@ -481,21 +517,27 @@ Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOp
     if (!image) return image.error();
     const int w = image->width, h = image->height;
     if (layout == EnvLayout::auto_detect) {
-      if (3 * w == 4 * h) layout = EnvLayout::horizontal_cross;
-      else if (4 * w == 3 * h) layout = EnvLayout::vertical_cross;
-      else if (w == 2 * h) layout = EnvLayout::equirect;
-      else if (w == h) layout = EnvLayout::sphere;
+      if (3 * w == 4 * h)
+        layout = EnvLayout::horizontal_cross;
+      else if (4 * w == 3 * h)
+        layout = EnvLayout::vertical_cross;
+      else if (w == 2 * h)
+        layout = EnvLayout::equirect;
+      else if (w == h)
+        layout = EnvLayout::sphere;
       else {
-        return Error{name, "", "cannot tell the environment layout of a " + size_text(w, h) +
-                                   " image: expected 4:3 or 3:4 (cross), 2:1 (equirect), 1:1 "
-                                   "(sphere map), or six face files (a '*' pattern)"};
+        return Error{name, "",
+                     "cannot tell the environment layout of a " + size_text(w, h) +
+                         " image: expected 4:3 or 3:4 (cross), 2:1 (equirect), 1:1 "
+                         "(sphere map), or six face files (a '*' pattern)"};
       }
       if (detected) *detected = layout;
     }
     if (options.z_up_3dsmax && (layout == EnvLayout::equirect || layout == EnvLayout::sphere)) {
-      return Error{name, "", std::string("the 3ds Max (Z-up) conversion applies to cube faces and "
-                                         "crosses, not to the ") +
-                                 env_layout_name(layout) + " layout"};
+      return Error{name, "",
+                   std::string("the 3ds Max (Z-up) conversion applies to cube faces and "
+                               "crosses, not to the ") +
+                       env_layout_name(layout) + " layout"};
     }
     switch (layout) {
       case EnvLayout::horizontal_cross:
@@ -507,8 +549,8 @@ Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOp
       case EnvLayout::sphere: {
         auto map = sphere_from_image(*image, name);
         if (!map) return map.error();
-        const int size =
-            options.face_size > 0 ? options.face_size : std::clamp(map->size / 2, 1, kMaxDerivedFaceSize);
+        const int size = options.face_size > 0 ? options.face_size
+                                               : std::clamp(map->size / 2, 1, kMaxDerivedFaceSize);
         return make_cube_map(size, [&](const glm::vec3& d) { return sample_sphere(*map, d); });
       }
       default:

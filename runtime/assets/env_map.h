@@ -149,8 +149,8 @@ struct EnvLoadOptions {
 ///   - horizontal_cross (4:3):   . +Y  .  .        vertical_cross (3:4):   . +Y  .
 ///                              -X +Z +X -Z                                -X +Z +X
 ///                               . -Y  .  .                                 . -Y  .
-///                                                                          . -Z  .  (-Z turned 180°)
-///     Every cell except the vertical cross's -Z is the GL face image as is.
+///                                                                          . -Z  .
+///     Every cell is the GL face image as is, except the vertical cross's -Z: turned 180°.
 ///   - equirect (2:1): longitude along x, column centre u = 0.5 is -Z, u = 0.75 is +X (as seen
 ///     from inside, not mirrored), u = 0 / 1 is +Z; row 0 is +Y (up), the last row -Y.
 ///     direction = (cos(lat) sin(lon), sin(lat), -cos(lat) cos(lon)), lon = 2 pi (u - 0.5),

@@ -66,8 +66,10 @@ int run_envmap_command(int argc, char** argv) {
         }
       }
       if (!known) {
-        return usage_error("--layout expects auto, faces, horizontal_cross, vertical_cross, "
-                           "equirect or sphere, got '" + v + "'");
+        return usage_error(
+            "--layout expects auto, faces, horizontal_cross, vertical_cross, "
+            "equirect or sphere, got '" +
+            v + "'");
       }
     } else if (arg == "--3dsmax") {
       options.z_up_3dsmax = true;
@@ -109,7 +111,8 @@ int run_envmap_command(int argc, char** argv) {
     const double ms = ms_since(t1);
     make_parent(sphere_out);
     if (auto st = save_sphere_map(map, sphere_out); !st) return fail(st.error());
-    std::printf("wrote     %s (sphere map %d^2, S3 eq. 2, %.1f ms)\n", sphere_out.c_str(), size, ms);
+    std::printf("wrote     %s (sphere map %d^2, S3 eq. 2, %.1f ms)\n", sphere_out.c_str(), size,
+                ms);
   }
   return 0;
 }
@@ -130,10 +133,11 @@ Status write_reflection_reference(const Scene& scene, const Image& aov, const gl
   if (!ref) return ref.error();
   make_parent(out);
   KASKAD_TRY(save_image(out, ref->image));
-  std::printf("wrote     %s (reflection reference: reflection.R/G/B reflection.hit mask; %llu rays, "
-              "%.1f ms, %.2f Mrays/s)\n",
-              fs::absolute(out).string().c_str(), static_cast<unsigned long long>(ref->rays),
-              ref->seconds * 1e3, ref->seconds > 0.0 ? double(ref->rays) / ref->seconds * 1e-6 : 0.0);
+  std::printf(
+      "wrote     %s (reflection reference: reflection.R/G/B reflection.hit mask; %llu rays, "
+      "%.1f ms, %.2f Mrays/s)\n",
+      fs::absolute(out).string().c_str(), static_cast<unsigned long long>(ref->rays),
+      ref->seconds * 1e3, ref->seconds > 0.0 ? double(ref->rays) / ref->seconds * 1e-6 : 0.0);
   return {};
 }
 

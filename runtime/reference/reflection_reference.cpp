@@ -90,8 +90,8 @@ glm::vec4 hit_base_color(const ReflectionScene& scene, const Material& material,
   if (material.base_color_texture == kNoTexture || !scene.assets || !scene.world ||
       material.base_color_texture >= scene.assets->textures.size())
     return material.base_color;
-  const auto* mr = scene.world->alive(hit.entity) ? scene.world->try_get<MeshRenderer>(hit.entity)
-                                                  : nullptr;
+  const auto* mr =
+      scene.world->alive(hit.entity) ? scene.world->try_get<MeshRenderer>(hit.entity) : nullptr;
   if (!mr || mr->mesh >= scene.assets->meshes.size()) return material.base_color;
   const MeshData& mesh = scene.assets->meshes[mr->mesh];
   const std::size_t first = 3 * std::size_t(hit.triangle);
@@ -134,9 +134,8 @@ ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment)
 }
 
 glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
-                      const Material& material, const glm::vec3& position,
-                      const glm::vec3& normal, const glm::vec3& to_eye, bool receives_shadows,
-                      std::uint64_t* rays) {
+                      const Material& material, const glm::vec3& position, const glm::vec3& normal,
+                      const glm::vec3& to_eye, bool receives_shadows, std::uint64_t* rays) {
   // forward.frag, main(), line by line (change together).
   const glm::vec3 base = glm::vec3(material.base_color);
   const glm::vec3& n = normal;
@@ -172,8 +171,7 @@ glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
     const float ndl = std::max(glm::dot(n, l), 0.0f);
     if (ndl <= 0.0f) continue;
     const glm::vec3 h = glm::normalize(l + v);
-    const glm::vec3 spec =
-        f0 * spec_norm * std::pow(std::max(glm::dot(n, h), 0.0f), shininess);
+    const glm::vec3 spec = f0 * spec_norm * std::pow(std::max(glm::dot(n, h), 0.0f), shininess);
     float shadow = 1.0f;
     if (light.shadowed && receives_shadows && attenuation > 0.0f) {
       ReferenceLight ref;
@@ -194,8 +192,7 @@ glm::vec3 reflected_radiance(const RayTracer& tracer, const ReflectionScene& sce
   if (hit) *hit = false;
   const glm::vec3 incident = position - eye;
   const float ul = glm::length(incident), nl = glm::length(normal);
-  if (!(ul > 0.0f) || !(nl > 0.0f) || !finite(incident) || !finite(normal))
-    return glm::vec3(0.0f);
+  if (!(ul > 0.0f) || !(nl > 0.0f) || !finite(incident) || !finite(normal)) return glm::vec3(0.0f);
   if (rays) ++*rays;
   const std::optional<SurfaceHit> surface = tracer.trace_mirror(position, normal, incident);
   if (!surface) {
@@ -220,14 +217,15 @@ glm::vec3 reflected_radiance(const RayTracer& tracer, const ReflectionScene& sce
   Material shaded = material ? *material : default_material;
   shaded.base_color = hit_base_color(scene, shaded, *surface);
   const glm::vec3 to_mirror = glm::normalize(position - surface->position);
-  return shade_point(tracer, scene, shaded, surface->position, surface->normal, to_mirror,
-                     receives, rays);
+  return shade_point(tracer, scene, shaded, surface->position, surface->normal, to_mirror, receives,
+                     rays);
 }
 
 Result<ReflectionReference> reflection_reference(const RayTracer& tracer, const Image& aov,
-                                                 const ReflectionScene& scene,
-                                                 const glm::vec3& eye, int threads) {
-  KASKAD_CHECK(threads >= 0, "threads must be >= 0 (0 = all cores), was " + std::to_string(threads));
+                                                 const ReflectionScene& scene, const glm::vec3& eye,
+                                                 int threads) {
+  KASKAD_CHECK(threads >= 0,
+               "threads must be >= 0 (0 = all cores), was " + std::to_string(threads));
   KASKAD_TRY(check_sizes(aov, "AOV image"));
   // Channels by name (EXR files may come back reordered); canonical order when unnamed.
   constexpr std::array<const char*, 7> kNames = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z", "mask"};
@@ -243,7 +241,8 @@ Result<ReflectionReference> reflection_reference(const RayTracer& tracer, const 
   } else {
     for (std::size_t i = 0; i < kNames.size(); ++i) {
       ch[i] = find_channel(aov, kNames[i]);
-      if (ch[i] < 0) return Error{"", "AOV image", std::string("has no channel '") + kNames[i] + "'"};
+      if (ch[i] < 0)
+        return Error{"", "AOV image", std::string("has no channel '") + kNames[i] + "'"};
     }
   }
 
@@ -308,9 +307,11 @@ Result<ReflectionErrorStats> compare_reflections(const Image& method, const Imag
     m[std::size_t(i)] = find_channel(method, kReflectionChannels[i]);
     r[std::size_t(i)] = find_channel(reference, kReflectionChannels[i]);
     if (m[std::size_t(i)] < 0)
-      return Error{"", "reflection image", std::string("has no channel '") + kReflectionChannels[i] + "'"};
+      return Error{"", "reflection image",
+                   std::string("has no channel '") + kReflectionChannels[i] + "'"};
     if (r[std::size_t(i)] < 0)
-      return Error{"", "reflection reference", std::string("has no channel '") + kReflectionChannels[i] + "'"};
+      return Error{"", "reflection reference",
+                   std::string("has no channel '") + kReflectionChannels[i] + "'"};
   }
   const int mask = find_channel(reference, "mask");
   if (mask < 0) return Error{"", "reflection reference", "has no channel 'mask'"};

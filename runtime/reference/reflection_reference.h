@@ -53,8 +53,8 @@ struct ReflectionScene {
   /// null: the base colour factor alone is used.
   const AssetStore* assets = nullptr;
   std::vector<ShadingLight> lights;
-  glm::vec3 ambient{0.05f};      ///< u_ambient.rgb: added as ambient * diffuse colour
-  glm::vec3 clear_color{0.0f};   ///< returned on a miss when there is no environment
+  glm::vec3 ambient{0.05f};     ///< u_ambient.rgb: added as ambient * diffuse colour
+  glm::vec3 clear_color{0.0f};  ///< returned on a miss when there is no environment
   /// Misses return sample_cube(*environment, R) (world-space R). Not owned; may be null.
   const CubeMap* environment = nullptr;
 };
@@ -83,8 +83,8 @@ glm::vec4 hit_base_color(const ReflectionScene& scene, const Material& material,
 /// * visibility, with glTF metallic-roughness mapped as in forward.frag. Shadow rays (shadowed
 /// lights, when `receives_shadows`) start at position + ray_offset() * normal.
 glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
-                      const Material& material, const glm::vec3& position,
-                      const glm::vec3& normal, const glm::vec3& to_eye, bool receives_shadows,
+                      const Material& material, const glm::vec3& position, const glm::vec3& normal,
+                      const glm::vec3& to_eye, bool receives_shadows,
                       std::uint64_t* rays = nullptr);
 
 /// What a mirror at `position` with normal `normal` (either side) reflects towards `eye`: the
@@ -115,13 +115,13 @@ struct ReflectionReference {
 /// the AOV was rendered from). Rows run in parallel on `threads` workers (0 = all cores).
 /// Error when a channel is missing or the image's sizes are inconsistent.
 Result<ReflectionReference> reflection_reference(const RayTracer& tracer, const Image& aov,
-                                                 const ReflectionScene& scene,
-                                                 const glm::vec3& eye, int threads = 0);
+                                                 const ReflectionScene& scene, const glm::vec3& eye,
+                                                 int threads = 0);
 
 /// Error of an engine reflection image against the reference, per colour channel value.
 struct ReflectionErrorStats {
-  std::size_t pixels = 0;      ///< pixels compared
-  std::size_t non_finite = 0;  ///< pixels skipped: the method or the reference is not finite
+  std::size_t pixels = 0;       ///< pixels compared
+  std::size_t non_finite = 0;   ///< pixels skipped: the method or the reference is not finite
   double rmse = 0.0;            ///< sqrt(mean over pixels and R, G, B of (method - reference)^2)
   double mean_abs_error = 0.0;  ///< mean over pixels and R, G, B of |method - reference|
   double max_abs_error = 0.0;   ///< largest |method - reference| of any channel

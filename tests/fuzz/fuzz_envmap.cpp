@@ -104,15 +104,15 @@ std::vector<kaskad::fuzz::Bytes> generated_seeds() {
     std::uint8_t mode;
   };
   const Seed kSeeds[] = {
-      {"face.png", 4, 4, 3, 1},            // faces
-      {"face.exr", 4, 4, 4, 1 | 8},        // faces, 3ds Max
-      {"hcross.png", 8, 6, 3, 0},          // auto: horizontal cross
-      {"hcross.exr", 8, 6, 4, 2 | 8},      // horizontal cross, 3ds Max
-      {"vcross.png", 6, 8, 4, 3 | 16},     // vertical cross, face_size 3
-      {"pano.hdr", 8, 4, 3, 4},            // equirect
-      {"pano.exr", 16, 8, 3, 0 | 32},      // auto: equirect, face_size 8
-      {"ball.png", 6, 6, 3, 5},            // sphere
-      {"ball.tif", 5, 5, 1, 0 | 48},       // auto: sphere, face_size 17
+      {"face.png", 4, 4, 3, 1},         // faces
+      {"face.exr", 4, 4, 4, 1 | 8},     // faces, 3ds Max
+      {"hcross.png", 8, 6, 3, 0},       // auto: horizontal cross
+      {"hcross.exr", 8, 6, 4, 2 | 8},   // horizontal cross, 3ds Max
+      {"vcross.png", 6, 8, 4, 3 | 16},  // vertical cross, face_size 3
+      {"pano.hdr", 8, 4, 3, 4},         // equirect
+      {"pano.exr", 16, 8, 3, 0 | 32},   // auto: equirect, face_size 8
+      {"ball.png", 6, 6, 3, 5},         // sphere
+      {"ball.tif", 5, 5, 1, 0 | 48},    // auto: sphere, face_size 17
   };
   const auto dir = scratch() / "seeds";
   std::filesystem::create_directories(dir);

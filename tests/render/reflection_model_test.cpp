@@ -71,8 +71,8 @@ TEST_F(ForwardModelTest, ShadePointReproducesTheForwardPass) {
       for (int x = 0; x < aov.width; ++x) {
         if (aov.at(x, y, 8) < 0.5f) continue;
         const glm::vec3 p(aov.at(x, y, 0), aov.at(x, y, 1), aov.at(x, y, 2));
-        const glm::vec3 n = glm::normalize(
-            glm::vec3(aov.at(x, y, 3), aov.at(x, y, 4), aov.at(x, y, 5)));
+        const glm::vec3 n =
+            glm::normalize(glm::vec3(aov.at(x, y, 3), aov.at(x, y, 4), aov.at(x, y, 5)));
         // Which entity the pixel shows: the first surface along the eye ray, if it is this point.
         const auto hit = tracer->intersect(eye, p - eye);
         if (!hit || glm::length(hit->position - p) > 1e-3f * glm::length(p - eye)) continue;
@@ -126,9 +126,9 @@ TEST_F(ForwardModelTest, BaseColourTexturesMatchTheForwardPass) {
   ro.shader_cache_dir = std::filesystem::path(KASKAD_TEST_TMP) / "shader_cache";
   auto player = Player::create(opt, ro);
   ASSERT_TRUE(player.ok()) << player.error().to_string();
-  auto scene = load_scene(content_dir() / "scenes" / "materials.json",
-                          {"render.width=640", "render.height=360",
-                           "checker_box.transform.translation=[0, 2.8, 5.6]"});
+  auto scene = load_scene(
+      content_dir() / "scenes" / "materials.json",
+      {"render.width=640", "render.height=360", "checker_box.transform.translation=[0, 2.8, 5.6]"});
   ASSERT_TRUE(scene.ok()) << scene.error().to_string();
   RenderRun run;
   auto frame = render_frames(*player, *scene, run);
@@ -159,10 +159,11 @@ TEST_F(ForwardModelTest, BaseColourTexturesMatchTheForwardPass) {
       for (int x = 0; x < aov.width; ++x) {
         if (aov.at(x, y, 8) < 0.5f) continue;
         const glm::vec3 p(aov.at(x, y, 0), aov.at(x, y, 1), aov.at(x, y, 2));
-        const glm::vec3 n = glm::normalize(
-            glm::vec3(aov.at(x, y, 3), aov.at(x, y, 4), aov.at(x, y, 5)));
+        const glm::vec3 n =
+            glm::normalize(glm::vec3(aov.at(x, y, 3), aov.at(x, y, 4), aov.at(x, y, 5)));
         const auto hit = tracer->intersect(eye, p - eye);
-        if (!hit || hit->entity != box || glm::length(hit->position - p) > 1e-3f * glm::length(p - eye))
+        if (!hit || hit->entity != box ||
+            glm::length(hit->position - p) > 1e-3f * glm::length(p - eye))
           continue;
         // Checker edges: a sub-texel difference in uv changes the colour a lot there; compare
         // where the engine's colour is locally smooth.
@@ -194,8 +195,9 @@ TEST_F(ForwardModelTest, BaseColourTexturesMatchTheForwardPass) {
   const int agree = agreement(true, compared);
   int compared_plain = 0;
   const int agree_plain = agreement(false, compared_plain);
-  std::printf("checker box: %d pixels, %.3f%% within 3/255 (%.3f%% without the texture)\n", compared,
-              100.0 * agree / std::max(compared, 1), 100.0 * agree_plain / std::max(compared_plain, 1));
+  std::printf("checker box: %d pixels, %.3f%% within 3/255 (%.3f%% without the texture)\n",
+              compared, 100.0 * agree / std::max(compared, 1),
+              100.0 * agree_plain / std::max(compared_plain, 1));
   EXPECT_GT(compared, 5000);
   EXPECT_GE(agree, compared * 95 / 100);
   EXPECT_LT(agree_plain, compared_plain / 2);

@@ -4,12 +4,12 @@
 
 #include <gtest/gtest.h>
 
-#include <glm/gtc/matrix_transform.hpp>
-
 #include <cmath>
 #include <numbers>
 #include <random>
 #include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "runtime/assets/image_io.h"
 #include "tests/unit/assets/asset_test_util.h"
@@ -23,9 +23,9 @@ constexpr std::array<CubeFace, 6> kFaces = {CubeFace::pos_x, CubeFace::neg_x, Cu
                                             CubeFace::neg_y, CubeFace::pos_z, CubeFace::neg_z};
 
 /// S3's coloured-cube environment: one distinct colour per face (by the direction's major axis).
-const std::array<glm::vec4, 6> kFaceColour = {
-    glm::vec4(1, 0, 0, 1), glm::vec4(0, 1, 1, 1), glm::vec4(0, 1, 0, 1),
-    glm::vec4(1, 0, 1, 1), glm::vec4(0, 0, 1, 1), glm::vec4(1, 1, 0, 1)};
+const std::array<glm::vec4, 6> kFaceColour = {glm::vec4(1, 0, 0, 1), glm::vec4(0, 1, 1, 1),
+                                              glm::vec4(0, 1, 0, 1), glm::vec4(1, 0, 1, 1),
+                                              glm::vec4(0, 0, 1, 1), glm::vec4(1, 1, 0, 1)};
 
 /// Major axis of a direction as a face, computed here without cube_coord().
 int major_axis_face(const glm::vec3& d) {
@@ -44,7 +44,8 @@ float axis_margin(const glm::vec3& d) {
 }
 
 CubeMap coloured_cube(int size) {
-  return make_cube_map(size, [](const glm::vec3& d) { return kFaceColour[std::size_t(major_axis_face(d))]; });
+  return make_cube_map(
+      size, [](const glm::vec3& d) { return kFaceColour[std::size_t(major_axis_face(d))]; });
 }
 
 /// A smooth environment: a different smooth function of the direction per channel, in [0,1].
@@ -141,13 +142,15 @@ TEST(CubeMath, DirectionAndCoordRoundTrip) {
 
 TEST(CubeMath, ColouredCubeAxesGiveTheirFaceColour) {
   const CubeMap cube = coloured_cube(8);
-  const std::array<glm::vec3, 6> axes = {glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0), glm::vec3(0, 1, 0),
-                                         glm::vec3(0, -1, 0), glm::vec3(0, 0, 1), glm::vec3(0, 0, -1)};
+  const std::array<glm::vec3, 6> axes = {glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0),
+                                         glm::vec3(0, 1, 0), glm::vec3(0, -1, 0),
+                                         glm::vec3(0, 0, 1), glm::vec3(0, 0, -1)};
   for (std::size_t f = 0; f < 6; ++f) {
     EXPECT_EQ(sample_cube(cube, axes[f]), kFaceColour[f]) << f;
     // Off-centre but well inside the face, and at a corner (bilinear clamped to the face).
-    EXPECT_EQ(sample_cube(cube, axes[f] + glm::vec3(0.3f, -0.2f, 0.25f) * (1.0f - glm::abs(axes[f]))),
-              kFaceColour[f]);
+    EXPECT_EQ(
+        sample_cube(cube, axes[f] + glm::vec3(0.3f, -0.2f, 0.25f) * (1.0f - glm::abs(axes[f]))),
+        kFaceColour[f]);
     EXPECT_EQ(sample_cube(cube, cube_direction(kFaces[f], 0.001f, 0.999f)), kFaceColour[f]);
   }
   EXPECT_EQ(sample_cube(CubeMap{}, {1, 0, 0}), glm::vec4(0.0f));
@@ -192,9 +195,9 @@ TEST(SphereMap, ColouredCubeCentreIsPlusZRimIsMinusZ) {
   EXPECT_EQ(map.at(n / 2, 0), kFaceColour[5]);
   EXPECT_EQ(map.at(n / 2, n - 1), kFaceColour[5]);
   // Up in the image is +Y of view space, right is +X: halfway out the reflection is sideways.
-  EXPECT_EQ(map.at(n / 2, n / 2 - int(0.7f * n / 2)), kFaceColour[2]);  // top: +Y
-  EXPECT_EQ(map.at(n / 2, n / 2 + int(0.7f * n / 2)), kFaceColour[3]);  // bottom: -Y
-  EXPECT_EQ(map.at(n / 2 + int(0.7f * n / 2), n / 2), kFaceColour[0]);  // right: +X
+  EXPECT_EQ(map.at(n / 2, n / 2 - int(0.7f * n / 2)), kFaceColour[2]);      // top: +Y
+  EXPECT_EQ(map.at(n / 2, n / 2 + int(0.7f * n / 2)), kFaceColour[3]);      // bottom: -Y
+  EXPECT_EQ(map.at(n / 2 + int(0.7f * n / 2), n / 2), kFaceColour[0]);      // right: +X
   EXPECT_EQ(map.at(n / 2 - 1 - int(0.7f * n / 2), n / 2), kFaceColour[1]);  // left: -X
   // Outside the circle: the rim value.
   EXPECT_EQ(map.at(0, 0), kFaceColour[5]);
@@ -220,14 +223,15 @@ TEST(SphereMap, EveryTexelIsFormulaExact) {
 TEST(SphereMap, ViewRotationPicksWhatTheViewerFaces) {
   // A camera looking down world +X (turned -90 degrees about Y): view -Z is world +X, so the rim
   // shows +X and the centre (towards the eye) -X; view +Y stays world +Y.
-  const glm::mat4 camera_to_world = glm::rotate(glm::mat4(1.0f), glm::radians(-90.0f), glm::vec3(0, 1, 0));
+  const glm::mat4 camera_to_world =
+      glm::rotate(glm::mat4(1.0f), glm::radians(-90.0f), glm::vec3(0, 1, 0));
   const glm::mat3 view_to_world(camera_to_world);
   ASSERT_LT(glm::length(view_to_world * glm::vec3(0, 0, -1) - glm::vec3(1, 0, 0)), 1e-6f);
   const int n = 64;
   const CubeMap cube = coloured_cube(8);
   const SphereMap map = sphere_map_from_cube(cube, n, view_to_world);
-  EXPECT_EQ(map.at(n / 2, n / 2), kFaceColour[1]);  // centre: -X
-  EXPECT_EQ(map.at(0, n / 2), kFaceColour[0]);      // rim: +X
+  EXPECT_EQ(map.at(n / 2, n / 2), kFaceColour[1]);                      // centre: -X
+  EXPECT_EQ(map.at(0, n / 2), kFaceColour[0]);                          // rim: +X
   EXPECT_EQ(map.at(n / 2, n / 2 - int(0.7f * n / 2)), kFaceColour[2]);  // up: +Y
   // Looking up a view-space direction gives the cube along its world direction.
   const SphereMap smooth = sphere_map_from_cube(make_cube_map(64, smooth_env), 256, view_to_world);
@@ -335,7 +339,8 @@ TEST(EnvLayouts, CrossesAreContinuousAcrossEveryInnerCellBorder) {
           if (x + dx >= w || y + dy >= h) continue;
           const glm::vec3 b = dirs[std::size_t((y + dy) * w + x + dx)];
           if (std::isnan(b.x)) continue;
-          EXPECT_LT(std::acos(std::min(1.0f, glm::dot(a, b))), 3.0f * (std::numbers::pi_v<float> / 2) / n)
+          EXPECT_LT(std::acos(std::min(1.0f, glm::dot(a, b))),
+                    3.0f * (std::numbers::pi_v<float> / 2) / n)
               << (vertical ? "vertical" : "horizontal") << " at " << x << "," << y;
           if (dx == 1 ? (x + 1) % n == 0 : (y + 1) % n == 0) ++borders;
         }
@@ -358,7 +363,8 @@ TEST(EnvLayouts, AllLayoutsOfOneEnvironmentGiveTheSameCube) {
   for (int y = 0; y < eh; ++y)
     for (int x = 0; x < ew; ++x) {
       const float lon = 2 * kPi * ((x + 0.5f) / ew - 0.5f), lat = kPi * (0.5f - (y + 0.5f) / eh);
-      eq.push_back(smooth_env({std::cos(lat) * std::sin(lon), std::sin(lat), -std::cos(lat) * std::cos(lon)}));
+      eq.push_back(smooth_env(
+          {std::cos(lat) * std::sin(lon), std::sin(lat), -std::cos(lat) * std::cos(lon)}));
     }
   ASSERT_TRUE(save_image(d / "pano.exr", image_of(eq, ew, eh)).ok());
 
@@ -382,7 +388,8 @@ TEST(EnvLayouts, AllLayoutsOfOneEnvironmentGiveTheSameCube) {
       auto cube = load_cube_map(c.path, options);
       ASSERT_TRUE(cube.ok()) << c.path << ": " << cube.error().to_string();
       ASSERT_EQ(cube->size, n) << c.path;
-      EXPECT_LE(cube_max_diff(*cube, original), c.tolerance) << c.path << " " << env_layout_name(layout);
+      EXPECT_LE(cube_max_diff(*cube, original), c.tolerance)
+          << c.path << " " << env_layout_name(layout);
     }
   }
   // Equirect default face size: width / 4.
@@ -417,7 +424,8 @@ TEST(EnvLayouts, EightBitFacesAndSphereMapImagesLoad) {
   ASSERT_TRUE(as_cube.ok()) << as_cube.error().to_string();
   EXPECT_EQ(as_cube->size, 32);
   EXPECT_LT(max_diff(sample_cube(*as_cube, glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f))),
-                     smooth_env(glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f)))), 0.03f);
+                     smooth_env(glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f)))),
+            0.03f);
   // Saving into a directory names the faces px.exr ... nz.exr.
   ASSERT_TRUE(save_cube_faces(original, d / "dump").ok());
   for (CubeFace f : kFaces)
@@ -437,14 +445,20 @@ TEST(EnvLayouts, ThreeDsMaxFacesConvertToTheYUpOriginal) {
     return smooth_env({c.x, -c.y, -c.z});
   });
   const fs::path d = dir_for("max");
-  const std::array<std::pair<const char*, CubeFace>, 6> table = {
-      {{"right", CubeFace::pos_x}, {"left", CubeFace::neg_x}, {"back", CubeFace::pos_z},
-       {"front", CubeFace::neg_z}, {"up", CubeFace::neg_y}, {"down", CubeFace::pos_y}}};
+  const std::array<std::pair<const char*, CubeFace>, 6> table = {{{"right", CubeFace::pos_x},
+                                                                  {"left", CubeFace::neg_x},
+                                                                  {"back", CubeFace::pos_z},
+                                                                  {"front", CubeFace::neg_z},
+                                                                  {"up", CubeFace::neg_y},
+                                                                  {"down", CubeFace::pos_y}}};
   const std::array<const char*, 6> axis_names = {"px", "nx", "py", "ny", "pz", "nz"};
   for (std::size_t a = 0; a < 6; ++a) {
     const auto& face = s3.faces[std::size_t(table[a].second)];
-    ASSERT_TRUE(save_image(d / (std::string("word_") + table[a].first + ".exr"), image_of(face, n, n)).ok());
-    ASSERT_TRUE(save_image(d / (std::string("axis_") + axis_names[a] + ".exr"), image_of(face, n, n)).ok());
+    ASSERT_TRUE(
+        save_image(d / (std::string("word_") + table[a].first + ".exr"), image_of(face, n, n))
+            .ok());
+    ASSERT_TRUE(
+        save_image(d / (std::string("axis_") + axis_names[a] + ".exr"), image_of(face, n, n)).ok());
   }
   EnvLoadOptions max;
   max.z_up_3dsmax = true;
@@ -488,14 +502,17 @@ TEST(EnvLayouts, BadInputGivesClearErrors) {
   // Missing face file.
   ASSERT_TRUE(save_cube_faces(cube, d / "gap_*.png").ok());
   fs::remove(d / "gap_ny.png");
-  expect_error(load_cube_map(d / "gap_*.png"), d / "gap_*.png", "missing face file " + (d / "gap_ny.png").string());
+  expect_error(load_cube_map(d / "gap_*.png"), d / "gap_*.png",
+               "missing face file " + (d / "gap_ny.png").string());
   // Non-square face, mismatched sizes.
   ASSERT_TRUE(save_cube_faces(cube, d / "rect_*.png").ok());
   ASSERT_TRUE(save_image(d / "rect_py.png", image_of(std::vector<glm::vec4>(8 * 6), 8, 6)).ok());
-  expect_error(load_cube_map(d / "rect_px.png"), d / "rect_py.png", "must be square, this one is 8x6");
+  expect_error(load_cube_map(d / "rect_px.png"), d / "rect_py.png",
+               "must be square, this one is 8x6");
   ASSERT_TRUE(save_cube_faces(cube, d / "mix_*.png").ok());
   ASSERT_TRUE(save_image(d / "mix_nz.png", image_of(std::vector<glm::vec4>(16 * 16), 16, 16)).ok());
-  expect_error(load_cube_map(d / "mix_*.png"), d / "mix_nz.png", "face size 16x16 differs from 8x8");
+  expect_error(load_cube_map(d / "mix_*.png"), d / "mix_nz.png",
+               "face size 16x16 differs from 8x8");
   // Unreadable image.
   ASSERT_TRUE(save_cube_faces(cube, d / "bad_*.png").ok());
   test::write_text(d / "bad_pz.png", "\x89PNG\r\n\x1a\n not really a png");
@@ -505,7 +522,8 @@ TEST(EnvLayouts, BadInputGivesClearErrors) {
   expect_error(load_cube_map(d / "ok_*_*.png"), d / "ok_*_*.png", "only one '*'");
   EnvLoadOptions faces;
   faces.layout = EnvLayout::faces;
-  expect_error(load_cube_map(d / "whatever.png", faces), d / "whatever.png", "must contain one '*'");
+  expect_error(load_cube_map(d / "whatever.png", faces), d / "whatever.png",
+               "must contain one '*'");
 
   // Wrong aspects.
   const fs::path wide = d / "wide.png", tall = d / "tall.png", odd = d / "odd.png";

@@ -37,10 +37,9 @@ WallScene wall_scene(bool with_blocker, const Material& wall_material) {
   w.wall = w.scene.world.create();
   w.scene.world.emplace<MeshRenderer>(w.wall, MeshRenderer{plane, true, true});
   // Plane faces +Y; a +90 degree turn about Z takes +Y to -X.
-  const glm::mat4 m = glm::scale(
-      glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(3, 0, 0)), glm::radians(90.0f),
-                  glm::vec3(0, 0, 1)),
-      glm::vec3(10.0f));
+  const glm::mat4 m = glm::scale(glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(3, 0, 0)),
+                                             glm::radians(90.0f), glm::vec3(0, 0, 1)),
+                                 glm::vec3(10.0f));
   w.scene.world.emplace<WorldTransform>(w.wall, WorldTransform{m});
   w.scene.world.emplace<Material>(w.wall, wall_material);
   if (with_blocker) {
@@ -122,17 +121,21 @@ TEST(ReflectionReference, MirrorRayOntoLitWallGivesBlinnPhong) {
 TEST(ReflectionReference, HitsAreShadowedByShadowRays) {
   WallScene w = wall_scene(true, wall_material());
   const RayTracer tracer = build(w.scene);
-  const glm::vec3 lit = expected_wall(glm::vec3(0.1f, 0.2f, 0.3f), glm::vec3(2.0f, 1.5f, 1.0f), 1.0f);
-  const glm::vec3 dark = expected_wall(glm::vec3(0.1f, 0.2f, 0.3f), glm::vec3(2.0f, 1.5f, 1.0f), 0.0f);
+  const glm::vec3 lit =
+      expected_wall(glm::vec3(0.1f, 0.2f, 0.3f), glm::vec3(2.0f, 1.5f, 1.0f), 1.0f);
+  const glm::vec3 dark =
+      expected_wall(glm::vec3(0.1f, 0.2f, 0.3f), glm::vec3(2.0f, 1.5f, 1.0f), 0.0f);
   std::uint64_t rays = 0;
   bool hit = false;
   const ReflectionScene shadowed = lit_by(w.scene, sun_along_x(true));
-  expect_near(reflected_radiance(tracer, shadowed, kMirror, kMirrorNormal, kEye, &hit, &rays), dark);
+  expect_near(reflected_radiance(tracer, shadowed, kMirror, kMirrorNormal, kEye, &hit, &rays),
+              dark);
   EXPECT_TRUE(hit);
   EXPECT_EQ(rays, 2u);  // the mirror ray and one shadow ray
   // A light without cast_shadows is never blocked; neither is a surface that receives none.
-  expect_near(reflected_radiance(tracer, lit_by(w.scene, sun_along_x(false)), kMirror,
-                                 kMirrorNormal, kEye), lit);
+  expect_near(
+      reflected_radiance(tracer, lit_by(w.scene, sun_along_x(false)), kMirror, kMirrorNormal, kEye),
+      lit);
   w.scene.world.get<MeshRenderer>(w.wall).receive_shadows = false;
   expect_near(reflected_radiance(tracer, shadowed, kMirror, kMirrorNormal, kEye), lit);
 }
@@ -171,7 +174,8 @@ TEST(ReflectionReference, MissReturnsTheEnvironmentOrTheClearColour) {
   // Looking straight down at a mirror facing up: R = +Y, nothing above.
   const glm::vec3 eye_above(0.0f, 2.0f, 0.0f);
   bool hit = true;
-  expect_near(reflected_radiance(tracer, rs, kMirror, kMirrorNormal, eye_above, &hit), rs.clear_color);
+  expect_near(reflected_radiance(tracer, rs, kMirror, kMirrorNormal, eye_above, &hit),
+              rs.clear_color);
   EXPECT_FALSE(hit);
   // With a coloured-cube environment: the +Y face's colour.
   const CubeMap cube = make_cube_map(4, [](const glm::vec3& d) {
@@ -180,7 +184,8 @@ TEST(ReflectionReference, MissReturnsTheEnvironmentOrTheClearColour) {
                : glm::vec4(0.5f, 0.5f, 0.5f, 1);
   });
   rs.environment = &cube;
-  expect_near(reflected_radiance(tracer, rs, kMirror, kMirrorNormal, eye_above), glm::vec3(0, 1, 0));
+  expect_near(reflected_radiance(tracer, rs, kMirror, kMirrorNormal, eye_above),
+              glm::vec3(0, 1, 0));
   // An oblique miss samples the cube along R: eye at (1, 1, 0) reflects towards (-1, 1, 0),
   // away from the wall; the cube's value along that direction.
   expect_near(reflected_radiance(tracer, rs, kMirror, kMirrorNormal, glm::vec3(1, 1, 0)),
@@ -208,7 +213,8 @@ TEST(ReflectionReference, ImageAndMetric) {
   WallScene w = wall_scene(false, wall_material());
   const RayTracer tracer = build(w.scene);
   const ReflectionScene rs = lit_by(w.scene, sun_along_x(false));
-  const glm::vec3 eye = kEye;  // sees pixel 0 at (0,0,0) obliquely (R hits the wall), pixel 1 from above
+  const glm::vec3 eye =
+      kEye;  // sees pixel 0 at (0,0,0) obliquely (R hits the wall), pixel 1 from above
   auto ref = reflection_reference(tracer, three_pixel_aov(), rs, eye, 2);
   ASSERT_TRUE(ref.ok()) << ref.error().to_string();
   const Image& img = ref->image;
@@ -325,8 +331,8 @@ TEST(ReflectionReference, HitsShowTheBaseColourTexture) {
   t.srgb = false;
   for (int y = 0; y < 4; ++y)
     for (int x = 0; x < 4; ++x) {
-      const std::array<std::uint8_t, 4> c =
-          x < 2 ? std::array<std::uint8_t, 4>{0, 0, 0, 255} : std::array<std::uint8_t, 4>{255, 128, 51, 255};
+      const std::array<std::uint8_t, 4> c = x < 2 ? std::array<std::uint8_t, 4>{0, 0, 0, 255}
+                                                  : std::array<std::uint8_t, 4>{255, 128, 51, 255};
       t.rgba8.insert(t.rgba8.end(), c.begin(), c.end());
     }
   textured.base_color_texture = w.scene.assets.add_texture(t);
