@@ -97,6 +97,9 @@ struct RayTracer::Impl {
   RTCScene surfaces = nullptr;              // every MeshRenderer
   std::vector<ecs::Entity> surface_entity;  // by geometry ID in `surfaces`
   std::vector<bool> surface_receives;       // MeshRenderer::receive_shadows, by geometry ID
+  // By geometry ID: the mesh triangle of each Embree primitive, when triangles were dropped
+  // (empty: primitive i is triangle i).
+  std::vector<std::vector<std::uint32_t>> surface_triangle;
   bool all_receive = true;                  // every surface receives: no receiver look-ups
   Aabb bounds;
   float offset = RayTracer::kRayOffsetScale;
@@ -388,6 +391,7 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
   // 2. One world-space triangle geometry per entity.
   std::vector<glm::vec3> world_positions;
   std::vector<std::uint32_t> kept;
+  std::vector<std::uint32_t> kept_triangle;  // mesh triangle of each kept triangle
   for (const Item& item : items) {
     const std::string where = "entity " + std::to_string(item.entity.index);
     if (item.renderer.mesh >= assets.meshes.size()) {
@@ -402,6 +406,7 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
       world_positions[i] = p;
     }
     kept.clear();
+    kept_triangle.clear();
     for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
       bool ok = true;
       for (std::size_t k = 0; k < 3; ++k) {
@@ -416,9 +421,11 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
       }
       // Embree needs finite vertices (its invalid-ray/primitive filters are compiled out here);
       // degenerate triangles are fine, they are never hit.
-      if (ok)
+      if (ok) {
         kept.insert(kept.end(), mesh.indices.begin() + std::ptrdiff_t(t),
                     mesh.indices.begin() + std::ptrdiff_t(t + 3));
+        kept_triangle.push_back(std::uint32_t(t / 3));
+      }
     }
     if (kept.empty()) continue;
     for (const std::uint32_t index : kept) impl->bounds.expand(world_positions[index]);
@@ -477,8 +484,10 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
     if (id >= impl->surface_entity.size()) {
       impl->surface_entity.resize(id + 1);
       impl->surface_receives.resize(id + 1, true);
+      impl->surface_triangle.resize(id + 1);
     }
     impl->surface_entity[id] = item.entity;
+    if (kept.size() != mesh.indices.size() / 3 * 3) impl->surface_triangle[id] = kept_triangle;
     impl->surface_receives[id] = item.renderer.receive_shadows;
     impl->all_receive = impl->all_receive && item.renderer.receive_shadows;
     impl->surface_triangles += kept.size() / 3;
@@ -538,6 +547,12 @@ std::optional<SurfaceHit> RayTracer::intersect(const glm::vec3& origin, const gl
                                                             : ecs::kNullEntity;
   hit.distance = rh.ray.tfar;
   hit.position = origin + hit.distance * dir;
+  hit.triangle = rh.hit.primID;
+  if (rh.hit.geomID < impl_->surface_triangle.size()) {
+    const auto& map = impl_->surface_triangle[rh.hit.geomID];
+    if (rh.hit.primID < map.size()) hit.triangle = map[rh.hit.primID];
+  }
+  hit.barycentric = {rh.hit.u, rh.hit.v};
   glm::vec3 n{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
   const float nl = glm::length(n);
   n = nl > 0.0f ? n / nl : -dir;

@@ -61,6 +61,10 @@ struct SurfaceHit {
   glm::vec3 position{0.0f};               ///< world position of the hit, metres
   glm::vec3 normal{0.0f, 1.0f, 0.0f};  ///< unit geometric (triangle) normal, facing the ray origin
   float distance = 0.0f;               ///< along the unit ray direction, metres
+  /// The hit triangle of the entity's mesh: indices[3 * triangle + 0..2] of its MeshData.
+  std::uint32_t triangle = 0;
+  /// Barycentric (u, v) of the hit in that triangle: position = (1 - u - v) p0 + u p1 + v p2.
+  glm::vec2 barycentric{0.0f};
 };
 
 struct ReferenceOptions {
