@@ -17,6 +17,7 @@
 
 #include "components/light.h"
 #include "components/material.h"
+#include "components/probe_state.h"
 #include "components/shadow_settings.h"
 #include "runtime/assets/asset_store.h"
 #include "runtime/assets/image_io.h"
@@ -40,6 +41,29 @@ struct DrawItem {
   bool cast_shadows = true;
   bool receive_shadows = true;
   std::uint8_t cascade_mask = 0xff;  ///< bit i: drawn into cascade i (when cast_shadows)
+  int layer = 0;                     ///< MeshRenderer::layer (probes may exclude layers)
+  /// The reflection probe this draw reflects (its own Reflector; kNoProbe: none). The draw is
+  /// never drawn into that probe. With a reflection material feature on, it is shaded with the
+  /// probe's visible map, scaled by `reflection_scale` = k_s * p_r (S3 eq. (3)).
+  std::uint32_t probe = kNoProbe;
+  float reflection_scale = 0.0f;
+};
+
+/// One reflection probe's GPU work this frame (systems/environment_probe_system.h). Each probe
+/// has two cube maps (RGBA16F with mips): `faces` of buffer `target` are captured, then buffer
+/// `visible` is shaded with. Captures draw the frame's draws (shadows included) except the
+/// probe's own and excluded layers; reflective draws in them use their probes' visible maps as
+/// of before this frame's captures (no recursion).
+struct ProbeJob {
+  std::uint32_t handle = kNoProbe;
+  glm::vec3 center{0.0f};
+  float near = 0.05f, far = 100.0f;
+  int resolution = 128;
+  std::uint32_t exclude_layers = 0;
+  std::uint8_t faces = 0;  ///< bit f: capture GL face f (+X, -X, +Y, -Y, +Z, -Z) into `target`
+  int target = 1;
+  int visible = 0;
+  bool sphere = false;     ///< shade with a sphere map made from the visible cube (S3 eq. (2))
 };
 
 /// A light as the shaders see it. `color` already includes the intensity.
@@ -74,6 +98,7 @@ struct FrameInput {
   std::vector<DrawItem> draws;
   std::vector<LightItem> lights;  ///< at most kMaxLights are used
   ShadowPass shadow;
+  std::vector<ProbeJob> probes;
   glm::vec3 ambient{0.05f};
   glm::vec3 clear_color{0.0f};
   float exposure = 1.0f;
