@@ -1,0 +1,204 @@
+// Environment maps on the CPU (S3 in shared/reference/SEEDS.md): cube maps in OpenGL's face
+// convention, sphere maps per S3 eq. (2), (4), (5), and loaders for the usual static layouts
+// (six face images, horizontal / vertical crosses, equirectangular panoramas, sphere-map images),
+// including 3ds Max (Z-up) authored cube maps via S3's face table and M_rot.
+//
+// Conventions used throughout (change together with the GPU side: systems/environment_probe_*):
+//   - Directions are in the engine's world space: right-handed, +Y up, a camera looks down -Z.
+//     A CubeMap maps a world direction d to the environment seen along d; no extra rotation is
+//     applied between world space and cube-map space (the shader samples with R_world directly).
+//   - A cube face's texel (x, y) lies at GL face coordinate s = (x + 0.5) / size,
+//     t = (y + 0.5) / size; the face's row y is the y-th row glTexImage2D uploads, so faces go to
+//     GL as they are. Image files are read top row first, so row 0 of a face image file is t ~ 0.
+//   - Face coordinates follow the OpenGL 4.5 spec, section 8.13, table 8.19 (major axis ma,
+//     s = (sc / |ma| + 1) / 2, t = (tc / |ma| + 1) / 2):
+//       face   ma   sc   tc            face   ma   sc   tc
+//       +X     +x   -z   -y            -X     -x   +z   -y
+//       +Y     +y   +x   +z            -Y     -y   +x   -z
+//       +Z     +z   +x   -y            -Z     -z   -x   -y
+//     So for the four side faces, row 0 (the top of the image file) is the +Y side.
+//   - Sphere maps are images with row 0 at the top (+Y of view space) and column 0 at the left
+//     (-X of view space). See SphereMap.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "runtime/core/result.h"
+
+namespace kaskad {
+
+/// GL cube-map face order: face i is GL_TEXTURE_CUBE_MAP_POSITIVE_X + i.
+enum class CubeFace : int { pos_x, neg_x, pos_y, neg_y, pos_z, neg_z };
+
+/// Short face names used in file names: "px", "nx", "py", "ny", "pz", "nz" (in CubeFace order).
+const char* cube_face_suffix(CubeFace face);
+
+/// A cube map in memory, e.g. loaded from files or read back from a probe.
+struct CubeMap {
+  int size = 0;  ///< face width = height, texels
+  /// Linear RGBA per face, row-major, size*size; texel (x, y) is GL's face coordinate
+  /// s = (x + 0.5)/size, t = (y + 0.5)/size, i.e. row y is the row glTexImage2D uploads y-th,
+  /// so faces upload to GL as is (OpenGL 4.5 spec section 8.13, table 8.19).
+  std::array<std::vector<glm::vec4>, 6> faces;
+
+  glm::vec4& at(CubeFace face, int x, int y) {
+    return faces[std::size_t(face)][std::size_t(y) * std::size_t(size) + std::size_t(x)];
+  }
+  const glm::vec4& at(CubeFace face, int x, int y) const {
+    return faces[std::size_t(face)][std::size_t(y) * std::size_t(size) + std::size_t(x)];
+  }
+};
+
+/// A cube map of `size` texels a side whose every texel holds fill(direction of its centre).
+/// Precondition: size >= 1.
+template <class F>
+CubeMap make_cube_map(int size, F&& fill);
+
+/// The unit direction through face coordinate (s, t), s,t in [0,1] (table 8.19 inverted; also
+/// S3's face formulas, e.g. +X: s = -z / (2|x|) + 1/2, t = -y / (2|x|) + 1/2).
+glm::vec3 cube_direction(CubeFace face, float s, float t);
+
+/// Where a direction meets the cube: the face of its major axis (ties go to X, then Y, then Z;
+/// S3: "the coordinate with the largest absolute value, by its sign") and s,t in [0,1].
+struct CubeCoord {
+  CubeFace face;
+  float s, t;
+};
+/// Inverse of cube_direction for any non-zero direction (need not be unit). Zero or non-finite
+/// directions give {pos_z, 0.5, 0.5}.
+CubeCoord cube_coord(const glm::vec3& direction);
+
+/// Bilinear lookup inside the face the direction selects (clamped at that face's edges: no
+/// filtering across faces, so seams are off by at most half a texel). Empty cube: vec4(0).
+glm::vec4 sample_cube(const CubeMap& cube, const glm::vec3& direction);
+
+/// A sphere map (S3 section 2): square, `size` x `size` texels, row 0 at the TOP (image
+/// convention, as files store it). Texel (i, j) (column i, row j from the top) has its centre at
+/// S3's (s, t) = (2 (i + 0.5) / size - 1, 1 - 2 (j + 0.5) / size), s to view-space +X, t to +Y
+/// (S3 counts j from the bottom and uses the texel corner; we use centres and image rows).
+/// Inside the unit circle the texel holds the environment along eq. (2)'s R. The centre is
+/// R = +Z of view space (the direction back towards the eye); the rim is R = -Z (the viewing
+/// direction, behind the mirror ball), S3's "every point of the rim maps to (0, 0, -1)".
+/// Texels outside the circle hold the rim value (R = -Z) so bilinear lookups near the rim stay
+/// sensible. To upload to GL so that texture(map, sphere_map_uv(R)) works, upload rows bottom
+/// up (row size-1 first), or sample at (u, 1 - v).
+struct SphereMap {
+  int size = 0;
+  std::vector<glm::vec4> texels;  ///< size * size, row-major, row 0 at the top
+
+  const glm::vec4& at(int i, int j) const {
+    return texels[std::size_t(j) * std::size_t(size) + std::size_t(i)];
+  }
+};
+
+/// S3 eq. (2) at texel centre (i, j) of a `size` map (row j from the top, see SphereMap): the
+/// view-space reflection direction stored there. Outside the unit circle: (0, 0, -1).
+glm::vec3 sphere_map_direction(int i, int j, int size);
+
+/// Sphere map from a cube map per S3 eq. (2), with view space = cube (world) space, i.e. as seen
+/// by a viewer looking down -Z with +Y up: the centre shows the cube's +Z direction, the rim its
+/// -Z direction. Each texel takes sample_cube() along R at its centre. Precondition: size >= 1.
+SphereMap sphere_map_from_cube(const CubeMap& cube, int size);
+
+/// S3 eq. (4)-(5): the texture coordinate (s', t') in [0,1]^2 of a view-space reflection
+/// direction (need not be unit): A_z = sqrt((R_z + 1) / 2), s = R_x / (2 A_z), t = R_y / (2 A_z),
+/// s' = (s + 1) / 2, t' = (t + 1) / 2. t' grows UPWARDS (GL texture convention): t' = 1 is the
+/// top row (row 0) of a SphereMap. R = (0, 0, -1) (the singular rim point) gives (1, 0.5).
+glm::vec2 sphere_map_uv(const glm::vec3& reflected_view);
+
+/// Bilinear lookup of a sphere map at sphere_map_uv(reflected_view), clamped at the map's edges.
+/// Empty map: vec4(0).
+glm::vec4 sample_sphere(const SphereMap& map, const glm::vec3& reflected_view);
+
+/// How an environment file is laid out. See load_cube_map() and README "Environment maps".
+enum class EnvLayout { auto_detect, faces, horizontal_cross, vertical_cross, equirect, sphere };
+
+/// Name of a layout as used in messages and settings: "auto", "faces", "horizontal_cross",
+/// "vertical_cross", "equirect", "sphere".
+const char* env_layout_name(EnvLayout layout);
+
+struct EnvLoadOptions {
+  EnvLayout layout = EnvLayout::auto_detect;
+  /// The faces were authored in 3ds Max (Z up, front = -Y): convert with S3's face table and
+  /// M_rot into the engine's Y-up convention. Only for layout faces / crosses.
+  bool z_up_3dsmax = false;
+  /// Face size of the result in texels; 0 = from the image: the face images' size, the cross
+  /// width / 4 (horizontal) or / 3 (vertical), the equirect width / 4 (90 degrees of the 360
+  /// the width covers), the sphere map's size / 2. Another value resamples (bilinear).
+  int face_size = 0;
+};
+
+/// Loads a cube map. Layouts (README "Environment maps"):
+///   - faces: six images `<prefix>px<suffix>` ... `<prefix>nz<suffix>`; `path` is either a
+///     pattern with one `*` (e.g. "sky_*.png") or any one of the six files (e.g. "sky_px.png":
+///     the name's stem must end in one of the six face names). With z_up_3dsmax the names are
+///     3ds Max's axes (px = RIGHT, nx = LEFT, py = BACK, ny = FRONT, pz = UP, nz = DOWN), and
+///     S3's face names right/left/back/front/up/down are accepted too.
+///   - horizontal_cross (4:3):   . +Y  .  .        vertical_cross (3:4):   . +Y  .
+///                              -X +Z +X -Z                                -X +Z +X
+///                               . -Y  .  .                                 . -Y  .
+///                                                                          . -Z  .  (-Z turned 180°)
+///     Every cell except the vertical cross's -Z is the GL face image as is.
+///   - equirect (2:1): longitude along x, column centre u = 0.5 is -Z, u = 0.75 is +X (as seen
+///     from inside, not mirrored), u = 0 / 1 is +Z; row 0 is +Y (up), the last row -Y.
+///     direction = (cos(lat) sin(lon), sin(lat), -cos(lat) cos(lon)), lon = 2 pi (u - 0.5),
+///     lat = pi (0.5 - v).
+///   - sphere (1:1): a sphere-map image (see SphereMap) resampled into a cube with view space =
+///     cube space (the -Z side comes from the rim, so it is poor there).
+///   - auto_detect: faces when the path contains `*` or its stem ends in a face name;
+///     otherwise by the image's aspect ratio (4:3, 3:4, 2:1, 1:1).
+/// Errors name the file and the problem: unreadable images, missing face files, non-square or
+/// mismatched faces, a wrong aspect for the layout.
+Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOptions& options = {});
+
+/// Loads a sphere-map image (square; row 0 at the top, see SphereMap).
+Result<SphereMap> load_sphere_map(const std::filesystem::path& path);
+
+/// Debug dump of the six faces as images (format from the extension; EXR keeps floats).
+/// `pattern_or_dir`: a path with one `*`, replaced by px nx py ny pz nz (e.g. "out/probe_*.png"),
+/// or a directory (created if missing) that receives px.exr ... nz.exr.
+Status save_cube_faces(const CubeMap& cube, const std::filesystem::path& pattern_or_dir);
+
+/// Debug dump of a sphere map as an image (format from the extension).
+Status save_sphere_map(const SphereMap& map, const std::filesystem::path& path);
+
+// --- 3ds Max (Z-up) conversion, S3 eq. (7) and its face table -----------------------------------
+
+/// S3's M_rot: (x, y, z) -> (x, -z, y), a 90 degree rotation about X. It maps an engine (Y-up)
+/// direction to the same direction in 3ds Max (Z-up) coordinates, and a 3ds Max direction to
+/// S3's cube-map space (CMCS).
+glm::vec3 m_rot(const glm::vec3& v);
+
+/// Converts a cube whose faces hold 3ds Max-authored images, named by 3ds Max axes (face px =
+/// RIGHT (+X), nx = LEFT, py = BACK (+Y), ny = FRONT (-Y), pz = UP (+Z), nz = DOWN (-Z)), into
+/// the engine's convention: sample_cube(result, d) is the authored environment along the engine
+/// direction d. Exact (a texel permutation, no filtering). See env_map.cpp for the derivation.
+CubeMap cube_from_3dsmax(const CubeMap& max_faces);
+
+// --- implementation of the template ------------------------------------------------------------
+
+template <class F>
+CubeMap make_cube_map(int size, F&& fill) {
+  KASKAD_CHECK(size >= 1, "size must be >= 1, was " + std::to_string(size));
+  CubeMap cube;
+  cube.size = size;
+  for (int f = 0; f < 6; ++f) {
+    auto& face = cube.faces[std::size_t(f)];
+    face.resize(std::size_t(size) * std::size_t(size));
+    for (int y = 0; y < size; ++y) {
+      for (int x = 0; x < size; ++x) {
+        const glm::vec3 d = cube_direction(CubeFace(f), (float(x) + 0.5f) / float(size),
+                                           (float(y) + 0.5f) / float(size));
+        face[std::size_t(y) * std::size_t(size) + std::size_t(x)] = fill(d);
+      }
+    }
+  }
+  return cube;
+}
+
+}  // namespace kaskad
