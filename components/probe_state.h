@@ -30,4 +30,10 @@ struct ProbeState {
   std::uint64_t faces_rendered = 0; ///< cube faces rendered
 };
 
+/// Set by the scene loader on a static_file Reflector: its loaded cube map, an index into
+/// AssetStore::env_maps.
+struct StaticEnvMap {
+  std::uint32_t index = kNoProbe;
+};
+
 }  // namespace kaskad

@@ -24,7 +24,8 @@ enum class ProbeUpdate {
 };
 
 /// How a static file holds its cube map (see README "Reflection probes" for the file names).
-enum class EnvLayoutName { faces, horizontal_cross, vertical_cross, equirect, sphere };
+/// Mirrors EnvLayout in runtime/assets/env_map.h (change together).
+enum class EnvLayoutName { auto_detect, faces, horizontal_cross, vertical_cross, equirect, sphere };
 
 struct Reflector {
   ReflectionMap map = ReflectionMap::cube;
@@ -50,9 +51,10 @@ struct Reflector {
   std::uint32_t exclude_layers = 0;
   /// S3's p_r, the map's amount, as a fraction in [0, 1] (the paper's percent / 100).
   float amount = 1.0f;
-  /// static_file: the image (or the first face's name pattern, see README), relative to the scene.
+  /// static_file: the image, or the six faces' name pattern with one `*` (load_cube_map in
+  /// runtime/assets/env_map.h), relative to the scene. Resampled to `resolution` texels a face.
   std::string file;
-  EnvLayoutName layout = EnvLayoutName::faces;
+  EnvLayoutName layout = EnvLayoutName::auto_detect;
   /// static_file: the file is 3ds Max-authored (Z up): S3 eq. (7) and its face table apply.
   bool z_up_3dsmax = false;
 };

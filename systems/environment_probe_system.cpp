@@ -203,6 +203,10 @@ ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool
     job.target = work.swap ? s.front : 1 - s.front;
     job.visible = s.front;
     job.sphere = entry.sphere;
+    const glm::mat4 proj = cube_face_projection(r.near, r.far);
+    for (int f = 0; f < 6; ++f) job.view_proj[std::size_t(f)] = proj * cube_face_view(f, s.center);
+    if (work.load)
+      if (const StaticEnvMap* env = world.try_get<StaticEnvMap>(e)) job.env_map = env->index;
     out.faces_this_frame += std::popcount(unsigned(work.faces));
     out.captures_this_frame += (work.swap || work.load) ? 1 : 0;
     out.captures_total += s.captures;

@@ -16,7 +16,7 @@ const std::vector<std::pair<const char*, ProbeUpdate>> kUpdates = {
     {"static_file", ProbeUpdate::static_file}, {"first_frame", ProbeUpdate::first_frame},
     {"every_n", ProbeUpdate::every_n}, {"on_change", ProbeUpdate::on_change}};
 const std::vector<std::pair<const char*, EnvLayoutName>> kLayouts = {
-    {"faces", EnvLayoutName::faces}, {"horizontal_cross", EnvLayoutName::horizontal_cross},
+    {"auto", EnvLayoutName::auto_detect}, {"faces", EnvLayoutName::faces}, {"horizontal_cross", EnvLayoutName::horizontal_cross},
     {"vertical_cross", EnvLayoutName::vertical_cross}, {"equirect", EnvLayoutName::equirect},
     {"sphere", EnvLayoutName::sphere}};
 
@@ -55,6 +55,21 @@ void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
   r.finish();
   if (std::string bad = validate_reflector(out); !bad.empty())
     fail(r.at(bad.substr(0, bad.find(' ')).c_str()), bad);
+}
+
+Result<CubeMap> load_static_env_map(const std::filesystem::path& file, const Reflector& r) {
+  EnvLoadOptions options;
+  switch (r.layout) {
+    case EnvLayoutName::auto_detect: options.layout = EnvLayout::auto_detect; break;
+    case EnvLayoutName::faces: options.layout = EnvLayout::faces; break;
+    case EnvLayoutName::horizontal_cross: options.layout = EnvLayout::horizontal_cross; break;
+    case EnvLayoutName::vertical_cross: options.layout = EnvLayout::vertical_cross; break;
+    case EnvLayoutName::equirect: options.layout = EnvLayout::equirect; break;
+    case EnvLayoutName::sphere: options.layout = EnvLayout::sphere; break;
+  }
+  options.z_up_3dsmax = r.z_up_3dsmax;
+  options.face_size = r.resolution;
+  return load_cube_map(file, options);
 }
 
 json reflector_to_json(const Reflector& r) {

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "components/reflector.h"
+#include "runtime/assets/env_map.h"
 #include "runtime/core/json_reader.h"
 
 namespace kaskad {
@@ -14,5 +15,8 @@ void read_reflector(json_reader::ObjectReader& r, Reflector& out);
 
 /// Every field (the canonical form: `--set` can address each); "center" only when set.
 nlohmann::json reflector_to_json(const Reflector& r);
+
+/// Loads a static_file Reflector's cube map with its layout and 3ds Max option (env_map.h).
+Result<CubeMap> load_static_env_map(const std::filesystem::path& file, const Reflector& r);
 
 }  // namespace kaskad

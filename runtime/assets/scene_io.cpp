@@ -17,6 +17,7 @@
 #include "components/mesh_renderer.h"
 #include "components/model.h"
 #include "components/name.h"
+#include "components/probe_state.h"
 #include "components/reflector.h"
 #include "components/transform.h"
 #include "runtime/assets/gltf_loader.h"
@@ -515,6 +516,17 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
     auto m = load_material_file(scene.file.parent_path() / ref.path, *manifest, scene.assets);
     if (!m) return m.error();
     w.emplace<Material>(e, *m);
+  }
+  // Static reflection maps (S3 (a)): loaded once here; the probe system uploads them once.
+  std::vector<std::pair<ecs::Entity, Reflector>> static_probes;
+  w.view<Reflector>().each([&](ecs::Entity e, Reflector& r) {
+    if (r.update == ProbeUpdate::static_file) static_probes.emplace_back(e, r);
+  });
+  for (auto& [e, r] : static_probes) {
+    auto cube = load_static_env_map(scene.file.parent_path() / r.file, r);
+    if (!cube) return cube.error();
+    scene.assets.env_maps.push_back(std::move(cube.value()));
+    w.emplace<StaticEnvMap>(e, StaticEnvMap{std::uint32_t(scene.assets.env_maps.size() - 1)});
   }
   std::vector<std::pair<ecs::Entity, PrimitiveMesh>> prims;
   std::vector<std::pair<ecs::Entity, ModelRef>> models;

@@ -11,6 +11,7 @@
 
 #include "runtime/core/log.h"
 #include "runtime/gpu/shader.h"
+#include "runtime/render/probe_capture.h"
 
 namespace kaskad::render {
 namespace {
@@ -46,8 +47,10 @@ GLenum depth_internal_format(DepthFormat f) {
 // Fixed attribute and uniform locations (see the shaders).
 constexpr GLuint kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
 constexpr GLint kUniModel = 0, kUniNormalMatrix = 4, kUniBaseColor = 8, kUniMaterial = 9,
-                kUniEmissive = 10, kUniOracleFeatures = 11, kUniLightViewProj = 12;
-constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2;
+                kUniEmissive = 10, kUniOracleFeatures = 11, kUniLightViewProj = 12,
+                kUniReflection = 16;
+constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2, kTexReflectionCube = 3,
+                 kTexReflectionSphere = 4;
 
 struct GpuMesh {
   gpu::VertexArray vao;
@@ -82,7 +85,8 @@ struct Renderer::Impl {
   // Forward targets.
   int width = 0, height = 0;
   gpu::Framebuffer fbo;
-  gpu::Texture color, position, normal, visibility, depth;
+  gpu::Texture color, position, normal, visibility, reflection, depth;
+  std::unique_ptr<ProbeMaps> probes;  // reflection probe maps (probe_capture.h)
 
   // Shadow map: a depth texture array, one layer per cascade.
   int shadow_size = 0, shadow_layers = 0;
@@ -176,12 +180,14 @@ struct Renderer::Impl {
     make(position, GL_RGBA32F);
     make(normal, GL_RGBA32F);
     make(visibility, GL_RG32F);  // r visibility, g cascade index
+    make(reflection, GL_RGBA16F);  // rgb reflected colour C_t (S3 eq. (3)), 0 without a map
     make(depth, GL_DEPTH_COMPONENT32F);
     fbo = gpu::make_framebuffer();
     glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0, color.id(), 0);
     glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT1, position.id(), 0);
     glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT2, normal.id(), 0);
     glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT3, visibility.id(), 0);
+    glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT4, reflection.id(), 0);
     glNamedFramebufferTexture(fbo.id(), GL_DEPTH_ATTACHMENT, depth.id(), 0);
   }
 
@@ -225,6 +231,9 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
   if (!lib) return lib.error();
   im.shaders = std::move(lib.value());
   im.oracle = options.uber_oracle;
+  auto probes = ProbeMaps::create(shader_dir);
+  if (!probes) return probes.error();
+  im.probes = std::move(probes.value());
   im.white = make_solid_texture({1, 1, 1, 1}, GL_SRGB8_ALPHA8);
   // Exactly (0.5, 0.5, 1): decodes to (0, 0, 1), so the cotangent frame leaves the normal as is.
   // An 8-bit 128 would tilt every normal by 0.2 degrees, with visible derivative noise.
@@ -352,6 +361,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   if (assets.uid != im.assets_uid) {
     im.meshes.clear();
     im.textures.clear();
+    im.probes->clear();  // probe handles are entity indices of that scene
     im.assets_uid = assets.uid;
   }
   for (const DrawItem& d : frame.draws)
@@ -371,11 +381,11 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
                     ma.roughness) < std::tie(mb.base_color_texture, mb.normal_texture,
                                              mb.double_sided, mb.metallic, mb.roughness);
   };
-  auto sorted_by = [&](Pass pass) {
+  auto sorted_by = [&](Pass pass, const std::vector<VariantKey>& by) {
     std::vector<std::uint32_t> order(frame.draws.size());
     for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-      const VariantKey ka = keys[a].filtered_for(pass), kb = keys[b].filtered_for(pass);
+      const VariantKey ka = by[a].filtered_for(pass), kb = by[b].filtered_for(pass);
       if (ka != kb) return ka < kb;
       return material_order(a, b);
     });
@@ -432,7 +442,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     }
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(s.slope_bias, s.constant_bias);
-    const std::vector<std::uint32_t> order = sorted_by(Pass::depth);
+    const std::vector<std::uint32_t> order = sorted_by(Pass::depth, keys);
     GLuint current = 0;  // kept across layers: the light matrix is a per-draw uniform
     for (int c = 0; c < cascades; ++c) {
       glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0,
@@ -468,12 +478,105 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   }
   glEndQuery(GL_TIME_ELAPSED);
 
-  // Pass 2: forward shading into colour (+ AOV targets when asked for).
+  // Forward draws: the main view and every probe face go through this one path. Draws reflecting
+  // a probe get its map (`visible_before`: the map as of before this frame's captures, so a probe
+  // never sees a cube that is being captured) and k_s * p_r.
+  std::map<std::uint32_t, const ProbeJob*> probe_jobs;
+  for (const ProbeJob& job : frame.probes) probe_jobs[job.handle] = &job;
+  auto bind_reflection = [&](GLuint prog, const DrawItem& d, VariantKey key, bool capture) {
+    if (!key.has(VariantKey::kReflectionCube) && !key.has(VariantKey::kReflectionSphere)) return;
+    auto it = probe_jobs.find(d.probe);
+    if (it == probe_jobs.end()) return;
+    const ProbeJob& job = *it->second;
+    const bool swapped_now = job.faces != 0 && job.target == job.visible;
+    const int buffer = capture && swapped_now ? 1 - job.visible : job.visible;
+    glBindTextureUnit(kTexReflectionCube, im.probes->existing_cube(job.handle, buffer));
+    glBindTextureUnit(kTexReflectionSphere, im.probes->existing_sphere(job.handle));
+    glProgramUniform4f(prog, kUniReflection, d.reflection_scale, 0.0f, 0.0f, 0.0f);
+  };
+  auto draw_forward = [&](const std::vector<VariantKey>& by, const ProbeJob* capture) -> Status {
+    GLuint current = 0;
+    for (std::uint32_t i : sorted_by(Pass::forward, by)) {
+      const DrawItem& d = frame.draws[i];
+      if (capture && (d.probe == capture->handle ||
+                      (capture->exclude_layers & (1u << (d.layer & 31)))))
+        continue;  // the reflector itself and excluded layers are not in its probe
+      const GpuMesh& m = im.mesh(d.mesh, assets);
+      if (m.index_count == 0) continue;
+      KASKAD_TRY(use_program(Pass::forward, by[i], current));
+      if (d.material.double_sided) {
+        glDisable(GL_CULL_FACE);
+      } else {
+        glEnable(GL_CULL_FACE);
+        glCullFace(GL_BACK);
+      }
+      bind_material(current, d, by[i]);
+      bind_reflection(current, d, by[i], capture != nullptr);
+      const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(d.model)));
+      glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+      glProgramUniformMatrix3fv(current, kUniNormalMatrix, 1, GL_FALSE, &normal_matrix[0][0]);
+      glBindVertexArray(m.vao.id());
+      glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+      ++stats_.draw_calls;
+      stats_.triangles += std::size_t(m.index_count / 3);
+    }
+    return {};
+  };
+  if (shadowed) glBindTextureUnit(kTexShadow, im.shadow_map.id());
+
+  // Pass 2: reflection probes (S3): each scheduled face of a probe's back cube is rendered by a
+  // 90° camera at the probe centre through the forward path, shadows included, without AOVs and
+  // without exposure (the cube holds linear radiance). u_view stays the main camera's: cascade
+  // selection and sphere-map lookups are the main view's. Then mips, then sphere maps.
+  stats_.probe_faces = 0;
+  stats_.probe_draw_calls = 0;
+  if (!frame.probes.empty()) {
+    const VariantKey capture_frame = VariantKey(frame_key.bits() & ~VariantKey::kAovs.mask());
+    std::vector<VariantKey> capture_keys(frame.draws.size());
+    for (std::size_t i = 0; i < frame.draws.size(); ++i)
+      capture_keys[i] = material_variant(frame.draws[i]) | capture_frame;
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    for (const ProbeJob& job : frame.probes) {
+      if (job.env_map != kNoProbe && job.env_map < assets.env_maps.size()) {
+        im.probes->upload(job.handle, job.visible, assets.env_maps[job.env_map]);
+        continue;
+      }
+      if (job.faces == 0) continue;
+      im.probes->cube(job.handle, job.target, job.resolution);
+      for (int f = 0; f < 6; ++f) {
+        if (!(job.faces & (1u << f))) continue;
+        FrameBlock face_fb = fb;
+        face_fb.view_proj = job.view_proj[std::size_t(f)];
+        face_fb.camera_pos = glm::vec4(job.center, 1.0f);
+        face_fb.ambient.w = 1.0f;  // linear radiance: exposure applies where the map is shown
+        glNamedBufferSubData(im.frame_ubo.id(), 0, sizeof face_fb, &face_fb);
+        im.probes->begin_face(job.handle, job.target, f, frame.clear_color);
+        const int before = stats_.draw_calls;
+        const std::size_t triangles_before = stats_.triangles;
+        KASKAD_TRY(draw_forward(capture_keys, &job));
+        stats_.probe_draw_calls += stats_.draw_calls - before;
+        stats_.draw_calls = before;
+        stats_.triangles = triangles_before;
+        ++stats_.probe_faces;
+      }
+      // Complete (the target is now the visible buffer): rebuild its mip chain.
+      if (job.target == job.visible) im.probes->finish_cube(job.handle, job.target);
+    }
+    glNamedBufferSubData(im.frame_ubo.id(), 0, sizeof fb, &fb);
+    for (const ProbeJob& job : frame.probes)
+      if (job.sphere && im.probes->existing_cube(job.handle, job.visible))
+        im.probes->update_sphere(job.handle, job.visible, glm::mat3(frame.camera.view));
+  }
+
+  // Pass 3: forward shading into colour (+ AOV targets when asked for).
   glBeginQuery(GL_TIME_ELAPSED, im.timers[1].id());
   im.ensure_targets(frame.width, frame.height);
-  const GLenum bufs[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
-                          GL_COLOR_ATTACHMENT3};
-  glNamedFramebufferDrawBuffers(im.fbo.id(), frame.write_aovs ? 4 : 1, bufs);
+  const GLenum bufs[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                          GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
+  glNamedFramebufferDrawBuffers(im.fbo.id(), frame.write_aovs ? 5 : 1, bufs);
   im.aovs_written = frame.write_aovs;
   glBindFramebuffer(GL_FRAMEBUFFER, im.fbo.id());
   glViewport(0, 0, frame.width, frame.height);
@@ -488,36 +591,16 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     glClearBufferfv(GL_COLOR, 1, zero);
     glClearBufferfv(GL_COLOR, 2, zero);
     glClearBufferfv(GL_COLOR, 3, zero);
+    glClearBufferfv(GL_COLOR, 4, zero);
   }
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   glClearBufferfv(GL_DEPTH, 0, &one);
-  if (shadowed) glBindTextureUnit(kTexShadow, im.shadow_map.id());
-  GLuint current = 0;
-  for (std::uint32_t i : sorted_by(Pass::forward)) {
-    const DrawItem& d = frame.draws[i];
-    const GpuMesh& m = im.mesh(d.mesh, assets);
-    if (m.index_count == 0) continue;
-    if (Status st = use_program(Pass::forward, keys[i], current); !st) {
-      glDisable(GL_FRAMEBUFFER_SRGB);
-      glEndQuery(GL_TIME_ELAPSED);
-      return st;
-    }
-    if (d.material.double_sided) {
-      glDisable(GL_CULL_FACE);
-    } else {
-      glEnable(GL_CULL_FACE);
-      glCullFace(GL_BACK);
-    }
-    bind_material(current, d, keys[i]);
-    const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(d.model)));
-    glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-    glProgramUniformMatrix3fv(current, kUniNormalMatrix, 1, GL_FALSE, &normal_matrix[0][0]);
-    glBindVertexArray(m.vao.id());
-    glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
-    ++stats_.draw_calls;
-    stats_.triangles += std::size_t(m.index_count / 3);
+  if (Status st = draw_forward(keys, nullptr); !st) {
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glEndQuery(GL_TIME_ELAPSED);
+    return st;
   }
   stats_.shaders = im.shaders->stats();
   glDisable(GL_FRAMEBUFFER_SRGB);
@@ -580,7 +663,10 @@ Image Renderer::read_aovs() const {
   Image img;
   img.width = w;
   img.height = h;
-  img.channel_names = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z", "Z", "visibility", "mask", "cascade"};
+  const auto refl = read_texture(im.reflection.id(), w, h, GL_RGBA, 4);
+  img.channel_names = {"P.X", "P.Y",        "P.Z",  "N.X",     "N.Y",          "N.Z",
+                       "Z",   "visibility", "mask", "cascade", "reflection.R", "reflection.G",
+                       "reflection.B"};
   img.channels = int(img.channel_names.size());
   img.pixels.resize(std::size_t(w) * h * img.channels);
   for (std::size_t i = 0; i < std::size_t(w) * h; ++i) {
@@ -595,6 +681,9 @@ Image Renderer::read_aovs() const {
     o[7] = vis[i * 2];
     o[8] = pos[i * 4 + 3];
     o[9] = vis[i * 2 + 1];
+    o[10] = refl[i * 4 + 0];
+    o[11] = refl[i * 4 + 1];
+    o[12] = refl[i * 4 + 2];
   }
   return img;
 }
@@ -615,6 +704,14 @@ Image Renderer::read_shadow_map() const {
     std::memcpy(&img.pixels[std::size_t(l) * layer],
                 &stack[std::size_t(im.shadow_layers - 1 - l) * layer], layer * sizeof(float));
   return img;
+}
+
+CubeMap Renderer::read_probe_cube(std::uint32_t handle, int buffer) const {
+  return impl_->probes->read_cube(handle, buffer);
+}
+
+SphereMap Renderer::read_probe_sphere(std::uint32_t handle) const {
+  return impl_->probes->read_sphere(handle);
 }
 
 void Renderer::present(int window_width, int window_height) const {

@@ -20,6 +20,7 @@
 #include "components/probe_state.h"
 #include "components/shadow_settings.h"
 #include "runtime/assets/asset_store.h"
+#include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/core/result.h"
 #include "runtime/gpu/gl_handles.h"
@@ -64,6 +65,11 @@ struct ProbeJob {
   int target = 1;
   int visible = 0;
   bool sphere = false;     ///< shade with a sphere map made from the visible cube (S3 eq. (2))
+  /// World -> clip of the six 90° face cameras (systems/environment_probe_system.h).
+  std::array<glm::mat4, 6> view_proj{};
+  /// Static file: index into AssetStore::env_maps to upload into buffer `visible` this frame;
+  /// kNoProbe: nothing to upload.
+  std::uint32_t env_map = kNoProbe;
 };
 
 /// A light as the shaders see it. `color` already includes the intensity.
@@ -120,6 +126,8 @@ struct FrameStats {
   /// GPU times are the previous frame's (queries are read a frame late); 0 until frame 3.
   double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
   double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)
+  int probe_faces = 0;                ///< reflection probe cube faces rendered this frame
+  int probe_draw_calls = 0;           ///< draws into those faces (not in draw_calls)
   int program_switches = 0;           ///< glUseProgram calls in the frame (draws are sorted)
   int material_switches = 0;          ///< material uniform/texture updates in the frame
   ShaderStats shaders;                ///< compiles, cache hits, compile ms (since creation)
@@ -162,6 +170,10 @@ class Renderer {
   /// AOVs of the last frame: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade (see README).
   /// Precondition: the last frame was rendered with write_aovs.
   Image read_aovs() const;
+  /// A probe's cube buffer (0 or 1; level 0) or its sphere map (row 0 at the top) as last
+  /// rendered; empty when the probe has none. Tests and `kaskad render --probe-maps`.
+  CubeMap read_probe_cube(std::uint32_t handle, int buffer) const;
+  SphereMap read_probe_sphere(std::uint32_t handle) const;
   /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom; with
   /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;
