@@ -125,6 +125,11 @@ CubeMap resized(const CubeMap& cube, int size) {
   return make_cube_map(size, [&](const glm::vec3& d) { return sample_cube(cube, d); });
 }
 
+/// Face sizes derived from an image (equirect width / 4, sphere size / 2) stop here: 2048^2 x 6
+/// RGBA floats are 400 MB. An explicit EnvLoadOptions::face_size may go up to kMaxFaceSize.
+constexpr int kMaxDerivedFaceSize = 2048;
+constexpr int kMaxFaceSize = 8192;
+
 /// Which texel of a `size` face a direction computed from another texel centre lands on (exact
 /// permutations of texel centres: rounding absorbs float error).
 int texel_index(float st, int size) {
@@ -149,11 +154,29 @@ std::vector<std::string> face_names(int f, bool max) {
   return names;
 }
 
-/// The pattern of a faces path: one `*`, or a file whose stem ends in a face name.
+/// The pattern of a faces path: one `*`, a file whose stem ends in a face name, or a directory
+/// holding a file whose stem is a face name (e.g. px.jpg: the pattern is dir/`*`.jpg).
 std::optional<FacePattern> face_pattern(const std::filesystem::path& path, bool max) {
   const std::string s = path.string();
   if (const auto star = s.find('*'); star != std::string::npos) {
     return FacePattern{s.substr(0, star), s.substr(star + 1)};
+  }
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    // The extension of px, else of the first face file by name (directory order varies).
+    std::vector<std::filesystem::path> faces;
+    for (const auto& entry : std::filesystem::directory_iterator(path, ec)) {
+      const std::string stem = entry.path().stem().string();
+      for (int f = 0; f < 6; ++f)
+        for (const std::string& name : face_names(f, max))
+          if (stem == name) faces.push_back(entry.path());
+    }
+    if (faces.empty()) return std::nullopt;
+    std::sort(faces.begin(), faces.end(), [](const auto& a, const auto& b) {
+      const bool apx = a.stem() == kFaceSuffix[0], bpx = b.stem() == kFaceSuffix[0];
+      return apx != bpx ? apx : a < b;
+    });
+    return FacePattern{(path / "").string(), faces.front().extension().string()};
   }
   const std::string stem = path.stem().string();
   const std::string ext = path.extension().string();
@@ -171,8 +194,8 @@ Result<CubeMap> load_faces(const std::filesystem::path& path, bool max) {
   const auto pattern = face_pattern(path, max);
   if (!pattern) {
     return Error{name, "",
-                 "faces layout: the path must contain one '*' or name one face file whose name "
-                 "ends in px, nx, py, ny, pz or nz"};
+                 "faces layout: the path must contain one '*', name one face file whose name "
+                 "ends in px, nx, py, ny, pz or nz, or be a folder holding such files"};
   }
   if (pattern->suffix.find('*') != std::string::npos)
     return Error{name, "", "faces layout: the pattern may contain only one '*'"};
@@ -268,7 +291,7 @@ Result<CubeMap> cube_from_equirect(const Image& image, const std::string& name, 
                                size_text(w, h)};
   }
   const std::vector<glm::vec4> texels = rgba_texels(image);
-  const int size = face_size > 0 ? face_size : std::max(1, w / 4);
+  const int size = face_size > 0 ? face_size : std::clamp(w / 4, 1, kMaxDerivedFaceSize);
   constexpr float kPi = std::numbers::pi_v<float>;
   return make_cube_map(size, [&](const glm::vec3& d) {
     // Inverse of env_map.h's direction = (cos(lat) sin(lon), sin(lat), -cos(lat) cos(lon)).
@@ -365,7 +388,7 @@ glm::vec3 sphere_map_direction(int i, int j, int size) {
   return {2.0f * az * s, 2.0f * az * t, 2.0f * az * az - 1.0f};
 }
 
-SphereMap sphere_map_from_cube(const CubeMap& cube, int size) {
+SphereMap sphere_map_from_cube(const CubeMap& cube, int size, const glm::mat3& view_to_world) {
   KASKAD_CHECK(size >= 1, "size must be >= 1, was " + std::to_string(size));
   SphereMap map;
   map.size = size;
@@ -373,7 +396,7 @@ SphereMap sphere_map_from_cube(const CubeMap& cube, int size) {
   for (int j = 0; j < size; ++j) {
     for (int i = 0; i < size; ++i) {
       map.texels[std::size_t(j) * std::size_t(size) + std::size_t(i)] =
-          sample_cube(cube, sphere_map_direction(i, j, size));
+          sample_cube(cube, view_to_world * sphere_map_direction(i, j, size));
     }
   }
   return map;
@@ -436,14 +459,19 @@ CubeMap cube_from_3dsmax(const CubeMap& max_faces) {
   return out;
 }
 
-Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOptions& options) {
+Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOptions& options,
+                              EnvLayout* detected) {
   const std::string name = path.string();
-  KASKAD_CHECK(options.face_size >= 0,
-               "face_size must be >= 0 (0 = from the image), was " + std::to_string(options.face_size));
+  if (options.face_size < 0 || options.face_size > kMaxFaceSize) {
+    return Error{name, "", "face_size must be in [0, " + std::to_string(kMaxFaceSize) +
+                               "] (0 = from the image), was " + std::to_string(options.face_size)};
+  }
   EnvLayout layout = options.layout;
   if (layout == EnvLayout::auto_detect && face_pattern(path, options.z_up_3dsmax)) {
     layout = EnvLayout::faces;
   }
+
+  if (detected) *detected = layout;
 
   Result<CubeMap> cube = Error{};
   if (layout == EnvLayout::faces) {
@@ -462,6 +490,7 @@ Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOp
                                    " image: expected 4:3 or 3:4 (cross), 2:1 (equirect), 1:1 "
                                    "(sphere map), or six face files (a '*' pattern)"};
       }
+      if (detected) *detected = layout;
     }
     if (options.z_up_3dsmax && (layout == EnvLayout::equirect || layout == EnvLayout::sphere)) {
       return Error{name, "", std::string("the 3ds Max (Z-up) conversion applies to cube faces and "
@@ -478,7 +507,8 @@ Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOp
       case EnvLayout::sphere: {
         auto map = sphere_from_image(*image, name);
         if (!map) return map.error();
-        const int size = options.face_size > 0 ? options.face_size : std::max(1, map->size / 2);
+        const int size =
+            options.face_size > 0 ? options.face_size : std::clamp(map->size / 2, 1, kMaxDerivedFaceSize);
         return make_cube_map(size, [&](const glm::vec3& d) { return sample_sphere(*map, d); });
       }
       default:

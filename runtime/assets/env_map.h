@@ -100,10 +100,13 @@ struct SphereMap {
 /// view-space reflection direction stored there. Outside the unit circle: (0, 0, -1).
 glm::vec3 sphere_map_direction(int i, int j, int size);
 
-/// Sphere map from a cube map per S3 eq. (2), with view space = cube (world) space, i.e. as seen
-/// by a viewer looking down -Z with +Y up: the centre shows the cube's +Z direction, the rim its
-/// -Z direction. Each texel takes sample_cube() along R at its centre. Precondition: size >= 1.
-SphereMap sphere_map_from_cube(const CubeMap& cube, int size);
+/// Sphere map from a cube map per S3 eq. (2), for a viewer whose view-space directions turn into
+/// world (cube) directions by `view_to_world` (the rotation part of (MV)^-1, S3 eq. 6; the
+/// transpose of the view matrix's rotation). Identity: a viewer looking down world -Z with +Y up,
+/// so the centre shows the cube's +Z direction and the rim its -Z direction. Each texel takes
+/// sample_cube() along view_to_world * R at its centre. Precondition: size >= 1.
+SphereMap sphere_map_from_cube(const CubeMap& cube, int size,
+                               const glm::mat3& view_to_world = glm::mat3(1.0f));
 
 /// S3 eq. (4)-(5): the texture coordinate (s', t') in [0,1]^2 of a view-space reflection
 /// direction (need not be unit): A_z = sqrt((R_z + 1) / 2), s = R_x / (2 A_z), t = R_y / (2 A_z),
@@ -125,18 +128,22 @@ const char* env_layout_name(EnvLayout layout);
 struct EnvLoadOptions {
   EnvLayout layout = EnvLayout::auto_detect;
   /// The faces were authored in 3ds Max (Z up, front = -Y): convert with S3's face table and
-  /// M_rot into the engine's Y-up convention. Only for layout faces / crosses.
+  /// M_rot into the engine's Y-up convention (cube_from_3dsmax). Faces and crosses only (an error
+  /// for equirect and sphere maps): face files are named, and cross cells placed, by 3ds Max's
+  /// axes (the cell drawn +Y below holds 3ds Max's +Y = BACK image, and so on).
   bool z_up_3dsmax = false;
-  /// Face size of the result in texels; 0 = from the image: the face images' size, the cross
-  /// width / 4 (horizontal) or / 3 (vertical), the equirect width / 4 (90 degrees of the 360
-  /// the width covers), the sphere map's size / 2. Another value resamples (bilinear).
+  /// Face size of the result in texels, at most 8192; 0 = from the image: the face images'
+  /// size, the cross width / 4 (horizontal) or / 3 (vertical), the equirect width / 4 (90
+  /// degrees of the 360 the width covers) and the sphere map's size / 2, those two at most 2048.
+  /// Another value resamples (bilinear).
   int face_size = 0;
 };
 
 /// Loads a cube map. Layouts (README "Environment maps"):
 ///   - faces: six images `<prefix>px<suffix>` ... `<prefix>nz<suffix>`; `path` is either a
-///     pattern with one `*` (e.g. "sky_*.png") or any one of the six files (e.g. "sky_px.png":
-///     the name's stem must end in one of the six face names). With z_up_3dsmax the names are
+///     pattern with one `*` (e.g. "sky_*.png"), any one of the six files (e.g. "sky_px.png":
+///     the name's stem must end in one of the six face names), or a folder holding px.<ext> ...
+///     nz.<ext>. With z_up_3dsmax the names are
 ///     3ds Max's axes (px = RIGHT, nx = LEFT, py = BACK, ny = FRONT, pz = UP, nz = DOWN), and
 ///     S3's face names right/left/back/front/up/down are accepted too.
 ///   - horizontal_cross (4:3):   . +Y  .  .        vertical_cross (3:4):   . +Y  .
@@ -150,11 +157,15 @@ struct EnvLoadOptions {
 ///     lat = pi (0.5 - v).
 ///   - sphere (1:1): a sphere-map image (see SphereMap) resampled into a cube with view space =
 ///     cube space (the -Z side comes from the rim, so it is poor there).
-///   - auto_detect: faces when the path contains `*` or its stem ends in a face name;
+///   - auto_detect: faces when the path contains `*`, its stem ends in a face name, or it is a
+///     folder of faces;
 ///     otherwise by the image's aspect ratio (4:3, 3:4, 2:1, 1:1).
 /// Errors name the file and the problem: unreadable images, missing face files, non-square or
-/// mismatched faces, a wrong aspect for the layout.
-Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOptions& options = {});
+/// mismatched faces, a wrong aspect for the layout, face_size out of range.
+/// `detected`, when given, receives the layout used (auto_detect resolved), also on errors
+/// found after detection.
+Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOptions& options = {},
+                              EnvLayout* detected = nullptr);
 
 /// Loads a sphere-map image (square; row 0 at the top, see SphereMap).
 Result<SphereMap> load_sphere_map(const std::filesystem::path& path);

@@ -12,6 +12,7 @@
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
 #include "runtime/cli/bench.h"
+#include "runtime/cli/envmap_command.h"
 #include "runtime/cli/player.h"
 #include "runtime/core/log.h"
 #include "runtime/gpu/context.h"
@@ -35,6 +36,12 @@ usage:
   kaskad bench [SCENE]... [--sweep SPEC] [--out DIR] [--frames N] [--size WxH] [--no-chart]
                                     sweep settings, write DIR/bench.csv and one speed-vs-accuracy
                                     chart per scene (default sweep: see README)
+  kaskad envmap IN [--layout L] [--3dsmax] [--face-size N] [--faces OUT] [--sphere OUT.png]
+                [--sphere-size N]
+                                    load an environment map (IN: a file, a face pattern sky_*.png
+                                    or a folder of faces; L: auto, faces, horizontal_cross,
+                                    vertical_cross, equirect, sphere), print what was found, write
+                                    its faces (OUT: a pattern with * or a folder) or S3 sphere map
   kaskad info                       print the OpenGL context kaskad gets on this machine
 
 render options:
@@ -47,6 +54,9 @@ render options:
   --shadow-map FILE      write the shadow map depth of the last frame
   --probe-maps DIR       write each reflection probe's visible cube faces (NAME_px.png ...
                          NAME_nz.png) and, for sphere probes, NAME_sphere.png into DIR
+  --reflection-reference FILE.exr
+                         ray-traced reflected radiance C_t of every pixel (README "Environment maps")
+  --env PATH             environment map for the reflection reference's misses (any layout)
   --headless             never open a window (default when there is no display)
   --window               open a window even if --headless would be the default
   -v, --verbose          debug logging (GL debug messages of every severity)
@@ -63,6 +73,8 @@ struct Args {
   std::string aov;
   std::string shadow_map;
   std::string probe_maps;
+  std::string reflection_reference;  ///< render: reference EXR to write
+  std::string env;                   ///< render: environment map of the reflection reference
   std::vector<std::string> sets;
   int width = 0, height = 0, frames = 10;
   bool headless = !gpu::display_available();
@@ -115,6 +127,10 @@ Args parse_args(int argc, char** argv) {
       a.shadow_map = value();
     } else if (arg == "--probe-maps") {
       a.probe_maps = value();
+    } else if (arg == "--reflection-reference") {
+      a.reflection_reference = value();
+    } else if (arg == "--env") {
+      a.env = value();
     } else if (arg == "--sweep") {
       a.sweep = value();
     } else if (arg == "--out") {
@@ -249,7 +265,8 @@ int run_render(Args a) {
 
   RenderRun run;
   run.frames = a.frames;
-  run.write_aovs = !a.aov.empty();  // the AOV targets cost fill rate: only when asked for
+  // The AOV targets cost fill rate: only when asked for.
+  run.write_aovs = !a.aov.empty() || !a.reflection_reference.empty();
   auto timings = render_frames(*player, *scene, run);
   if (!timings) return fail(timings.error());
   if (!player->context->headless()) {
@@ -308,6 +325,13 @@ int run_render(Args a) {
     std::printf("wrote     %s (AOVs: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade)\n",
                 fs::absolute(a.aov).string().c_str());
   }
+  if (!a.reflection_reference.empty()) {
+    if (auto s = write_reflection_reference(*scene, player->renderer->read_aovs(),
+                                            timings->last.camera.position, a.env,
+                                            a.reflection_reference);
+        !s)
+      return fail(s.error());
+  }
   if (!a.shadow_map.empty()) {
     if (auto s = save_image(a.shadow_map, player->renderer->read_shadow_map()); !s)
       return fail(s.error());
@@ -345,6 +369,7 @@ int run_render(Args a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::strcmp(argv[1], "envmap") == 0) return run_envmap_command(argc, argv);
   const Args a = parse_args(argc, argv);
   if (a.command == "info") return run_info(a);
   if (a.command == "save") return run_save(a);

@@ -62,6 +62,27 @@ printf '{ "entities": [ { "name": "b", "primitive": { "shape": "box" } } ] }' >"
 check no_camera nonzero "no camera" -- "$KASKAD" render "$tmp/nocam.json" --headless
 check unwritable_output nonzero "cannot|could not|error" -- "$KASKAD" render --headless --size 32x32 --frames 1 -o /proc/nope/x.png
 
+# kaskad envmap and the reflection reference: every layout of one sky loads; bad input names the file.
+check envmap_folder 0 "faces, 32\^2 x 6 faces" -- "$KASKAD" envmap "$KASKAD_CONTENT/env/cube/SwedishRoyalCastle" \
+  --face-size 32 --faces "$tmp/env/sky_*.png" --sphere "$tmp/env/ball.png" --sphere-size 64
+check envmap_equirect 0 "equirect, 256\^2 x 6 faces" -- "$KASKAD" envmap "$KASKAD_CONTENT/env/equirect/venice_sunset_1k.hdr"
+check envmap_pattern 0 "faces, 32\^2" -- "$KASKAD" envmap "$tmp/env/sky_*.png"
+check envmap_sphere 0 "sphere, 32\^2" -- "$KASKAD" envmap "$tmp/env/ball.png"
+check envmap_3dsmax 0 "converted from 3ds Max" -- "$KASKAD" envmap "$tmp/env/sky_pz.png" --3dsmax
+check envmap_missing_face nonzero "missing face file .*nope_px.png" -- "$KASKAD" envmap "$tmp/env/nope_*.png"
+check envmap_bad_aspect nonzero "default.png.*cannot tell the environment layout of a 160x90 image" -- \
+  "$KASKAD" envmap "$tmp/default.png"
+check envmap_wrong_layout nonzero "ball.png.*horizontal cross must be 4:3" -- \
+  "$KASKAD" envmap "$tmp/env/ball.png" --layout horizontal_cross
+check envmap_bad_option nonzero "--layout expects" -- "$KASKAD" envmap "$tmp/env/ball.png" --layout diagonal
+check reflection_reference 0 "reflection reference: .* rays" -- "$KASKAD" render --headless --size 96x54 --frames 1 \
+  -o "$tmp/refl.png" --reflection-reference "$tmp/refl.exr" --env "$tmp/env/sky_*.png"
+if command -v oiiotool >/dev/null; then
+  check reflection_channels 0 "reflection.B.*reflection.G.*reflection.R|reflection.R.*reflection.G.*reflection.B" -- oiiotool --info -v "$tmp/refl.exr"
+fi
+check reflection_bad_env nonzero "nothing.hdr.*not found" -- "$KASKAD" render --headless --size 32x32 --frames 1 \
+  -o "$tmp/refl2.png" --reflection-reference "$tmp/refl2.exr" --env "$tmp/nothing.hdr"
+
 # kaskad bench: CSV with the documented columns, a chart, and a bad configuration (256^2 map, no
 # bias) scoring worse than the default one on misclassified pixels.
 check bench_runs 0 "wrote .*bench.csv \(8 rows\)" -- "$KASKAD" bench --size 200x112 --frames 2 --out "$tmp/bench" \

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -213,6 +215,24 @@ TEST(SphereMap, EveryTexelIsFormulaExact) {
     }
   }
   EXPECT_GT(checked, n * n / 2);
+}
+
+TEST(SphereMap, ViewRotationPicksWhatTheViewerFaces) {
+  // A camera looking down world +X (turned -90 degrees about Y): view -Z is world +X, so the rim
+  // shows +X and the centre (towards the eye) -X; view +Y stays world +Y.
+  const glm::mat4 camera_to_world = glm::rotate(glm::mat4(1.0f), glm::radians(-90.0f), glm::vec3(0, 1, 0));
+  const glm::mat3 view_to_world(camera_to_world);
+  ASSERT_LT(glm::length(view_to_world * glm::vec3(0, 0, -1) - glm::vec3(1, 0, 0)), 1e-6f);
+  const int n = 64;
+  const CubeMap cube = coloured_cube(8);
+  const SphereMap map = sphere_map_from_cube(cube, n, view_to_world);
+  EXPECT_EQ(map.at(n / 2, n / 2), kFaceColour[1]);  // centre: -X
+  EXPECT_EQ(map.at(0, n / 2), kFaceColour[0]);      // rim: +X
+  EXPECT_EQ(map.at(n / 2, n / 2 - int(0.7f * n / 2)), kFaceColour[2]);  // up: +Y
+  // Looking up a view-space direction gives the cube along its world direction.
+  const SphereMap smooth = sphere_map_from_cube(make_cube_map(64, smooth_env), 256, view_to_world);
+  const glm::vec3 r_view = glm::normalize(glm::vec3(0.3f, -0.4f, 0.6f));
+  EXPECT_LT(max_diff(sample_sphere(smooth, r_view), smooth_env(view_to_world * r_view)), 0.02f);
 }
 
 TEST(SphereMap, UvIsS3Eq4And5AndInvertsEq2) {
@@ -518,6 +538,102 @@ TEST(EnvLayouts, BadInputGivesClearErrors) {
   EXPECT_FALSE(load_cube_map(d).ok());
   // The good set still loads.
   EXPECT_TRUE(load_cube_map(d / "ok_*.png").ok());
+}
+
+}  // namespace
+}  // namespace kaskad
+
+namespace kaskad {
+namespace {
+
+/// Mean |difference| (RGB) between each border texel of every face and the texel across the
+/// cube edge (found through cube_direction() beyond [0,1] and cube_coord()), and between
+/// horizontally adjacent texels inside the faces, for comparison.
+std::pair<double, double> seam_and_interior_difference(const CubeMap& cube) {
+  const int n = cube.size;
+  double seam = 0.0, interior = 0.0;
+  int seams = 0, interiors = 0;
+  auto rgb_diff = [](const glm::vec4& a, const glm::vec4& b) {
+    const glm::vec3 d = glm::abs(glm::vec3(a) - glm::vec3(b));
+    return double(d.x + d.y + d.z) / 3.0;
+  };
+  for (int f = 0; f < 6; ++f) {
+    for (int i = 0; i < n; ++i) {
+      // The four edges: (x, y) of the border texel and the texel centre one step outside.
+      const std::array<std::array<float, 4>, 4> edges = {{
+          {0.0f, float(i), -0.5f, i + 0.5f},
+          {float(n - 1), float(i), n + 0.5f, i + 0.5f},
+          {float(i), 0.0f, i + 0.5f, -0.5f},
+          {float(i), float(n - 1), i + 0.5f, n + 0.5f},
+      }};
+      for (const auto& e : edges) {
+        const CubeCoord c = cube_coord(cube_direction(CubeFace(f), e[2] / n, e[3] / n));
+        EXPECT_NE(int(c.face), f);
+        const int x = std::clamp(int(c.s * n), 0, n - 1), y = std::clamp(int(c.t * n), 0, n - 1);
+        seam += rgb_diff(cube.at(CubeFace(f), int(e[0]), int(e[1])), cube.at(c.face, x, y));
+        ++seams;
+      }
+      for (int x = 0; x + 1 < n; x += 7) {
+        interior += rgb_diff(cube.at(CubeFace(f), x, i), cube.at(CubeFace(f), x + 1, i));
+        ++interiors;
+      }
+    }
+  }
+  return {seam / seams, interior / interiors};
+}
+
+TEST(EnvLayouts, SeamsOfASmoothEnvironmentAreContinuous) {
+  const auto [seam, interior] = seam_and_interior_difference(make_cube_map(32, smooth_env));
+  EXPECT_LT(seam, 2.0 * interior);
+  // A face turned by 90 degrees breaks the seams: the check can fail.
+  CubeMap turned = make_cube_map(32, smooth_env);
+  auto& face = turned.faces[std::size_t(CubeFace::pos_z)];
+  const auto copy = face;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) face[std::size_t(y * 32 + x)] = copy[std::size_t(x * 32 + 31 - y)];
+  EXPECT_GT(seam_and_interior_difference(turned).first, 3.0 * interior);
+}
+
+TEST(EnvLayouts, ShippedSkyBoxLoadsFromItsFolderWithSeamlessEdges) {
+  const fs::path folder = test::content_path("env/cube/SwedishRoyalCastle");
+  auto cube = load_cube_map(folder);
+  ASSERT_TRUE(cube.ok()) << cube.error().to_string();
+  EXPECT_EQ(cube->size, 512);
+  auto same = load_cube_map(folder / "nz.jpg");
+  ASSERT_TRUE(same.ok());
+  EXPECT_EQ(cube_max_diff(*cube, *same), 0.0f);
+  // The photos meet at the cube's edges in GL's face convention (a wrongly oriented or placed
+  // face would differ by a lot more than neighbouring texels do).
+  const auto [seam, interior] = seam_and_interior_difference(*cube);
+  EXPECT_LT(seam, 1.5 * interior) << "seam " << seam << " interior " << interior;
+  // The sky is above: +Y is brighter than -Y.
+  const glm::vec4 up = sample_cube(*cube, {0, 1, 0}), down = sample_cube(*cube, {0, -1, 0});
+  EXPECT_GT(up.r + up.g + up.b, down.r + down.g + down.b);
+}
+
+TEST(EnvLayouts, ShippedEquirectHdrLoads) {
+  auto cube = load_cube_map(test::content_path("env/equirect/venice_sunset_1k.hdr"));
+  ASSERT_TRUE(cube.ok()) << cube.error().to_string();
+  EXPECT_EQ(cube->size, 256);  // 1024 / 4
+  float brightest = 0.0f;
+  for (const auto& face : cube->faces)
+    for (const glm::vec4& t : face) brightest = std::max(brightest, t.r);
+  EXPECT_GT(brightest, 1.0f);  // HDR values survive
+  const glm::vec4 up = sample_cube(*cube, {0, 1, 0}), down = sample_cube(*cube, {0, -1, 0});
+  EXPECT_GT(up.b, down.b);  // sky above, ground below
+}
+
+TEST(EnvLayouts, FolderAndOptionErrors) {
+  const fs::path d = dir_for("folder_errors");
+  fs::create_directories(d / "empty");
+  auto empty = load_cube_map(d / "empty");
+  ASSERT_FALSE(empty.ok());
+  EXPECT_EQ(empty.error().file, (d / "empty").string());
+  EnvLoadOptions big;
+  big.face_size = 100000;
+  auto too_big = load_cube_map(test::content_path("env/cube/SwedishRoyalCastle"), big);
+  ASSERT_FALSE(too_big.ok());
+  EXPECT_NE(too_big.error().message.find("face_size must be in [0, 8192]"), std::string::npos);
 }
 
 }  // namespace

@@ -1,0 +1,140 @@
+#include "runtime/cli/envmap_command.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string_view>
+
+#include "runtime/assets/env_map.h"
+#include "runtime/reference/reflection_reference.h"
+
+namespace kaskad {
+namespace {
+
+namespace fs = std::filesystem;
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int usage_error(const std::string& message) {
+  std::fprintf(stderr, "kaskad: %s\n(run `kaskad --help` for usage)\n", message.c_str());
+  return 2;
+}
+
+int fail(const Error& e) {
+  std::fprintf(stderr, "kaskad: error: %s\n", e.to_string().c_str());
+  return 1;
+}
+
+/// A positive integer no larger than `hi`, or -1.
+int parse_size(const std::string& v, int hi) {
+  char* end = nullptr;
+  const long n = std::strtol(v.c_str(), &end, 10);
+  if (v.empty() || *end != '\0' || n < 1 || n > hi) return -1;
+  return int(n);
+}
+
+void make_parent(const fs::path& file) {
+  std::error_code ec;
+  if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);
+}
+
+}  // namespace
+
+int run_envmap_command(int argc, char** argv) {
+  std::string in, faces_out, sphere_out;
+  EnvLoadOptions options;
+  int sphere_size = 0;
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&](std::string& into) {
+      if (i + 1 >= argc) return false;
+      into = argv[++i];
+      return true;
+    };
+    std::string v;
+    if (arg == "--layout") {
+      if (!value(v)) return usage_error(arg + " needs a value");
+      bool known = false;
+      for (EnvLayout l : {EnvLayout::auto_detect, EnvLayout::faces, EnvLayout::horizontal_cross,
+                          EnvLayout::vertical_cross, EnvLayout::equirect, EnvLayout::sphere}) {
+        if (v == env_layout_name(l)) {
+          options.layout = l;
+          known = true;
+        }
+      }
+      if (!known) {
+        return usage_error("--layout expects auto, faces, horizontal_cross, vertical_cross, "
+                           "equirect or sphere, got '" + v + "'");
+      }
+    } else if (arg == "--3dsmax") {
+      options.z_up_3dsmax = true;
+    } else if (arg == "--face-size" || arg == "--sphere-size") {
+      if (!value(v)) return usage_error(arg + " needs a value");
+      const int n = parse_size(v, 8192);
+      if (n < 0) return usage_error(arg + " expects an integer in [1, 8192], got '" + v + "'");
+      (arg == "--face-size" ? options.face_size : sphere_size) = n;
+    } else if (arg == "--faces") {
+      if (!value(faces_out)) return usage_error(arg + " needs a value");
+    } else if (arg == "--sphere") {
+      if (!value(sphere_out)) return usage_error(arg + " needs a value");
+    } else if (!arg.empty() && arg[0] == '-') {
+      return usage_error("unknown option '" + arg + "'");
+    } else if (in.empty()) {
+      in = arg;
+    } else {
+      return usage_error("unexpected argument '" + arg + "'");
+    }
+  }
+  if (in.empty()) return usage_error("envmap needs an input map");
+
+  const auto t0 = std::chrono::steady_clock::now();
+  EnvLayout layout = options.layout;
+  auto cube = load_cube_map(in, options, &layout);
+  if (!cube) return fail(cube.error());
+  std::printf("envmap    %s: %s, %d^2 x 6 faces%s (load %.1f ms)\n", in.c_str(),
+              env_layout_name(layout), cube->size,
+              options.z_up_3dsmax ? ", converted from 3ds Max Z-up" : "", ms_since(t0));
+  if (!faces_out.empty()) {
+    if (faces_out.find('*') != std::string::npos) make_parent(faces_out);
+    if (auto st = save_cube_faces(*cube, faces_out); !st) return fail(st.error());
+    std::printf("wrote     %s (px nx py ny pz nz)\n", faces_out.c_str());
+  }
+  if (!sphere_out.empty()) {
+    const int size = sphere_size > 0 ? sphere_size : 2 * cube->size;
+    const auto t1 = std::chrono::steady_clock::now();
+    const SphereMap map = sphere_map_from_cube(*cube, size);
+    const double ms = ms_since(t1);
+    make_parent(sphere_out);
+    if (auto st = save_sphere_map(map, sphere_out); !st) return fail(st.error());
+    std::printf("wrote     %s (sphere map %d^2, S3 eq. 2, %.1f ms)\n", sphere_out.c_str(), size, ms);
+  }
+  return 0;
+}
+
+Status write_reflection_reference(const Scene& scene, const Image& aov, const glm::vec3& eye,
+                                  const std::string& environment, const std::string& out) {
+  CubeMap env;
+  if (!environment.empty()) {
+    auto cube = load_cube_map(environment);
+    if (!cube) return cube.error();
+    env = std::move(*cube);
+  }
+  auto tracer = reference::RayTracer::build(scene);
+  if (!tracer) return tracer.error();
+  const reference::ReflectionScene rs =
+      reference::reflection_scene(scene, environment.empty() ? nullptr : &env);
+  auto ref = reference::reflection_reference(*tracer, aov, rs, eye);
+  if (!ref) return ref.error();
+  make_parent(out);
+  KASKAD_TRY(save_image(out, ref->image));
+  std::printf("wrote     %s (reflection reference: reflection.R/G/B reflection.hit mask; %llu rays, "
+              "%.1f ms, %.2f Mrays/s)\n",
+              fs::absolute(out).string().c_str(), static_cast<unsigned long long>(ref->rays),
+              ref->seconds * 1e3, ref->seconds > 0.0 ? double(ref->rays) / ref->seconds * 1e-6 : 0.0);
+  return {};
+}
+
+}  // namespace kaskad

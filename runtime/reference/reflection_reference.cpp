@@ -1,0 +1,298 @@
+// The reflection reference. Per AOV pixel:
+//   1. the rasterised position P and normal N; U = P - eye;
+//   2. the mirror ray R = U - 2 (N.U) N (S3 eq. 1), traced by RayTracer::trace_mirror();
+//   3. hit: forward.frag's shading of the hit surface towards P (shade_point(), hard shadow rays);
+//      miss: the environment cube along R, else the clear colour;
+//   4. rows are shared out to worker threads through one atomic counter.
+#include "runtime/reference/reflection_reference.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <thread>
+
+#include "components/mesh_renderer.h"
+#include "components/transform.h"
+
+namespace kaskad::reference {
+namespace {
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+/// GLSL smoothstep, with a step where the edges meet (GLSL leaves e0 >= e1 undefined).
+float smoothstep(float e0, float e1, float x) {
+  if (!(e1 > e0)) return x >= e1 ? 1.0f : 0.0f;
+  const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
+  return t * t * (3.0f - 2.0f * t);
+}
+
+int find_channel(const Image& image, const char* name) {
+  const auto it = std::find(image.channel_names.begin(), image.channel_names.end(), name);
+  if (it == image.channel_names.end() || it - image.channel_names.begin() >= image.channels)
+    return -1;
+  return int(it - image.channel_names.begin());
+}
+
+Status check_sizes(const Image& image, const char* what) {
+  if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
+      image.pixels.size() !=
+          std::size_t(image.width) * std::size_t(image.height) * std::size_t(image.channels)) {
+    std::string message = "size ";
+    message += std::to_string(image.width);
+    message += "x";
+    message += std::to_string(image.height);
+    message += "x";
+    message += std::to_string(image.channels);
+    message += " does not match its ";
+    message += std::to_string(image.pixels.size());
+    message += " values";
+    return Error{"", what, message};
+  }
+  return {};
+}
+
+}  // namespace
+
+ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment) {
+  ReflectionScene out;
+  out.world = &scene.world;
+  out.ambient = scene.render.ambient;
+  out.clear_color = scene.render.clear_color;
+  out.environment = environment;
+  // As systems/frame.cpp build_frame_input() fills render::LightItem (change together).
+  scene.world.view<Light, WorldTransform>().each(
+      [&](ecs::Entity, const Light& l, const WorldTransform& wt) {
+        ShadingLight s;
+        s.type = l.type;
+        s.radiance = l.color * l.intensity;
+        s.direction = light_direction(wt.matrix);
+        s.position = glm::vec3(wt.matrix[3]);
+        s.range = l.range;
+        s.cos_inner = std::cos(glm::radians(l.inner_cone_deg));
+        s.cos_outer = std::cos(glm::radians(l.outer_cone_deg));
+        s.shadowed = l.cast_shadows;
+        out.lights.push_back(s);
+      });
+  return out;
+}
+
+glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
+                      const Material& material, const glm::vec3& position,
+                      const glm::vec3& normal, const glm::vec3& to_eye, bool receives_shadows,
+                      std::uint64_t* rays) {
+  // forward.frag, main(), line by line (change together).
+  const glm::vec3 base = glm::vec3(material.base_color);
+  const glm::vec3& n = normal;
+  const glm::vec3& v = to_eye;
+  const float metallic = std::clamp(material.metallic, 0.0f, 1.0f);
+  const float roughness = std::clamp(material.roughness, 0.03f, 1.0f);
+  const glm::vec3 diffuse_color = base * (1.0f - metallic);
+  const glm::vec3 f0 = glm::mix(glm::vec3(0.04f), base, metallic);
+  // Blinn-Phong exponent from roughness (alpha = roughness^2, n = 2 / alpha^2 - 2), normalised.
+  const float alpha = roughness * roughness;
+  const float shininess = std::max(2.0f / (alpha * alpha) - 2.0f, 1.0f);
+  const float spec_norm = (shininess + 8.0f) / 8.0f;
+
+  glm::vec3 color = scene.ambient * diffuse_color + material.emissive;
+  for (const ShadingLight& light : scene.lights) {
+    glm::vec3 l;
+    float attenuation = 1.0f;
+    const glm::vec3 dir = glm::normalize(light.direction);
+    if (light.type == LightType::directional) {
+      l = -dir;
+    } else {
+      const glm::vec3 to_light = light.position - position;
+      const float d2 = std::max(glm::dot(to_light, to_light), 1e-8f);
+      l = to_light / std::sqrt(d2);
+      attenuation = 1.0f / d2;
+      if (light.range > 0.0f) {  // KHR_lights_punctual's recommended smooth window
+        const float r = d2 / (light.range * light.range);
+        attenuation *= std::clamp(1.0f - r * r, 0.0f, 1.0f);
+      }
+      if (light.type == LightType::spot)
+        attenuation *= smoothstep(light.cos_outer, light.cos_inner, glm::dot(-l, dir));
+    }
+    const float ndl = std::max(glm::dot(n, l), 0.0f);
+    if (ndl <= 0.0f) continue;
+    const glm::vec3 h = glm::normalize(l + v);
+    const glm::vec3 spec =
+        f0 * spec_norm * std::pow(std::max(glm::dot(n, h), 0.0f), shininess);
+    float shadow = 1.0f;
+    if (light.shadowed && receives_shadows && attenuation > 0.0f) {
+      ReferenceLight ref;
+      ref.type = light.type;
+      ref.position = light.position;
+      ref.direction = dir;
+      shadow = tracer.hard_visibility(position, n, ref);
+      if (rays) ++*rays;
+    }
+    color += (diffuse_color + spec) * light.radiance * ndl * attenuation * shadow;
+  }
+  return color;
+}
+
+glm::vec3 reflected_radiance(const RayTracer& tracer, const ReflectionScene& scene,
+                             const glm::vec3& position, const glm::vec3& normal,
+                             const glm::vec3& eye, bool* hit, std::uint64_t* rays) {
+  if (hit) *hit = false;
+  const glm::vec3 incident = position - eye;
+  const float ul = glm::length(incident), nl = glm::length(normal);
+  if (!(ul > 0.0f) || !(nl > 0.0f) || !finite(incident) || !finite(normal))
+    return glm::vec3(0.0f);
+  if (rays) ++*rays;
+  const std::optional<SurfaceHit> surface = tracer.trace_mirror(position, normal, incident);
+  if (!surface) {
+    // S3 eq. (1), as trace_mirror() computes it (N turned towards the eye first).
+    const glm::vec3 u = incident / ul;
+    glm::vec3 n = normal / nl;
+    if (glm::dot(n, u) > 0.0f) n = -n;
+    const glm::vec3 r = u - 2.0f * glm::dot(n, u) * n;
+    if (scene.environment && scene.environment->size > 0)
+      return glm::vec3(sample_cube(*scene.environment, r));
+    return scene.clear_color;
+  }
+  if (hit) *hit = true;
+  const Material default_material;
+  const Material* material = nullptr;
+  bool receives = true;
+  if (scene.world && scene.world->alive(surface->entity)) {
+    material = scene.world->try_get<Material>(surface->entity);
+    if (const auto* mr = scene.world->try_get<MeshRenderer>(surface->entity))
+      receives = mr->receive_shadows;
+  }
+  const glm::vec3 to_mirror = glm::normalize(position - surface->position);
+  return shade_point(tracer, scene, material ? *material : default_material, surface->position,
+                     surface->normal, to_mirror, receives, rays);
+}
+
+Result<ReflectionReference> reflection_reference(const RayTracer& tracer, const Image& aov,
+                                                 const ReflectionScene& scene,
+                                                 const glm::vec3& eye, int threads) {
+  KASKAD_CHECK(threads >= 0, "threads must be >= 0 (0 = all cores), was " + std::to_string(threads));
+  KASKAD_TRY(check_sizes(aov, "AOV image"));
+  // Channels by name (EXR files may come back reordered); canonical order when unnamed.
+  constexpr std::array<const char*, 7> kNames = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z", "mask"};
+  constexpr std::array<int, 7> kCanonical = {0, 1, 2, 3, 4, 5, 8};
+  std::array<int, 7> ch{};
+  if (aov.channel_names.empty()) {
+    if (aov.channels != 9 && aov.channels != 10) {
+      return Error{"", "AOV image",
+                   "has no channel names and " + std::to_string(aov.channels) +
+                       " channels, not the 9 or 10 of Renderer::read_aovs()"};
+    }
+    ch = kCanonical;
+  } else {
+    for (std::size_t i = 0; i < kNames.size(); ++i) {
+      ch[i] = find_channel(aov, kNames[i]);
+      if (ch[i] < 0) return Error{"", "AOV image", std::string("has no channel '") + kNames[i] + "'"};
+    }
+  }
+
+  ReflectionReference out;
+  Image& img = out.image;
+  img.width = aov.width;
+  img.height = aov.height;
+  img.channel_names = {kReflectionChannels[0], kReflectionChannels[1], kReflectionChannels[2],
+                       "reflection.hit", "mask"};
+  img.channels = int(img.channel_names.size());
+  img.pixels.assign(std::size_t(aov.width) * std::size_t(aov.height) * std::size_t(img.channels),
+                    0.0f);
+
+  std::atomic<int> next_row{0};
+  std::atomic<std::uint64_t> total_rays{0};
+  auto worker = [&] {
+    std::uint64_t rays = 0;
+    for (int y = next_row.fetch_add(1); y < aov.height; y = next_row.fetch_add(1)) {
+      for (int x = 0; x < aov.width; ++x) {
+        if (!(aov.at(x, y, ch[6]) >= 0.5f)) continue;  // background (or NaN mask)
+        const glm::vec3 p{aov.at(x, y, ch[0]), aov.at(x, y, ch[1]), aov.at(x, y, ch[2])};
+        const glm::vec3 n{aov.at(x, y, ch[3]), aov.at(x, y, ch[4]), aov.at(x, y, ch[5])};
+        if (!finite(p) || !finite(n) || !(glm::length(n) > 0.0f)) continue;
+        bool hit = false;
+        const glm::vec3 c = reflected_radiance(tracer, scene, p, n, eye, &hit, &rays);
+        for (int i = 0; i < 3; ++i) img.at(x, y, i) = c[i];
+        img.at(x, y, 3) = hit ? 1.0f : 0.0f;
+        img.at(x, y, 4) = 1.0f;
+      }
+    }
+    total_rays.fetch_add(rays);
+  };
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const int thread_count = std::min(aov.height, threads > 0 ? threads : int(hw));
+  const auto start = std::chrono::steady_clock::now();
+  {  // the pool joins at the end of this block
+    std::vector<std::jthread> pool;
+    for (int i = 1; i < thread_count; ++i) pool.emplace_back(worker);
+    worker();  // the calling thread works too
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.rays = total_rays.load();
+  return out;
+}
+
+Result<ReflectionErrorStats> compare_reflections(const Image& method, const Image& reference) {
+  KASKAD_TRY(check_sizes(method, "reflection image"));
+  KASKAD_TRY(check_sizes(reference, "reflection reference"));
+  if (method.width != reference.width || method.height != reference.height) {
+    std::string message = "is ";
+    message += std::to_string(method.width);
+    message += "x";
+    message += std::to_string(method.height);
+    message += ", the reference ";
+    message += std::to_string(reference.width);
+    message += "x";
+    message += std::to_string(reference.height);
+    return Error{"", "reflection image", message};
+  }
+  std::array<int, 3> m{}, r{};
+  for (int i = 0; i < 3; ++i) {
+    m[std::size_t(i)] = find_channel(method, kReflectionChannels[i]);
+    r[std::size_t(i)] = find_channel(reference, kReflectionChannels[i]);
+    if (m[std::size_t(i)] < 0)
+      return Error{"", "reflection image", std::string("has no channel '") + kReflectionChannels[i] + "'"};
+    if (r[std::size_t(i)] < 0)
+      return Error{"", "reflection reference", std::string("has no channel '") + kReflectionChannels[i] + "'"};
+  }
+  const int mask = find_channel(reference, "mask");
+  if (mask < 0) return Error{"", "reflection reference", "has no channel 'mask'"};
+  const int reflector = find_channel(method, "reflector");  // optional
+
+  ReflectionErrorStats stats;
+  double sum_sq = 0.0, sum_abs = 0.0;
+  for (int y = 0; y < method.height; ++y) {
+    for (int x = 0; x < method.width; ++x) {
+      if (!(reference.at(x, y, mask) >= 0.5f)) continue;
+      if (reflector >= 0 && !(method.at(x, y, reflector) >= 0.5f)) continue;
+      std::array<double, 3> d{};
+      bool ok = true;
+      for (std::size_t i = 0; i < 3; ++i) {
+        const float a = method.at(x, y, m[i]), b = reference.at(x, y, r[i]);
+        ok = ok && std::isfinite(a) && std::isfinite(b);
+        d[i] = double(a) - double(b);
+      }
+      if (!ok) {
+        ++stats.non_finite;
+        continue;
+      }
+      ++stats.pixels;
+      for (double e : d) {
+        sum_sq += e * e;
+        sum_abs += std::abs(e);
+        stats.max_abs_error = std::max(stats.max_abs_error, std::abs(e));
+      }
+    }
+  }
+  if (stats.pixels > 0) {
+    const double values = 3.0 * double(stats.pixels);
+    stats.rmse = std::sqrt(sum_sq / values);
+    stats.mean_abs_error = sum_abs / values;
+  }
+  return stats;
+}
+
+}  // namespace kaskad::reference
