@@ -280,12 +280,24 @@ VariantKey material_variant(const DrawItem& d) {
 
 std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   const VariantKey fk = frame_variant(frame);
+  // Probe captures draw without AOVs; a reflector's draw gets its map feature once its first
+  // capture completes (possibly frames later when time-sliced): compile those up front too.
+  const VariantKey capture_fk = VariantKey(fk.bits() & ~VariantKey::kAovs.mask());
   std::vector<ProgramRequest> out;
   for (const DrawItem& d : frame.draws) {
     const VariantKey k = material_variant(d) | fk;
     out.push_back({Pass::forward, k.filtered_for(Pass::forward)});
     if (fk.has(VariantKey::kShadow) && d.cast_shadows)
       out.push_back({Pass::depth, k.filtered_for(Pass::depth)});
+    std::vector<VariantKey> materials = {material_variant(d)};
+    for (const ProbeJob& job : frame.probes)
+      if (job.handle == d.probe)
+        materials.push_back(VariantKey(materials[0]).set(
+            job.sphere ? VariantKey::kReflectionSphere : VariantKey::kReflectionCube, 1));
+    for (const VariantKey m : materials) {
+      out.push_back({Pass::forward, (m | fk).filtered_for(Pass::forward)});
+      if (!frame.probes.empty()) out.push_back({Pass::forward, (m | capture_fk).filtered_for(Pass::forward)});
+    }
   }
   auto less = [](const ProgramRequest& a, const ProgramRequest& b) {
     return std::pair(a.pass, a.key) < std::pair(b.pass, b.key);
