@@ -15,7 +15,7 @@ layout(location = 1) out vec4 o_position;    // xyz world position, w mask (1 = 
 layout(location = 2) out vec4 o_normal;      // xyz world normal facing the camera, w view depth
 layout(location = 3) out vec2 o_visibility;  // x shadow visibility of the shadowed light,
                                              // y its cascade (-1 outside every cascade)
-layout(location = 4) out vec4 o_reflection;  // rgb reflected colour C_t (0 without a map)
+layout(location = 4) out vec4 o_reflection;  // rgb reflected colour C_t, a 1 with a map (else 0)
 #endif
 
 // Reflection maps (S3). The probe's map and x = k_s * p_r (eq. (3)) are set per draw.
@@ -115,13 +115,17 @@ void main() {
   }
 
   vec3 reflected = vec3(0.0);  // S3's C_t
+  float reflector = 0.0;       // 1 where a reflection map applies (AOV)
 #if MATERIAL_HAS_REFLECTION_CUBE || MATERIAL_HAS_REFLECTION_SPHERE
   // S3 eq. (1), R = U - 2 (N.U) N with U the unit vector from the eye to the point. Computed in
   // world space, which is eq. (6)'s (MV)^-1 R_VCS (rotation part): the cube is in world space.
   vec3 r_world = reflect(-v, n);
 #endif
 #if MATERIAL_HAS_REFLECTION_CUBE
-  if (ENABLED(BIT_REFLECTION_CUBE)) reflected = texture(u_reflection_cube, r_world).rgb;
+  if (ENABLED(BIT_REFLECTION_CUBE)) {
+    reflected = texture(u_reflection_cube, r_world).rgb;
+    reflector = 1.0;
+  }
 #endif
 #if MATERIAL_HAS_REFLECTION_SPHERE
   if (ENABLED(BIT_REFLECTION_SPHERE)) {
@@ -130,6 +134,7 @@ void main() {
     float a_z = sqrt(max((r_view.z + 1.0) * 0.5, 1e-8));
     vec2 st = r_view.xy / (2.0 * a_z);
     reflected = texture(u_reflection_sphere, st * 0.5 + 0.5).rgb;
+    reflector = 1.0;
   }
 #endif
 #if MATERIAL_HAS_REFLECTION_CUBE || MATERIAL_HAS_REFLECTION_SPHERE
@@ -144,6 +149,6 @@ void main() {
   o_position = vec4(v_world_pos, 1.0);
   o_normal = vec4(geometric_n, view_depth);
   o_visibility = vec2(visibility, float(cascade));
-  o_reflection = vec4(reflected, 1.0);
+  o_reflection = vec4(reflected, reflector);
 #endif
 }

@@ -96,7 +96,7 @@ struct Renderer::Impl {
   gpu::Texture shadow_map;
   bool shadow_valid = false;
 
-  std::array<gpu::Query, 2> timers;
+  std::array<gpu::Query, 3> timers;  // shadow, forward, probe captures
   bool timers_pending = false;
   std::uint64_t frames_rendered = 0;
   bool aovs_written = false;
@@ -242,6 +242,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
   glNamedBufferStorage(im.frame_ubo.id(), sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   im.timers[0] = gpu::make_query(GL_TIME_ELAPSED);
   im.timers[1] = gpu::make_query(GL_TIME_ELAPSED);
+  im.timers[2] = gpu::make_query(GL_TIME_ELAPSED);
   // Empty shadow map so the sampler is complete even in frames without a shadow pass.
   im.ensure_shadow_map(64, 1, DepthFormat::d24, ShadowFilter::none);
   return r;
@@ -326,11 +327,14 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
                    std::to_string(frame.height));
   // Timer results of the previous frame (available after finish()).
   if (im.timers_pending) {
-    GLuint64 ns[2] = {0, 0};
+    GLuint64 ns[3] = {0, 0, 0};
     glGetQueryObjectui64v(im.timers[0].id(), GL_QUERY_RESULT, &ns[0]);
     glGetQueryObjectui64v(im.timers[1].id(), GL_QUERY_RESULT, &ns[1]);
+    glGetQueryObjectui64v(im.timers[2].id(), GL_QUERY_RESULT, &ns[2]);
     stats_.shadow_gpu_ms = double(ns[0]) * 1e-6;
     stats_.forward_gpu_ms = double(ns[1]) * 1e-6;
+    stats_.probe_gpu_ms = double(ns[2]) * 1e-6;
+    stats_.probe_faces_timed = stats_.probe_faces;  // still the previous frame's count here
   }
   stats_.draw_calls = stats_.shadow_draw_calls = 0;
   stats_.triangles = stats_.shadow_triangles = 0;
@@ -542,6 +546,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   // selection and sphere-map lookups are the main view's. Then mips, then sphere maps.
   stats_.probe_faces = 0;
   stats_.probe_draw_calls = 0;
+  glBeginQuery(GL_TIME_ELAPSED, im.timers[2].id());
   if (!frame.probes.empty()) {
     const VariantKey capture_frame = VariantKey(frame_key.bits() & ~VariantKey::kAovs.mask());
     std::vector<VariantKey> capture_keys(frame.draws.size());
@@ -568,7 +573,10 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
         im.probes->begin_face(job.handle, job.target, f, frame.clear_color);
         const int before = stats_.draw_calls;
         const std::size_t triangles_before = stats_.triangles;
-        KASKAD_TRY(draw_forward(capture_keys, &job));
+        if (Status st = draw_forward(capture_keys, &job); !st) {
+          glEndQuery(GL_TIME_ELAPSED);
+          return st;
+        }
         stats_.probe_draw_calls += stats_.draw_calls - before;
         stats_.draw_calls = before;
         stats_.triangles = triangles_before;
@@ -582,6 +590,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
       if (job.sphere && im.probes->existing_cube(job.handle, job.visible))
         im.probes->update_sphere(job.handle, job.visible, glm::mat3(frame.camera.view));
   }
+  glEndQuery(GL_TIME_ELAPSED);
 
   // Pass 3: forward shading into colour (+ AOV targets when asked for).
   glBeginQuery(GL_TIME_ELAPSED, im.timers[1].id());
@@ -676,9 +685,10 @@ Image Renderer::read_aovs() const {
   img.width = w;
   img.height = h;
   const auto refl = read_texture(im.reflection.id(), w, h, GL_RGBA, 4);
-  img.channel_names = {"P.X", "P.Y",        "P.Z",  "N.X",     "N.Y",          "N.Z",
-                       "Z",   "visibility", "mask", "cascade", "reflection.R", "reflection.G",
-                       "reflection.B"};
+  img.channel_names = {"P.X",          "P.Y",          "P.Z",          "N.X",
+                       "N.Y",          "N.Z",          "Z",            "visibility",
+                       "mask",         "cascade",      "reflection.R", "reflection.G",
+                       "reflection.B", "reflector"};
   img.channels = int(img.channel_names.size());
   img.pixels.resize(std::size_t(w) * h * img.channels);
   for (std::size_t i = 0; i < std::size_t(w) * h; ++i) {
@@ -696,6 +706,7 @@ Image Renderer::read_aovs() const {
     o[10] = refl[i * 4 + 0];
     o[11] = refl[i * 4 + 1];
     o[12] = refl[i * 4 + 2];
+    o[13] = refl[i * 4 + 3];
   }
   return img;
 }

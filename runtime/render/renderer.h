@@ -126,6 +126,8 @@ struct FrameStats {
   /// GPU times are the previous frame's (queries are read a frame late); 0 until frame 3.
   double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
   double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)
+  double probe_gpu_ms = 0.0;          ///< GL_TIME_ELAPSED of the probe captures (previous frame)
+  int probe_faces_timed = 0;          ///< faces that probe_gpu_ms covers (previous frame's)
   int probe_faces = 0;                ///< reflection probe cube faces rendered this frame
   int probe_draw_calls = 0;           ///< draws into those faces (not in draw_calls)
   int program_switches = 0;           ///< glUseProgram calls in the frame (draws are sorted)
@@ -167,7 +169,8 @@ class Renderer {
 
   /// sRGB-encoded colour of the last frame, RGBA in [0,1], rows top to bottom.
   Image read_color() const;
-  /// AOVs of the last frame: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade (see README).
+  /// AOVs of the last frame: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade reflection.R
+  /// reflection.G reflection.B reflector (see README).
   /// Precondition: the last frame was rendered with write_aovs.
   Image read_aovs() const;
   /// A probe's cube buffer (0 or 1; level 0) or its sphere map (row 0 at the top) as last

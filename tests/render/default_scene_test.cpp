@@ -413,7 +413,7 @@ TEST_F(DefaultSceneTest, BadConfigurationIsCaughtByTheSameCheck) {
 TEST_F(DefaultSceneTest, AovChannelsFollowTheContract) {
   Image aov;
   render_and_compare({}, &aov);
-  ASSERT_EQ(aov.channels, 13);
+  ASSERT_EQ(aov.channels, 14);
   ASSERT_EQ(aov.channel_names[9], "cascade");
   ASSERT_EQ(aov.channel_names[7], "visibility");
   ASSERT_EQ(aov.channel_names[10], "reflection.R");
@@ -432,6 +432,7 @@ TEST_F(DefaultSceneTest, AovChannelsFollowTheContract) {
       const float v = aov.at(x, y, 7);
       ASSERT_TRUE(v >= 0.0f && v <= 1.0f);
       ASSERT_EQ(aov.at(x, y, 10), 0.0f);  // no reflector in the default scene: C_t = 0
+      ASSERT_EQ(aov.at(x, y, 13), 0.0f);
     }
   EXPECT_GT(drawn, aov.width * aov.height / 2);
   EXPECT_GT(background, 0);  // the sky is visible above the horizon
