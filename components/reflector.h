@@ -49,6 +49,12 @@ struct Reflector {
   /// MeshRenderer layers (bit i = layer i) not drawn into the probe; the reflector itself is
   /// never drawn into its own probe.
   std::uint32_t exclude_layers = 0;
+  /// Box projection (parallax correction; beyond S3, as in Unity, Godot and Bevy), cube maps
+  /// only: lookups treat the environment as lying on this world-space box (which should hold the
+  /// capture centre), so R is replaced by the direction from the centre to where the ray from the
+  /// shaded point along R leaves the box.
+  bool box_projection = false;
+  glm::vec3 box_min{0.0f}, box_max{0.0f};
   /// S3's p_r, the map's amount, as a fraction in [0, 1] (the paper's percent / 100).
   float amount = 1.0f;
   /// static_file: the image, or the six faces' name pattern with one `*` (load_cube_map in
@@ -80,6 +86,12 @@ inline std::string validate_reflector(const Reflector& r) {
   if (!(r.far > r.near && std::isfinite(r.far)))
     return "far must be finite and greater than near, was " + str(r.far);
   if (!(r.amount >= 0.0f && r.amount <= 1.0f)) return "amount must be in [0, 1], was " + str(r.amount);
+  if (r.box_projection && !(r.box_min.x < r.box_max.x && r.box_min.y < r.box_max.y &&
+                            r.box_min.z < r.box_max.z))
+    return "box min must be below max on every axis";
+  if (r.box_projection && r.has_center &&
+      (glm::any(glm::lessThan(r.center, r.box_min)) || glm::any(glm::greaterThan(r.center, r.box_max))))
+    return "box must contain the capture centre";
   if (r.update == ProbeUpdate::static_file && r.file.empty())
     return "file must name an image when update is static_file";
   return {};

@@ -203,6 +203,9 @@ ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool
     job.target = work.swap ? s.front : 1 - s.front;
     job.visible = s.front;
     job.sphere = entry.sphere;
+    job.box = r.box_projection && !entry.sphere;
+    job.box_min = r.box_min;
+    job.box_max = r.box_max;
     const glm::mat4 proj = cube_face_projection(r.near, r.far);
     for (int f = 0; f < 6; ++f) job.view_proj[std::size_t(f)] = proj * cube_face_view(f, s.center);
     if (work.load)

@@ -50,12 +50,14 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         d.layer = mr.layer;
         // A reflector's own draw reflects its probe's map once one is complete (S3 eq. (3)).
         d.material.features &= ~(render::VariantKey::kReflectionCube.mask() |
-                                 render::VariantKey::kReflectionSphere.mask());
+                                 render::VariantKey::kReflectionSphere.mask() |
+                                 render::VariantKey::kReflectionBox.mask());
         if (const ProbeData::Entry* p = probes.find(e)) {
           d.probe = p->job.handle;
           if (p->has_map) {
             d.material.features |= (p->sphere ? render::VariantKey::kReflectionSphere
                                               : render::VariantKey::kReflectionCube).mask();
+            if (p->job.box) d.material.features |= render::VariantKey::kReflectionBox.mask();
             d.reflection_scale = d.material.k_s * p->amount;
           }
         }

@@ -25,6 +25,19 @@ layout(location = 16) uniform vec4 u_reflection;
 #if MATERIAL_HAS_REFLECTION_CUBE
 layout(binding = 3) uniform samplerCube u_reflection_cube;
 #endif
+#if MATERIAL_HAS_REFLECTION_BOX
+layout(location = 17) uniform vec4 u_reflection_box_min;  // xyz: world-space box (Reflector)
+layout(location = 18) uniform vec4 u_reflection_box_max;
+layout(location = 19) uniform vec4 u_reflection_centre;   // xyz: the probe's capture centre
+
+// Box projection (parallax correction, beyond S3): the environment is taken to lie on the box,
+// so look up the direction from the capture centre to where the ray (p, r) leaves the box.
+vec3 box_project(vec3 p, vec3 r) {
+  vec3 exits = max((u_reflection_box_max.xyz - p) / r, (u_reflection_box_min.xyz - p) / r);
+  float t = max(min(min(exits.x, exits.y), exits.z), 0.0);
+  return p + t * r - u_reflection_centre.xyz;
+}
+#endif
 #if MATERIAL_HAS_REFLECTION_SPHERE
 layout(binding = 4) uniform sampler2D u_reflection_sphere;  // made for this camera (probe_sphere.frag)
 #endif
@@ -123,7 +136,11 @@ void main() {
 #endif
 #if MATERIAL_HAS_REFLECTION_CUBE
   if (ENABLED(BIT_REFLECTION_CUBE)) {
-    reflected = texture(u_reflection_cube, r_world).rgb;
+    vec3 lookup = r_world;
+#if MATERIAL_HAS_REFLECTION_BOX
+    if (ENABLED(BIT_REFLECTION_BOX)) lookup = box_project(v_world_pos, r_world);
+#endif
+    reflected = texture(u_reflection_cube, lookup).rgb;
     reflector = 1.0;
   }
 #endif

@@ -48,6 +48,14 @@ void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
       out.exclude_layers |= 1u << layer;
     }
   }
+  if (r.has("box")) {
+    json_reader::ObjectReader br(r.raw("box"), r.at("box"));
+    if (!br.has("min") || !br.has("max")) fail(r.at("box"), "a box needs min and max");
+    br.vector<3>("min", out.box_min, -kBig, kBig);
+    br.vector<3>("max", out.box_max, -kBig, kBig);
+    br.finish();
+    out.box_projection = true;
+  }
   r.number("amount", out.amount, 0.0f, 1.0f);
   r.string("file", out.file);
   r.enumeration("layout", out.layout, kLayouts);
@@ -85,6 +93,7 @@ json reflector_to_json(const Reflector& r) {
   for (int i = 0; i < 32; ++i)
     if (r.exclude_layers & (1u << i)) layers.push_back(i);
   j["exclude_layers"] = layers;
+  if (r.box_projection) j["box"] = {{"min", vec(r.box_min)}, {"max", vec(r.box_max)}};
   j["amount"] = num(r.amount);
   j["file"] = r.file;
   j["layout"] = enum_name(r.layout, kLayouts);

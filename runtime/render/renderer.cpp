@@ -48,7 +48,8 @@ GLenum depth_internal_format(DepthFormat f) {
 constexpr GLuint kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
 constexpr GLint kUniModel = 0, kUniNormalMatrix = 4, kUniBaseColor = 8, kUniMaterial = 9,
                 kUniEmissive = 10, kUniOracleFeatures = 11, kUniLightViewProj = 12,
-                kUniReflection = 16;
+                kUniReflection = 16, kUniReflectionBoxMin = 17, kUniReflectionBoxMax = 18,
+                kUniReflectionCentre = 19;
 constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2, kTexReflectionCube = 3,
                  kTexReflectionSphere = 4;
 
@@ -293,8 +294,10 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
     std::vector<VariantKey> materials = {material_variant(d)};
     for (const ProbeJob& job : frame.probes)
       if (job.handle == d.probe)
-        materials.push_back(VariantKey(materials[0]).set(
-            job.sphere ? VariantKey::kReflectionSphere : VariantKey::kReflectionCube, 1));
+        materials.push_back(VariantKey(materials[0])
+                                .set(job.sphere ? VariantKey::kReflectionSphere
+                                                : VariantKey::kReflectionCube, 1)
+                                .set(VariantKey::kReflectionBox, job.box ? 1u : 0u));
     for (const VariantKey m : materials) {
       out.push_back({Pass::forward, (m | fk).filtered_for(Pass::forward)});
       if (!frame.probes.empty()) out.push_back({Pass::forward, (m | capture_fk).filtered_for(Pass::forward)});
@@ -509,6 +512,11 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     glBindTextureUnit(kTexReflectionCube, im.probes->existing_cube(job.handle, buffer));
     glBindTextureUnit(kTexReflectionSphere, im.probes->existing_sphere(job.handle));
     glProgramUniform4f(prog, kUniReflection, d.reflection_scale, 0.0f, 0.0f, 0.0f);
+    if (key.has(VariantKey::kReflectionBox)) {
+      glProgramUniform4f(prog, kUniReflectionBoxMin, job.box_min.x, job.box_min.y, job.box_min.z, 0);
+      glProgramUniform4f(prog, kUniReflectionBoxMax, job.box_max.x, job.box_max.y, job.box_max.z, 0);
+      glProgramUniform4f(prog, kUniReflectionCentre, job.center.x, job.center.y, job.center.z, 0);
+    }
   };
   auto draw_forward = [&](const std::vector<VariantKey>& by, const ProbeJob* capture) -> Status {
     GLuint current = 0;

@@ -65,6 +65,8 @@ struct ProbeJob {
   int target = 1;
   int visible = 0;
   bool sphere = false;     ///< shade with a sphere map made from the visible cube (S3 eq. (2))
+  bool box = false;        ///< box projection of cube lookups onto [box_min, box_max] (world)
+  glm::vec3 box_min{0.0f}, box_max{0.0f};
   /// World -> clip of the six 90° face cameras (systems/environment_probe_system.h).
   std::array<glm::mat4, 6> view_proj{};
   /// Static file: index into AssetStore::env_maps to upload into buffer `visible` this frame;

@@ -1,5 +1,5 @@
 // Reflection probes (S3): what a capture costs and where a cube map is wrong.
-//   probe_bench [frames=120] [runs=3]
+//   probe_bench [frames=120] [runs=3]   (build/release/tests/probe_bench)
 // 1. Capture cost per face: GL_TIME_ELAPSED of the probe pass divided by the faces it rendered
 //    (content/scenes/reflections.json, both probes captured every frame at 128^2), against the
 //    forward pass of the main view rendered at the same 128^2 resolution.
@@ -8,7 +8,8 @@
 // 3. Reflection error: RMSE of the `reflection` AOV (C_t) of a mirror sphere against the Embree
 //    mirror-ray reference, in a near room (walls 2.5 m away, the sphere's radius 0.5 m) and a
 //    far one (250 m, 100x larger, so the camera image is the same); cube maps assume a distant
-//    environment, so only the far room should be nearly exact.
+//    environment, so only the far room should be nearly exact; and the near room again with box
+//    projection onto the room's inner walls.
 // Absolute times mean little on llvmpipe: compare the ratios.
 #include <algorithm>
 #include <chrono>
@@ -57,7 +58,7 @@ RenderTimings render_or_die(Player& player, Scene& scene, const RenderRun& run) 
 // A mirror sphere (radius 0.5) in a room of half-size `d` whose six walls are 2x2 tiles of
 // distinct emissive colours (unlit: ambient 0, no lights, so the reference shades exactly what
 // the rasteriser does). The camera is 2 m from the sphere in both rooms.
-fs::path room_scene(float d, const fs::path& dir) {
+fs::path room_scene(float d, bool box, const fs::path& dir) {
   std::string ents;
   const float t = 0.01f * d;  // wall thickness
   int tile = 0;
@@ -85,10 +86,19 @@ fs::path room_scene(float d, const fs::path& dir) {
         }
   ents += R"({"name": "mirror", "primitive": {"shape": "sphere", "segments": 128},
               "material": {"base_color": [0, 0, 0, 1], "k_s": 1},
-              "reflector": {"update": "first_frame", "resolution": 256, "near": 0.01, "far": 1000}},
+              "reflector": {"update": "first_frame", "resolution": 256, "near": 0.01, "far": 1000)";
+  if (box) {
+    const float inner = 0.995f * d;  // the walls' inner faces
+    char buf[160];
+    std::snprintf(buf, sizeof buf, R"(, "box": {"min": [%g, %g, %g], "max": [%g, %g, %g]})",
+                  double(-inner), double(-inner), double(-inner), double(inner), double(inner),
+                  double(inner));
+    ents += buf;
+  }
+  ents += R"(}},
              {"name": "camera", "transform": {"translation": [0.3, 0.4, 1.93], "look_at": [0, 0, 0]},
               "camera": {"fov_y_deg": 30, "near": 0.05, "far": 2000, "active": true}})";
-  const fs::path file = dir / ("room_" + std::to_string(int(d)) + ".json");
+  const fs::path file = dir / ("room_" + std::to_string(int(d)) + (box ? "_box" : "") + ".json");
   std::ofstream(file) << R"({"kaskad_scene": 1, "render": {"width": 320, "height": 320,
       "ambient": [0, 0, 0], "clear_color": [0, 0, 0], "exposure": 1}, "entities": [)"
                       << ents << "]}";
@@ -178,8 +188,8 @@ int main(int argc, char** argv) {
   // 3. Reflection error against the ray-traced reference, near and far environment.
   const fs::path dir = fs::temp_directory_path() / "kaskad_probe_bench";
   fs::create_directories(dir);
-  for (const float d : {2.5f, 250.0f}) {
-    Scene s = load_or_die(room_scene(d, dir), {});
+  for (const auto& [d, box] : {std::pair(2.5f, false), std::pair(2.5f, true), std::pair(250.0f, false)}) {
+    Scene s = load_or_die(room_scene(d, box, dir), {});
     RenderRun run;
     run.frames = 2;
     const RenderTimings t = render_or_die(*player, s, run);
@@ -200,9 +210,9 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "probe_bench: %s\n", err.error().to_string().c_str());
       return 1;
     }
-    std::printf("reflection walls at %6.1f m (mirror radius 0.5 m, cube 256^2): RMSE %.4f, mean abs "
-                "%.4f, max abs %.3f over %zu mirror pixels\n",
-                double(d), err->rmse, err->mean_abs_error, err->max_abs_error, err->pixels);
+    std::printf("reflection walls at %6.1f m%s (mirror radius 0.5 m, cube 256^2): RMSE %.4f, mean "
+                "abs %.4f, max abs %.3f over %zu mirror pixels\n",
+                double(d), box ? ", box-projected" : "", err->rmse, err->mean_abs_error, err->max_abs_error, err->pixels);
   }
   return gpu::debug_error_count() > 0 ? 1 : 0;
 }

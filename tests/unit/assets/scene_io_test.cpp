@@ -271,6 +271,9 @@ TEST(SceneIo, ReflectorsRoundTripAndOverride) {
   a->world.get<Reflector>(plane).has_center = true;
   a->world.get<Reflector>(plane).center = {0.5f, 1.5f, -4.25f};
   a->world.get<Reflector>(plane).exclude_layers = (1u << 3) | (1u << 31);
+  a->world.get<Reflector>(plane).box_projection = true;
+  a->world.get<Reflector>(plane).box_min = {-5, 0, -9};
+  a->world.get<Reflector>(plane).box_max = {5, 4.5f, 1};
   const fs::path first = temp_dir() / "refl1.json", second = temp_dir() / "refl2.json";
   ASSERT_TRUE(save_scene(first, *a).ok());
   auto b = read_scene(first);
@@ -281,6 +284,8 @@ TEST(SceneIo, ReflectorsRoundTripAndOverride) {
   EXPECT_TRUE(rb.has_center);
   EXPECT_EQ(rb.center, glm::vec3(0.5f, 1.5f, -4.25f));
   EXPECT_EQ(rb.exclude_layers, (1u << 3) | (1u << 31));
+  EXPECT_TRUE(rb.box_projection);
+  EXPECT_EQ(rb.box_max, glm::vec3(5, 4.5f, 1));
 }
 
 TEST(SceneIo, BadReflectorsNameTheKey) {
@@ -299,6 +304,10 @@ TEST(SceneIo, BadReflectorsNameTheKey) {
   EXPECT_NE(bad(R"({"exclude_layers": [40]})").find("/entities/0/reflector/exclude_layers/0"), std::string::npos);
   EXPECT_NE(bad(R"({"amount": 1.5})").find("/entities/0/reflector/amount"), std::string::npos);
   EXPECT_NE(bad(R"({"mirror": true})").find("unknown key 'mirror'"), std::string::npos);
+  EXPECT_NE(bad(R"({"box": {"min": [0, 0, 0], "max": [1, -1, 1]}})").find("/entities/0/reflector/box"), std::string::npos);
+  EXPECT_NE(bad(R"({"box": {"min": [0, 0, 0]}})").find("a box needs min and max"), std::string::npos);
+  EXPECT_NE(bad(R"({"center": [5, 0, 0], "box": {"min": [-1, -1, -1], "max": [1, 1, 1]}})")
+                .find("box must contain the capture centre"), std::string::npos);
   auto s = read_scene(write_file("reflector_no_mesh.json",
                                  R"({"kaskad_scene": 1, "entities": [{"reflector": {}}]})"));
   ASSERT_FALSE(s.ok());
