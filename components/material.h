@@ -21,6 +21,9 @@ struct Material {
   bool double_sided = false;                   ///< glTF doubleSided: light both faces
   bool alpha_mask = false;                     ///< glTF alphaMode MASK: discard below alpha_cutoff
   float alpha_cutoff = 0.5f;                   ///< glTF alphaCutoff
+  /// S3's k_s, the specular level that scales a reflection map's colour (eq. (3)), in [0, 1].
+  /// Used only on entities with a Reflector. 1: a mirror.
+  float k_s = 1.0f;
   /// Shader features this material uses, as VariantKey material bits (runtime/render/
   /// variant_key.h). Material files list them; other loaders call derive_material_features().
   std::uint32_t features = 0;

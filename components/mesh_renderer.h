@@ -16,6 +16,7 @@ struct MeshRenderer {
   MeshId mesh = kNoMesh;
   bool cast_shadows = true;     ///< drawn into shadow maps
   bool receive_shadows = true;  ///< shadow maps are sampled when shading it
+  int layer = 0;                ///< render layer in [0, 31]; Reflector::exclude_layers masks it
 };
 
 }  // namespace kaskad

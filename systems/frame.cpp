@@ -21,7 +21,8 @@ double ms_since(Clock::time_point t0) {
 }  // namespace
 
 render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx,
-                                     const CameraState& camera, const ShadowData& shadow) {
+                                     const CameraState& camera, const ShadowData& shadow,
+                                     const ProbeData& probes) {
   const ecs::World& world = scene.world;
   render::FrameInput in;
   in.width = ctx.width;
@@ -39,9 +40,30 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
       [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
         if (mr.mesh == kNoMesh) return;
         const Material* mat = world.try_get<Material>(e);
-        in.draws.push_back({mr.mesh, wt.matrix, mat ? *mat : default_material, mr.cast_shadows,
-                            mr.receive_shadows, shadow.cascade_mask(e)});
+        render::DrawItem d;
+        d.mesh = mr.mesh;
+        d.model = wt.matrix;
+        d.material = mat ? *mat : default_material;
+        d.cast_shadows = mr.cast_shadows;
+        d.receive_shadows = mr.receive_shadows;
+        d.cascade_mask = shadow.cascade_mask(e);
+        d.layer = mr.layer;
+        // A reflector's own draw reflects its probe's map once one is complete (S3 eq. (3)).
+        d.material.features &= ~(render::VariantKey::kReflectionCube.mask() |
+                                 render::VariantKey::kReflectionSphere.mask() |
+                                 render::VariantKey::kReflectionBox.mask());
+        if (const ProbeData::Entry* p = probes.find(e)) {
+          d.probe = p->job.handle;
+          if (p->has_map) {
+            d.material.features |= (p->sphere ? render::VariantKey::kReflectionSphere
+                                              : render::VariantKey::kReflectionCube).mask();
+            if (p->job.box) d.material.features |= render::VariantKey::kReflectionBox.mask();
+            d.reflection_scale = d.material.k_s * p->amount;
+          }
+        }
+        in.draws.push_back(d);
       });
+  for (const ProbeData::Entry& p : probes.probes) in.probes.push_back(p.job);
 
   world.view<Light, WorldTransform>().each(
       [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {
@@ -73,7 +95,8 @@ render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx, ShadowData&
   const CameraState camera = select_camera(scene.world, float(ctx.width) / float(ctx.height));
   ShadowCascadeState state;
   shadow = update_shadow_cascades(scene.world, camera, state);
-  return build_frame_input(scene, ctx, camera, shadow);
+  const ProbeData probes = update_environment_probes(scene.world, ctx.index, /*commit=*/false);
+  return build_frame_input(scene, ctx, camera, shadow, probes);
 }
 
 render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx) {
@@ -102,7 +125,12 @@ Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& c
   report.shadows_ms = ms_since(t);
 
   t = Clock::now();
-  const render::FrameInput input = build_frame_input(scene, ctx, report.camera, report.shadow);
+  report.probes = update_environment_probes(scene.world, ctx.index);
+  report.probes_ms = ms_since(t);
+
+  t = Clock::now();
+  const render::FrameInput input =
+      build_frame_input(scene, ctx, report.camera, report.shadow, report.probes);
   report.draw_list_ms = ms_since(t);
 
   t = Clock::now();

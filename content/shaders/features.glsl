@@ -17,3 +17,4 @@ layout(location = 11) uniform uint u_oracle_features;  // VariantKey material bi
 #define BIT_REFLECTION_CUBE 4
 #define BIT_REFLECTION_SPHERE 5
 #define BIT_RECEIVE_SHADOWS 6
+#define BIT_REFLECTION_BOX 7

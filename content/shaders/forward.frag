@@ -15,6 +15,31 @@ layout(location = 1) out vec4 o_position;    // xyz world position, w mask (1 = 
 layout(location = 2) out vec4 o_normal;      // xyz world normal facing the camera, w view depth
 layout(location = 3) out vec2 o_visibility;  // x shadow visibility of the shadowed light,
                                              // y its cascade (-1 outside every cascade)
+layout(location = 4) out vec4 o_reflection;  // rgb reflected colour C_t, a 1 with a map (else 0)
+#endif
+
+// Reflection maps (S3). The probe's map and x = k_s * p_r (eq. (3)) are set per draw.
+#if MATERIAL_HAS_REFLECTION_CUBE || MATERIAL_HAS_REFLECTION_SPHERE
+layout(location = 16) uniform vec4 u_reflection;
+#endif
+#if MATERIAL_HAS_REFLECTION_CUBE
+layout(binding = 3) uniform samplerCube u_reflection_cube;
+#endif
+#if MATERIAL_HAS_REFLECTION_BOX
+layout(location = 17) uniform vec4 u_reflection_box_min;  // xyz: world-space box (Reflector)
+layout(location = 18) uniform vec4 u_reflection_box_max;
+layout(location = 19) uniform vec4 u_reflection_centre;   // xyz: the probe's capture centre
+
+// Box projection (parallax correction, beyond S3): the environment is taken to lie on the box,
+// so look up the direction from the capture centre to where the ray (p, r) leaves the box.
+vec3 box_project(vec3 p, vec3 r) {
+  vec3 exits = max((u_reflection_box_max.xyz - p) / r, (u_reflection_box_min.xyz - p) / r);
+  float t = max(min(min(exits.x, exits.y), exits.z), 0.0);
+  return p + t * r - u_reflection_centre.xyz;
+}
+#endif
+#if MATERIAL_HAS_REFLECTION_SPHERE
+layout(binding = 4) uniform sampler2D u_reflection_sphere;  // made for this camera (probe_sphere.frag)
 #endif
 
 // Cotangent frame from screen-space derivatives: normal mapping without stored tangents.
@@ -102,6 +127,37 @@ void main() {
     color += (diffuse_color + spec) * u_light_color[i].rgb * ndl * attenuation * shadow;
   }
 
+  vec3 reflected = vec3(0.0);  // S3's C_t
+  float reflector = 0.0;       // 1 where a reflection map applies (AOV)
+#if MATERIAL_HAS_REFLECTION_CUBE || MATERIAL_HAS_REFLECTION_SPHERE
+  // S3 eq. (1), R = U - 2 (N.U) N with U the unit vector from the eye to the point. Computed in
+  // world space, which is eq. (6)'s (MV)^-1 R_VCS (rotation part): the cube is in world space.
+  vec3 r_world = reflect(-v, n);
+#endif
+#if MATERIAL_HAS_REFLECTION_CUBE
+  if (ENABLED(BIT_REFLECTION_CUBE)) {
+    vec3 lookup = r_world;
+#if MATERIAL_HAS_REFLECTION_BOX
+    if (ENABLED(BIT_REFLECTION_BOX)) lookup = box_project(v_world_pos, r_world);
+#endif
+    reflected = texture(u_reflection_cube, lookup).rgb;
+    reflector = 1.0;
+  }
+#endif
+#if MATERIAL_HAS_REFLECTION_SPHERE
+  if (ENABLED(BIT_REFLECTION_SPHERE)) {
+    // S3 eq. (4)-(5) in view space: A_z = sqrt((R_z + 1) / 2), s = R_x / (2 A_z), t = R_y / (2 A_z).
+    vec3 r_view = mat3(u_view) * r_world;
+    float a_z = sqrt(max((r_view.z + 1.0) * 0.5, 1e-8));
+    vec2 st = r_view.xy / (2.0 * a_z);
+    reflected = texture(u_reflection_sphere, st * 0.5 + 0.5).rgb;
+    reflector = 1.0;
+  }
+#endif
+#if MATERIAL_HAS_REFLECTION_CUBE || MATERIAL_HAS_REFLECTION_SPHERE
+  color += u_reflection.x * reflected;  // S3 eq. (3): I' = I + k_s p_r C_t
+#endif
+
 #if VARIANT_HAS_SHADOW && VARIANT_DEBUG_CASCADES
   color *= cascade_tint(cascade);
 #endif
@@ -110,5 +166,6 @@ void main() {
   o_position = vec4(v_world_pos, 1.0);
   o_normal = vec4(geometric_n, view_depth);
   o_visibility = vec2(visibility, float(cascade));
+  o_reflection = vec4(reflected, reflector);
 #endif
 }

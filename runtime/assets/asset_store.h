@@ -11,6 +11,7 @@
 
 #include "components/bounds.h"
 #include "components/mesh_renderer.h"
+#include "runtime/assets/env_map.h"
 
 namespace kaskad {
 
@@ -44,6 +45,9 @@ struct TextureData {
 struct AssetStore {
   std::vector<MeshData> meshes;
   std::vector<TextureData> textures;
+  /// Static reflection-probe cube maps (Reflector update static_file), loaded by
+  /// instantiate_scene; an entity's StaticEnvMap names its entry.
+  std::vector<CubeMap> env_maps;
   /// Identifies this store's contents for GPU caches (MeshId 0 of another scene is another
   /// mesh): unique per constructed store, kept when the store is moved.
   std::uint64_t uid = next_uid();

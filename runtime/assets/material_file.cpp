@@ -100,6 +100,7 @@ Result<Material> load_material_file(const std::filesystem::path& file,
         else if (p.name == "emissive") pr.vector<3>(key, m.emissive, mn, mx);
         else if (p.name == "alpha_cutoff") pr.number(key, m.alpha_cutoff, mn, mx);
         else if (p.name == "double_sided") pr.boolean(key, m.double_sided);
+        else if (p.name == "k_s") pr.number(key, m.k_s, mn, mx);
         else fail(pr.at(key), "parameter '" + p.name + "' is declared but the engine does not know it");
       }
     }

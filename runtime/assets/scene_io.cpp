@@ -17,10 +17,13 @@
 #include "components/mesh_renderer.h"
 #include "components/model.h"
 #include "components/name.h"
+#include "components/probe_state.h"
+#include "components/reflector.h"
 #include "components/transform.h"
 #include "runtime/assets/gltf_loader.h"
 #include "runtime/assets/material_file.h"
 #include "runtime/assets/primitives.h"
+#include "runtime/assets/reflector_io.h"
 #include "runtime/core/json_reader.h"
 #include "runtime/core/log.h"
 
@@ -162,6 +165,7 @@ Material read_inline_material(ObjectReader& mr) {
   mr.number("roughness", m.roughness, 0.0f, 1.0f);
   mr.vector<3>("emissive", m.emissive, 0.0f, 1.0e6f);
   mr.boolean("double_sided", m.double_sided);
+  mr.number("k_s", m.k_s, 0.0f, 1.0f);
   mr.finish();
   m.features = derive_material_features(m);
   return m;
@@ -224,6 +228,7 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
     ObjectReader rr(r.raw("renderer"), r.at("renderer"));
     rr.boolean("cast_shadows", mrend.cast_shadows);
     rr.boolean("receive_shadows", mrend.receive_shadows);
+    rr.integer("layer", mrend.layer, 0, 31);
     rr.finish();
     w.emplace<MeshRenderer>(e, mrend);
   } else if (has_primitive || has_model) {
@@ -272,6 +277,13 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
   } else if (r.has("shadow")) {
     fail(r.at("shadow"), "shadow settings belong to an entity with a light");
   }
+  if (r.has("reflector")) {
+    if (!has_primitive && !has_model) fail(r.at("reflector"), "a reflector needs a primitive or model");
+    Reflector refl;
+    ObjectReader rr(r.raw("reflector"), r.at("reflector"));
+    read_reflector(rr, refl);
+    w.emplace<Reflector>(e, refl);
+  }
   if (r.has("camera")) {
     Camera c;
     ObjectReader cr(r.raw("camera"), r.at("camera"));
@@ -313,7 +325,9 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
   };
   if (const auto* m = w.try_get<ModelRef>(e)) j["model"] = {{"path", rebase(m->path)}};
   if (const auto* mr = w.try_get<MeshRenderer>(e))
-    j["renderer"] = {{"cast_shadows", mr->cast_shadows}, {"receive_shadows", mr->receive_shadows}};
+    j["renderer"] = {{"cast_shadows", mr->cast_shadows},
+                     {"receive_shadows", mr->receive_shadows},
+                     {"layer", mr->layer}};
   if (const auto* ref = w.try_get<MaterialRef>(e)) {
     j["material"] = {{"file", rebase(ref->path)}};
   } else if (const auto* m = w.try_get<Material>(e)) {
@@ -321,7 +335,8 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
                      {"metallic", num(m->metallic)},
                      {"roughness", num(m->roughness)},
                      {"emissive", vec(m->emissive)},
-                     {"double_sided", m->double_sided}};
+                     {"double_sided", m->double_sided},
+                     {"k_s", num(m->k_s)}};
   }
   if (const auto* l = w.try_get<Light>(e)) {
     j["light"] = {{"type", enum_name(l->type, kLightTypes)},
@@ -335,6 +350,10 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
       json sj = write_shadow(*s, &scene.shadow_defaults);
       if (!sj.empty()) j["shadow"] = sj;
     }
+  }
+  if (const auto* refl = w.try_get<Reflector>(e)) {
+    j["reflector"] = reflector_to_json(*refl);
+    if (!refl->file.empty()) j["reflector"]["file"] = rebase(refl->file);
   }
   if (const auto* c = w.try_get<Camera>(e)) {
     j["camera"] = {{"projection", enum_name(c->projection, kProjections)},
@@ -497,6 +516,17 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
     auto m = load_material_file(scene.file.parent_path() / ref.path, *manifest, scene.assets);
     if (!m) return m.error();
     w.emplace<Material>(e, *m);
+  }
+  // Static reflection maps (S3 (a)): loaded once here; the probe system uploads them once.
+  std::vector<std::pair<ecs::Entity, Reflector>> static_probes;
+  w.view<Reflector>().each([&](ecs::Entity e, Reflector& r) {
+    if (r.update == ProbeUpdate::static_file) static_probes.emplace_back(e, r);
+  });
+  for (auto& [e, r] : static_probes) {
+    auto cube = load_static_env_map(scene.file.parent_path() / r.file, r);
+    if (!cube) return cube.error();
+    scene.assets.env_maps.push_back(std::move(cube.value()));
+    w.emplace<StaticEnvMap>(e, StaticEnvMap{std::uint32_t(scene.assets.env_maps.size() - 1)});
   }
   std::vector<std::pair<ecs::Entity, PrimitiveMesh>> prims;
   std::vector<std::pair<ecs::Entity, ModelRef>> models;

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "components/name.h"
+#include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
 #include "runtime/cli/bench.h"
@@ -52,6 +54,8 @@ render options:
                          sun.light.intensity=3, camera.camera.fov_y_deg=40 (repeatable)
   --aov FILE.exr         write the AOVs of the last frame (P, N, Z, visibility, mask, cascade)
   --shadow-map FILE      write the shadow map depth of the last frame
+  --probe-maps DIR       write each reflection probe's visible cube faces (NAME_px.png ...
+                         NAME_nz.png) and, for sphere probes, NAME_sphere.png into DIR
   --reflection-reference FILE.exr
                          ray-traced reflected radiance C_t of every pixel (README "Environment maps")
   --env PATH             environment map for the reflection reference's misses (any layout)
@@ -71,6 +75,7 @@ struct Args {
   std::string output;
   std::string aov;
   std::string shadow_map;
+  std::string probe_maps;
   std::string reflection_reference;  ///< render: reference EXR to write
   std::string env;                   ///< render: environment map of the reflection reference
   std::vector<std::string> sets;
@@ -123,6 +128,8 @@ Args parse_args(int argc, char** argv) {
       a.aov = value();
     } else if (arg == "--shadow-map") {
       a.shadow_map = value();
+    } else if (arg == "--probe-maps") {
+      a.probe_maps = value();
     } else if (arg == "--reflection-reference") {
       a.reflection_reference = value();
     } else if (arg == "--env") {
@@ -298,6 +305,13 @@ int run_render(Args a) {
                   st.cascade_triangles[std::size_t(i)], sh.skipped[std::size_t(i)] ? " (skipped)" : "");
     std::printf("\n");
   }
+  if (const ProbeData& pd = timings->last.probes; !pd.probes.empty()) {
+    std::printf("probes    %zu reflectors: %llu captures, %llu faces since load; last frame %d "
+                "faces, %d draws into them\n",
+                pd.probes.size(), static_cast<unsigned long long>(pd.captures_total),
+                static_cast<unsigned long long>(pd.faces_total), st.probe_faces,
+                st.probe_draw_calls);
+  }
   std::printf("shaders   %d compiled, %d from the binary cache, %.1f ms (prewarm %.1f ms); "
               "%d compiled after the first frame\n",
               st.shaders.programs_compiled, st.shaders.cache_hits, st.shaders.compile_ms,
@@ -328,6 +342,27 @@ int run_render(Args a) {
     if (auto s = save_image(a.shadow_map, player->renderer->read_shadow_map()); !s)
       return fail(s.error());
     std::printf("wrote     %s (shadow map depth)\n", fs::absolute(a.shadow_map).string().c_str());
+  }
+  if (!a.probe_maps.empty()) {
+    std::error_code ec;
+    fs::create_directories(a.probe_maps, ec);
+    if (ec) return fail(Error{a.probe_maps, "", "cannot create the directory: " + ec.message()});
+    for (const ProbeData::Entry& p : timings->last.probes.probes) {
+      const Name* name = scene->world.try_get<Name>(p.entity);
+      const std::string stem =
+          name ? name->value : "probe" + std::to_string(p.entity.index);
+      const fs::path dir(a.probe_maps);
+      const CubeMap cube = player->renderer->read_probe_cube(p.job.handle, p.job.visible);
+      if (cube.size == 0) continue;
+      if (auto s = save_cube_faces(cube, dir / (stem + "_*.png")); !s) return fail(s.error());
+      std::printf("wrote     %s (probe faces)\n", fs::absolute(dir / (stem + "_*.png")).string().c_str());
+      if (p.sphere) {
+        const fs::path file = dir / (stem + "_sphere.png");
+        if (auto s = save_sphere_map(player->renderer->read_probe_sphere(p.job.handle), file); !s)
+          return fail(s.error());
+        std::printf("wrote     %s (sphere map)\n", fs::absolute(file).string().c_str());
+      }
+    }
   }
   if (gpu::debug_error_count() > 0) {
     std::fprintf(stderr, "kaskad: error: %d OpenGL errors were reported (see log above)\n",

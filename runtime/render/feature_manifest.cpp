@@ -28,6 +28,7 @@ constexpr LayoutEntry kLayout[] = {
     {"reflection_cube", VariantKey::kReflectionCube, 0},
     {"reflection_sphere", VariantKey::kReflectionSphere, 0},
     {"receive_shadows", VariantKey::kReceiveShadows, 0},
+    {"reflection_box", VariantKey::kReflectionBox, 0},
     {"shadow", VariantKey::kShadow, 0},
     {"shadow_filter", VariantKey::kShadowFilter, 0},
     {"cascade_count", VariantKey::kCascadeCountMinus1, 1},

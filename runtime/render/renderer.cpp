@@ -12,6 +12,7 @@
 
 #include "runtime/core/log.h"
 #include "runtime/gpu/shader.h"
+#include "runtime/render/probe_capture.h"
 
 namespace kaskad::render {
 namespace {
@@ -48,8 +49,10 @@ GLenum depth_internal_format(DepthFormat f) {
 constexpr GLuint kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
 constexpr GLint kUniModel = 0, kUniNormalMatrix = 4, kUniBaseColor = 8, kUniMaterial = 9,
                 kUniEmissive = 10, kUniOracleFeatures = 11, kUniLightViewProj = 12,
-                kUniTargetSize = 13;
-constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2;
+                kUniTargetSize = 13, kUniReflection = 16, kUniReflectionBoxMin = 17, kUniReflectionBoxMax = 18,
+                kUniReflectionCentre = 19;
+constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2, kTexReflectionCube = 3,
+                 kTexReflectionSphere = 4;
 
 struct GpuMesh {
   gpu::VertexArray vao;
@@ -84,7 +87,8 @@ struct Renderer::Impl {
   // Forward targets.
   int width = 0, height = 0;
   gpu::Framebuffer fbo;
-  gpu::Texture color, position, normal, visibility, depth;
+  gpu::Texture color, position, normal, visibility, reflection, depth;
+  std::unique_ptr<ProbeMaps> probes;  // reflection probe maps (probe_capture.h)
 
   // Shadow map: a depth texture array, one layer per cascade.
   int shadow_size = 0, shadow_layers = 0;
@@ -101,7 +105,7 @@ struct Renderer::Impl {
 
   std::optional<VariantKey> frame_key;  // frame features of the last render()
 
-  std::array<gpu::Query, 2> timers;
+  std::array<gpu::Query, 3> timers;  // shadow, forward, probe captures
   bool timers_pending = false;
   std::uint64_t frames_rendered = 0;
   bool aovs_written = false;
@@ -185,12 +189,14 @@ struct Renderer::Impl {
     make(position, GL_RGBA32F);
     make(normal, GL_RGBA32F);
     make(visibility, GL_RG32F);  // r visibility, g cascade index
+    make(reflection, GL_RGBA16F);  // rgb reflected colour C_t (S3 eq. (3)), 0 without a map
     make(depth, GL_DEPTH_COMPONENT32F);
     fbo = gpu::make_framebuffer();
     glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0, color.id(), 0);
     glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT1, position.id(), 0);
     glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT2, normal.id(), 0);
     glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT3, visibility.id(), 0);
+    glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT4, reflection.id(), 0);
     glNamedFramebufferTexture(fbo.id(), GL_DEPTH_ATTACHMENT, depth.id(), 0);
   }
 
@@ -234,6 +240,9 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
   if (!lib) return lib.error();
   im.shaders = std::move(lib.value());
   im.oracle = options.uber_oracle;
+  auto probes = ProbeMaps::create(shader_dir);
+  if (!probes) return probes.error();
+  im.probes = std::move(probes.value());
   im.white = make_solid_texture({1, 1, 1, 1}, GL_SRGB8_ALPHA8);
   // Exactly (0.5, 0.5, 1): decodes to (0, 0, 1), so the cotangent frame leaves the normal as is.
   // An 8-bit 128 would tilt every normal by 0.2 degrees, with visible derivative noise.
@@ -242,6 +251,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
   glNamedBufferStorage(im.frame_ubo.id(), sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   im.timers[0] = gpu::make_query(GL_TIME_ELAPSED);
   im.timers[1] = gpu::make_query(GL_TIME_ELAPSED);
+  im.timers[2] = gpu::make_query(GL_TIME_ELAPSED);
   // Empty shadow map so the sampler is complete even in frames without a shadow pass.
   im.ensure_shadow_map(64, 1, DepthFormat::d24, ShadowFilter::none);
   return r;
@@ -280,12 +290,26 @@ VariantKey material_variant(const DrawItem& d) {
 
 std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   const VariantKey fk = frame_variant(frame);
+  // Probe captures draw without AOVs; a reflector's draw gets its map feature once its first
+  // capture completes (possibly frames later when time-sliced): compile those up front too.
+  const VariantKey capture_fk = VariantKey(fk.bits() & ~VariantKey::kAovs.mask());
   std::vector<ProgramRequest> out;
   for (const DrawItem& d : frame.draws) {
     const VariantKey k = material_variant(d) | fk;
     out.push_back({Pass::forward, k.filtered_for(Pass::forward)});
     if (fk.has(VariantKey::kShadow) && d.cast_shadows)
       out.push_back({Pass::depth, k.filtered_for(Pass::depth)});
+    std::vector<VariantKey> materials = {material_variant(d)};
+    for (const ProbeJob& job : frame.probes)
+      if (job.handle == d.probe)
+        materials.push_back(VariantKey(materials[0])
+                                .set(job.sphere ? VariantKey::kReflectionSphere
+                                                : VariantKey::kReflectionCube, 1)
+                                .set(VariantKey::kReflectionBox, job.box ? 1u : 0u));
+    for (const VariantKey m : materials) {
+      out.push_back({Pass::forward, (m | fk).filtered_for(Pass::forward)});
+      if (!frame.probes.empty()) out.push_back({Pass::forward, (m | capture_fk).filtered_for(Pass::forward)});
+    }
   }
   auto less = [](const ProgramRequest& a, const ProgramRequest& b) {
     return std::pair(a.pass, a.key) < std::pair(b.pass, b.key);
@@ -314,11 +338,14 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
                    std::to_string(frame.height));
   // Timer results of the previous frame (available after finish()).
   if (im.timers_pending) {
-    GLuint64 ns[2] = {0, 0};
+    GLuint64 ns[3] = {0, 0, 0};
     glGetQueryObjectui64v(im.timers[0].id(), GL_QUERY_RESULT, &ns[0]);
     glGetQueryObjectui64v(im.timers[1].id(), GL_QUERY_RESULT, &ns[1]);
+    glGetQueryObjectui64v(im.timers[2].id(), GL_QUERY_RESULT, &ns[2]);
     stats_.shadow_gpu_ms = double(ns[0]) * 1e-6;
     stats_.forward_gpu_ms = double(ns[1]) * 1e-6;
+    stats_.probe_gpu_ms = double(ns[2]) * 1e-6;
+    stats_.probe_faces_timed = stats_.probe_faces;  // still the previous frame's count here
   }
   stats_.draw_calls = stats_.shadow_draw_calls = 0;
   stats_.triangles = stats_.shadow_triangles = 0;
@@ -361,6 +388,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   if (assets.uid != im.assets_uid) {
     im.meshes.clear();
     im.textures.clear();
+    im.probes->clear();  // probe handles are entity indices of that scene
     im.assets_uid = assets.uid;
   }
   for (const DrawItem& d : frame.draws)
@@ -381,11 +409,11 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
                     ma.roughness) < std::tie(mb.base_color_texture, mb.normal_texture,
                                              mb.double_sided, mb.metallic, mb.roughness);
   };
-  auto sorted_by = [&](Pass pass) {
+  auto sorted_by = [&](Pass pass, const std::vector<VariantKey>& by) {
     std::vector<std::uint32_t> order(frame.draws.size());
     for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-      const VariantKey ka = keys[a].filtered_for(pass), kb = keys[b].filtered_for(pass);
+      const VariantKey ka = by[a].filtered_for(pass), kb = by[b].filtered_for(pass);
       if (ka != kb) return ka < kb;
       return material_order(a, b);
     });
@@ -442,7 +470,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     }
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(s.slope_bias, s.constant_bias);
-    const std::vector<std::uint32_t> order = sorted_by(Pass::depth);
+    const std::vector<std::uint32_t> order = sorted_by(Pass::depth, keys);
     GLuint current = 0;  // kept across layers: the light matrix is a per-draw uniform
     for (int c = 0; c < cascades; ++c) {
       glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0,
@@ -478,12 +506,115 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   }
   glEndQuery(GL_TIME_ELAPSED);
 
-  // Pass 2: forward shading into colour (+ AOV targets when asked for).
+  // Forward draws: the main view and every probe face go through this one path. Draws reflecting
+  // a probe get its map (`visible_before`: the map as of before this frame's captures, so a probe
+  // never sees a cube that is being captured) and k_s * p_r.
+  std::map<std::uint32_t, const ProbeJob*> probe_jobs;
+  for (const ProbeJob& job : frame.probes) probe_jobs[job.handle] = &job;
+  auto bind_reflection = [&](GLuint prog, const DrawItem& d, VariantKey key, bool capture) {
+    if (!key.has(VariantKey::kReflectionCube) && !key.has(VariantKey::kReflectionSphere)) return;
+    auto it = probe_jobs.find(d.probe);
+    if (it == probe_jobs.end()) return;
+    const ProbeJob& job = *it->second;
+    const bool swapped_now = job.faces != 0 && job.target == job.visible;
+    const int buffer = capture && swapped_now ? 1 - job.visible : job.visible;
+    glBindTextureUnit(kTexReflectionCube, im.probes->existing_cube(job.handle, buffer));
+    glBindTextureUnit(kTexReflectionSphere, im.probes->existing_sphere(job.handle));
+    glProgramUniform4f(prog, kUniReflection, d.reflection_scale, 0.0f, 0.0f, 0.0f);
+    if (key.has(VariantKey::kReflectionBox)) {
+      glProgramUniform4f(prog, kUniReflectionBoxMin, job.box_min.x, job.box_min.y, job.box_min.z, 0);
+      glProgramUniform4f(prog, kUniReflectionBoxMax, job.box_max.x, job.box_max.y, job.box_max.z, 0);
+      glProgramUniform4f(prog, kUniReflectionCentre, job.center.x, job.center.y, job.center.z, 0);
+    }
+  };
+  auto draw_forward = [&](const std::vector<VariantKey>& by, const ProbeJob* capture) -> Status {
+    GLuint current = 0;
+    for (std::uint32_t i : sorted_by(Pass::forward, by)) {
+      const DrawItem& d = frame.draws[i];
+      if (capture && (d.probe == capture->handle ||
+                      (capture->exclude_layers & (1u << (d.layer & 31)))))
+        continue;  // the reflector itself and excluded layers are not in its probe
+      const GpuMesh& m = im.mesh(d.mesh, assets);
+      if (m.index_count == 0) continue;
+      KASKAD_TRY(use_program(Pass::forward, by[i], current));
+      if (d.material.double_sided) {
+        glDisable(GL_CULL_FACE);
+      } else {
+        glEnable(GL_CULL_FACE);
+        glCullFace(GL_BACK);
+      }
+      bind_material(current, d, by[i]);
+      bind_reflection(current, d, by[i], capture != nullptr);
+      const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(d.model)));
+      glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+      glProgramUniformMatrix3fv(current, kUniNormalMatrix, 1, GL_FALSE, &normal_matrix[0][0]);
+      glBindVertexArray(m.vao.id());
+      glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+      ++stats_.draw_calls;
+      stats_.triangles += std::size_t(m.index_count / 3);
+    }
+    return {};
+  };
+  if (shadowed) glBindTextureUnit(kTexShadow, im.shadow_map.id());
+
+  // Pass 2: reflection probes (S3): each scheduled face of a probe's back cube is rendered by a
+  // 90° camera at the probe centre through the forward path, shadows included, without AOVs and
+  // without exposure (the cube holds linear radiance). u_view stays the main camera's: cascade
+  // selection and sphere-map lookups are the main view's. Then mips, then sphere maps.
+  stats_.probe_faces = 0;
+  stats_.probe_draw_calls = 0;
+  glBeginQuery(GL_TIME_ELAPSED, im.timers[2].id());
+  if (!frame.probes.empty()) {
+    const VariantKey capture_frame = VariantKey(frame_key.bits() & ~VariantKey::kAovs.mask());
+    std::vector<VariantKey> capture_keys(frame.draws.size());
+    for (std::size_t i = 0; i < frame.draws.size(); ++i)
+      capture_keys[i] = material_variant(frame.draws[i]) | capture_frame;
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    for (const ProbeJob& job : frame.probes) {
+      if (job.env_map != kNoProbe && job.env_map < assets.env_maps.size()) {
+        im.probes->upload(job.handle, job.visible, assets.env_maps[job.env_map]);
+        continue;
+      }
+      if (job.faces == 0) continue;
+      im.probes->cube(job.handle, job.target, job.resolution);
+      for (int f = 0; f < 6; ++f) {
+        if (!(job.faces & (1u << f))) continue;
+        FrameBlock face_fb = fb;
+        face_fb.view_proj = job.view_proj[std::size_t(f)];
+        face_fb.camera_pos = glm::vec4(job.center, 1.0f);
+        face_fb.ambient.w = 1.0f;  // linear radiance: exposure applies where the map is shown
+        glNamedBufferSubData(im.frame_ubo.id(), 0, sizeof face_fb, &face_fb);
+        im.probes->begin_face(job.handle, job.target, f, frame.clear_color);
+        const int before = stats_.draw_calls;
+        const std::size_t triangles_before = stats_.triangles;
+        if (Status st = draw_forward(capture_keys, &job); !st) {
+          glEndQuery(GL_TIME_ELAPSED);
+          return st;
+        }
+        stats_.probe_draw_calls += stats_.draw_calls - before;
+        stats_.draw_calls = before;
+        stats_.triangles = triangles_before;
+        ++stats_.probe_faces;
+      }
+      // Complete (the target is now the visible buffer): rebuild its mip chain.
+      if (job.target == job.visible) im.probes->finish_cube(job.handle, job.target);
+    }
+    glNamedBufferSubData(im.frame_ubo.id(), 0, sizeof fb, &fb);
+    for (const ProbeJob& job : frame.probes)
+      if (job.sphere && im.probes->existing_cube(job.handle, job.visible))
+        im.probes->update_sphere(job.handle, job.visible, glm::mat3(frame.camera.view));
+  }
+  glEndQuery(GL_TIME_ELAPSED);
+
+  // Pass 3: forward shading into colour (+ AOV targets when asked for).
   glBeginQuery(GL_TIME_ELAPSED, im.timers[1].id());
   im.ensure_targets(frame.width, frame.height);
-  const GLenum bufs[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
-                          GL_COLOR_ATTACHMENT3};
-  glNamedFramebufferDrawBuffers(im.fbo.id(), frame.write_aovs ? 4 : 1, bufs);
+  const GLenum bufs[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                          GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
+  glNamedFramebufferDrawBuffers(im.fbo.id(), frame.write_aovs ? 5 : 1, bufs);
   im.aovs_written = frame.write_aovs;
   glBindFramebuffer(GL_FRAMEBUFFER, im.fbo.id());
   glViewport(0, 0, frame.width, frame.height);
@@ -498,36 +629,16 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     glClearBufferfv(GL_COLOR, 1, zero);
     glClearBufferfv(GL_COLOR, 2, zero);
     glClearBufferfv(GL_COLOR, 3, zero);
+    glClearBufferfv(GL_COLOR, 4, zero);
   }
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   glClearBufferfv(GL_DEPTH, 0, &one);
-  if (shadowed) glBindTextureUnit(kTexShadow, im.shadow_map.id());
-  GLuint current = 0;
-  for (std::uint32_t i : sorted_by(Pass::forward)) {
-    const DrawItem& d = frame.draws[i];
-    const GpuMesh& m = im.mesh(d.mesh, assets);
-    if (m.index_count == 0) continue;
-    if (Status st = use_program(Pass::forward, keys[i], current); !st) {
-      glDisable(GL_FRAMEBUFFER_SRGB);
-      glEndQuery(GL_TIME_ELAPSED);
-      return st;
-    }
-    if (d.material.double_sided) {
-      glDisable(GL_CULL_FACE);
-    } else {
-      glEnable(GL_CULL_FACE);
-      glCullFace(GL_BACK);
-    }
-    bind_material(current, d, keys[i]);
-    const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(d.model)));
-    glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-    glProgramUniformMatrix3fv(current, kUniNormalMatrix, 1, GL_FALSE, &normal_matrix[0][0]);
-    glBindVertexArray(m.vao.id());
-    glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
-    ++stats_.draw_calls;
-    stats_.triangles += std::size_t(m.index_count / 3);
+  if (Status st = draw_forward(keys, nullptr); !st) {
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glEndQuery(GL_TIME_ELAPSED);
+    return st;
   }
   stats_.shaders = im.shaders->stats();
   glDisable(GL_FRAMEBUFFER_SRGB);
@@ -656,7 +767,11 @@ Image Renderer::read_aovs() const {
   Image img;
   img.width = w;
   img.height = h;
-  img.channel_names = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z", "Z", "visibility", "mask", "cascade"};
+  const auto refl = read_texture(im.reflection.id(), w, h, GL_RGBA, 4);
+  img.channel_names = {"P.X",          "P.Y",          "P.Z",          "N.X",
+                       "N.Y",          "N.Z",          "Z",            "visibility",
+                       "mask",         "cascade",      "reflection.R", "reflection.G",
+                       "reflection.B", "reflector"};
   img.channels = int(img.channel_names.size());
   img.pixels.resize(std::size_t(w) * h * img.channels);
   for (std::size_t i = 0; i < std::size_t(w) * h; ++i) {
@@ -671,6 +786,10 @@ Image Renderer::read_aovs() const {
     o[7] = vis[i * 2];
     o[8] = pos[i * 4 + 3];
     o[9] = vis[i * 2 + 1];
+    o[10] = refl[i * 4 + 0];
+    o[11] = refl[i * 4 + 1];
+    o[12] = refl[i * 4 + 2];
+    o[13] = refl[i * 4 + 3];
   }
   return img;
 }
@@ -691,6 +810,14 @@ Image Renderer::read_shadow_map() const {
     std::memcpy(&img.pixels[std::size_t(l) * layer],
                 &stack[std::size_t(im.shadow_layers - 1 - l) * layer], layer * sizeof(float));
   return img;
+}
+
+CubeMap Renderer::read_probe_cube(std::uint32_t handle, int buffer) const {
+  return impl_->probes->read_cube(handle, buffer);
+}
+
+SphereMap Renderer::read_probe_sphere(std::uint32_t handle) const {
+  return impl_->probes->read_sphere(handle);
 }
 
 void Renderer::present(int window_width, int window_height) const {

@@ -18,8 +18,10 @@
 
 #include "components/light.h"
 #include "components/material.h"
+#include "components/probe_state.h"
 #include "components/shadow_settings.h"
 #include "runtime/assets/asset_store.h"
+#include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/core/result.h"
 #include "runtime/gpu/gl_handles.h"
@@ -41,6 +43,36 @@ struct DrawItem {
   bool cast_shadows = true;
   bool receive_shadows = true;
   std::uint8_t cascade_mask = 0xff;  ///< bit i: drawn into cascade i (when cast_shadows)
+  int layer = 0;                     ///< MeshRenderer::layer (probes may exclude layers)
+  /// The reflection probe this draw reflects (its own Reflector; kNoProbe: none). The draw is
+  /// never drawn into that probe. With a reflection material feature on, it is shaded with the
+  /// probe's visible map, scaled by `reflection_scale` = k_s * p_r (S3 eq. (3)).
+  std::uint32_t probe = kNoProbe;
+  float reflection_scale = 0.0f;
+};
+
+/// One reflection probe's GPU work this frame (systems/environment_probe_system.h). Each probe
+/// has two cube maps (RGBA16F with mips): `faces` of buffer `target` are captured, then buffer
+/// `visible` is shaded with. Captures draw the frame's draws (shadows included) except the
+/// probe's own and excluded layers; reflective draws in them use their probes' visible maps as
+/// of before this frame's captures (no recursion).
+struct ProbeJob {
+  std::uint32_t handle = kNoProbe;
+  glm::vec3 center{0.0f};
+  float near = 0.05f, far = 100.0f;
+  int resolution = 128;
+  std::uint32_t exclude_layers = 0;
+  std::uint8_t faces = 0;  ///< bit f: capture GL face f (+X, -X, +Y, -Y, +Z, -Z) into `target`
+  int target = 1;
+  int visible = 0;
+  bool sphere = false;     ///< shade with a sphere map made from the visible cube (S3 eq. (2))
+  bool box = false;        ///< box projection of cube lookups onto [box_min, box_max] (world)
+  glm::vec3 box_min{0.0f}, box_max{0.0f};
+  /// World -> clip of the six 90° face cameras (systems/environment_probe_system.h).
+  std::array<glm::mat4, 6> view_proj{};
+  /// Static file: index into AssetStore::env_maps to upload into buffer `visible` this frame;
+  /// kNoProbe: nothing to upload.
+  std::uint32_t env_map = kNoProbe;
 };
 
 /// A light as the shaders see it. `color` already includes the intensity.
@@ -75,6 +107,7 @@ struct FrameInput {
   std::vector<DrawItem> draws;
   std::vector<LightItem> lights;  ///< at most kMaxLights are used
   ShadowPass shadow;
+  std::vector<ProbeJob> probes;
   glm::vec3 ambient{0.05f};
   glm::vec3 clear_color{0.0f};
   float exposure = 1.0f;
@@ -96,6 +129,10 @@ struct FrameStats {
   /// GPU times are the previous frame's (queries are read a frame late); 0 until frame 3.
   double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
   double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)
+  double probe_gpu_ms = 0.0;          ///< GL_TIME_ELAPSED of the probe captures (previous frame)
+  int probe_faces_timed = 0;          ///< faces that probe_gpu_ms covers (previous frame's)
+  int probe_faces = 0;                ///< reflection probe cube faces rendered this frame
+  int probe_draw_calls = 0;           ///< draws into those faces (not in draw_calls)
   int program_switches = 0;           ///< glUseProgram calls in the frame (draws are sorted)
   int material_switches = 0;          ///< material uniform/texture updates in the frame
   ShaderStats shaders;                ///< compiles, cache hits, compile ms (since creation)
@@ -135,9 +172,14 @@ class Renderer {
 
   /// sRGB-encoded colour of the last frame, RGBA in [0,1], rows top to bottom.
   Image read_color() const;
-  /// AOVs of the last frame: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade (see README).
+  /// AOVs of the last frame: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade reflection.R
+  /// reflection.G reflection.B reflector (see README).
   /// Precondition: the last frame was rendered with write_aovs.
   Image read_aovs() const;
+  /// A probe's cube buffer (0 or 1; level 0) or its sphere map (row 0 at the top) as last
+  /// rendered; empty when the probe has none. Tests and `kaskad render --probe-maps`.
+  CubeMap read_probe_cube(std::uint32_t handle, int buffer) const;
+  SphereMap read_probe_sphere(std::uint32_t handle) const;
   /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom; with
   /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;

@@ -8,6 +8,7 @@
 //
 // Valid combinations (valid()):
 //   reflection_cube and reflection_sphere exclude each other
+//   reflection_box needs reflection_cube
 //   shadow_filter != 0 and cascade_count != 1 need shadow
 //   debug_cascades and cascade_selection need shadow
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask), so every material
@@ -49,6 +50,7 @@ class VariantKey {
   static constexpr Field kReflectionCube{4, 1};
   static constexpr Field kReflectionSphere{5, 1};
   static constexpr Field kReceiveShadows{6, 1};
+  static constexpr Field kReflectionBox{7, 1};
   static constexpr std::uint32_t kMaterialMask = 0x0000ffffu;
   // Frame features.
   static constexpr Field kShadow{16, 1};
@@ -81,11 +83,13 @@ class VariantKey {
     constexpr std::uint32_t used = kBaseColorTexture.mask() | kNormalMap.mask() | kAlphaMask.mask() |
                                    kEmissive.mask() | kReflectionCube.mask() |
                                    kReflectionSphere.mask() | kReceiveShadows.mask() |
+                                   kReflectionBox.mask() |
                                    kShadow.mask() | kShadowFilter.mask() |
                                    kCascadeCountMinus1.mask() | kAovs.mask() |
                                    kDebugCascades.mask() | kCascadeSelection.mask();
     if (bits_ & ~used) return false;
     if (has(kReflectionCube) && has(kReflectionSphere)) return false;
+    if (has(kReflectionBox) && !has(kReflectionCube)) return false;
     if (get(kShadowFilter) > 2) return false;
     if (!has(kShadow) && (has(kShadowFilter) || has(kCascadeCountMinus1) || has(kDebugCascades) ||
                         has(kCascadeSelection)))
@@ -112,6 +116,8 @@ static_assert(VariantKey().valid());
 static_assert(!VariantKey().set(VariantKey::kReflectionCube, 1).set(VariantKey::kReflectionSphere, 1).valid());
 static_assert(!VariantKey().set(VariantKey::kShadowFilter, 2).valid());
 static_assert(VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowFilter, 2).valid());
+static_assert(!VariantKey().set(VariantKey::kReflectionBox, 1).valid());
+static_assert(VariantKey().set(VariantKey::kReflectionBox, 1).set(VariantKey::kReflectionCube, 1).valid());
 static_assert(VariantKey().set(VariantKey::kNormalMap, 1).filtered_for(Pass::depth) == VariantKey());
 
 }  // namespace kaskad::render

@@ -33,7 +33,7 @@ check render_default 0 "median .* ms" -- "$KASKAD" render --headless --size 160x
 [ -s "$tmp/default.png" ] && [ -s "$tmp/default.exr" ] || { echo "FAIL render_default: no files"; failed=$((failed + 1)); }
 if command -v oiiotool >/dev/null; then
   # EXR stores channels sorted by name; the contract is the set of names.
-  for ch in P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade; do
+  for ch in P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade reflection.R reflection.G reflection.B reflector; do
     check "aov_channel_$ch" 0 "channel list:.*(^|[ ,])$ch(,|$)" -- oiiotool --info -v "$tmp/default.exr"
   done
 fi
@@ -142,6 +142,18 @@ for scene in sorted({r["scene"] for r in rows}):
 assert caught >= 6, caught
 print("acne caught on %d scenes" % caught)
 ' "$tmp/stab/bench.csv"
+
+# Reflection probes: counters printed (13 frames: the sphere captures on 0 and 10, the plane
+# two faces a frame on 0-2 and 10-12), faces dumped, bad settings named.
+check probes_render 0 "probes +2 reflectors: 4 captures, 24 faces since load" -- "$KASKAD" render \
+  "$KASKAD_CONTENT/scenes/reflections.json" --headless --size 160x90 --frames 13 -o "$tmp/refl.png" \
+  --set mirror_sphere.reflector.resolution=32 --set mirror_plane.reflector.resolution=32 \
+  --set mirror_plane.reflector.map=sphere --probe-maps "$tmp/probes"
+for f in mirror_sphere_px mirror_sphere_nz mirror_plane_py mirror_plane_sphere; do
+  [ -s "$tmp/probes/$f.png" ] || { echo "FAIL probes_dump: no $f.png"; failed=$((failed + 1)); }
+done
+check bad_reflector nonzero "reflections.json.*/entities/1/reflector/faces_per_frame.*\[1, 6\]" -- \
+  "$KASKAD" render "$KASKAD_CONTENT/scenes/reflections.json" --headless --set mirror_sphere.reflector.faces_per_frame=9
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

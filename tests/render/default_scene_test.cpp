@@ -413,9 +413,11 @@ TEST_F(DefaultSceneTest, BadConfigurationIsCaughtByTheSameCheck) {
 TEST_F(DefaultSceneTest, AovChannelsFollowTheContract) {
   Image aov;
   render_and_compare({}, &aov);
-  ASSERT_EQ(aov.channels, 10);
+  ASSERT_EQ(aov.channels, 14);
   ASSERT_EQ(aov.channel_names[9], "cascade");
   ASSERT_EQ(aov.channel_names[7], "visibility");
+  ASSERT_EQ(aov.channel_names[10], "reflection.R");
+  ASSERT_EQ(aov.channel_names[12], "reflection.B");
   int drawn = 0, background = 0;
   for (int y = 0; y < aov.height; ++y)
     for (int x = 0; x < aov.width; ++x) {
@@ -429,6 +431,8 @@ TEST_F(DefaultSceneTest, AovChannelsFollowTheContract) {
       ASSERT_GT(aov.at(x, y, 6), 0.0f);  // view depth is positive in front of the camera
       const float v = aov.at(x, y, 7);
       ASSERT_TRUE(v >= 0.0f && v <= 1.0f);
+      ASSERT_EQ(aov.at(x, y, 10), 0.0f);  // no reflector in the default scene: C_t = 0
+      ASSERT_EQ(aov.at(x, y, 13), 0.0f);
     }
   EXPECT_GT(drawn, aov.width * aov.height / 2);
   EXPECT_GT(background, 0);  // the sky is visible above the horizon

@@ -9,6 +9,7 @@
 #include "components/material.h"
 #include "components/model.h"
 #include "components/name.h"
+#include "components/reflector.h"
 #include "components/transform.h"
 #include "runtime/assets/scene_io.h"
 
@@ -251,6 +252,66 @@ TEST(SceneIo, GltfMaterialsMapOntoFeatureBits) {
   });
   EXPECT_GT(textured, 0);
   EXPECT_GT(plain, 0);
+}
+
+TEST(SceneIo, ReflectorsRoundTripAndOverride) {
+  auto a = read_scene(kContent / "scenes" / "reflections.json",
+                      {"mirror_sphere.reflector.faces_per_frame=2", "mirror_plane.reflector.map=sphere"});
+  ASSERT_TRUE(a.ok()) << a.error().to_string();
+  const ecs::Entity sphere = find(*a, "mirror_sphere"), plane = find(*a, "mirror_plane");
+  ASSERT_TRUE(sphere.valid() && plane.valid());
+  const Reflector& r = a->world.get<Reflector>(sphere);
+  EXPECT_EQ(r.update, ProbeUpdate::every_n);
+  EXPECT_EQ(r.every_n, 10);
+  EXPECT_EQ(r.faces_per_frame, 2);
+  EXPECT_FLOAT_EQ(r.amount, 0.9f);
+  EXPECT_EQ(a->world.get<Reflector>(plane).map, ReflectionMap::sphere);
+  EXPECT_FLOAT_EQ(a->world.get<Material>(plane).k_s, 0.9f);
+  // Explicit centre and excluded layers survive a save and load, byte for byte.
+  a->world.get<Reflector>(plane).has_center = true;
+  a->world.get<Reflector>(plane).center = {0.5f, 1.5f, -4.25f};
+  a->world.get<Reflector>(plane).exclude_layers = (1u << 3) | (1u << 31);
+  a->world.get<Reflector>(plane).box_projection = true;
+  a->world.get<Reflector>(plane).box_min = {-5, 0, -9};
+  a->world.get<Reflector>(plane).box_max = {5, 4.5f, 1};
+  const fs::path first = temp_dir() / "refl1.json", second = temp_dir() / "refl2.json";
+  ASSERT_TRUE(save_scene(first, *a).ok());
+  auto b = read_scene(first);
+  ASSERT_TRUE(b.ok()) << b.error().to_string();
+  ASSERT_TRUE(save_scene(second, *b).ok());
+  EXPECT_EQ(read_file(first), read_file(second));
+  const Reflector& rb = b->world.get<Reflector>(find(*b, "mirror_plane"));
+  EXPECT_TRUE(rb.has_center);
+  EXPECT_EQ(rb.center, glm::vec3(0.5f, 1.5f, -4.25f));
+  EXPECT_EQ(rb.exclude_layers, (1u << 3) | (1u << 31));
+  EXPECT_TRUE(rb.box_projection);
+  EXPECT_EQ(rb.box_max, glm::vec3(5, 4.5f, 1));
+}
+
+TEST(SceneIo, BadReflectorsNameTheKey) {
+  auto bad = [](const std::string& reflector) {
+    const std::string text = R"({"kaskad_scene": 1, "entities": [{"primitive": {"shape": "sphere"}, "reflector": )" +
+                             reflector + "}]}";
+    auto s = read_scene(write_file("bad_reflector.json", text));
+    EXPECT_FALSE(s.ok()) << reflector;
+    return s.ok() ? std::string() : s.error().to_string();
+  };
+  EXPECT_NE(bad(R"({"faces_per_frame": 7})").find("/entities/0/reflector/faces_per_frame"), std::string::npos);
+  EXPECT_NE(bad(R"({"resolution": 100})").find("resolution must be a power of two"), std::string::npos);
+  EXPECT_NE(bad(R"({"near": 5, "far": 2})").find("/entities/0/reflector/far"), std::string::npos);
+  EXPECT_NE(bad(R"({"update": "sometimes"})").find("unknown value 'sometimes'"), std::string::npos);
+  EXPECT_NE(bad(R"({"update": "static_file"})").find("/entities/0/reflector/file"), std::string::npos);
+  EXPECT_NE(bad(R"({"exclude_layers": [40]})").find("/entities/0/reflector/exclude_layers/0"), std::string::npos);
+  EXPECT_NE(bad(R"({"amount": 1.5})").find("/entities/0/reflector/amount"), std::string::npos);
+  EXPECT_NE(bad(R"({"mirror": true})").find("unknown key 'mirror'"), std::string::npos);
+  EXPECT_NE(bad(R"({"box": {"min": [0, 0, 0], "max": [1, -1, 1]}})").find("/entities/0/reflector/box"), std::string::npos);
+  EXPECT_NE(bad(R"({"box": {"min": [0, 0, 0]}})").find("a box needs min and max"), std::string::npos);
+  EXPECT_NE(bad(R"({"center": [5, 0, 0], "box": {"min": [-1, -1, -1], "max": [1, 1, 1]}})")
+                .find("box must contain the capture centre"), std::string::npos);
+  auto s = read_scene(write_file("reflector_no_mesh.json",
+                                 R"({"kaskad_scene": 1, "entities": [{"reflector": {}}]})"));
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().to_string().find("needs a primitive or model"), std::string::npos);
 }
 
 }  // namespace

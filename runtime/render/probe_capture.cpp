@@ -1,0 +1,161 @@
+#include "runtime/render/probe_capture.h"
+
+#include <epoxy/gl.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "runtime/gpu/shader.h"
+
+namespace kaskad::render {
+namespace {
+
+int mip_levels(int size) { return 1 + int(std::floor(std::log2(double(std::max(1, size))))); }
+
+gpu::Texture make_cube(int size) {
+  gpu::Texture t = gpu::make_texture(GL_TEXTURE_CUBE_MAP);
+  glTextureStorage2D(t.id(), mip_levels(size), GL_RGBA16F, size, size);
+  glTextureParameteri(t.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTextureParameteri(t.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(t.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.id(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  // A new map is black until its first capture or upload (never uninitialised memory).
+  const float black[4] = {0, 0, 0, 1};
+  for (int level = 0; level < mip_levels(size); ++level)
+    glClearTexImage(t.id(), level, GL_RGBA, GL_FLOAT, black);
+  return t;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<ProbeMaps>> ProbeMaps::create(const std::filesystem::path& shader_dir) {
+  std::unique_ptr<ProbeMaps> m(new ProbeMaps());
+  auto vs = gpu::preprocess_shader(shader_dir, "fullscreen.vert", {});
+  if (!vs) return vs.error();
+  auto fs = gpu::preprocess_shader(shader_dir, "probe_sphere.frag", {});
+  if (!fs) return fs.error();
+  auto prog = gpu::build_program(*vs, *fs);
+  if (!prog) return prog.error();
+  m->sphere_program_ = std::move(prog.value());
+  m->empty_vao_ = gpu::make_vertex_array();
+  m->fbo_ = gpu::make_framebuffer();
+  return m;
+}
+
+GLuint ProbeMaps::cube(std::uint32_t handle, int buffer, int resolution) {
+  Probe& p = probes_[handle];
+  if (p.resolution != resolution || !p.cubes[0]) {
+    p.resolution = resolution;
+    p.cubes[0] = make_cube(resolution);
+    p.cubes[1] = make_cube(resolution);
+    p.sphere = gpu::Texture();
+  }
+  return p.cubes[buffer & 1].id();
+}
+
+GLuint ProbeMaps::existing_cube(std::uint32_t handle, int buffer) const {
+  auto it = probes_.find(handle);
+  return it == probes_.end() ? 0 : it->second.cubes[buffer & 1].id();
+}
+
+void ProbeMaps::begin_face(std::uint32_t handle, int buffer, int face, const glm::vec3& clear) {
+  const Probe& p = probes_.at(handle);
+  if (!depth_ || depth_size_ != p.resolution) {
+    GLuint id = 0;
+    glCreateRenderbuffers(1, &id);
+    depth_ = gpu::Renderbuffer(id);
+    glNamedRenderbufferStorage(depth_.id(), GL_DEPTH_COMPONENT32F, p.resolution, p.resolution);
+    depth_size_ = p.resolution;
+  }
+  glNamedFramebufferRenderbuffer(fbo_.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_.id());
+  // A cube map's layer f is face f (GL 4.5 section 9.2.8).
+  glNamedFramebufferTextureLayer(fbo_.id(), GL_COLOR_ATTACHMENT0, p.cubes[buffer & 1].id(), 0, face);
+  glNamedFramebufferDrawBuffer(fbo_.id(), GL_COLOR_ATTACHMENT0);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
+  glViewport(0, 0, p.resolution, p.resolution);
+  const float c[4] = {clear.r, clear.g, clear.b, 1.0f};
+  const float one = 1.0f;
+  glClearBufferfv(GL_COLOR, 0, c);
+  glClearBufferfv(GL_DEPTH, 0, &one);
+  ++faces_rendered;
+}
+
+void ProbeMaps::finish_cube(std::uint32_t handle, int buffer) {
+  glGenerateTextureMipmap(probes_.at(handle).cubes[buffer & 1].id());
+}
+
+void ProbeMaps::upload(std::uint32_t handle, int buffer, const CubeMap& cube_map) {
+  const GLuint tex = cube(handle, buffer, cube_map.size);
+  for (int f = 0; f < 6; ++f)
+    glTextureSubImage3D(tex, 0, 0, 0, f, cube_map.size, cube_map.size, 1, GL_RGBA, GL_FLOAT,
+                        cube_map.faces[std::size_t(f)].data());
+  glGenerateTextureMipmap(tex);
+}
+
+GLuint ProbeMaps::update_sphere(std::uint32_t handle, int buffer, const glm::mat3& view_rotation) {
+  Probe& p = probes_.at(handle);
+  if (!p.sphere) {
+    p.sphere = gpu::make_texture(GL_TEXTURE_2D);
+    glTextureStorage2D(p.sphere.id(), 1, GL_RGBA16F, p.resolution, p.resolution);
+    glTextureParameteri(p.sphere.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(p.sphere.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(p.sphere.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(p.sphere.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  }
+  glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, p.sphere.id(), 0);
+  glNamedFramebufferRenderbuffer(fbo_.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, 0);  // no depth
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
+  glViewport(0, 0, p.resolution, p.resolution);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  glUseProgram(sphere_program_.id());
+  const glm::mat3 view_to_world = glm::transpose(view_rotation);
+  glProgramUniformMatrix3fv(sphere_program_.id(), 0, 1, GL_FALSE, &view_to_world[0][0]);
+  glBindTextureUnit(0, p.cubes[buffer & 1].id());
+  glBindVertexArray(empty_vao_.id());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
+  return p.sphere.id();
+}
+
+GLuint ProbeMaps::existing_sphere(std::uint32_t handle) const {
+  auto it = probes_.find(handle);
+  return it == probes_.end() ? 0 : it->second.sphere.id();
+}
+
+CubeMap ProbeMaps::read_cube(std::uint32_t handle, int buffer) const {
+  CubeMap out;
+  auto it = probes_.find(handle);
+  if (it == probes_.end() || !it->second.cubes[buffer & 1]) return out;
+  const int n = it->second.resolution;
+  out.size = n;
+  std::vector<glm::vec4> all(std::size_t(n) * n * 6);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(it->second.cubes[buffer & 1].id(), 0, GL_RGBA, GL_FLOAT,
+                    GLsizei(all.size() * sizeof(glm::vec4)), all.data());
+  for (std::size_t f = 0; f < 6; ++f)
+    out.faces[f].assign(all.begin() + std::ptrdiff_t(f * std::size_t(n) * n),
+                        all.begin() + std::ptrdiff_t((f + 1) * std::size_t(n) * n));
+  return out;
+}
+
+SphereMap ProbeMaps::read_sphere(std::uint32_t handle) const {
+  SphereMap out;
+  auto it = probes_.find(handle);
+  if (it == probes_.end() || !it->second.sphere) return out;
+  const int n = it->second.resolution;
+  std::vector<glm::vec4> gl(std::size_t(n) * n);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(it->second.sphere.id(), 0, GL_RGBA, GL_FLOAT,
+                    GLsizei(gl.size() * sizeof(glm::vec4)), gl.data());
+  out.size = n;
+  out.texels.resize(gl.size());
+  for (int y = 0; y < n; ++y)  // GL rows bottom up -> image rows top down
+    std::memcpy(&out.texels[std::size_t(y) * n], &gl[std::size_t(n - 1 - y) * n],
+                std::size_t(n) * sizeof(glm::vec4));
+  return out;
+}
+
+}  // namespace kaskad::render

@@ -1,0 +1,71 @@
+// GL resources of the reflection probes (S3): per probe two cube maps (RGBA16F, full mip chain;
+// a front one shown and a back one captured into), a 2D sphere map when the probe shows one,
+// one capture framebuffer with a depth renderbuffer per face size, and the fullscreen pass that
+// makes sphere maps from cubes (S3 eq. (2), content/shaders/probe_sphere.frag). The Renderer owns
+// one ProbeMaps and records captures through its own forward path (renderer.cpp); this file holds
+// everything else about probes on the GPU.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+
+#include <glm/glm.hpp>
+
+#include "runtime/assets/env_map.h"
+#include "runtime/core/result.h"
+#include "runtime/gpu/gl_handles.h"
+
+namespace kaskad::render {
+
+class ProbeMaps {
+ public:
+  /// Builds the sphere-map program from `shader_dir`. Needs a current GL 4.5 context.
+  static Result<std::unique_ptr<ProbeMaps>> create(const std::filesystem::path& shader_dir);
+
+  /// The GL name of cube buffer `buffer` (0 or 1) of probe `handle`, created (black) on first
+  /// use and recreated when `resolution` changes (both buffers: a resize drops the old maps).
+  GLuint cube(std::uint32_t handle, int buffer, int resolution);
+  /// The cube buffer if it exists, else 0 (for lookups: a probe that was never made has none).
+  GLuint existing_cube(std::uint32_t handle, int buffer) const;
+
+  /// Binds face `face` (GL order) of the cube as the colour target of the capture framebuffer,
+  /// with a depth buffer of the cube's size, sets the viewport and clears to `clear` (linear).
+  void begin_face(std::uint32_t handle, int buffer, int face, const glm::vec3& clear);
+  /// After the last face of a capture: rebuilds the cube's mip chain.
+  void finish_cube(std::uint32_t handle, int buffer);
+  /// Uploads a CPU cube map (faces as GL expects them, env_map.h) into a buffer, with mips.
+  void upload(std::uint32_t handle, int buffer, const CubeMap& cube);
+
+  /// Renders probe `handle`'s sphere map from cube `buffer` for a camera with world -> view
+  /// rotation `view_rotation` (S3 eq. (2) in that view space); returns the 2D texture.
+  GLuint update_sphere(std::uint32_t handle, int buffer, const glm::mat3& view_rotation);
+  GLuint existing_sphere(std::uint32_t handle) const;
+
+  /// Read-back (tests, debug dumps): a cube buffer as a CubeMap (level 0), the sphere map with
+  /// row 0 at the top (SphereMap's convention). Empty when the probe has no such map.
+  CubeMap read_cube(std::uint32_t handle, int buffer) const;
+  SphereMap read_sphere(std::uint32_t handle) const;
+
+  /// Forgets every probe (another scene: handles are entity indices of one world).
+  void clear() { probes_.clear(); }
+
+  int faces_rendered = 0;  ///< faces begun since creation (tests compare with the system)
+
+ private:
+  struct Probe {
+    int resolution = 0;
+    gpu::Texture cubes[2];
+    gpu::Texture sphere;
+  };
+  ProbeMaps() = default;
+  gpu::Program sphere_program_;
+  gpu::VertexArray empty_vao_;
+  gpu::Framebuffer fbo_;
+  gpu::Renderbuffer depth_;
+  int depth_size_ = 0;
+  std::map<std::uint32_t, Probe> probes_;
+};
+
+}  // namespace kaskad::render

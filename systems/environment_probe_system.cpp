@@ -1,0 +1,224 @@
+#include "systems/environment_probe_system.h"
+
+#include <bit>
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "components/light.h"
+#include "components/material.h"
+#include "components/mesh_renderer.h"
+#include "components/transform.h"
+#include "runtime/core/log.h"
+
+namespace kaskad {
+namespace {
+
+// A pivot farther than this fraction of the bounds' diagonal from their centre is "off-centre"
+// (S3 assumes the pivot is the geometric centre). Engine choice: 5%.
+constexpr float kOffCentreFraction = 0.05f;
+
+bool sphere_intersects_box(const glm::vec3& c, float r, const Aabb& b) {
+  if (b.empty()) return false;
+  const glm::vec3 nearest = glm::clamp(c, b.min, b.max);
+  const glm::vec3 d = nearest - c;
+  return glm::dot(d, d) <= r * r;
+}
+
+void hash_material(SignatureHash& h, const Material& m) {
+  h.add(m.base_color);
+  h.add(m.base_color_texture);
+  h.add(m.metallic);
+  h.add(m.roughness);
+  h.add(m.normal_texture);
+  h.add(m.normal_scale);
+  h.add(m.emissive);
+  h.add(m.double_sided);
+  h.add(m.alpha_mask);
+  h.add(m.alpha_cutoff);
+  h.add(m.k_s);
+  h.add(m.features);
+}
+
+}  // namespace
+
+const ProbeData::Entry* ProbeData::find(ecs::Entity e) const {
+  for (const Entry& p : probes)
+    if (p.entity == e) return &p;
+  return nullptr;
+}
+
+void SignatureHash::add(const void* data, std::size_t bytes) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < bytes; ++i) {
+    h_ ^= p[i];
+    h_ *= 1099511628211ull;  // FNV-1a 64 prime
+  }
+}
+
+ProbeWork schedule_probe(const Reflector& r, ProbeState& s, std::uint64_t frame,
+                         std::uint64_t signature) {
+  ProbeWork work;
+  // 1. Static files: one load, shown at once.
+  if (r.update == ProbeUpdate::static_file) {
+    if (!s.has_map) {
+      work.load = true;
+      s.has_map = true;
+      s.last_capture_frame = frame;
+      ++s.captures;
+    }
+    return work;
+  }
+  // 2. Is a capture due? (It waits while one is in progress.)
+  const bool never = s.captures == 0 && !s.capturing;
+  switch (r.update) {
+    case ProbeUpdate::first_frame: s.requested = s.requested || never; break;
+    case ProbeUpdate::every_n:
+      s.requested = s.requested || frame % std::uint64_t(std::max(1, r.every_n)) == 0 || never;
+      break;
+    case ProbeUpdate::on_change: s.requested = s.requested || never || signature != s.signature; break;
+    case ProbeUpdate::static_file: break;
+  }
+  if (!s.capturing && s.requested) {
+    s.capturing = true;
+    s.requested = false;
+    s.faces_done = 0;
+    s.signature = signature;
+  }
+  if (!s.capturing) return work;
+  // 3. The next faces in GL order into the back buffer; swap when all six are there.
+  const int per_frame = std::clamp(r.faces_per_frame, 1, 6);
+  for (int f = 0, n = 0; f < 6 && n < per_frame; ++f) {
+    const std::uint8_t bit = std::uint8_t(1u << f);
+    if (s.faces_done & bit) continue;
+    work.faces |= bit;
+    ++n;
+  }
+  s.faces_done |= work.faces;
+  s.faces_rendered += std::uint64_t(std::popcount(unsigned(work.faces)));
+  if (s.faces_done == kAllFaces) {
+    work.swap = true;
+    s.front = 1 - s.front;
+    s.has_map = true;
+    s.capturing = false;
+    s.last_capture_frame = frame;
+    ++s.captures;
+  }
+  return work;
+}
+
+glm::mat4 cube_face_view(int face, const glm::vec3& center) {
+  // GL's cube-map table: the face's major axis is the view direction, and "up" is chosen so that
+  // NDC +x/+y run along the face's s/t axes (e.g. +X: s = -z, t = -y).
+  static const std::array<glm::vec3, 6> forward = {glm::vec3(1, 0, 0),  glm::vec3(-1, 0, 0),
+                                                   glm::vec3(0, 1, 0),  glm::vec3(0, -1, 0),
+                                                   glm::vec3(0, 0, 1),  glm::vec3(0, 0, -1)};
+  static const std::array<glm::vec3, 6> up = {glm::vec3(0, -1, 0), glm::vec3(0, -1, 0),
+                                              glm::vec3(0, 0, 1),  glm::vec3(0, 0, -1),
+                                              glm::vec3(0, -1, 0), glm::vec3(0, -1, 0)};
+  const std::size_t f = std::size_t(std::clamp(face, 0, 5));
+  return glm::lookAt(center, center + forward[f], up[f]);
+}
+
+glm::mat4 cube_face_projection(float near, float far) {
+  return glm::perspective(glm::half_pi<float>(), 1.0f, near, far);
+}
+
+std::uint64_t scene_signature(const ecs::World& world, ecs::Entity self, const glm::vec3& center,
+                              float far, std::uint32_t exclude_layers) {
+  SignatureHash h;
+  h.add(center);
+  world.view<Light, WorldTransform>().each(
+      [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {
+        h.add(e.index);
+        h.add(l);
+        h.add(wt.matrix);
+      });
+  const Material none;
+  world.view<MeshRenderer, WorldTransform, WorldBounds>().each(
+      [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt, const WorldBounds& b) {
+        if (e == self || (exclude_layers & (1u << (mr.layer & 31)))) return;
+        if (!sphere_intersects_box(center, far, b.box)) return;
+        h.add(e.index);
+        h.add(mr.mesh);
+        h.add(wt.matrix);
+        const Material* m = world.try_get<Material>(e);
+        hash_material(h, m ? *m : none);
+      });
+  return h.value();
+}
+
+ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool commit) {
+  ProbeData out;
+  std::vector<std::pair<ecs::Entity, ProbeState>> states;
+  world.view<Reflector>().each([&](ecs::Entity e, const Reflector&) {
+    const ProbeState* s = world.try_get<ProbeState>(e);
+    ProbeState st = s ? *s : ProbeState{};
+    st.handle = e.index;  // entity indices are unique among live entities of one world
+    states.emplace_back(e, st);
+  });
+  for (auto& [e, s] : states) {
+    const Reflector& r = world.get<Reflector>(e);
+    // 1. Capture centre: explicit, else the world-bounds centre (S3 wants the pivot there).
+    const WorldTransform* wt = world.try_get<WorldTransform>(e);
+    const WorldBounds* wb = world.try_get<WorldBounds>(e);
+    const glm::vec3 pivot = wt ? glm::vec3(wt->matrix[3]) : glm::vec3(0.0f);
+    if (r.has_center) {
+      s.center = r.center;
+    } else if (wb && !wb->box.empty()) {
+      s.center = wb->box.center();
+      const float diagonal = glm::length(wb->box.extent());
+      if (!s.warned_off_centre && glm::length(pivot - s.center) > kOffCentreFraction * diagonal) {
+        if (commit)
+          log::warn("reflector entity %u: pivot (%g, %g, %g) is off the bounds centre (%g, %g, "
+                    "%g); capturing from the bounds centre (S3 assumes the pivot is the centre)",
+                    e.index, double(pivot.x), double(pivot.y), double(pivot.z),
+                    double(s.center.x), double(s.center.y), double(s.center.z));
+        s.warned_off_centre = true;
+      }
+    } else {
+      s.center = pivot;
+    }
+    // 2. Schedule (the signature only matters for on_change).
+    const std::uint64_t signature =
+        r.update == ProbeUpdate::on_change
+            ? scene_signature(world, e, s.center, r.far, r.exclude_layers)
+            : 0;
+    const ProbeWork work = schedule_probe(r, s, frame, signature);
+    // 3. Publish.
+    ProbeData::Entry entry;
+    entry.entity = e;
+    entry.has_map = s.has_map;
+    entry.sphere = r.map == ReflectionMap::sphere;
+    entry.amount = r.amount;
+    render::ProbeJob& job = entry.job;
+    job.handle = s.handle;
+    job.center = s.center;
+    job.near = r.near;
+    job.far = r.far;
+    job.resolution = r.resolution;
+    job.exclude_layers = r.exclude_layers;
+    job.faces = work.faces;
+    // After a swap s.front is already the buffer just completed; else the back buffer is 1 - front.
+    job.target = work.swap ? s.front : 1 - s.front;
+    job.visible = s.front;
+    job.sphere = entry.sphere;
+    job.box = r.box_projection && !entry.sphere;
+    job.box_min = r.box_min;
+    job.box_max = r.box_max;
+    const glm::mat4 proj = cube_face_projection(r.near, r.far);
+    for (int f = 0; f < 6; ++f) job.view_proj[std::size_t(f)] = proj * cube_face_view(f, s.center);
+    if (work.load)
+      if (const StaticEnvMap* env = world.try_get<StaticEnvMap>(e)) job.env_map = env->index;
+    out.faces_this_frame += std::popcount(unsigned(work.faces));
+    out.captures_this_frame += (work.swap || work.load) ? 1 : 0;
+    out.captures_total += s.captures;
+    out.faces_total += s.faces_rendered;
+    out.probes.push_back(entry);
+  }
+  if (commit)
+    for (auto& [e, s] : states) world.emplace<ProbeState>(e, s);
+  return out;
+}
+
+}  // namespace kaskad
