@@ -45,6 +45,29 @@ struct Aabb {
   }
 };
 
+/// Whether `box` lies entirely outside the clip volume of `view_proj` (-w <= x, y, z <= w): all 8
+/// corners beyond one of the six clip planes. Conservative (a box near a frustum corner may be
+/// kept) and exact for corners behind the eye, since each plane test is linear in homogeneous
+/// coordinates. An empty box is never outside (nothing known: draw it).
+inline bool outside_clip_volume(const glm::mat4& view_proj, const Aabb& box) {
+  if (box.empty()) return false;
+  int out[6] = {0, 0, 0, 0, 0, 0};
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec4 c = view_proj * glm::vec4((i & 1) ? box.max.x : box.min.x,
+                                              (i & 2) ? box.max.y : box.min.y,
+                                              (i & 4) ? box.max.z : box.min.z, 1.0f);
+    out[0] += c.x < -c.w;
+    out[1] += c.x > c.w;
+    out[2] += c.y < -c.w;
+    out[3] += c.y > c.w;
+    out[4] += c.z < -c.w;
+    out[5] += c.z > c.w;
+  }
+  for (int n : out)
+    if (n == 8) return true;
+  return false;
+}
+
 /// Derived: world-space bounds of an entity's mesh.
 struct WorldBounds {
   Aabb box;

@@ -48,6 +48,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         d.receive_shadows = mr.receive_shadows;
         d.cascade_mask = shadow.cascade_mask(e);
         d.layer = mr.layer;
+        if (const auto* wb = world.try_get<WorldBounds>(e)) d.bounds = wb->box;
         // A reflector's own draw reflects its probe's map once one is complete (S3 eq. (3)).
         d.material.features &= ~(render::VariantKey::kReflectionCube.mask() |
                                  render::VariantKey::kReflectionSphere.mask() |

@@ -285,9 +285,10 @@ int run_render(Args a) {
   std::printf("frames    %d at %dx%d: first %.1f ms, median %.2f ms (frames 2..%d)\n", a.frames,
               scene->render.width, scene->render.height, timings->first_frame_ms,
               timings->median_ms(), a.frames);
-  std::printf("last      %d draws, %zu triangles; shadow pass %d draws, %zu triangles; "
-              "GPU shadow %.2f ms, forward %.2f ms; %d program and %d material switches\n",
-              st.draw_calls, st.triangles, st.shadow_draw_calls, st.shadow_triangles,
+  std::printf("last      %d draws (%d outside the view, culled), %zu triangles; shadow pass %d "
+              "draws, %zu triangles; GPU shadow %.2f ms, forward %.2f ms; %d program and %d "
+              "material switches\n",
+              st.draw_calls, st.frustum_culled, st.triangles, st.shadow_draw_calls, st.shadow_triangles,
               st.shadow_gpu_ms, st.forward_gpu_ms, st.program_switches, st.material_switches);
   if (const ShadowData& sh = timings->last.shadow; sh.light.valid() && st.cascades > 0) {
     const char* fits[] = {"crop", "stable", "scene"};
@@ -307,10 +308,10 @@ int run_render(Args a) {
   }
   if (const ProbeData& pd = timings->last.probes; !pd.probes.empty()) {
     std::printf("probes    %zu reflectors: %llu captures, %llu faces since load; last frame %d "
-                "faces, %d draws into them\n",
+                "faces, %d draws into them (%d culled by the face frusta)\n",
                 pd.probes.size(), static_cast<unsigned long long>(pd.captures_total),
                 static_cast<unsigned long long>(pd.faces_total), st.probe_faces,
-                st.probe_draw_calls);
+                st.probe_draw_calls, st.probe_culled);
   }
   std::printf("shaders   %d compiled, %d from the binary cache, %.1f ms (prewarm %.1f ms); "
               "%d compiled after the first frame\n",

@@ -527,13 +527,19 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
       glProgramUniform4f(prog, kUniReflectionCentre, job.center.x, job.center.y, job.center.z, 0);
     }
   };
-  auto draw_forward = [&](const std::vector<VariantKey>& by, const ProbeJob* capture) -> Status {
+  // `view_proj`: the view drawn (main camera or probe face); draws outside it are culled.
+  auto draw_forward = [&](const std::vector<VariantKey>& by, const ProbeJob* capture,
+                          const glm::mat4& view_proj) -> Status {
     GLuint current = 0;
     for (std::uint32_t i : sorted_by(Pass::forward, by)) {
       const DrawItem& d = frame.draws[i];
       if (capture && (d.probe == capture->handle ||
                       (capture->exclude_layers & (1u << (d.layer & 31)))))
         continue;  // the reflector itself and excluded layers are not in its probe
+      if (outside_clip_volume(view_proj, d.bounds)) {
+        ++(capture ? stats_.probe_culled : stats_.frustum_culled);
+        continue;
+      }
       const GpuMesh& m = im.mesh(d.mesh, assets);
       if (m.index_count == 0) continue;
       KASKAD_TRY(use_program(Pass::forward, by[i], current));
@@ -563,6 +569,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   // selection and sphere-map lookups are the main view's. Then mips, then sphere maps.
   stats_.probe_faces = 0;
   stats_.probe_draw_calls = 0;
+  stats_.probe_culled = 0;
+  stats_.frustum_culled = 0;
   glBeginQuery(GL_TIME_ELAPSED, im.timers[2].id());
   if (!frame.probes.empty()) {
     const VariantKey capture_frame = VariantKey(frame_key.bits() & ~VariantKey::kAovs.mask());
@@ -590,7 +598,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
         im.probes->begin_face(job.handle, job.target, f, frame.clear_color);
         const int before = stats_.draw_calls;
         const std::size_t triangles_before = stats_.triangles;
-        if (Status st = draw_forward(capture_keys, &job); !st) {
+        if (Status st = draw_forward(capture_keys, &job, face_fb.view_proj); !st) {
           glEndQuery(GL_TIME_ELAPSED);
           return st;
         }
@@ -635,7 +643,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   glClearBufferfv(GL_DEPTH, 0, &one);
-  if (Status st = draw_forward(keys, nullptr); !st) {
+  if (Status st = draw_forward(keys, nullptr, fb.view_proj); !st) {
     glDisable(GL_FRAMEBUFFER_SRGB);
     glEndQuery(GL_TIME_ELAPSED);
     return st;

@@ -16,6 +16,7 @@
 
 #include <glm/glm.hpp>
 
+#include "components/bounds.h"
 #include "components/light.h"
 #include "components/material.h"
 #include "components/probe_state.h"
@@ -44,6 +45,8 @@ struct DrawItem {
   bool receive_shadows = true;
   std::uint8_t cascade_mask = 0xff;  ///< bit i: drawn into cascade i (when cast_shadows)
   int layer = 0;                     ///< MeshRenderer::layer (probes may exclude layers)
+  /// World bounds, for culling against the main view and each probe face; empty: always drawn.
+  Aabb bounds;
   /// The reflection probe this draw reflects (its own Reflector; kNoProbe: none). The draw is
   /// never drawn into that probe. With a reflection material feature on, it is shaded with the
   /// probe's visible map, scaled by `reflection_scale` = k_s * p_r (S3 eq. (3)).
@@ -120,6 +123,7 @@ inline constexpr int kMaxLights = 8;  // change together with MAX_LIGHTS in comm
 
 struct FrameStats {
   int draw_calls = 0;
+  int frustum_culled = 0;             ///< draws outside the main view's frustum, not drawn
   std::size_t triangles = 0;          ///< submitted in the forward pass
   int shadow_draw_calls = 0;
   std::size_t shadow_triangles = 0;   ///< submitted to the shadow map (all cascades)
@@ -133,6 +137,7 @@ struct FrameStats {
   int probe_faces_timed = 0;          ///< faces that probe_gpu_ms covers (previous frame's)
   int probe_faces = 0;                ///< reflection probe cube faces rendered this frame
   int probe_draw_calls = 0;           ///< draws into those faces (not in draw_calls)
+  int probe_culled = 0;               ///< draws outside a captured face's frustum, not drawn
   int program_switches = 0;           ///< glUseProgram calls in the frame (draws are sorted)
   int material_switches = 0;          ///< material uniform/texture updates in the frame
   ShaderStats shaders;                ///< compiles, cache hits, compile ms (since creation)
