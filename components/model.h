@@ -17,6 +17,9 @@ enum class PrimitiveShape { plane, box, sphere, cylinder, cone, terrain };
 struct PrimitiveMesh {
   PrimitiveShape shape = PrimitiveShape::box;
   int segments = 32;  ///< tessellation around the axis for sphere / cylinder / cone, in [3, 1024]
+  /// terrain only: split into tiles x tiles meshes (child entities of this one), so that view and
+  /// cascade culling can keep parts of it; segments must be a multiple. 1 = one mesh.
+  int tiles = 1;
 };
 
 /// A glTF file (.gltf or .glb) instanced under this entity; path relative to the scene file.

@@ -231,13 +231,20 @@ float terrain_height(float u, float v) {
   return sum / norm;
 }
 
-MeshData make_terrain(int segments) {
+MeshData make_terrain_tile(int segments, int tiles, int tile_x, int tile_z) {
+  KASKAD_CHECK(segments >= 1 && tiles >= 1 && segments % tiles == 0 && tile_x >= 0 &&
+                   tile_x < tiles && tile_z >= 0 && tile_z < tiles,
+               "terrain tile " + std::to_string(tile_x) + "," + std::to_string(tile_z) + " of " +
+                   std::to_string(tiles) + " with " + std::to_string(segments) + " segments");
   MeshData m;
-  m.name = "terrain";
-  const int n = segments;
-  const float step = 1.0f / float(n);
-  for (int j = 0; j <= n; ++j) {
-    for (int i = 0; i <= n; ++i) {
+  m.name = tiles == 1 ? "terrain" : "terrain tile " + std::to_string(tile_x) + "," + std::to_string(tile_z);
+  const int n = segments / tiles;  // cells per tile side
+  const float step = 1.0f / float(segments);
+  // Grid vertices are computed from their global index, so neighbouring tiles share edge
+  // vertices bit for bit (no cracks).
+  const int i0 = tile_x * n, j0 = tile_z * n;
+  for (int j = j0; j <= j0 + n; ++j) {
+    for (int i = i0; i <= i0 + n; ++i) {
       const float u = float(i) * step, v = float(j) * step;
       // Normal from central differences of the height (local space; the normal matrix handles
       // the transform's non-uniform scale).
@@ -253,6 +260,7 @@ MeshData make_terrain(int segments) {
       add_triangle(m, at(i, j), at(i, j + 1), at(i + 1, j + 1));
       add_triangle(m, at(i, j), at(i + 1, j + 1), at(i + 1, j));
     }
+  m.compute_bounds();
   return m;
 }
 
@@ -277,7 +285,7 @@ MeshData make_primitive(PrimitiveShape shape, int segments) {
       mesh = make_cone(segments);
       break;
     case PrimitiveShape::terrain:
-      mesh = make_terrain(segments);
+      mesh = make_terrain_tile(segments, 1, 0, 0);
       break;
   }
   mesh.compute_bounds();

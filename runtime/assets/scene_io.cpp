@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -211,6 +212,15 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
     ObjectReader pr(r.raw("primitive"), r.at("primitive"));
     pr.enumeration("shape", p.shape, kShapes);
     pr.integer("segments", p.segments, 3, 1024);
+    if (pr.has("tiles")) {
+      pr.integer("tiles", p.tiles, 1, 64);
+      if (p.shape != PrimitiveShape::terrain && p.tiles != 1)
+        fail(r.at("primitive") + "/tiles", "tiles applies to the terrain shape only");
+      if (p.segments % p.tiles != 0)
+        fail(r.at("primitive") + "/tiles", "segments (" + std::to_string(p.segments) +
+                                               ") must be a multiple of tiles (" +
+                                               std::to_string(p.tiles) + ")");
+    }
     pr.finish();
     w.emplace<PrimitiveMesh>(e, p);
   }
@@ -315,8 +325,10 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
       if (const auto* pn = w.try_get<Name>(t->parent)) tj["parent"] = pn->value;
     j["transform"] = tj;
   }
-  if (const auto* p = w.try_get<PrimitiveMesh>(e))
+  if (const auto* p = w.try_get<PrimitiveMesh>(e)) {
     j["primitive"] = {{"shape", enum_name(p->shape, kShapes)}, {"segments", p->segments}};
+    if (p->shape == PrimitiveShape::terrain) j["primitive"]["tiles"] = p->tiles;
+  }
   // Paths are relative to the scene file: rebase them when writing somewhere else.
   auto rebase = [&](const std::string& path) {
     if (base.empty() || !fs::path(path).is_relative()) return path;
@@ -535,6 +547,32 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
   // One mesh per distinct (shape, segments): instances share it.
   std::map<std::pair<int, int>, MeshId> shared;
   for (auto& [e, p] : prims) {
+    if (p.tiles > 1) {
+      // Tile (0, 0) on the entity itself, the others on imported children with its renderer
+      // flags and material (not written back: the primitive recreates them).
+      const MeshRenderer flags = w.get<MeshRenderer>(e);
+      // A copy: emplacing into the Material pool may move the entity's own component.
+      const std::optional<Material> material =
+          w.has<Material>(e) ? std::optional<Material>(w.get<Material>(e)) : std::nullopt;
+      for (int tz = 0; tz < p.tiles; ++tz)
+        for (int tx = 0; tx < p.tiles; ++tx) {
+          const MeshId mesh = scene.assets.add_mesh(make_terrain_tile(p.segments, p.tiles, tx, tz));
+          if (tx == 0 && tz == 0) {
+            w.get<MeshRenderer>(e).mesh = mesh;
+            continue;
+          }
+          const ecs::Entity tile = w.create();
+          Transform t;
+          t.parent = e;
+          w.emplace<Transform>(tile, t);
+          MeshRenderer mr = flags;
+          mr.mesh = mesh;
+          w.emplace<MeshRenderer>(tile, mr);
+          if (material) w.emplace<Material>(tile, *material);
+          w.emplace<Imported>(tile, Imported{e});
+        }
+      continue;
+    }
     auto key = std::make_pair(int(p.shape), p.segments);
     auto it = shared.find(key);
     if (it == shared.end())

@@ -206,5 +206,28 @@ TEST(Primitives, TerrainIsADeterministicUnitHeightfield) {
   }
 }
 
+// Tiles partition the whole terrain: every tile vertex is the whole mesh's vertex at the same
+// grid index (bit for bit, so shared edges have no cracks) and the triangles add up.
+TEST(Primitives, TerrainTilesPartitionTheWholeHeightfield) {
+  constexpr int kSegments = 48, kTiles = 4, kCells = kSegments / kTiles;
+  const MeshData whole = make_primitive(PrimitiveShape::terrain, kSegments);
+  std::size_t triangles = 0;
+  for (int tz = 0; tz < kTiles; ++tz)
+    for (int tx = 0; tx < kTiles; ++tx) {
+      const MeshData tile = make_terrain_tile(kSegments, kTiles, tx, tz);
+      triangles += tile.triangle_count();
+      ASSERT_EQ(tile.positions.size(), std::size_t((kCells + 1) * (kCells + 1)));
+      for (int j = 0; j <= kCells; ++j)
+        for (int i = 0; i <= kCells; ++i) {
+          const std::size_t w = std::size_t((tz * kCells + j) * (kSegments + 1) + tx * kCells + i);
+          const std::size_t t = std::size_t(j * (kCells + 1) + i);
+          ASSERT_EQ(tile.positions[t], whole.positions[w]) << tx << "," << tz << " " << i << "," << j;
+          ASSERT_EQ(tile.normals[t], whole.normals[w]);
+        }
+      EXPECT_LE(tile.bounds.max.x - tile.bounds.min.x, 1.0f / kTiles + 1e-6f);
+    }
+  EXPECT_EQ(triangles, whole.triangle_count());
+}
+
 }  // namespace
 }  // namespace kaskad

@@ -7,6 +7,7 @@
 #include "components/camera.h"
 #include "components/light.h"
 #include "components/material.h"
+#include "components/mesh_renderer.h"
 #include "components/model.h"
 #include "components/name.h"
 #include "components/reflector.h"
@@ -200,6 +201,41 @@ TEST(SceneIo, MalformedFilesGiveErrorsNamingFileAndPlace) {
   expect_error(read_scene(write_file("bad12.json", "")), {"bad12.json", "malformed JSON"});
   expect_error(read_scene(temp_dir() / "does_not_exist.json"), {"does_not_exist.json", "cannot open"});
   expect_error(read_scene(write_file("bad.txt", "{}")), {"bad.txt", ".json"});
+  expect_error(read_scene(write_file("bad13.json",
+                                     R"({"entities": [{"primitive": {"shape": "box", "tiles": 2}}]})")),
+               {"/entities/0/primitive/tiles", "terrain"});
+  expect_error(read_scene(write_file("bad14.json",
+                                     R"({"entities": [{"primitive": {"shape": "terrain", "segments": 30, "tiles": 4}}]})")),
+               {"/entities/0/primitive/tiles", "multiple"});
+}
+
+// A tiled terrain instantiates one entity per tile (the authored one plus imported children with
+// its material and renderer flags), and saves back as the one primitive it was.
+TEST(SceneIo, TiledTerrainBecomesTileEntitiesAndSavesAsOnePrimitive) {
+  const fs::path file = write_file("tiled.json", R"({"entities": [{"name": "ground",
+      "primitive": {"shape": "terrain", "segments": 16, "tiles": 4},
+      "renderer": {"cast_shadows": false},
+      "material": {"base_color": [0.2, 0.4, 0.6, 1]}}]})");
+  auto scene = read_scene(file);
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  ASSERT_TRUE(instantiate_scene(*scene).ok());
+  int tiles = 0;
+  std::size_t triangles = 0;
+  scene->world.view<MeshRenderer>().each([&](ecs::Entity e, const MeshRenderer& mr) {
+    ++tiles;
+    triangles += scene->assets.meshes[mr.mesh].triangle_count();
+    EXPECT_FALSE(mr.cast_shadows);
+    EXPECT_EQ(scene->world.get<Material>(e).base_color, glm::vec4(0.2f, 0.4f, 0.6f, 1.0f));
+  });
+  EXPECT_EQ(tiles, 16);
+  EXPECT_EQ(triangles, 2u * 16u * 16u);
+  const fs::path out = temp_dir() / "tiled_saved.json";
+  ASSERT_TRUE(save_scene(out, *scene).ok());
+  const std::string saved = read_file(out);
+  EXPECT_NE(saved.find("\"tiles\": 4"), std::string::npos);
+  auto again = read_scene(out);
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_EQ(again->world.view<PrimitiveMesh>().size_hint(), 1u);
 }
 
 TEST(SceneIo, MissingModelIsAnErrorAtInstantiation) {
