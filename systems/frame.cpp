@@ -57,6 +57,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
           render::ShadowPass& sp = in.shadow;
           sp.light_index = int(in.lights.size());
           sp.settings = shadow.settings;
+          sp.projection = shadow.projection;
           sp.cascade_count = shadow.cascade_count;
           sp.view_proj = shadow.view_proj;
           sp.splits = shadow.splits;

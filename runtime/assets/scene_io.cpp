@@ -64,6 +64,8 @@ const std::vector<std::pair<const char*, FitMode>> kFitModes = {
     {"crop", FitMode::crop}, {"stable", FitMode::stable}, {"scene", FitMode::scene}};
 const std::vector<std::pair<const char*, CascadeSelection>> kSelections = {
     {"depth", CascadeSelection::depth}, {"map_bounds", CascadeSelection::map_bounds}};
+const std::vector<std::pair<const char*, PointShadowMode>> kPointModes = {
+    {"cube", PointShadowMode::cube}, {"dual_paraboloid", PointShadowMode::dual_paraboloid}};
 
 // Range checks here; combinations (fit_mode scene with several cascades) by
 // validate_shadow_settings(), whose message starts with the bad key.
@@ -84,6 +86,7 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
   r.number("blend_band", s.blend_band, 0.0f, 1.0f);
   r.enumeration("selection", s.selection, kSelections);
   r.boolean("debug_cascades", s.debug_cascades);
+  r.enumeration("point_mode", s.point_mode, kPointModes);
   r.finish();
   if (std::string bad = validate_shadow_settings(s); !bad.empty())
     fail(r.at(bad.substr(0, bad.find(' ')).c_str()), bad);
@@ -112,6 +115,7 @@ json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
   put("blend_band", num(s.blend_band), s.blend_band != d.blend_band);
   put("selection", enum_name(s.selection, kSelections), s.selection != d.selection);
   put("debug_cascades", s.debug_cascades, s.debug_cascades != d.debug_cascades);
+  put("point_mode", enum_name(s.point_mode, kPointModes), s.point_mode != d.point_mode);
   return j;
 }
 

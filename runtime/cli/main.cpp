@@ -259,7 +259,19 @@ int run_render(Args a) {
               "GPU shadow %.2f ms, forward %.2f ms; %d program and %d material switches\n",
               st.draw_calls, st.triangles, st.shadow_draw_calls, st.shadow_triangles,
               st.shadow_gpu_ms, st.forward_gpu_ms, st.program_switches, st.material_switches);
-  if (const ShadowData& sh = timings->last.shadow; sh.light.valid() && st.cascades > 0) {
+  if (const ShadowData& sh = timings->last.shadow;
+      sh.light.valid() && st.cascades > 0 && sh.projection != ShadowProjection::ortho) {
+    const char* kinds[] = {"", "spot: 1 perspective map", "point: 6 cube faces",
+                           "point: 2 paraboloid hemispheres"};
+    std::printf("shadow    %s (%d^2 each), near %.3g m, far %.3g m from the light\n",
+                kinds[int(sh.projection)], sh.settings.map_size, double(sh.splits[0]),
+                double(sh.splits[1]));
+    std::printf("          per layer draws/triangles:");
+    for (int i = 0; i < st.cascades; ++i)
+      std::printf(" %d/%zu%s", st.cascade_draw_calls[std::size_t(i)],
+                  st.cascade_triangles[std::size_t(i)], sh.skipped[std::size_t(i)] ? " (skipped)" : "");
+    std::printf("\n");
+  } else if (sh.light.valid() && st.cascades > 0) {
     const char* fits[] = {"crop", "stable", "scene"};
     std::printf("cascades  %d (%s fit, %d^2 each)", st.cascades, fits[int(sh.settings.fit_mode)],
                 sh.settings.map_size);

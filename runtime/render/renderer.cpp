@@ -254,7 +254,10 @@ VariantKey frame_variant(const FrameInput& frame) {
     const ShadowSettings& s = frame.shadow.settings;
     k.set(VariantKey::kShadow, 1);
     k.set(VariantKey::kShadowFilter, std::uint32_t(s.filter));
-    k.set(VariantKey::kCascadeCountMinus1, std::uint32_t(cascade_layers(frame.shadow) - 1));
+    k.set(VariantKey::kShadowProjection, std::uint32_t(frame.shadow.projection));
+    // Layers of spot and point lights are faces, not cascades: no cascade selection code.
+    if (frame.shadow.projection == ShadowProjection::ortho)
+      k.set(VariantKey::kCascadeCountMinus1, std::uint32_t(cascade_layers(frame.shadow) - 1));
     k.set(VariantKey::kCascadeSelection, s.selection == CascadeSelection::map_bounds ? 1u : 0u);
     k.set(VariantKey::kDebugCascades, s.debug_cascades ? 1u : 0u);
   }
@@ -330,7 +333,9 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     const ShadowPass& sp = frame.shadow;
     // The basic map (fit scene) is biased by polygon offset alone, as before the cascades.
     const float normal_offset =
-        sp.settings.fit_mode == FitMode::scene ? 0.0f : sp.settings.normal_offset_bias;
+        sp.projection == ShadowProjection::ortho && sp.settings.fit_mode == FitMode::scene
+            ? 0.0f
+            : sp.settings.normal_offset_bias;
     fb.shadow_params = glm::vec4(normal_offset, sp.settings.blend_band, float(sp.settings.map_size), 0);
     for (int i = 0; i < cascades; ++i) {
       fb.cascade_view_proj[i] = sp.view_proj[std::size_t(i)];
@@ -432,6 +437,9 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     }
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(s.slope_bias, s.constant_bias);
+    // Paraboloid hemispheres end at a clip distance (shadow_depth.vert).
+    const bool paraboloid = frame.shadow.projection == ShadowProjection::dual_paraboloid;
+    if (paraboloid) glEnable(GL_CLIP_DISTANCE0);
     const std::vector<std::uint32_t> order = sorted_by(Pass::depth);
     GLuint current = 0;  // kept across layers: the light matrix is a per-draw uniform
     for (int c = 0; c < cascades; ++c) {
@@ -447,6 +455,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
         if (m.index_count == 0) continue;
         if (Status st = use_program(Pass::depth, keys[i], current); !st) {
           glDisable(GL_POLYGON_OFFSET_FILL);
+          glDisable(GL_CLIP_DISTANCE0);
           glEndQuery(GL_TIME_ELAPSED);
           return st;
         }
@@ -464,6 +473,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
       }
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
+    glDisable(GL_CLIP_DISTANCE0);
     im.shadow_valid = true;
   }
   glEndQuery(GL_TIME_ELAPSED);

@@ -60,10 +60,16 @@ inline constexpr int kMaxCascades = 8;  // change together with systems/cascade_
 struct ShadowPass {
   int light_index = -1;          ///< index into FrameInput::lights; -1: no shadow pass
   ShadowSettings settings;
+  /// ortho cascades (directional), perspective (spot), cube (6 faces) or dual_paraboloid (2
+  /// hemispheres) for point lights; the layers below are faces or hemispheres then.
+  ShadowProjection projection = ShadowProjection::ortho;
   int cascade_count = 0;         ///< layers drawn; 0 with light_index >= 0 is treated as 1
-  std::array<glm::mat4, kMaxCascades> view_proj{};  ///< world -> light clip space per cascade
-  std::array<float, kMaxCascades + 1> splits{};     ///< S0's D, metres of view depth
-  std::array<float, kMaxCascades> texel_size{};     ///< metres per texel per cascade
+  /// World -> light clip space per cascade; dual_paraboloid: world -> hemisphere view.
+  std::array<glm::mat4, kMaxCascades> view_proj{};
+  /// S0's D, metres of view depth; spot/point: [near, far] metres from the light.
+  std::array<float, kMaxCascades + 1> splits{};
+  /// Metres per texel per cascade; spot/point: at 1 m from the light.
+  std::array<float, kMaxCascades> texel_size{};
   std::array<bool, kMaxCascades> skipped{};         ///< no receivers: cleared, nothing drawn
 };
 

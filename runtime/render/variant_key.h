@@ -9,9 +9,11 @@
 // Valid combinations (valid()):
 //   reflection_cube and reflection_sphere exclude each other
 //   shadow_filter != 0 and cascade_count != 1 need shadow
-//   debug_cascades and cascade_selection need shadow
-// filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask), so every material
-// shares one or two shadow programs.
+//   debug_cascades, cascade_selection and shadow_projection need shadow
+//   shadow_projection != ortho has cascade_count 1 (cascades are directional only)
+// filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask, and the projection
+// when it is dual_paraboloid: its vertex shader differs), so every material shares one or two
+// shadow programs.
 #pragma once
 
 #include <cstdint>
@@ -46,6 +48,9 @@ class VariantKey {
   static constexpr Field kAovs{22, 1};
   static constexpr Field kDebugCascades{23, 1};
   static constexpr Field kCascadeSelection{24, 1};  ///< 0 depth (S0's D), 1 map bounds
+  /// ShadowProjection: 0 ortho, 1 perspective, 2 cube, 3 dual_paraboloid.
+  static constexpr Field kShadowProjection{25, 2};
+  static constexpr std::uint32_t kProjectionDualParaboloid = 3;
   static constexpr std::uint32_t kFrameMask = 0xffff0000u;
 
   constexpr VariantKey() = default;
@@ -72,20 +77,28 @@ class VariantKey {
                                    kReflectionSphere.mask() | kReceiveShadows.mask() |
                                    kShadow.mask() | kShadowFilter.mask() |
                                    kCascadeCountMinus1.mask() | kAovs.mask() |
-                                   kDebugCascades.mask() | kCascadeSelection.mask();
+                                   kDebugCascades.mask() | kCascadeSelection.mask() |
+                                   kShadowProjection.mask();
     if (bits_ & ~used) return false;
     if (has(kReflectionCube) && has(kReflectionSphere)) return false;
     if (get(kShadowFilter) > 2) return false;
     if (!has(kShadow) && (has(kShadowFilter) || has(kCascadeCountMinus1) || has(kDebugCascades) ||
-                        has(kCascadeSelection)))
+                        has(kCascadeSelection) || has(kShadowProjection)))
       return false;
+    if (has(kShadowProjection) && has(kCascadeCountMinus1)) return false;
     return true;
   }
 
   /// The part of the key a pass's shaders read. The depth pass only needs alpha masking; the
   /// forward pass needs everything.
   constexpr VariantKey filtered_for(Pass pass) const {
-    if (pass == Pass::depth) return VariantKey(bits_ & kAlphaMask.mask());
+    if (pass == Pass::depth) {
+      const std::uint32_t projection =
+          get(kShadowProjection) == kProjectionDualParaboloid
+              ? kShadowProjection.mask() | kShadow.mask()
+              : 0u;
+      return VariantKey(bits_ & (kAlphaMask.mask() | projection));
+    }
     return *this;
   }
 
@@ -98,5 +111,14 @@ static_assert(!VariantKey().set(VariantKey::kReflectionCube, 1).set(VariantKey::
 static_assert(!VariantKey().set(VariantKey::kShadowFilter, 2).valid());
 static_assert(VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowFilter, 2).valid());
 static_assert(VariantKey().set(VariantKey::kNormalMap, 1).filtered_for(Pass::depth) == VariantKey());
+static_assert(!VariantKey().set(VariantKey::kShadowProjection, 1).valid());
+static_assert(VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 2).valid());
+static_assert(!VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 2)
+                   .set(VariantKey::kCascadeCountMinus1, 5).valid());
+static_assert(VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 2)
+                  .filtered_for(Pass::depth) == VariantKey());
+static_assert(VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 3)
+                  .set(VariantKey::kShadowFilter, 2).filtered_for(Pass::depth) ==
+              VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 3));
 
 }  // namespace kaskad::render
