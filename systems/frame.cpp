@@ -20,8 +20,26 @@ double ms_since(Clock::time_point t0) {
 
 }  // namespace
 
+namespace {
+
+render::ShadowPass shadow_pass(const ShadowData& shadow, int light_index) {
+  render::ShadowPass sp;
+  sp.light_index = light_index;
+  sp.settings = shadow.settings;
+  sp.projection = shadow.projection;
+  sp.cascade_count = shadow.cascade_count;
+  sp.view_proj = shadow.view_proj;
+  sp.splits = shadow.splits;
+  sp.texel_size = shadow.texel_size;
+  sp.skipped = shadow.skipped;
+  return sp;
+}
+
+}  // namespace
+
 render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx,
-                                     const CameraState& camera, const ShadowData& shadow) {
+                                     const CameraState& camera, const ShadowData& shadow,
+                                     std::span<const ShadowData> extra) {
   const ecs::World& world = scene.world;
   render::FrameInput in;
   in.width = ctx.width;
@@ -33,14 +51,18 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.clear_color = scene.render.clear_color;
   in.exposure = scene.render.exposure;
   in.write_aovs = ctx.write_aovs;
+  in.aov_shadow_light = scene.render.aov_shadow_light;
 
   const Material default_material;
   world.view<MeshRenderer, WorldTransform>().each(
       [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
         if (mr.mesh == kNoMesh) return;
         const Material* mat = world.try_get<Material>(e);
-        in.draws.push_back({mr.mesh, wt.matrix, mat ? *mat : default_material, mr.cast_shadows,
-                            mr.receive_shadows, shadow.cascade_mask(e)});
+        render::DrawItem item{mr.mesh,          wt.matrix,           mat ? *mat : default_material,
+                              mr.cast_shadows,  mr.receive_shadows,  shadow.cascade_mask(e)};
+        for (std::size_t k = 0; k < extra.size() && k + 1 < render::kMaxShadowedLights; ++k)
+          item.extra_cascade_masks |= std::uint32_t(extra[k].cascade_mask(e)) << (8 * k);
+        in.draws.push_back(item);
       });
 
   world.view<Light, WorldTransform>().each(
@@ -53,17 +75,12 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         item.range = l.range;
         item.cos_inner = std::cos(glm::radians(l.inner_cone_deg));
         item.cos_outer = std::cos(glm::radians(l.outer_cone_deg));
-        if (e == shadow.light) {
-          render::ShadowPass& sp = in.shadow;
-          sp.light_index = int(in.lights.size());
-          sp.settings = shadow.settings;
-          sp.projection = shadow.projection;
-          sp.cascade_count = shadow.cascade_count;
-          sp.view_proj = shadow.view_proj;
-          sp.splits = shadow.splits;
-          sp.texel_size = shadow.texel_size;
-          sp.skipped = shadow.skipped;
-        }
+        if (e == shadow.light) in.shadow = shadow_pass(shadow, int(in.lights.size()));
+        for (std::size_t k = 0; k < extra.size() && k + 1 < render::kMaxShadowedLights; ++k)
+          if (e == extra[k].light) {
+            if (in.extra_shadows.size() < k + 1) in.extra_shadows.resize(k + 1);
+            in.extra_shadows[k] = shadow_pass(extra[k], int(in.lights.size()));
+          }
         in.lights.push_back(item);
       });
   return in;
@@ -73,8 +90,10 @@ render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx, ShadowData&
   update_transforms(scene.world, scene.assets);
   const CameraState camera = select_camera(scene.world, float(ctx.width) / float(ctx.height));
   ShadowCascadeState state;
-  shadow = update_shadow_cascades(scene.world, camera, state);
-  return build_frame_input(scene, ctx, camera, shadow);
+  std::vector<ShadowData> shadows = update_shadows(scene.world, camera, state);
+  shadow = shadows.front();
+  return build_frame_input(scene, ctx, camera, shadow,
+                           std::span<const ShadowData>(shadows).subspan(1));
 }
 
 render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx) {
@@ -99,11 +118,15 @@ Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& c
     return Error{scene.file.string(), "", "the scene has no camera"};
 
   t = Clock::now();
-  report.shadow = update_shadow_cascades(scene.world, report.camera, report.shadow_state);
+  std::vector<ShadowData> shadows = update_shadows(scene.world, report.camera, report.shadow_state);
+  report.shadow = std::move(shadows.front());
+  report.extra_shadows.assign(std::make_move_iterator(shadows.begin() + 1),
+                              std::make_move_iterator(shadows.end()));
   report.shadows_ms = ms_since(t);
 
   t = Clock::now();
-  const render::FrameInput input = build_frame_input(scene, ctx, report.camera, report.shadow);
+  const render::FrameInput input =
+      build_frame_input(scene, ctx, report.camera, report.shadow, report.extra_shadows);
   report.draw_list_ms = ms_since(t);
 
   t = Clock::now();

@@ -3,13 +3,16 @@
 //   1. Transforms  after it: every Transform has a current WorldTransform and every MeshRenderer
 //                  a current WorldBounds.
 //   2. Camera      after it: the active camera's view/projection for this frame's aspect.
-//   3. Cascades    after it: the shadowed directional light (if any) has current splits, one
-//                  light matrix per cascade and the casters drawn into each (ShadowData).
+//   3. Cascades    after it: every shadowed light (the first of any type, up to 3 more
+//                  directional ones) has current splits or faces, one light matrix per layer
+//                  and the casters drawn into each (ShadowData).
 //   4. DrawList    after it: the renderer's FrameInput holds every drawable, light and setting.
 //   5. Render      after it: shadow and forward passes are submitted (not necessarily finished).
 #pragma once
 
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "runtime/assets/scene.h"
 #include "runtime/core/result.h"
@@ -30,7 +33,8 @@ struct FrameContext {
 struct FrameReport {
   double transforms_ms = 0, camera_ms = 0, shadows_ms = 0, draw_list_ms = 0, render_ms = 0;
   CameraState camera;
-  ShadowData shadow;
+  ShadowData shadow;                     ///< the first shadowed light
+  std::vector<ShadowData> extra_shadows;  ///< further shadowed directional lights
   render::FrameStats stats;
   /// Carried from frame to frame when the caller reuses its report (the player does).
   ShadowCascadeState shadow_state;
@@ -48,8 +52,10 @@ render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx, ShadowData&
 /// Phases 1-4, then compiles every program the frame will use (scene load: no compiles later).
 Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx);
 
-/// Phase 4 on its own (pure: no GL), exposed for tests.
+/// Phase 4 on its own (pure: no GL), exposed for tests. `extra` are the further shadowed
+/// directional lights (update_shadows() after its first element).
 render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx,
-                                     const CameraState& camera, const ShadowData& shadow);
+                                     const CameraState& camera, const ShadowData& shadow,
+                                     std::span<const ShadowData> extra = {});
 
 }  // namespace kaskad

@@ -55,19 +55,6 @@ void set_error(ShadowData& out, const std::string& message) {
   if (out.error.empty()) out.error = message;
 }
 
-// The first Light with cast_shadows (entity order), any type.
-ecs::Entity first_shadowed_light(const ecs::World& world, glm::mat4& world_matrix, Light& light) {
-  ecs::Entity found;
-  world.view<Light, WorldTransform>().each(
-      [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {
-        if (found.valid() || !l.cast_shadows) return;
-        found = e;
-        world_matrix = wt.matrix;
-        light = l;
-      });
-  return found;
-}
-
 // Whether any part of the box lies in the half space z <= margin of `view` (a paraboloid
 // hemisphere drawn slightly past its rim).
 bool in_hemisphere(const glm::mat4& view, const Aabb& box, float margin) {
@@ -180,17 +167,20 @@ std::vector<std::uint32_t> cull_casters(const glm::mat4& light_view_proj,
   return out;
 }
 
-ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& camera,
-                                  ShadowCascadeState& state) {
+namespace {
+
+// The maps of one shadowed light (entity `e`, null for none). Errors are logged when they differ
+// from `last_error`, which is updated.
+ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera, ecs::Entity e,
+                              const Light& light_component, const glm::mat4& light_matrix,
+                              std::string& last_error) {
   ShadowData out;
-  // 1. The light: the first shadowed light, its settings and a finite transform.
-  glm::mat4 light_matrix(1.0f);
-  Light light_component;
-  out.light = first_shadowed_light(world, light_matrix, light_component);
+  // 1. The light: its settings and a finite transform.
+  out.light = e;
   auto finish = [&]() -> ShadowData {
-    if (out.error != state.last_error) {
+    if (out.error != last_error) {
       if (!out.error.empty()) log::error("shadows: %s", out.error.c_str());
-      state.last_error = out.error;
+      last_error = out.error;
     }
     return std::move(out);
   };
@@ -314,6 +304,69 @@ ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& ca
     std::sort(out.casters[c].begin(), out.casters[c].end(), entity_less);
   }
   return finish();
+}
+
+}  // namespace
+
+std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraState& camera,
+                                       ShadowCascadeState& state) {
+  struct Shadowed {
+    ecs::Entity entity;
+    Light light;
+    glm::mat4 matrix;
+  };
+  std::vector<Shadowed> lights;
+  world.view<Light, WorldTransform>().each(
+      [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {
+        if (l.cast_shadows) lights.push_back({e, l, wt.matrix});
+      });
+  std::vector<ShadowData> out;
+  std::string notice;
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    const Shadowed& l = lights[i];
+    const std::string name = "light " + std::to_string(l.entity.index);
+    if (i > 0 && l.light.type != LightType::directional) {
+      notice = name + ": only the first shadowed light may be a spot or point light; it is lit "
+                      "without shadows";
+      continue;
+    }
+    if (out.size() == std::size_t(kMaxShadowedLights)) {
+      notice = std::to_string(lights.size()) + " shadowed lights; only the first " +
+               std::to_string(kMaxShadowedLights) + " get shadow maps";
+      break;
+    }
+    ShadowData d = fit_shadowed_light(world, camera, l.entity, l.light, l.matrix,
+                                      state.last_errors[out.size()]);
+    if (i == 0) {
+      out.push_back(std::move(d));
+      if (!out[0].light.valid()) break;  // no primary: no extra lights either
+      continue;
+    }
+    if (!d.light.valid()) continue;  // its error is logged
+    // One depth texture array holds every light's layers: the first light's map size, format
+    // and filter apply to all, and its cascade selection (a frame feature of the shaders).
+    const ShadowSettings& first = out[0].settings;
+    if (d.settings.map_size != first.map_size || d.settings.depth_format != first.depth_format ||
+        d.settings.filter != first.filter || d.settings.selection != first.selection)
+      notice = name + ": takes map_size, depth_format, filter and selection from the first "
+                      "shadowed light (one shared texture array)";
+    d.settings.map_size = first.map_size;
+    d.settings.depth_format = first.depth_format;
+    d.settings.filter = first.filter;
+    d.settings.selection = first.selection;
+    out.push_back(std::move(d));
+  }
+  if (out.empty()) out.emplace_back();
+  if (notice != state.last_notice) {
+    if (!notice.empty()) log::warn("shadows: %s", notice.c_str());
+    state.last_notice = notice;
+  }
+  return out;
+}
+
+ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& camera,
+                                  ShadowCascadeState& state) {
+  return std::move(update_shadows(world, camera, state).front());
 }
 
 }  // namespace kaskad

@@ -60,9 +60,14 @@ struct ShadowData {
   std::uint8_t cascade_mask(ecs::Entity e) const;
 };
 
-/// State the system owns between frames: the last error, so it is logged once, not every frame.
+/// Shadowed lights with maps at most: the first (any type) and up to 3 more directional lights.
+inline constexpr int kMaxShadowedLights = 4;  // change together with render::kMaxShadowedLights
+
+/// State the system owns between frames: the last error per shadowed light and the last notice,
+/// so each is logged once, not every frame.
 struct ShadowCascadeState {
-  std::string last_error;
+  std::array<std::string, kMaxShadowedLights> last_errors;
+  std::string last_notice;
 };
 
 /// Phase 3. Picks the first Light with cast_shadows (entity order). A spot light gets one
@@ -78,6 +83,16 @@ struct ShadowCascadeState {
 /// with non-finite bounds are left out. Needs current WorldTransform/WorldBounds.
 ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& camera,
                                   ShadowCascadeState& state);
+
+/// Phase 3 for every shadowed light: element 0 is update_shadow_cascades()'s result (light null
+/// when there is none); elements 1.. are further directional lights with cast_shadows (entity
+/// order), each fitted with its own settings and cascades, as S0 asks of several directional
+/// lights. They share the first light's map_size, depth_format, filter and selection (one
+/// texture array; a warning says so when theirs differ). Spot and point lights after the first
+/// shadowed light are lit without shadows, and lights beyond kMaxShadowedLights are left out,
+/// with a warning logged once. Extra lights are present only when the first one is valid.
+std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraState& camera,
+                                       ShadowCascadeState& state);
 
 // ---- Pure parts, exposed for tests -------------------------------------------------------------
 

@@ -163,6 +163,49 @@ float shadow_visibility(vec3 p, vec3 n, float depth, out int cascade) {
   return v;
 }
 
+// Further shadowed directional lights (S0: each has its own N maps): light k's cascades, with the
+// first light's filter and selection (frame features), its own matrices, splits, blend band and
+// normal offset (data). The same steps as cascade_visibility / select_cascade / blend_weight.
+float extra_cascade_visibility(int k, int c, vec3 p, vec3 n) {
+  vec3 q = p + n * (u_extra_params[k].x * extra_texel(k, c));
+  vec4 clip = u_extra_view_proj[k * MAX_CASCADES + c] * vec4(q, 1.0);
+  vec3 t = clip.xyz / clip.w * 0.5 + 0.5;
+  if (t.z > 1.0) return 1.0;
+  return shadow_taps(u_extra_light[k].y + c, t);
+}
+
+float extra_shadow_visibility(int k, vec3 p, vec3 n, float depth, out int cascade) {
+  int count = u_extra_light[k].z;
+  float band = u_extra_params[k].y;
+  float w = 0.0;
+  cascade = -1;
+#if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
+  float edge = 1.0 - 2.0 * (1.5 + u_extra_params[k].x) / u_extra_params[k].z;
+  for (int i = 0; i < count && cascade < 0; ++i) {
+    vec4 clip = u_extra_view_proj[k * MAX_CASCADES + i] * vec4(p, 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    if (abs(ndc.x) <= edge && abs(ndc.y) <= edge && abs(ndc.z) <= 1.0) {
+      cascade = i;
+      if (band > 0.0)
+        w = clamp((max(abs(ndc.x), abs(ndc.y)) - (edge - band * edge)) / (band * edge), 0.0, 1.0);
+    }
+  }
+  if (cascade < 0) return 1.0;
+#else
+  if (depth >= extra_split(k, count)) return 1.0;
+  cascade = 0;
+  for (int i = 1; i < count; ++i)
+    if (depth >= extra_split(k, i)) cascade = i;
+  if (band > 0.0) {
+    float d0 = extra_split(k, cascade), d1 = extra_split(k, cascade + 1);
+    w = clamp((depth - (d1 - band * (d1 - d0))) / (band * (d1 - d0)), 0.0, 1.0);
+  }
+#endif
+  float v = extra_cascade_visibility(k, cascade, p, n);
+  if (cascade < count - 1 && w > 0.0) v = mix(v, extra_cascade_visibility(k, cascade + 1, p, n), w);
+  return v;
+}
+
 #if VARIANT_DEBUG_CASCADES
 // Tints per cascade: red, green, blue, yellow, magenta, cyan, orange, violet.
 vec3 cascade_tint(int cascade) {

@@ -462,6 +462,7 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
       r.vector<3>("ambient", s.ambient, 0.0f, 1.0e4f);
       r.vector<3>("clear_color", s.clear_color, 0.0f, 1.0e4f);
       r.number("exposure", s.exposure, 0.0f, 1.0e4f);
+      r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
       r.finish();
     }
     if (root.has("shadow")) {
@@ -540,7 +541,8 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
                    {"height", r.height},
                    {"ambient", vec(r.ambient)},
                    {"clear_color", vec(r.clear_color)},
-                   {"exposure", num(r.exposure)}};
+                   {"exposure", num(r.exposure)},
+                   {"aov_shadow_light", r.aov_shadow_light}};
   doc["shadow"] = write_shadow(scene.shadow_defaults, nullptr);
   std::vector<ecs::Entity> authored;
   scene.world.view<Transform>().each([&](ecs::Entity e, const Transform&) {

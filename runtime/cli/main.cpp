@@ -287,6 +287,11 @@ int run_render(Args a) {
                   st.cascade_triangles[std::size_t(i)], sh.skipped[std::size_t(i)] ? " (skipped)" : "");
     std::printf("\n");
   }
+  for (const ShadowData& ex : timings->last.extra_shadows) {
+    std::printf("shadowed  light %u: %d cascades; splits", ex.light.index, ex.cascade_count);
+    for (int i = 0; i <= ex.cascade_count; ++i) std::printf(" %.3g", double(ex.splits[std::size_t(i)]));
+    std::printf(" m\n");
+  }
   std::printf("shaders   %d compiled, %d from the binary cache, %.1f ms (prewarm %.1f ms); "
               "%d compiled after the first frame\n",
               st.shaders.programs_compiled, st.shaders.cache_hits, st.shaders.compile_ms,

@@ -15,6 +15,8 @@
 namespace kaskad::render {
 namespace {
 
+constexpr int kMaxExtra = kMaxShadowedLights - 1;
+
 // std140 mirror of FrameBlock in content/shaders/common.glsl (change together).
 struct alignas(16) FrameBlock {
   glm::mat4 view_proj;
@@ -30,9 +32,17 @@ struct alignas(16) FrameBlock {
   glm::vec4 light_dir[kMaxLights];
   glm::vec4 light_pos[kMaxLights];
   glm::vec4 light_cone[kMaxLights];
+  // Further shadowed directional lights (FrameInput::extra_shadows).
+  glm::ivec4 extra_count;                        // x: how many
+  glm::ivec4 extra_light[kMaxExtra];             // x light index, y first layer, z cascades
+  glm::vec4 extra_params[kMaxExtra];             // x normal offset, y blend band, z map size
+  glm::mat4 extra_view_proj[kMaxExtra * kMaxCascades];
+  glm::vec4 extra_splits[kMaxExtra * 3];         // D[0..8] of light k: [3k .. 3k+2]
+  glm::vec4 extra_texel[kMaxExtra * 2];          // metres per texel of light k: [2k, 2k+1]
 };
 static_assert(sizeof(FrameBlock) ==
-              2 * 64 + 4 * 16 + kMaxCascades * 64 + 5 * 16 + 4 * kMaxLights * 16);
+              2 * 64 + 4 * 16 + kMaxCascades * 64 + 5 * 16 + 4 * kMaxLights * 16 + 16 +
+                  kMaxExtra * (2 * 16 + kMaxCascades * 64 + 5 * 16));
 
 GLenum depth_internal_format(DepthFormat f) {
   switch (f) {
@@ -328,14 +338,48 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     log::warn("%zu lights; only the first %d are shaded", frame.lights.size(), kMaxLights);
   const bool shadowed = frame.shadow.light_index >= 0 && frame.shadow.light_index < light_count;
   const int cascades = shadowed ? cascade_layers(frame.shadow) : 0;
-  fb.counts = glm::ivec4(light_count, shadowed ? frame.shadow.light_index : -1, cascades, 0);
+  // Further shadowed directional lights: their cascades follow the first light's layers.
+  std::vector<const ShadowPass*> extras;
+  std::array<int, kMaxShadowedLights> first_layer{};
+  int total_layers = cascades;
+  if (shadowed)
+    for (const ShadowPass& e : frame.extra_shadows) {
+      if (int(extras.size()) == kMaxExtra) break;
+      if (e.light_index < 0 || e.light_index >= light_count ||
+          e.projection != ShadowProjection::ortho)
+        continue;
+      first_layer[extras.size()] = total_layers;
+      total_layers += cascade_layers(e);
+      extras.push_back(&e);
+    }
+  const int aov_light =
+      frame.aov_shadow_light >= 0 && frame.aov_shadow_light <= int(extras.size())
+          ? frame.aov_shadow_light
+          : 0;
+  fb.counts = glm::ivec4(light_count, shadowed ? frame.shadow.light_index : -1, cascades, aov_light);
+  // The basic map (fit scene) is biased by polygon offset alone, as before the cascades.
+  auto normal_offset_of = [](const ShadowPass& sp) {
+    return sp.projection == ShadowProjection::ortho && sp.settings.fit_mode == FitMode::scene
+               ? 0.0f
+               : sp.settings.normal_offset_bias;
+  };
+  fb.extra_count = glm::ivec4(int(extras.size()), 0, 0, 0);
+  for (std::size_t k = 0; k < extras.size(); ++k) {
+    const ShadowPass& e = *extras[k];
+    const int n = cascade_layers(e);
+    fb.extra_light[k] = glm::ivec4(e.light_index, first_layer[k], n, 0);
+    fb.extra_params[k] = glm::vec4(normal_offset_of(e), e.settings.blend_band,
+                                   float(frame.shadow.settings.map_size), 0);
+    for (int i = 0; i < n; ++i) {
+      fb.extra_view_proj[k * kMaxCascades + std::size_t(i)] = e.view_proj[std::size_t(i)];
+      fb.extra_texel[k * 2 + std::size_t(i / 4)][i % 4] = e.texel_size[std::size_t(i)];
+    }
+    for (int i = 0; i <= n; ++i)
+      fb.extra_splits[k * 3 + std::size_t(i / 4)][i % 4] = e.splits[std::size_t(i)];
+  }
   if (shadowed) {
     const ShadowPass& sp = frame.shadow;
-    // The basic map (fit scene) is biased by polygon offset alone, as before the cascades.
-    const float normal_offset =
-        sp.projection == ShadowProjection::ortho && sp.settings.fit_mode == FitMode::scene
-            ? 0.0f
-            : sp.settings.normal_offset_bias;
+    const float normal_offset = normal_offset_of(sp);
     fb.shadow_params = glm::vec4(normal_offset, sp.settings.blend_band, float(sp.settings.map_size), 0);
     for (int i = 0; i < cascades; ++i) {
       fb.cascade_view_proj[i] = sp.view_proj[std::size_t(i)];
@@ -422,35 +466,43 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.cascade_triangles.fill(0);
   if (shadowed) {
     const ShadowSettings& s = frame.shadow.settings;
-    im.ensure_shadow_map(s.map_size, cascades, s.depth_format, s.filter);
+    im.ensure_shadow_map(s.map_size, total_layers, s.depth_format, s.filter);
     glBindFramebuffer(GL_FRAMEBUFFER, im.shadow_fbo.id());
     glViewport(0, 0, s.map_size, s.map_size);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     glClearDepth(1.0);
-    if (s.cull == CullMode::none) {
-      glDisable(GL_CULL_FACE);
-    } else {
-      glEnable(GL_CULL_FACE);
-      glCullFace(s.cull == CullMode::front ? GL_FRONT : GL_BACK);
-    }
     glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(s.slope_bias, s.constant_bias);
     // Paraboloid hemispheres end at a clip distance (shadow_depth.vert).
     const bool paraboloid = frame.shadow.projection == ShadowProjection::dual_paraboloid;
     if (paraboloid) glEnable(GL_CLIP_DISTANCE0);
     const std::vector<std::uint32_t> order = sorted_by(Pass::depth);
     GLuint current = 0;  // kept across layers: the light matrix is a per-draw uniform
-    for (int c = 0; c < cascades; ++c) {
+    // Light 0 is the first shadowed light, 1.. the extra directional ones; each with its own
+    // culling, bias and casters per cascade, into consecutive layers.
+    for (std::size_t light = 0; light <= extras.size(); ++light) {
+    const ShadowPass& pass = light == 0 ? frame.shadow : *extras[light - 1];
+    const int base = light == 0 ? 0 : first_layer[light - 1];
+    const int layers = light == 0 ? cascades : cascade_layers(pass);
+    if (pass.settings.cull == CullMode::none) {
+      glDisable(GL_CULL_FACE);
+    } else {
+      glEnable(GL_CULL_FACE);
+      glCullFace(pass.settings.cull == CullMode::front ? GL_FRONT : GL_BACK);
+    }
+    glPolygonOffset(pass.settings.slope_bias, pass.settings.constant_bias);
+    for (int c = 0; c < layers; ++c) {
       glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0,
-                                     c);
+                                     base + c);
       glClear(GL_DEPTH_BUFFER_BIT);
-      if (frame.shadow.skipped[std::size_t(c)]) continue;
-      const glm::mat4& light_vp = frame.shadow.view_proj[std::size_t(c)];
+      if (pass.skipped[std::size_t(c)]) continue;
+      const glm::mat4& light_vp = pass.view_proj[std::size_t(c)];
       for (std::uint32_t i : order) {
         const DrawItem& d = frame.draws[i];
-        if (!d.cast_shadows || !(d.cascade_mask & (1u << c))) continue;
+        const std::uint32_t mask =
+            light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu;
+        if (!d.cast_shadows || !(mask & (1u << c))) continue;
         const GpuMesh& m = im.mesh(d.mesh, assets);
         if (m.index_count == 0) continue;
         if (Status st = use_program(Pass::depth, keys[i], current); !st) {
@@ -468,9 +520,12 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
         glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
         ++stats_.shadow_draw_calls;
         stats_.shadow_triangles += std::size_t(m.index_count / 3);
-        ++stats_.cascade_draw_calls[std::size_t(c)];
-        stats_.cascade_triangles[std::size_t(c)] += std::size_t(m.index_count / 3);
+        if (light == 0) {
+          ++stats_.cascade_draw_calls[std::size_t(c)];
+          stats_.cascade_triangles[std::size_t(c)] += std::size_t(m.index_count / 3);
+        }
       }
+    }
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
     glDisable(GL_CLIP_DISTANCE0);

@@ -40,6 +40,8 @@ struct DrawItem {
   bool cast_shadows = true;
   bool receive_shadows = true;
   std::uint8_t cascade_mask = 0xff;  ///< bit i: drawn into cascade i (when cast_shadows)
+  /// Bit 8k + i: drawn into cascade i of FrameInput::extra_shadows[k].
+  std::uint32_t extra_cascade_masks = 0;
 };
 
 /// A light as the shaders see it. `color` already includes the intensity.
@@ -55,6 +57,9 @@ struct LightItem {
 
 inline constexpr int kMaxCascades = 8;  // change together with systems/cascade_math.h and
                                         // MAX_CASCADES in common.glsl
+/// The first shadowed light plus up to 3 further directional ones. Change together with
+/// systems/shadow_cascade_system.h and MAX_EXTRA_SHADOWS (= this - 1) in common.glsl.
+inline constexpr int kMaxShadowedLights = 4;
 
 /// The shadowed light's cascades (systems/shadow_cascade_system.h, ShadowData).
 struct ShadowPass {
@@ -79,7 +84,13 @@ struct FrameInput {
   CameraView camera;
   std::vector<DrawItem> draws;
   std::vector<LightItem> lights;  ///< at most kMaxLights are used
-  ShadowPass shadow;
+  ShadowPass shadow;  ///< the first shadowed light (any type)
+  /// Further shadowed directional lights (ortho cascades), at most kMaxShadowedLights - 1; their
+  /// layers follow the first light's in the same texture array, so map size, format, filter and
+  /// selection are the first light's. Ignored without `shadow`.
+  std::vector<ShadowPass> extra_shadows;
+  /// The AOV's visibility and cascade show this shadowed light: 0 `shadow`, k extra_shadows[k-1].
+  int aov_shadow_light = 0;
   glm::vec3 ambient{0.05f};
   glm::vec3 clear_color{0.0f};
   float exposure = 1.0f;

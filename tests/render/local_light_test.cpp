@@ -29,6 +29,7 @@ std::string describe(const reference::ShadowMetrics& m) {
 struct Rendered {
   reference::ShadowMetrics metrics;
   ShadowData shadow;
+  std::vector<ShadowData> extra;
   Image aov;
   std::set<int> layers_seen;  ///< AOV cascade (layer) values of receiver pixels
 };
@@ -51,8 +52,10 @@ class LocalLightTest : public ::testing::Test {
   void SetUp() override { gpu::reset_debug_error_count(); }
   void TearDown() override { EXPECT_EQ(gpu::debug_error_count(), 0) << "GL errors were logged"; }
 
-  // Renders `scene_file` at 400x225 with overrides and compares with the ray-traced reference.
-  static Rendered render_and_compare(const char* scene_file, std::vector<std::string> sets) {
+  // Renders `scene_file` at 400x225 with overrides and compares with the ray-traced reference of
+  // shadowed light `reference_of` (0 the first, k the k-th extra directional light).
+  static Rendered render_and_compare(const char* scene_file, std::vector<std::string> sets,
+                                     int reference_of = 0) {
     Rendered out;
     sets.push_back("render.width=400");
     sets.push_back("render.height=225");
@@ -64,8 +67,12 @@ class LocalLightTest : public ::testing::Test {
     EXPECT_TRUE(t.ok()) << t.error().to_string();
     if (!t.ok()) return out;
     out.shadow = t->last.shadow;
+    out.extra = t->last.extra_shadows;
     out.aov = player_->renderer->read_aovs();
-    const ecs::Entity light = out.shadow.light;
+    EXPECT_LE(reference_of, int(out.extra.size()));
+    if (reference_of > int(out.extra.size())) return out;
+    const ecs::Entity light =
+        reference_of == 0 ? out.shadow.light : out.extra[std::size_t(reference_of - 1)].light;
     EXPECT_TRUE(light.valid());
     if (!light.valid()) return out;
     auto tracer = reference::RayTracer::build(*scene);
@@ -143,6 +150,37 @@ TEST_F(LocalLightTest, UnbiasedMapsScoreWorse) {
   }
   const Rendered bad_spot = render_and_compare("spot.json", no_bias);
   EXPECT_GT(bad_spot.metrics.outside_edges.false_shadow_pct, 1.0) << describe(bad_spot.metrics);
+}
+
+// Two directional lights, each with its own cascades (4 and 2): the AOV shows either light's
+// visibility (render.aov_shadow_light) and each agrees with that light's ray cast; read against
+// the other light's reference it does not, so the comparison tells the lights apart.
+TEST_F(LocalLightTest, TwoDirectionalLightsEachAgreeWithTheirRayCasts) {
+  const Rendered sun = render_and_compare("two_suns.json", {"render.aov_shadow_light=0"}, 0);
+  ASSERT_EQ(sun.extra.size(), 1u);
+  EXPECT_EQ(sun.shadow.cascade_count, 4);
+  EXPECT_EQ(sun.extra[0].cascade_count, 2);
+  EXPECT_NE(sun.extra[0].light, sun.shadow.light);
+  expect_meaningful(sun);
+  EXPECT_LT(sun.metrics.outside_edges.misclassified_pct, 1.0) << describe(sun.metrics);
+  const Rendered moon = render_and_compare("two_suns.json", {"render.aov_shadow_light=1"}, 1);
+  expect_meaningful(moon);
+  EXPECT_LT(moon.metrics.outside_edges.misclassified_pct, 1.0) << describe(moon.metrics);
+  const Rendered crossed = render_and_compare("two_suns.json", {"render.aov_shadow_light=1"}, 0);
+  EXPECT_GT(crossed.metrics.outside_edges.misclassified_pct, 5.0) << describe(crossed.metrics);
+}
+
+// The first shadowed light may be a spot or point light; shadowed lights beyond the cap and
+// shadowed spot/point lights after the first are left without maps (a warning), never an error.
+TEST_F(LocalLightTest, ExtraShadowedLightsAreCappedAndMustBeDirectional) {
+  auto scene = load_scene(content_dir() / "scenes" / "two_suns.json",
+                          {"render.width=160", "render.height=90", "moon.light.type=spot"});
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  RenderRun run;
+  auto t = render_frames(*player_, *scene, run);
+  ASSERT_TRUE(t.ok()) << t.error().to_string();
+  EXPECT_TRUE(t->last.shadow.light.valid());
+  EXPECT_TRUE(t->last.extra_shadows.empty());
 }
 
 }  // namespace

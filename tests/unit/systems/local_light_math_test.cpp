@@ -214,5 +214,44 @@ TEST(ShadowCascadeSystem, SpotAndPointLightsGetTheirMaps) {
   }
 }
 
+TEST(ShadowCascadeSystem, SeveralDirectionalLightsEachGetCascadesUpToTheCap) {
+  ecs::World w;
+  box(w, Aabb::from_corners({-10, -0.1f, -10}, {10, 0, 10}), false, true);
+  box(w, Aabb::from_corners({-0.5f, 1, -0.5f}, {0.5f, 2, 0.5f}), true, true);
+  std::vector<ecs::Entity> suns;
+  for (int i = 0; i < 5; ++i) {
+    const float a = 0.7f * float(i);
+    suns.push_back(light(w, LightType::directional, {0, 10, 0},
+                         glm::normalize(glm::vec3(std::cos(a), -1.5f, std::sin(a)))));
+    ShadowSettings& s = w.get<ShadowSettings>(suns.back());
+    s.cascade_count = 1 + i;
+    s.map_size = 512 << i;  // extra lights take the first one's
+  }
+  CameraState cam;
+  cam.entity = w.create();
+  cam.camera.near = 0.5f;
+  cam.camera.far = 60.0f;
+  cam.view = glm::lookAt(glm::vec3(0, 5, 12), glm::vec3(0), glm::vec3(0, 1, 0));
+  cam.proj = glm::perspective(glm::radians(cam.camera.fov_y_deg), 1.0f, 0.5f, 60.0f);
+  ShadowCascadeState state;
+  const std::vector<ShadowData> all = update_shadows(w, cam, state);
+  ASSERT_EQ(all.size(), std::size_t(kMaxShadowedLights));
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(all[i].light, suns[i]) << all[i].error;
+    EXPECT_EQ(all[i].cascade_count, int(i) + 1);
+    EXPECT_EQ(all[i].settings.map_size, 512);
+    // Each light's own direction: its cascade matrices differ from the first light's.
+    if (i > 0) {
+      EXPECT_NE(all[i].view_proj[0], all[0].view_proj[0]);
+    }
+  }
+  EXPECT_NE(state.last_notice.find("only the first 4"), std::string::npos) << state.last_notice;
+  // A spot light after the first shadowed light gets no maps.
+  w.get<Light>(suns[1]).type = LightType::spot;
+  const std::vector<ShadowData> some = update_shadows(w, cam, state);
+  ASSERT_EQ(some.size(), std::size_t(kMaxShadowedLights));
+  EXPECT_EQ(some[1].light, suns[2]);
+}
+
 }  // namespace
 }  // namespace kaskad
