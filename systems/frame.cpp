@@ -58,8 +58,8 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
       [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
         if (mr.mesh == kNoMesh) return;
         const Material* mat = world.try_get<Material>(e);
-        render::DrawItem item{mr.mesh,          wt.matrix,           mat ? *mat : default_material,
-                              mr.cast_shadows,  mr.receive_shadows,  shadow.cascade_mask(e)};
+        render::DrawItem item{mr.mesh,         wt.matrix,          mat ? *mat : default_material,
+                              mr.cast_shadows, mr.receive_shadows, shadow.cascade_mask(e)};
         for (std::size_t k = 0; k < extra.size() && k + 1 < render::kMaxShadowedLights; ++k)
           item.extra_cascade_masks |= std::uint32_t(extra[k].cascade_mask(e)) << (8 * k);
         in.draws.push_back(item);

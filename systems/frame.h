@@ -33,7 +33,7 @@ struct FrameContext {
 struct FrameReport {
   double transforms_ms = 0, camera_ms = 0, shadows_ms = 0, draw_list_ms = 0, render_ms = 0;
   CameraState camera;
-  ShadowData shadow;                     ///< the first shadowed light
+  ShadowData shadow;                      ///< the first shadowed light
   std::vector<ShadowData> extra_shadows;  ///< further shadowed directional lights
   render::FrameStats stats;
   /// Carried from frame to frame when the caller reuses its report (the player does).

@@ -2,17 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <string>
-
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include <string>
 
 #include "runtime/core/result.h"
 
 namespace kaskad {
 
-NearFar local_light_near_far(const glm::vec3& position, std::span<const Aabb> boxes,
-                             float range) {
+NearFar local_light_near_far(const glm::vec3& position, std::span<const Aabb> boxes, float range) {
   NearFar out;
   float near = 3.4e38f, far = 0.0f;
   for (const Aabb& b : boxes) {
@@ -24,8 +22,8 @@ NearFar local_light_near_far(const glm::vec3& position, std::span<const Aabb> bo
     if (range > 0.0f && dmin > range) continue;
     glm::vec3 farthest;
     for (int a = 0; a < 3; ++a)
-      farthest[a] = std::abs(b.min[a] - position[a]) > std::abs(b.max[a] - position[a]) ? b.min[a]
-                                                                                          : b.max[a];
+      farthest[a] =
+          std::abs(b.min[a] - position[a]) > std::abs(b.max[a] - position[a]) ? b.min[a] : b.max[a];
     near = std::min(near, dmin);
     far = std::max(far, glm::length(farthest - position));
   }
@@ -88,8 +86,8 @@ int cube_face_of(const glm::vec3& d) {
   return d.z >= 0.0f ? 4 : 5;
 }
 
-PerspectiveShadow cube_face_shadow(const glm::vec3& position, int face, float tan_half,
-                                   float near, float far, int map_size) {
+PerspectiveShadow cube_face_shadow(const glm::vec3& position, int face, float tan_half, float near,
+                                   float far, int map_size) {
   KASKAD_CHECK(face >= 0 && face < kCubeFaces,
                "cube_face_shadow: face must be in [0, 6), was " + std::to_string(face));
   // GL's cube-map face axes (forward, up); any up would do, these make the dumped layers read

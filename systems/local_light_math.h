@@ -8,9 +8,8 @@
 #pragma once
 
 #include <array>
-#include <span>
-
 #include <glm/glm.hpp>
+#include <span>
 
 #include "components/bounds.h"
 #include "systems/cascade_math.h"  // NearFar
@@ -68,8 +67,8 @@ inline float cube_tan_half_fov(int map_size, float border_texels) {
   return widen_tan_half_fov(1.0f, map_size, border_texels);
 }
 /// Face `face` of a cube map at `position`, tan_half from cube_tan_half_fov().
-PerspectiveShadow cube_face_shadow(const glm::vec3& position, int face, float tan_half,
-                                   float near, float far, int map_size);
+PerspectiveShadow cube_face_shadow(const glm::vec3& position, int face, float tan_half, float near,
+                                   float far, int map_size);
 
 // ---- Dual-paraboloid maps -----------------------------------------------------------------------
 

@@ -115,7 +115,8 @@ void fit_local_light(const Light& light, const LightFrame& frame, ShadowData& ou
     out.projection = ShadowProjection::cube;
     out.cascade_count = kCubeFaces;
     for (int f = 0; f < kCubeFaces; ++f) {
-      const PerspectiveShadow map = cube_face_shadow(frame.origin, f, tan_half, near, far, s.map_size);
+      const PerspectiveShadow map =
+          cube_face_shadow(frame.origin, f, tan_half, near, far, s.map_size);
       out.view_proj[std::size_t(f)] = map.view_proj();
       out.texel_size[std::size_t(f)] = map.texel_at_unit_distance;
       finish_layer(f, frustum_overlaps(f));
@@ -326,8 +327,9 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
     const Shadowed& l = lights[i];
     const std::string name = "light " + std::to_string(l.entity.index);
     if (i > 0 && l.light.type != LightType::directional) {
-      notice = name + ": only the first shadowed light may be a spot or point light; it is lit "
-                      "without shadows";
+      notice = name +
+               ": only the first shadowed light may be a spot or point light; it is lit "
+               "without shadows";
       continue;
     }
     if (out.size() == std::size_t(kMaxShadowedLights)) {
@@ -348,8 +350,9 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
     const ShadowSettings& first = out[0].settings;
     if (d.settings.map_size != first.map_size || d.settings.depth_format != first.depth_format ||
         d.settings.filter != first.filter || d.settings.selection != first.selection)
-      notice = name + ": takes map_size, depth_format, filter and selection from the first "
-                      "shadowed light (one shared texture array)";
+      notice = name +
+               ": takes map_size, depth_format, filter and selection from the first "
+               "shadowed light (one shared texture array)";
     d.settings.map_size = first.map_size;
     d.settings.depth_format = first.depth_format;
     d.settings.filter = first.filter;

@@ -269,7 +269,8 @@ int run_render(Args a) {
     std::printf("          per layer draws/triangles:");
     for (int i = 0; i < st.cascades; ++i)
       std::printf(" %d/%zu%s", st.cascade_draw_calls[std::size_t(i)],
-                  st.cascade_triangles[std::size_t(i)], sh.skipped[std::size_t(i)] ? " (skipped)" : "");
+                  st.cascade_triangles[std::size_t(i)],
+                  sh.skipped[std::size_t(i)] ? " (skipped)" : "");
     std::printf("\n");
   } else if (sh.light.valid() && st.cascades > 0) {
     const char* fits[] = {"crop", "stable", "scene"};
@@ -289,7 +290,8 @@ int run_render(Args a) {
   }
   for (const ShadowData& ex : timings->last.extra_shadows) {
     std::printf("shadowed  light %u: %d cascades; splits", ex.light.index, ex.cascade_count);
-    for (int i = 0; i <= ex.cascade_count; ++i) std::printf(" %.3g", double(ex.splits[std::size_t(i)]));
+    for (int i = 0; i <= ex.cascade_count; ++i)
+      std::printf(" %.3g", double(ex.splits[std::size_t(i)]));
     std::printf(" m\n");
   }
   std::printf("shaders   %d compiled, %d from the binary cache, %.1f ms (prewarm %.1f ms); "

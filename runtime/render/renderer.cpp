@@ -33,16 +33,16 @@ struct alignas(16) FrameBlock {
   glm::vec4 light_pos[kMaxLights];
   glm::vec4 light_cone[kMaxLights];
   // Further shadowed directional lights (FrameInput::extra_shadows).
-  glm::ivec4 extra_count;                        // x: how many
-  glm::ivec4 extra_light[kMaxExtra];             // x light index, y first layer, z cascades
-  glm::vec4 extra_params[kMaxExtra];             // x normal offset, y blend band, z map size
+  glm::ivec4 extra_count;             // x: how many
+  glm::ivec4 extra_light[kMaxExtra];  // x light index, y first layer, z cascades
+  glm::vec4 extra_params[kMaxExtra];  // x normal offset, y blend band, z map size
   glm::mat4 extra_view_proj[kMaxExtra * kMaxCascades];
-  glm::vec4 extra_splits[kMaxExtra * 3];         // D[0..8] of light k: [3k .. 3k+2]
-  glm::vec4 extra_texel[kMaxExtra * 2];          // metres per texel of light k: [2k, 2k+1]
+  glm::vec4 extra_splits[kMaxExtra * 3];  // D[0..8] of light k: [3k .. 3k+2]
+  glm::vec4 extra_texel[kMaxExtra * 2];   // metres per texel of light k: [2k, 2k+1]
 };
-static_assert(sizeof(FrameBlock) ==
-              2 * 64 + 4 * 16 + kMaxCascades * 64 + 5 * 16 + 4 * kMaxLights * 16 + 16 +
-                  kMaxExtra * (2 * 16 + kMaxCascades * 64 + 5 * 16));
+static_assert(sizeof(FrameBlock) == 2 * 64 + 4 * 16 + kMaxCascades * 64 + 5 * 16 +
+                                        4 * kMaxLights * 16 + 16 +
+                                        kMaxExtra * (2 * 16 + kMaxCascades * 64 + 5 * 16));
 
 GLenum depth_internal_format(DepthFormat f) {
   switch (f) {
@@ -352,11 +352,11 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
       total_layers += cascade_layers(e);
       extras.push_back(&e);
     }
-  const int aov_light =
-      frame.aov_shadow_light >= 0 && frame.aov_shadow_light <= int(extras.size())
-          ? frame.aov_shadow_light
-          : 0;
-  fb.counts = glm::ivec4(light_count, shadowed ? frame.shadow.light_index : -1, cascades, aov_light);
+  const int aov_light = frame.aov_shadow_light >= 0 && frame.aov_shadow_light <= int(extras.size())
+                            ? frame.aov_shadow_light
+                            : 0;
+  fb.counts =
+      glm::ivec4(light_count, shadowed ? frame.shadow.light_index : -1, cascades, aov_light);
   // The basic map (fit scene) is biased by polygon offset alone, as before the cascades.
   auto normal_offset_of = [](const ShadowPass& sp) {
     return sp.projection == ShadowProjection::ortho && sp.settings.fit_mode == FitMode::scene
@@ -482,50 +482,50 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     // Light 0 is the first shadowed light, 1.. the extra directional ones; each with its own
     // culling, bias and casters per cascade, into consecutive layers.
     for (std::size_t light = 0; light <= extras.size(); ++light) {
-    const ShadowPass& pass = light == 0 ? frame.shadow : *extras[light - 1];
-    const int base = light == 0 ? 0 : first_layer[light - 1];
-    const int layers = light == 0 ? cascades : cascade_layers(pass);
-    if (pass.settings.cull == CullMode::none) {
-      glDisable(GL_CULL_FACE);
-    } else {
-      glEnable(GL_CULL_FACE);
-      glCullFace(pass.settings.cull == CullMode::front ? GL_FRONT : GL_BACK);
-    }
-    glPolygonOffset(pass.settings.slope_bias, pass.settings.constant_bias);
-    for (int c = 0; c < layers; ++c) {
-      glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0,
-                                     base + c);
-      glClear(GL_DEPTH_BUFFER_BIT);
-      if (pass.skipped[std::size_t(c)]) continue;
-      const glm::mat4& light_vp = pass.view_proj[std::size_t(c)];
-      for (std::uint32_t i : order) {
-        const DrawItem& d = frame.draws[i];
-        const std::uint32_t mask =
-            light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu;
-        if (!d.cast_shadows || !(mask & (1u << c))) continue;
-        const GpuMesh& m = im.mesh(d.mesh, assets);
-        if (m.index_count == 0) continue;
-        if (Status st = use_program(Pass::depth, keys[i], current); !st) {
-          glDisable(GL_POLYGON_OFFSET_FILL);
-          glDisable(GL_CLIP_DISTANCE0);
-          glEndQuery(GL_TIME_ELAPSED);
-          return st;
-        }
-        // The oracle's one depth program reads the material bits from a uniform: set it for
-        // every draw, or an alpha-masked draw's bits leak into the next layer's opaque draws.
-        if (keys[i].has(VariantKey::kAlphaMask) || im.oracle) bind_material(current, d, keys[i]);
-        glProgramUniformMatrix4fv(current, kUniLightViewProj, 1, GL_FALSE, &light_vp[0][0]);
-        glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-        glBindVertexArray(m.vao.id());
-        glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
-        ++stats_.shadow_draw_calls;
-        stats_.shadow_triangles += std::size_t(m.index_count / 3);
-        if (light == 0) {
-          ++stats_.cascade_draw_calls[std::size_t(c)];
-          stats_.cascade_triangles[std::size_t(c)] += std::size_t(m.index_count / 3);
+      const ShadowPass& pass = light == 0 ? frame.shadow : *extras[light - 1];
+      const int base = light == 0 ? 0 : first_layer[light - 1];
+      const int layers = light == 0 ? cascades : cascade_layers(pass);
+      if (pass.settings.cull == CullMode::none) {
+        glDisable(GL_CULL_FACE);
+      } else {
+        glEnable(GL_CULL_FACE);
+        glCullFace(pass.settings.cull == CullMode::front ? GL_FRONT : GL_BACK);
+      }
+      glPolygonOffset(pass.settings.slope_bias, pass.settings.constant_bias);
+      for (int c = 0; c < layers; ++c) {
+        glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(),
+                                       0, base + c);
+        glClear(GL_DEPTH_BUFFER_BIT);
+        if (pass.skipped[std::size_t(c)]) continue;
+        const glm::mat4& light_vp = pass.view_proj[std::size_t(c)];
+        for (std::uint32_t i : order) {
+          const DrawItem& d = frame.draws[i];
+          const std::uint32_t mask =
+              light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu;
+          if (!d.cast_shadows || !(mask & (1u << c))) continue;
+          const GpuMesh& m = im.mesh(d.mesh, assets);
+          if (m.index_count == 0) continue;
+          if (Status st = use_program(Pass::depth, keys[i], current); !st) {
+            glDisable(GL_POLYGON_OFFSET_FILL);
+            glDisable(GL_CLIP_DISTANCE0);
+            glEndQuery(GL_TIME_ELAPSED);
+            return st;
+          }
+          // The oracle's one depth program reads the material bits from a uniform: set it for
+          // every draw, or an alpha-masked draw's bits leak into the next layer's opaque draws.
+          if (keys[i].has(VariantKey::kAlphaMask) || im.oracle) bind_material(current, d, keys[i]);
+          glProgramUniformMatrix4fv(current, kUniLightViewProj, 1, GL_FALSE, &light_vp[0][0]);
+          glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+          glBindVertexArray(m.vao.id());
+          glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+          ++stats_.shadow_draw_calls;
+          stats_.shadow_triangles += std::size_t(m.index_count / 3);
+          if (light == 0) {
+            ++stats_.cascade_draw_calls[std::size_t(c)];
+            stats_.cascade_triangles[std::size_t(c)] += std::size_t(m.index_count / 3);
+          }
         }
       }
-    }
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
     glDisable(GL_CLIP_DISTANCE0);

@@ -84,7 +84,7 @@ struct FrameInput {
   CameraView camera;
   std::vector<DrawItem> draws;
   std::vector<LightItem> lights;  ///< at most kMaxLights are used
-  ShadowPass shadow;  ///< the first shadowed light (any type)
+  ShadowPass shadow;              ///< the first shadowed light (any type)
   /// Further shadowed directional lights (ortho cascades), at most kMaxShadowedLights - 1; their
   /// layers follow the first light's in the same texture array, so map size, format, filter and
   /// selection are the first light's. Ignored without `shadow`.

@@ -72,18 +72,16 @@ class VariantKey {
 
   /// The combination rules in the header comment. Unused bits must be zero.
   constexpr bool valid() const {
-    constexpr std::uint32_t used = kBaseColorTexture.mask() | kNormalMap.mask() | kAlphaMask.mask() |
-                                   kEmissive.mask() | kReflectionCube.mask() |
-                                   kReflectionSphere.mask() | kReceiveShadows.mask() |
-                                   kShadow.mask() | kShadowFilter.mask() |
-                                   kCascadeCountMinus1.mask() | kAovs.mask() |
-                                   kDebugCascades.mask() | kCascadeSelection.mask() |
-                                   kShadowProjection.mask();
+    constexpr std::uint32_t used =
+        kBaseColorTexture.mask() | kNormalMap.mask() | kAlphaMask.mask() | kEmissive.mask() |
+        kReflectionCube.mask() | kReflectionSphere.mask() | kReceiveShadows.mask() |
+        kShadow.mask() | kShadowFilter.mask() | kCascadeCountMinus1.mask() | kAovs.mask() |
+        kDebugCascades.mask() | kCascadeSelection.mask() | kShadowProjection.mask();
     if (bits_ & ~used) return false;
     if (has(kReflectionCube) && has(kReflectionSphere)) return false;
     if (get(kShadowFilter) > 2) return false;
     if (!has(kShadow) && (has(kShadowFilter) || has(kCascadeCountMinus1) || has(kDebugCascades) ||
-                        has(kCascadeSelection) || has(kShadowProjection)))
+                          has(kCascadeSelection) || has(kShadowProjection)))
       return false;
     if (has(kShadowProjection) && has(kCascadeCountMinus1)) return false;
     return true;
@@ -93,10 +91,9 @@ class VariantKey {
   /// forward pass needs everything.
   constexpr VariantKey filtered_for(Pass pass) const {
     if (pass == Pass::depth) {
-      const std::uint32_t projection =
-          get(kShadowProjection) == kProjectionDualParaboloid
-              ? kShadowProjection.mask() | kShadow.mask()
-              : 0u;
+      const std::uint32_t projection = get(kShadowProjection) == kProjectionDualParaboloid
+                                           ? kShadowProjection.mask() | kShadow.mask()
+                                           : 0u;
       return VariantKey(bits_ & (kAlphaMask.mask() | projection));
     }
     return *this;
@@ -112,13 +109,22 @@ static_assert(!VariantKey().set(VariantKey::kShadowFilter, 2).valid());
 static_assert(VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowFilter, 2).valid());
 static_assert(VariantKey().set(VariantKey::kNormalMap, 1).filtered_for(Pass::depth) == VariantKey());
 static_assert(!VariantKey().set(VariantKey::kShadowProjection, 1).valid());
-static_assert(VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 2).valid());
-static_assert(!VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 2)
-                   .set(VariantKey::kCascadeCountMinus1, 5).valid());
-static_assert(VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 2)
+static_assert(
+    VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 2).valid());
+static_assert(!VariantKey()
+                   .set(VariantKey::kShadow, 1)
+                   .set(VariantKey::kShadowProjection, 2)
+                   .set(VariantKey::kCascadeCountMinus1, 5)
+                   .valid());
+static_assert(VariantKey()
+                  .set(VariantKey::kShadow, 1)
+                  .set(VariantKey::kShadowProjection, 2)
                   .filtered_for(Pass::depth) == VariantKey());
-static_assert(VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 3)
-                  .set(VariantKey::kShadowFilter, 2).filtered_for(Pass::depth) ==
+static_assert(VariantKey()
+                  .set(VariantKey::kShadow, 1)
+                  .set(VariantKey::kShadowProjection, 3)
+                  .set(VariantKey::kShadowFilter, 2)
+                  .filtered_for(Pass::depth) ==
               VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 3));
 
 }  // namespace kaskad::render

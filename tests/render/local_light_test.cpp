@@ -78,8 +78,8 @@ class LocalLightTest : public ::testing::Test {
     auto tracer = reference::RayTracer::build(*scene);
     EXPECT_TRUE(tracer.ok()) << tracer.error().to_string();
     if (!tracer.ok()) return out;
-    const auto rlight = reference::reference_light(
-        scene->world.get<Light>(light), scene->world.get<WorldTransform>(light).matrix);
+    const auto rlight = reference::reference_light(scene->world.get<Light>(light),
+                                                   scene->world.get<WorldTransform>(light).matrix);
     auto ref = tracer->shadow_reference(out.aov, rlight, {});
     EXPECT_TRUE(ref.ok()) << ref.error().to_string();
     if (!ref.ok()) return out;
@@ -107,7 +107,6 @@ void expect_meaningful(const Rendered& r) {
   EXPECT_GT(s.pixels, 20000u);
   EXPECT_LT(r.metrics.non_finite, 1u);
 }
-
 
 TEST_F(LocalLightTest, SpotLightAgreesWithRayCastsAwayFromEdges) {
   const Rendered r = render_and_compare("spot.json", {});

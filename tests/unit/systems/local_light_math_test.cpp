@@ -2,17 +2,17 @@
 // near plane that keeps every box inside the frustum, the spot frustum around its cone, cube face
 // selection against each face's frustum, and the dual-paraboloid projection; plus the system's
 // output for a spot and a point light.
+#include "systems/local_light_math.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
-
 #include <glm/gtc/matrix_transform.hpp>
+#include <random>
 
 #include "components/light.h"
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
-#include "systems/local_light_math.h"
 #include "systems/shadow_cascade_system.h"
 
 namespace kaskad {
@@ -29,7 +29,7 @@ bool inside(const glm::vec3& n, float eps = 1e-5f) {
 
 TEST(LocalLightMath, NearFarHoldsEveryBoxWithinRange) {
   const glm::vec3 light(0, 2, 0);
-  const Aabb boxes[] = {Aabb::from_corners({1, 0, -1}, {3, 1, 1}),   // nearest point (1, 1, 0)
+  const Aabb boxes[] = {Aabb::from_corners({1, 0, -1}, {3, 1, 1}),    // nearest point (1, 1, 0)
                         Aabb::from_corners({-5, -1, -5}, {5, 0, 5}),  // ground, 2 m below
                         Aabb::from_corners({50, 0, 0}, {51, 1, 1})};  // far away
   const NearFar all = local_light_near_far(light, boxes);
@@ -69,8 +69,8 @@ TEST(LocalLightMath, SpotFrustumHoldsItsConeAndEveryBoxPointNearIt) {
     for (int k = 0; k < 16; ++k) {
       const float a = float(k) * 0.3927f;
       const glm::vec3 across = glm::rotate(glm::mat4(1.0f), a, dir) * glm::vec4(side, 0.0f);
-      const glm::vec3 p = pos + d * (std::cos(glm::radians(cone)) * dir +
-                                     std::sin(glm::radians(cone)) * across);
+      const glm::vec3 p =
+          pos + d * (std::cos(glm::radians(cone)) * dir + std::sin(glm::radians(cone)) * across);
       const glm::vec3 n = ndc(m.view_proj(), p);
       EXPECT_TRUE(inside(n)) << d << " " << k;
       EXPECT_LE(std::max(std::abs(n.x), std::abs(n.y)), 1.0f - 2.0f * 3.5f / 1024 + 1e-4f);
@@ -102,7 +102,7 @@ TEST(LocalLightMath, CubeFaceOfEveryDirectionHoldsIt) {
     EXPECT_LE(std::max(std::abs(n.x), std::abs(n.y)), 1.0f - 2.0f * 3.5f / 256 + 1e-4f);
   }
   for (int h : hits) EXPECT_GT(h, 200);
-  EXPECT_EQ(cube_face_of({1, 1, 0.5f}), 0);   // tie x/y: x
+  EXPECT_EQ(cube_face_of({1, 1, 0.5f}), 0);  // tie x/y: x
   EXPECT_EQ(cube_face_of({0, -2, 1}), 3);
   EXPECT_EQ(cube_face_of({0.1f, 0.2f, -3}), 5);
 }
@@ -113,8 +113,8 @@ TEST(LocalLightMath, ParaboloidProjectionCoversEachHemisphere) {
   const float margin = paraboloid_margin(512, 3.5f);
   EXPECT_NEAR(margin, 7.0f / 512, 1e-7f);
   // The axis maps to the centre, the rim to radius 1 / (1 + margin), depth linear in distance.
-  const glm::vec3 centre = paraboloid_project(glm::vec3(views[0] * glm::vec4(pos + 3.0f * dir, 1)),
-                                              1.0f, 5.0f, margin);
+  const glm::vec3 centre =
+      paraboloid_project(glm::vec3(views[0] * glm::vec4(pos + 3.0f * dir, 1)), 1.0f, 5.0f, margin);
   EXPECT_NEAR(glm::length(glm::vec2(centre)), 0.0f, 1e-6f);
   EXPECT_NEAR(centre.z, 0.0f, 1e-6f);
   const glm::vec3 rim = paraboloid_project({0, 2, 0}, 1.0f, 5.0f, margin);
@@ -175,11 +175,14 @@ TEST(ShadowCascadeSystem, SpotAndPointLightsGetTheirMaps) {
       if (type == LightType::spot && mode != PointShadowMode::cube) continue;
       ecs::World w;
       const ecs::Entity l = light(w, type, {0, 4, 0}, {0, -1, 0}, mode);
-      const ecs::Entity ground = box(w, Aabb::from_corners({-10, -0.1f, -10}, {10, 0, 10}), false, true);
-      const ecs::Entity blocker = box(w, Aabb::from_corners({-0.5f, 1, -0.5f}, {0.5f, 2, 0.5f}), true, true);
+      const ecs::Entity ground =
+          box(w, Aabb::from_corners({-10, -0.1f, -10}, {10, 0, 10}), false, true);
+      const ecs::Entity blocker =
+          box(w, Aabb::from_corners({-0.5f, 1, -0.5f}, {0.5f, 2, 0.5f}), true, true);
       // Far to the side, outside the spot's cone; a caster above the light.
       const ecs::Entity side = box(w, Aabb::from_corners({30, 0, 0}, {31, 1, 1}), true, false);
-      const ecs::Entity above = box(w, Aabb::from_corners({-0.5f, 6, -0.5f}, {0.5f, 7, 0.5f}), true, false);
+      const ecs::Entity above =
+          box(w, Aabb::from_corners({-0.5f, 6, -0.5f}, {0.5f, 7, 0.5f}), true, false);
       ShadowCascadeState state;
       CameraState cam;  // local lights do not need the camera
       const ShadowData d = update_shadow_cascades(w, cam, state);
@@ -206,7 +209,7 @@ TEST(ShadowCascadeSystem, SpotAndPointLightsGetTheirMaps) {
       } else {
         EXPECT_EQ(d.projection, ShadowProjection::dual_paraboloid);
         EXPECT_EQ(d.cascade_count, 2);
-        EXPECT_GT(d.splits[2], 0.0f);  // the margin
+        EXPECT_GT(d.splits[2], 0.0f);            // the margin
         EXPECT_EQ(d.cascade_mask(blocker), 1u);  // the lower hemisphere only
         EXPECT_FALSE(d.skipped[0]);
       }
