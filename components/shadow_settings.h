@@ -103,6 +103,10 @@ struct ShadowSettings {
   /// Colours each cascade in the forward pass (MJP's "visualise cascades", Filament's
   /// d.shadowmap.visualize_cascades). A debug view, off by default.
   bool debug_cascades = false;
+  /// Keeps the cascades' splits and matrices of the frame it was turned on while the camera
+  /// moves on (MJP's "freeze cascades"), to look at them from elsewhere. Directional lights; a
+  /// debug toggle, off by default.
+  bool freeze_cascades = false;
   /// Point lights only. cube by default: exact for any tessellation; dual_paraboloid draws 2
   /// maps instead of 6 (S0's earlier work).
   PointShadowMode point_mode = PointShadowMode::cube;

@@ -171,10 +171,10 @@ std::vector<std::uint32_t> cull_casters(const glm::mat4& light_view_proj,
 namespace {
 
 // The maps of one shadowed light (entity `e`, null for none). Errors are logged when they differ
-// from `last_error`, which is updated.
+// from `last_error`, which is updated. `previous` is this slot's last result (freeze_cascades).
 ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera, ecs::Entity e,
                               const Light& light_component, const glm::mat4& light_matrix,
-                              std::string& last_error) {
+                              const ShadowData& previous, std::string& last_error) {
   ShadowData out;
   // 1. The light: its settings and a finite transform.
   out.light = e;
@@ -291,14 +291,33 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
   options.depth = DepthFit::enclose_slice;
   const ShadowGeometry geometry{scene, caster_boxes, receiver_boxes};
   for (int i = 0; i <= s.cascade_count; ++i) out.splits[std::size_t(i)] = D[std::size_t(i)];
+  // Debug freeze (MJP's "freeze cascades"): last frame's splits and matrices stay while the
+  // camera moves on, so the cascades can be inspected from elsewhere; casters are still culled
+  // against the frozen volumes. Only when the previous result has the same light and layout.
+  const bool frozen = s.freeze_cascades && previous.light == out.light &&
+                      previous.projection == ShadowProjection::ortho &&
+                      previous.cascade_count == s.cascade_count &&
+                      previous.settings.fit_mode == s.fit_mode &&
+                      previous.settings.map_size == s.map_size;
+  if (frozen) {
+    out.splits = previous.splits;
+    out.far_requested = previous.far_requested;
+    out.far_used = previous.far_used;
+  }
   for (int i = 0; i < s.cascade_count; ++i) {
     const auto c = std::size_t(i);
-    slice.near = D[c];
-    slice.far = D[c + 1];
-    const CascadeFit fit = fit_cascade(slice, light, options, geometry);
-    out.view_proj[c] = fit.view_proj();
-    out.texel_size[c] = fit.world_units_per_texel;
-    out.skipped[c] = fit.empty || receiver_boxes.empty();
+    if (frozen) {
+      out.view_proj[c] = previous.view_proj[c];
+      out.texel_size[c] = previous.texel_size[c];
+      out.skipped[c] = previous.skipped[c];
+    } else {
+      slice.near = D[c];
+      slice.far = D[c + 1];
+      const CascadeFit fit = fit_cascade(slice, light, options, geometry);
+      out.view_proj[c] = fit.view_proj();
+      out.texel_size[c] = fit.world_units_per_texel;
+      out.skipped[c] = fit.empty || receiver_boxes.empty();
+    }
     if (out.skipped[c]) continue;
     for (std::uint32_t k : cull_casters(out.view_proj[c], caster_boxes))
       out.casters[c].push_back(caster_entities[k]);
@@ -337,8 +356,10 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
                std::to_string(kMaxShadowedLights) + " get shadow maps";
       break;
     }
+    const std::size_t slot = out.size();
     ShadowData d = fit_shadowed_light(world, camera, l.entity, l.light, l.matrix,
-                                      state.last_errors[out.size()]);
+                                      state.previous[slot], state.last_errors[slot]);
+    state.previous[slot] = d;
     if (i == 0) {
       out.push_back(std::move(d));
       if (!out[0].light.valid()) break;  // no primary: no extra lights either

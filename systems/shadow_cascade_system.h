@@ -68,6 +68,8 @@ inline constexpr int kMaxShadowedLights = 4;  // change together with render::kM
 struct ShadowCascadeState {
   std::array<std::string, kMaxShadowedLights> last_errors;
   std::string last_notice;
+  /// Each slot's last result: ShadowSettings::freeze_cascades keeps its splits and matrices.
+  std::array<ShadowData, kMaxShadowedLights> previous;
 };
 
 /// Phase 3. Picks the first Light with cast_shadows (entity order). A spot light gets one

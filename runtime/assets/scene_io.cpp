@@ -87,6 +87,7 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
   r.enumeration("selection", s.selection, kSelections);
   r.boolean("debug_cascades", s.debug_cascades);
   r.enumeration("point_mode", s.point_mode, kPointModes);
+  r.boolean("freeze_cascades", s.freeze_cascades);
   r.finish();
   if (std::string bad = validate_shadow_settings(s); !bad.empty())
     fail(r.at(bad.substr(0, bad.find(' ')).c_str()), bad);
@@ -116,6 +117,7 @@ json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
   put("selection", enum_name(s.selection, kSelections), s.selection != d.selection);
   put("debug_cascades", s.debug_cascades, s.debug_cascades != d.debug_cascades);
   put("point_mode", enum_name(s.point_mode, kPointModes), s.point_mode != d.point_mode);
+  put("freeze_cascades", s.freeze_cascades, s.freeze_cascades != d.freeze_cascades);
   return j;
 }
 
@@ -263,6 +265,7 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
     lr.number("inner_cone_deg", l.inner_cone_deg, 0.0f, 90.0f);
     lr.number("outer_cone_deg", l.outer_cone_deg, 0.0f, 90.0f);
     lr.boolean("cast_shadows", l.cast_shadows);
+    lr.number("angular_size_deg", l.angular_size_deg, 0.0f, 45.0f);
     lr.finish();
     if (l.inner_cone_deg > l.outer_cone_deg)
       fail(r.at("light") + "/inner_cone_deg", "must not exceed outer_cone_deg");
@@ -334,7 +337,8 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
                   {"range", num(l->range)},
                   {"inner_cone_deg", num(l->inner_cone_deg)},
                   {"outer_cone_deg", num(l->outer_cone_deg)},
-                  {"cast_shadows", l->cast_shadows}};
+                  {"cast_shadows", l->cast_shadows},
+                  {"angular_size_deg", num(l->angular_size_deg)}};
     if (const auto* s = w.try_get<ShadowSettings>(e)) {
       json sj = write_shadow(*s, &scene.shadow_defaults);
       if (!sj.empty()) j["shadow"] = sj;

@@ -213,6 +213,18 @@ int run_bench_command(const Args& a, bool frames_given) {
   return 0;
 }
 
+// Per-cascade (or per-layer) stats: world units per texel, casters drawn, their triangles,
+// receiver pixels (AOV pixels shaded from that cascade; 0 without AOVs).
+void print_cascade_table(const render::FrameStats& st, const ShadowData& sh) {
+  std::printf("          layer  m/texel   casters  triangles  receiver px\n");
+  for (int i = 0; i < st.cascades; ++i) {
+    const auto c = std::size_t(i);
+    std::printf("          %-5d  %-8.3g  %-7d  %-9zu  %zu%s\n", i, double(st.cascade_texel_size[c]),
+                st.cascade_draw_calls[c], st.cascade_triangles[c], st.cascade_receiver_pixels[c],
+                sh.skipped[c] ? "  (skipped)" : "");
+  }
+}
+
 int run_render(Args a) {
   const fs::path scene_path =
       a.scene.empty() ? content_dir() / "scenes" / "default.json" : fs::path(a.scene);
@@ -266,12 +278,7 @@ int run_render(Args a) {
     std::printf("shadow    %s (%d^2 each), near %.3g m, far %.3g m from the light\n",
                 kinds[int(sh.projection)], sh.settings.map_size, double(sh.splits[0]),
                 double(sh.splits[1]));
-    std::printf("          per layer draws/triangles:");
-    for (int i = 0; i < st.cascades; ++i)
-      std::printf(" %d/%zu%s", st.cascade_draw_calls[std::size_t(i)],
-                  st.cascade_triangles[std::size_t(i)],
-                  sh.skipped[std::size_t(i)] ? " (skipped)" : "");
-    std::printf("\n");
+    print_cascade_table(st, sh);
   } else if (sh.light.valid() && st.cascades > 0) {
     const char* fits[] = {"crop", "stable", "scene"};
     std::printf("cascades  %d (%s fit, %d^2 each)", st.cascades, fits[int(sh.settings.fit_mode)],
@@ -287,6 +294,7 @@ int run_render(Args a) {
       std::printf(" %d/%zu%s", st.cascade_draw_calls[std::size_t(i)],
                   st.cascade_triangles[std::size_t(i)], sh.skipped[std::size_t(i)] ? " (skipped)" : "");
     std::printf("\n");
+    print_cascade_table(st, sh);
   }
   for (const ShadowData& ex : timings->last.extra_shadows) {
     std::printf("shadowed  light %u: %d cascades; splits", ex.light.index, ex.cascade_count);

@@ -464,6 +464,10 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.cascades = cascades;
   stats_.cascade_draw_calls.fill(0);
   stats_.cascade_triangles.fill(0);
+  stats_.cascade_texel_size.fill(0.0f);
+  stats_.cascade_receiver_pixels.fill(0);
+  for (int c = 0; c < cascades; ++c)
+    stats_.cascade_texel_size[std::size_t(c)] = frame.shadow.texel_size[std::size_t(c)];
   if (shadowed) {
     const ShadowSettings& s = frame.shadow.settings;
     im.ensure_shadow_map(s.map_size, total_layers, s.depth_format, s.filter);
@@ -662,6 +666,18 @@ Image Renderer::read_aovs() const {
     o[9] = vis[i * 2 + 1];
   }
   return img;
+}
+
+std::array<std::size_t, kMaxCascades> Renderer::cascade_pixel_counts() const {
+  const Impl& im = *impl_;
+  KASKAD_CHECK(im.aovs_written, "the last frame was rendered without write_aovs");
+  std::array<std::size_t, kMaxCascades> out{};
+  const auto vis = read_texture(im.visibility.id(), im.width, im.height, GL_RG, 2);
+  for (std::size_t i = 1; i < vis.size(); i += 2) {
+    const int c = int(vis[i]);
+    if (c >= 0 && c < kMaxCascades) ++out[std::size_t(c)];
+  }
+  return out;
 }
 
 Image Renderer::read_shadow_map() const {

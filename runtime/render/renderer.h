@@ -109,6 +109,14 @@ struct FrameStats {
   int cascades = 0;                   ///< cascade layers of the shadow map this frame
   std::array<int, kMaxCascades> cascade_draw_calls{};         ///< casters drawn per cascade
   std::array<std::size_t, kMaxCascades> cascade_triangles{};  ///< their triangles
+  /// World units (metres) per shadow-map texel of each cascade (of the first shadowed light;
+  /// spot/point layers: at 1 m from the light).
+  std::array<float, kMaxCascades> cascade_texel_size{};
+  /// Receiver pixels per cascade: pixels of the frame's AOV whose `cascade` channel is i (visible
+  /// shadow-receiving surfaces shaded from cascade i; the first one where blending). Counted by
+  /// cascade_pixel_counts(), which render_frames() calls after its last frame when AOVs are
+  /// written; 0 otherwise.
+  std::array<std::size_t, kMaxCascades> cascade_receiver_pixels{};
   /// GPU times are the previous frame's (queries are read a frame late); 0 until frame 3.
   double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
   double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)
@@ -157,6 +165,10 @@ class Renderer {
   /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom; with
   /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;
+
+  /// Pixels of the last frame's AOV per cascade index (FrameStats::cascade_receiver_pixels).
+  /// Precondition: the last frame was rendered with write_aovs.
+  std::array<std::size_t, kMaxCascades> cascade_pixel_counts() const;
 
   /// Copies the colour target to the default framebuffer (windowed mode).
   void present(int window_width, int window_height) const;

@@ -30,6 +30,7 @@ struct Rendered {
   reference::ShadowMetrics metrics;
   ShadowData shadow;
   std::vector<ShadowData> extra;
+  render::FrameStats stats;
   Image aov;
   std::set<int> layers_seen;  ///< AOV cascade (layer) values of receiver pixels
 };
@@ -68,6 +69,7 @@ class LocalLightTest : public ::testing::Test {
     if (!t.ok()) return out;
     out.shadow = t->last.shadow;
     out.extra = t->last.extra_shadows;
+    out.stats = t->last.stats;
     out.aov = player_->renderer->read_aovs();
     EXPECT_LE(reference_of, int(out.extra.size()));
     if (reference_of > int(out.extra.size())) return out;
@@ -121,6 +123,15 @@ TEST_F(LocalLightTest, PointLightCubeMapAgreesWithRayCastsAwayFromEdges) {
   EXPECT_EQ(r.shadow.projection, ShadowProjection::cube);
   EXPECT_EQ(r.shadow.cascade_count, 6);
   expect_meaningful(r);
+  // Stats: receiver pixels per layer are the AOV's cascade channel counted; texel sizes are the
+  // system's.
+  std::array<std::size_t, render::kMaxCascades> counted{};
+  for (int y = 0; y < r.aov.height; ++y)
+    for (int x = 0; x < r.aov.width; ++x)
+      if (const int c = int(r.aov.at(x, y, 9)); c >= 0) ++counted[std::size_t(c)];
+  EXPECT_EQ(r.stats.cascade_receiver_pixels, counted);
+  for (int i = 0; i < 6; ++i)
+    EXPECT_EQ(r.stats.cascade_texel_size[std::size_t(i)], r.shadow.texel_size[std::size_t(i)]);
   EXPECT_GE(r.layers_seen.size(), 4u) << "the view should see receivers on several cube faces";
   EXPECT_LT(r.metrics.outside_edges.misclassified_pct, 1.0) << describe(r.metrics);
 }

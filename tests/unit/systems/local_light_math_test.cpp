@@ -256,5 +256,45 @@ TEST(ShadowCascadeSystem, SeveralDirectionalLightsEachGetCascadesUpToTheCap) {
   EXPECT_EQ(some[1].light, suns[2]);
 }
 
+// freeze_cascades keeps the splits and matrices while the camera moves, and unfreezing fits
+// them to the camera again.
+TEST(ShadowCascadeSystem, FrozenCascadesKeepTheirMatricesWhileTheCameraMoves) {
+  ecs::World w;
+  box(w, Aabb::from_corners({-50, -0.1f, -50}, {50, 0, 50}), false, true);
+  const ecs::Entity blocker = box(w, Aabb::from_corners({-0.5f, 0, -0.5f}, {0.5f, 2, 0.5f}), true, true);
+  const ecs::Entity sun = light(w, LightType::directional, {0, 10, 0},
+                                glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f)));
+  auto camera_at = [&](glm::vec3 eye) {
+    CameraState cam;
+    cam.entity = w.create();
+    cam.camera.near = 0.5f;
+    cam.camera.far = 80.0f;
+    cam.aspect = 1.5f;
+    cam.view = glm::lookAt(eye, eye + glm::vec3(0, -0.3f, -1), glm::vec3(0, 1, 0));
+    cam.proj = glm::perspective(glm::radians(cam.camera.fov_y_deg), 1.5f, 0.5f, 80.0f);
+    return cam;
+  };
+  auto same_matrices = [](const ShadowData& a, const ShadowData& b) {
+    for (int i = 0; i < a.cascade_count; ++i)
+      if (a.view_proj[std::size_t(i)] != b.view_proj[std::size_t(i)]) return false;
+    return a.splits == b.splits;
+  };
+  ShadowCascadeState state;
+  const ShadowData before = update_shadow_cascades(w, camera_at({0, 3, 8}), state);
+  ASSERT_TRUE(before.light.valid()) << before.error;
+  // Unfrozen, a camera 20 m away gets other cascades.
+  ShadowCascadeState other;
+  EXPECT_FALSE(same_matrices(before, update_shadow_cascades(w, camera_at({20, 3, 30}), other)));
+  w.get<ShadowSettings>(sun).freeze_cascades = true;
+  const ShadowData frozen = update_shadow_cascades(w, camera_at({20, 3, 30}), state);
+  EXPECT_TRUE(same_matrices(before, frozen));
+  const ShadowData still = update_shadow_cascades(w, camera_at({-15, 6, 2}), state);
+  EXPECT_TRUE(same_matrices(before, still));
+  EXPECT_NE(still.cascade_mask(blocker), 0u);  // casters are culled against the frozen volumes
+  w.get<ShadowSettings>(sun).freeze_cascades = false;
+  const ShadowData moved = update_shadow_cascades(w, camera_at({-15, 6, 2}), state);
+  EXPECT_FALSE(same_matrices(before, moved));
+}
+
 }  // namespace
 }  // namespace kaskad
