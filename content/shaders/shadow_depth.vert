@@ -1,8 +1,18 @@
+#if VARIANT_SHADOW_LAYERED
+#extension GL_ARB_shader_viewport_layer_array : require
+#endif
 #include "common.glsl"
 
 // World -> light clip space of the cascade being drawn (set per layer by the renderer);
 // dual-paraboloid maps: world -> hemisphere view.
 layout(location = 12) uniform mat4 u_light_view_proj;
+#if VARIANT_SHADOW_LAYERED
+// Layered pass (all of a light's layers at once): instance i of a draw goes to the i-th set bit
+// of u_layer_mask, layer u_layer_base + that bit, with that layer's matrix.
+layout(location = 13) uniform uint u_layer_mask;
+layout(location = 14) uniform int u_layer_base;
+layout(location = 16) uniform mat4 u_layer_view_proj[MAX_CASCADES];
+#endif
 
 layout(location = 0) in vec3 a_position;
 #if MATERIAL_HAS_ALPHA_MASK
@@ -28,6 +38,12 @@ void main() {
   float w = 1.0 - u.z;
   gl_Position = vec4(u.xy / (1.0 + margin), (2.0 * (d - near) / (far - near) - 1.0) * w, w);
   gl_ClipDistance[0] = margin - u.z;
+#elif VARIANT_SHADOW_LAYERED
+  uint mask = u_layer_mask;
+  for (int i = 0; i < gl_InstanceID; ++i) mask &= mask - 1u;  // drop the lowest set bits
+  int layer = findLSB(mask);
+  gl_Layer = u_layer_base + layer;
+  gl_Position = u_layer_view_proj[layer] * (u_model * vec4(a_position, 1.0));
 #else
   gl_Position = u_light_view_proj * (u_model * vec4(a_position, 1.0));
 #endif

@@ -88,6 +88,7 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
   r.boolean("debug_cascades", s.debug_cascades);
   r.enumeration("point_mode", s.point_mode, kPointModes);
   r.boolean("freeze_cascades", s.freeze_cascades);
+  r.boolean("layered", s.layered);
   r.finish();
   if (std::string bad = validate_shadow_settings(s); !bad.empty())
     fail(r.at(bad.substr(0, bad.find(' ')).c_str()), bad);
@@ -118,6 +119,7 @@ json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
   put("debug_cascades", s.debug_cascades, s.debug_cascades != d.debug_cascades);
   put("point_mode", enum_name(s.point_mode, kPointModes), s.point_mode != d.point_mode);
   put("freeze_cascades", s.freeze_cascades, s.freeze_cascades != d.freeze_cascades);
+  put("layered", s.layered, s.layered != d.layered);
   return j;
 }
 

@@ -3,6 +3,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <bit>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -56,7 +57,8 @@ GLenum depth_internal_format(DepthFormat f) {
 // Fixed attribute and uniform locations (see the shaders).
 constexpr GLuint kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
 constexpr GLint kUniModel = 0, kUniNormalMatrix = 4, kUniBaseColor = 8, kUniMaterial = 9,
-                kUniEmissive = 10, kUniOracleFeatures = 11, kUniLightViewProj = 12;
+                kUniEmissive = 10, kUniOracleFeatures = 11, kUniLightViewProj = 12,
+                kUniLayerMask = 13, kUniLayerBase = 14, kUniLayerViewProj = 16;
 constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2;
 
 struct GpuMesh {
@@ -106,6 +108,14 @@ struct Renderer::Impl {
   bool timers_pending = false;
   std::uint64_t frames_rendered = 0;
   bool aovs_written = false;
+  bool layer_from_vertex = false;  // GL_ARB_shader_viewport_layer_array: gl_Layer in the VS
+
+  // The key as this driver can build it: without gl_Layer in vertex shaders the layered shadow
+  // pass falls back to one pass per layer (the same maps).
+  VariantKey supported(VariantKey k) const {
+    if (!layer_from_vertex) k.set(VariantKey::kShadowLayered, 0);
+    return k;
+  }
 
   const GpuMesh& mesh(MeshId id, const AssetStore& assets) {
     if (id >= meshes.size()) meshes.resize(std::size_t(id) + 1);
@@ -239,6 +249,10 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
   // Exactly (0.5, 0.5, 1): decodes to (0, 0, 1), so the cotangent frame leaves the normal as is.
   // An 8-bit 128 would tilt every normal by 0.2 degrees, with visible derivative noise.
   im.flat_normal = make_solid_texture({0.5f, 0.5f, 1, 1}, GL_RGBA16F);
+  im.layer_from_vertex = epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array");
+  if (!im.layer_from_vertex)
+    log::warn("GL_ARB_shader_viewport_layer_array missing: shadow maps are drawn one layer at a "
+              "time");
   im.frame_ubo = gpu::make_buffer();
   glNamedBufferStorage(im.frame_ubo.id(), sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   im.timers[0] = gpu::make_query(GL_TIME_ELAPSED);
@@ -265,6 +279,9 @@ VariantKey frame_variant(const FrameInput& frame) {
     k.set(VariantKey::kShadow, 1);
     k.set(VariantKey::kShadowFilter, std::uint32_t(s.filter));
     k.set(VariantKey::kShadowProjection, std::uint32_t(frame.shadow.projection));
+    // Paraboloid hemispheres are projected in code, one pass each: no layered pass for them.
+    if (s.layered && frame.shadow.projection != ShadowProjection::dual_paraboloid)
+      k.set(VariantKey::kShadowLayered, 1);
     // Layers of spot and point lights are faces, not cascades: no cascade selection code.
     if (frame.shadow.projection == ShadowProjection::ortho)
       k.set(VariantKey::kCascadeCountMinus1, std::uint32_t(cascade_layers(frame.shadow) - 1));
@@ -304,7 +321,8 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
 }
 
 Status Renderer::prewarm(const FrameInput& frame) {
-  const auto requests = required_programs(frame);
+  auto requests = required_programs(frame);
+  for (ProgramRequest& r : requests) r.key = impl_->supported(r.key);
   Status st = impl_->shaders->prewarm(requests);
   stats_.shaders = impl_->shaders->stats();
   return st;
@@ -409,7 +427,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
 
   // Draw order: sorted by program (variant key), then by material, so program and material
   // state change as rarely as possible. Keys are computed once per draw.
-  const VariantKey frame_key = frame_variant(frame);
+  const VariantKey frame_key = im.supported(frame_variant(frame));
   std::vector<VariantKey> keys(frame.draws.size());
   for (std::size_t i = 0; i < frame.draws.size(); ++i)
     keys[i] = material_variant(frame.draws[i]) | frame_key;
@@ -483,6 +501,15 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     if (paraboloid) glEnable(GL_CLIP_DISTANCE0);
     const std::vector<std::uint32_t> order = sorted_by(Pass::depth);
     GLuint current = 0;  // kept across layers: the light matrix is a per-draw uniform
+    // Layered: every layer attached at once and cleared together (skipped layers stay clear);
+    // each caster is drawn once per light, instanced over the layers it overlaps, and the vertex
+    // shader routes instance i to the i-th of them (shadow_depth.vert). The same maps as one pass
+    // per layer (render test), with fewer draw calls.
+    const bool layered = frame_key.has(VariantKey::kShadowLayered);
+    if (layered) {
+      glNamedFramebufferTexture(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0);
+      glClear(GL_DEPTH_BUFFER_BIT);
+    }
     // Light 0 is the first shadowed light, 1.. the extra directional ones; each with its own
     // culling, bias and casters per cascade, into consecutive layers.
     for (std::size_t light = 0; light <= extras.size(); ++light) {
@@ -496,6 +523,42 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
         glCullFace(pass.settings.cull == CullMode::front ? GL_FRONT : GL_BACK);
       }
       glPolygonOffset(pass.settings.slope_bias, pass.settings.constant_bias);
+      if (layered) {
+        std::uint32_t live = 0;
+        for (int c = 0; c < layers; ++c)
+          if (!pass.skipped[std::size_t(c)]) live |= 1u << c;
+        for (std::uint32_t i : order) {
+          const DrawItem& d = frame.draws[i];
+          const std::uint32_t mask =
+              live &
+              (light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu);
+          if (!d.cast_shadows || mask == 0) continue;
+          const GpuMesh& m = im.mesh(d.mesh, assets);
+          if (m.index_count == 0) continue;
+          if (Status st = use_program(Pass::depth, keys[i], current); !st) {
+            glDisable(GL_POLYGON_OFFSET_FILL);
+            glEndQuery(GL_TIME_ELAPSED);
+            return st;
+          }
+          if (keys[i].has(VariantKey::kAlphaMask) || im.oracle) bind_material(current, d, keys[i]);
+          glProgramUniform1ui(current, kUniLayerMask, mask);
+          glProgramUniform1i(current, kUniLayerBase, base);
+          glProgramUniformMatrix4fv(current, kUniLayerViewProj, layers, GL_FALSE,
+                                    &pass.view_proj[0][0][0]);
+          glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+          glBindVertexArray(m.vao.id());
+          const int instances = std::popcount(mask);
+          glDrawElementsInstanced(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr, instances);
+          ++stats_.shadow_draw_calls;
+          stats_.shadow_triangles += std::size_t(instances) * std::size_t(m.index_count / 3);
+          for (int c = 0; light == 0 && c < layers; ++c)
+            if (mask & (1u << c)) {
+              ++stats_.cascade_draw_calls[std::size_t(c)];
+              stats_.cascade_triangles[std::size_t(c)] += std::size_t(m.index_count / 3);
+            }
+        }
+        continue;
+      }
       for (int c = 0; c < layers; ++c) {
         glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(),
                                        0, base + c);

@@ -11,6 +11,7 @@
 //   shadow_filter != 0 and cascade_count != 1 need shadow
 //   debug_cascades, cascade_selection and shadow_projection need shadow
 //   shadow_projection != ortho has cascade_count 1 (cascades are directional only)
+//   shadow_layered needs shadow; the depth pass keeps it (its vertex shader picks the layer)
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask, and the projection
 // when it is dual_paraboloid: its vertex shader differs), so every material shares one or two
 // shadow programs.
@@ -51,6 +52,7 @@ class VariantKey {
   /// ShadowProjection: 0 ortho, 1 perspective, 2 cube, 3 dual_paraboloid.
   static constexpr Field kShadowProjection{25, 2};
   static constexpr std::uint32_t kProjectionDualParaboloid = 3;
+  static constexpr Field kShadowLayered{27, 1};  ///< depth pass: all layers in one pass
   static constexpr std::uint32_t kFrameMask = 0xffff0000u;
 
   constexpr VariantKey() = default;
@@ -76,12 +78,14 @@ class VariantKey {
         kBaseColorTexture.mask() | kNormalMap.mask() | kAlphaMask.mask() | kEmissive.mask() |
         kReflectionCube.mask() | kReflectionSphere.mask() | kReceiveShadows.mask() |
         kShadow.mask() | kShadowFilter.mask() | kCascadeCountMinus1.mask() | kAovs.mask() |
-        kDebugCascades.mask() | kCascadeSelection.mask() | kShadowProjection.mask();
+        kDebugCascades.mask() | kCascadeSelection.mask() | kShadowProjection.mask() |
+        kShadowLayered.mask();
     if (bits_ & ~used) return false;
     if (has(kReflectionCube) && has(kReflectionSphere)) return false;
     if (get(kShadowFilter) > 2) return false;
     if (!has(kShadow) && (has(kShadowFilter) || has(kCascadeCountMinus1) || has(kDebugCascades) ||
-                          has(kCascadeSelection) || has(kShadowProjection)))
+                          has(kCascadeSelection) || has(kShadowProjection) ||
+                          has(kShadowLayered)))
       return false;
     if (has(kShadowProjection) && has(kCascadeCountMinus1)) return false;
     return true;
@@ -94,7 +98,9 @@ class VariantKey {
       const std::uint32_t projection = get(kShadowProjection) == kProjectionDualParaboloid
                                            ? kShadowProjection.mask() | kShadow.mask()
                                            : 0u;
-      return VariantKey(bits_ & (kAlphaMask.mask() | projection));
+      const std::uint32_t layered =
+          has(kShadowLayered) ? kShadowLayered.mask() | kShadow.mask() : 0u;
+      return VariantKey(bits_ & (kAlphaMask.mask() | projection | layered));
     }
     return *this;
   }

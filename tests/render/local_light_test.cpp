@@ -193,5 +193,48 @@ TEST_F(LocalLightTest, ExtraShadowedLightsAreCappedAndMustBeDirectional) {
   EXPECT_TRUE(t->last.extra_shadows.empty());
 }
 
+// The layered shadow pass (one instanced draw per caster and light, gl_Layer from the vertex
+// shader) writes exactly the maps of one pass per layer: cascades, extra lights, spot, cube.
+TEST_F(LocalLightTest, LayeredPassWritesTheSameMapsAsOnePassPerLayer) {
+  struct Case {
+    const char* scene;
+    std::vector<std::string> sets;
+  };
+  const Case cases[] = {{"default.json", {}},
+                        {"default.json", {"shadow.fit_mode=\"crop\"", "shadow.cascade_count=8"}},
+                        {"two_suns.json", {}},
+                        {"spot.json", {}},
+                        {"point.json", {}}};
+  for (const Case& c : cases) {
+    std::array<Image, 2> maps;
+    std::array<int, 2> draws{};
+    for (int layered = 0; layered < 2; ++layered) {
+      std::vector<std::string> sets = c.sets;
+      sets.push_back("render.width=160");
+      sets.push_back("render.height=90");
+      sets.push_back("shadow.map_size=512");
+      sets.push_back(layered ? "shadow.layered=true" : "shadow.layered=false");
+      auto scene = load_scene(content_dir() / "scenes" / c.scene, sets);
+      ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+      RenderRun run;
+      run.write_aovs = false;
+      auto t = render_frames(*player_, *scene, run);
+      ASSERT_TRUE(t.ok()) << t.error().to_string();
+      maps[std::size_t(layered)] = player_->renderer->read_shadow_map();
+      draws[std::size_t(layered)] = t->last.stats.shadow_draw_calls;
+    }
+    ASSERT_EQ(maps[0].height, maps[1].height) << c.scene;
+    ASSERT_EQ(maps[0].pixels.size(), maps[1].pixels.size()) << c.scene;
+    std::size_t differ = 0, written = 0;
+    for (std::size_t i = 0; i < maps[0].pixels.size(); ++i) {
+      differ += maps[0].pixels[i] != maps[1].pixels[i];
+      written += maps[0].pixels[i] < 1.0f;
+    }
+    EXPECT_EQ(differ, 0u) << c.scene;
+    EXPECT_GT(written, 1000u) << c.scene << ": the maps should hold casters";
+    EXPECT_LE(draws[1], draws[0]) << c.scene;
+  }
+}
+
 }  // namespace
 }  // namespace kaskad
