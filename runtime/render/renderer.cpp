@@ -523,6 +523,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
         glCullFace(pass.settings.cull == CullMode::front ? GL_FRONT : GL_BACK);
       }
       glPolygonOffset(pass.settings.slope_bias, pass.settings.constant_bias);
+      if (light > 0) glDisable(GL_CLIP_DISTANCE0);  // only paraboloid hemispheres clip
       if (layered) {
         std::uint32_t live = 0;
         for (int c = 0; c < layers; ++c)
@@ -572,7 +573,10 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
           if (!d.cast_shadows || !(mask & (1u << c))) continue;
           const GpuMesh& m = im.mesh(d.mesh, assets);
           if (m.index_count == 0) continue;
-          if (Status st = use_program(Pass::depth, keys[i], current); !st) {
+          // Extra lights are cascades: the plain depth program even after paraboloid maps.
+          VariantKey depth_key = keys[i];
+          if (light > 0) depth_key.set(VariantKey::kShadowProjection, 0);
+          if (Status st = use_program(Pass::depth, depth_key, current); !st) {
             glDisable(GL_POLYGON_OFFSET_FILL);
             glDisable(GL_CLIP_DISTANCE0);
             glEndQuery(GL_TIME_ELAPSED);

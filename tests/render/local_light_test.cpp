@@ -178,6 +178,21 @@ TEST_F(LocalLightTest, TwoDirectionalLightsEachAgreeWithTheirRayCasts) {
   EXPECT_LT(moon.metrics.outside_edges.misclassified_pct, 1.0) << describe(moon.metrics);
   const Rendered crossed = render_and_compare("two_suns.json", {"render.aov_shadow_light=1"}, 0);
   EXPECT_GT(crossed.metrics.outside_edges.misclassified_pct, 5.0) << describe(crossed.metrics);
+  // The first shadowed light a point light with paraboloid maps (another depth program): the
+  // extra light's cascades are still right.
+  for (const char* mode : {"cube", "dual_paraboloid"}) {
+    const Rendered after_point = render_and_compare(
+        "two_suns.json",
+        {"render.aov_shadow_light=1", "sun.light.type=point", "sun.transform.translation=[1,4,1]",
+         std::string("shadow.point_mode=") + mode},
+        1);
+    EXPECT_EQ(after_point.shadow.projection, std::string(mode) == "cube"
+                                                 ? ShadowProjection::cube
+                                                 : ShadowProjection::dual_paraboloid);
+    ASSERT_EQ(after_point.extra.size(), 1u);
+    EXPECT_LT(after_point.metrics.outside_edges.misclassified_pct, 1.0)
+        << mode << ": " << describe(after_point.metrics);
+  }
 }
 
 // The first shadowed light may be a spot or point light; shadowed lights beyond the cap and
