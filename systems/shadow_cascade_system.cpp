@@ -294,11 +294,10 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
   // Debug freeze (MJP's "freeze cascades"): last frame's splits and matrices stay while the
   // camera moves on, so the cascades can be inspected from elsewhere; casters are still culled
   // against the frozen volumes. Only when the previous result has the same light and layout.
-  const bool frozen = s.freeze_cascades && previous.light == out.light &&
-                      previous.projection == ShadowProjection::ortho &&
-                      previous.cascade_count == s.cascade_count &&
-                      previous.settings.fit_mode == s.fit_mode &&
-                      previous.settings.map_size == s.map_size;
+  const bool frozen =
+      s.freeze_cascades && previous.light == out.light &&
+      previous.projection == ShadowProjection::ortho && previous.cascade_count == s.cascade_count &&
+      previous.settings.fit_mode == s.fit_mode && previous.settings.map_size == s.map_size;
   if (frozen) {
     out.splits = previous.splits;
     out.far_requested = previous.far_requested;

@@ -3,8 +3,8 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
-#include <bit>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <numeric>
@@ -251,8 +251,9 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
   im.flat_normal = make_solid_texture({0.5f, 0.5f, 1, 1}, GL_RGBA16F);
   im.layer_from_vertex = epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array");
   if (!im.layer_from_vertex)
-    log::warn("GL_ARB_shader_viewport_layer_array missing: shadow maps are drawn one layer at a "
-              "time");
+    log::warn(
+        "GL_ARB_shader_viewport_layer_array missing: shadow maps are drawn one layer at a "
+        "time");
   im.frame_ubo = gpu::make_buffer();
   glNamedBufferStorage(im.frame_ubo.id(), sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   im.timers[0] = gpu::make_query(GL_TIME_ELAPSED);

@@ -84,8 +84,7 @@ class VariantKey {
     if (has(kReflectionCube) && has(kReflectionSphere)) return false;
     if (get(kShadowFilter) > 2) return false;
     if (!has(kShadow) && (has(kShadowFilter) || has(kCascadeCountMinus1) || has(kDebugCascades) ||
-                          has(kCascadeSelection) || has(kShadowProjection) ||
-                          has(kShadowLayered)))
+                          has(kCascadeSelection) || has(kShadowProjection) || has(kShadowLayered)))
       return false;
     if (has(kShadowProjection) && has(kCascadeCountMinus1)) return false;
     return true;

@@ -291,9 +291,9 @@ TEST_F(DefaultSceneTest, StableCascadesDoNotShimmerUnderSubTexelCameraMoves) {
 // receivers draw nothing; the farthest receiver pulls the last split in from max_distance.
 TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
   // One pass per layer: one draw call per caster and cascade (the layered pass is below).
-  auto scene = load_scene(content_dir() / "scenes" / "default.json",
-                          {"render.width=160", "render.height=90", "shadow.cascade_count=8",
-                           "shadow.layered=false"});
+  auto scene = load_scene(
+      content_dir() / "scenes" / "default.json",
+      {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=false"});
   ASSERT_TRUE(scene.ok()) << scene.error().to_string();
   auto t = render_frames(*player_, *scene, {});
   ASSERT_TRUE(t.ok()) << t.error().to_string();
@@ -322,9 +322,9 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
 
   // Layered: the same casters per cascade and the same triangles, but one instanced draw call
   // per caster that is in any cascade.
-  auto layered_scene = load_scene(content_dir() / "scenes" / "default.json",
-                                  {"render.width=160", "render.height=90",
-                                   "shadow.cascade_count=8", "shadow.layered=true"});
+  auto layered_scene = load_scene(
+      content_dir() / "scenes" / "default.json",
+      {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=true"});
   ASSERT_TRUE(layered_scene.ok()) << layered_scene.error().to_string();
   auto lt = render_frames(*player_, *layered_scene, {});
   ASSERT_TRUE(lt.ok()) << lt.error().to_string();

@@ -261,9 +261,10 @@ TEST(ShadowCascadeSystem, SeveralDirectionalLightsEachGetCascadesUpToTheCap) {
 TEST(ShadowCascadeSystem, FrozenCascadesKeepTheirMatricesWhileTheCameraMoves) {
   ecs::World w;
   box(w, Aabb::from_corners({-50, -0.1f, -50}, {50, 0, 50}), false, true);
-  const ecs::Entity blocker = box(w, Aabb::from_corners({-0.5f, 0, -0.5f}, {0.5f, 2, 0.5f}), true, true);
-  const ecs::Entity sun = light(w, LightType::directional, {0, 10, 0},
-                                glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f)));
+  const ecs::Entity blocker =
+      box(w, Aabb::from_corners({-0.5f, 0, -0.5f}, {0.5f, 2, 0.5f}), true, true);
+  const ecs::Entity sun =
+      light(w, LightType::directional, {0, 10, 0}, glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f)));
   auto camera_at = [&](glm::vec3 eye) {
     CameraState cam;
     cam.entity = w.create();
