@@ -17,6 +17,10 @@ struct Light {
   float inner_cone_deg = 0.0f;  ///< spot: full intensity inside this half-angle (degrees)
   float outer_cone_deg = 45.0f; ///< spot: zero intensity outside this half-angle (degrees)
   bool cast_shadows = false;    ///< only shadowed lights get shadow maps
+  /// Directional only: apex angle of the cone of directions the light arrives from, degrees, in
+  /// [0, 45] (the sun: about 0.53). 0 = punctual. The ray-traced reference's area visibility uses
+  /// it (reference_light()); the shadow maps are hard until soft shadows land.
+  float angular_size_deg = 0.0f;
 };
 
 /// World-space direction a light shines along: its world matrix applied to local (0, 0, -1),

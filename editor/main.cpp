@@ -87,6 +87,13 @@ bool shadow_panel(ShadowSettings& s) {
     changed = true;
   }
   changed |= ImGui::Checkbox("debug: colour cascades", &s.debug_cascades);
+  changed |= ImGui::Checkbox("debug: freeze cascades", &s.freeze_cascades);
+  int point_mode = int(s.point_mode);
+  const char* point_modes[] = {"cube (6 faces)", "dual paraboloid (2)"};
+  if (ImGui::Combo("point light maps", &point_mode, point_modes, 2)) {
+    s.point_mode = PointShadowMode(point_mode);
+    changed = true;
+  }
   return changed;
 }
 

@@ -20,9 +20,27 @@ double ms_since(Clock::time_point t0) {
 
 }  // namespace
 
+namespace {
+
+render::ShadowPass shadow_pass(const ShadowData& shadow, int light_index) {
+  render::ShadowPass sp;
+  sp.light_index = light_index;
+  sp.settings = shadow.settings;
+  sp.projection = shadow.projection;
+  sp.cascade_count = shadow.cascade_count;
+  sp.view_proj = shadow.view_proj;
+  sp.splits = shadow.splits;
+  sp.texel_size = shadow.texel_size;
+  sp.skipped = shadow.skipped;
+  return sp;
+}
+
+}  // namespace
+
 render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx,
                                      const CameraState& camera, const ShadowData& shadow,
-                                     const ProbeData& probes) {
+                                     const ProbeData& probes,
+                                     std::span<const ShadowData> extra) {
   const ecs::World& world = scene.world;
   render::FrameInput in;
   in.width = ctx.width;
@@ -34,6 +52,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.clear_color = scene.render.clear_color;
   in.exposure = scene.render.exposure;
   in.write_aovs = ctx.write_aovs;
+  in.aov_shadow_light = scene.render.aov_shadow_light;
 
   const Material default_material;
   world.view<MeshRenderer, WorldTransform>().each(
@@ -48,6 +67,8 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         d.receive_shadows = mr.receive_shadows;
         d.cascade_mask = shadow.cascade_mask(e);
         d.layer = mr.layer;
+        for (std::size_t k = 0; k < extra.size() && k + 1 < render::kMaxShadowedLights; ++k)
+          d.extra_cascade_masks |= std::uint32_t(extra[k].cascade_mask(e)) << (8 * k);
         if (const auto* wb = world.try_get<WorldBounds>(e)) d.bounds = wb->box;
         // A reflector's own draw reflects its probe's map once one is complete (S3 eq. (3)).
         d.material.features &= ~(render::VariantKey::kReflectionCube.mask() |
@@ -76,16 +97,12 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         item.range = l.range;
         item.cos_inner = std::cos(glm::radians(l.inner_cone_deg));
         item.cos_outer = std::cos(glm::radians(l.outer_cone_deg));
-        if (e == shadow.light) {
-          render::ShadowPass& sp = in.shadow;
-          sp.light_index = int(in.lights.size());
-          sp.settings = shadow.settings;
-          sp.cascade_count = shadow.cascade_count;
-          sp.view_proj = shadow.view_proj;
-          sp.splits = shadow.splits;
-          sp.texel_size = shadow.texel_size;
-          sp.skipped = shadow.skipped;
-        }
+        if (e == shadow.light) in.shadow = shadow_pass(shadow, int(in.lights.size()));
+        for (std::size_t k = 0; k < extra.size() && k + 1 < render::kMaxShadowedLights; ++k)
+          if (e == extra[k].light) {
+            if (in.extra_shadows.size() < k + 1) in.extra_shadows.resize(k + 1);
+            in.extra_shadows[k] = shadow_pass(extra[k], int(in.lights.size()));
+          }
         in.lights.push_back(item);
       });
   return in;
@@ -95,9 +112,11 @@ render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx, ShadowData&
   update_transforms(scene.world, scene.assets);
   const CameraState camera = select_camera(scene.world, float(ctx.width) / float(ctx.height));
   ShadowCascadeState state;
-  shadow = update_shadow_cascades(scene.world, camera, state);
+  std::vector<ShadowData> shadows = update_shadows(scene.world, camera, state);
+  shadow = shadows.front();
   const ProbeData probes = update_environment_probes(scene.world, ctx.index, /*commit=*/false);
-  return build_frame_input(scene, ctx, camera, shadow, probes);
+  return build_frame_input(scene, ctx, camera, shadow, probes,
+                           std::span<const ShadowData>(shadows).subspan(1));
 }
 
 render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx) {
@@ -122,7 +141,10 @@ Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& c
     return Error{scene.file.string(), "", "the scene has no camera"};
 
   t = Clock::now();
-  report.shadow = update_shadow_cascades(scene.world, report.camera, report.shadow_state);
+  std::vector<ShadowData> shadows = update_shadows(scene.world, report.camera, report.shadow_state);
+  report.shadow = std::move(shadows.front());
+  report.extra_shadows.assign(std::make_move_iterator(shadows.begin() + 1),
+                              std::make_move_iterator(shadows.end()));
   report.shadows_ms = ms_since(t);
 
   t = Clock::now();
@@ -130,8 +152,8 @@ Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& c
   report.probes_ms = ms_since(t);
 
   t = Clock::now();
-  const render::FrameInput input =
-      build_frame_input(scene, ctx, report.camera, report.shadow, report.probes);
+  const render::FrameInput input = build_frame_input(scene, ctx, report.camera, report.shadow,
+                                                     report.probes, report.extra_shadows);
   report.draw_list_ms = ms_since(t);
 
   t = Clock::now();

@@ -3,8 +3,9 @@
 //   1. Transforms  after it: every Transform has a current WorldTransform and every MeshRenderer
 //                  a current WorldBounds.
 //   2. Camera      after it: the active camera's view/projection for this frame's aspect.
-//   3. Cascades    after it: the shadowed directional light (if any) has current splits, one
-//                  light matrix per cascade and the casters drawn into each (ShadowData).
+//   3. Cascades    after it: every shadowed light (the first of any type, up to 3 more
+//                  directional ones) has current splits or faces, one light matrix per layer
+//                  and the casters drawn into each (ShadowData).
 //   4. Probes      after it: every Reflector has a ProbeState and this frame's probe job (faces
 //                  to capture, buffer to show); counters are current (ProbeData).
 //   5. DrawList    after it: the renderer's FrameInput holds every drawable, light, probe and
@@ -14,6 +15,8 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "runtime/assets/scene.h"
 #include "runtime/core/result.h"
@@ -36,7 +39,8 @@ struct FrameReport {
   double transforms_ms = 0, camera_ms = 0, shadows_ms = 0, probes_ms = 0, draw_list_ms = 0,
          render_ms = 0;
   CameraState camera;
-  ShadowData shadow;
+  ShadowData shadow;                      ///< the first shadowed light
+  std::vector<ShadowData> extra_shadows;  ///< further shadowed directional lights
   ProbeData probes;
   render::FrameStats stats;
   /// Carried from frame to frame when the caller reuses its report (the player does).
@@ -57,9 +61,11 @@ render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx, ShadowData&
 Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx);
 
 /// Phase 5 on its own (pure: no GL), exposed for tests. Draws of entities with a Reflector whose
-/// map is ready get the reflection_cube or reflection_sphere material feature.
+/// map is ready get the reflection_cube or reflection_sphere material feature. `extra` are the
+/// further shadowed directional lights (update_shadows() after its first element).
 render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx,
                                      const CameraState& camera, const ShadowData& shadow,
-                                     const ProbeData& probes = {});
+                                     const ProbeData& probes = {},
+                                     std::span<const ShadowData> extra = {});
 
 }  // namespace kaskad

@@ -8,6 +8,7 @@
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
 #include "runtime/core/log.h"
+#include "systems/local_light_math.h"
 
 namespace kaskad {
 namespace {
@@ -54,6 +55,88 @@ void set_error(ShadowData& out, const std::string& message) {
   if (out.error.empty()) out.error = message;
 }
 
+// Whether any part of the box lies in the half space z <= margin of `view` (a paraboloid
+// hemisphere drawn slightly past its rim).
+bool in_hemisphere(const glm::mat4& view, const Aabb& box, float margin) {
+  const Aabb v = box.transformed(view);
+  const float reach = std::max(glm::length(v.min), glm::length(v.max));
+  return v.min.z <= margin * reach;
+}
+
+// Spot and point lights: the maps' depth range from every box in range, then per layer the
+// projection, the skip test (no receiver in the layer) and the casters drawn into it.
+void fit_local_light(const Light& light, const LightFrame& frame, ShadowData& out,
+                     std::span<const Aabb> caster_boxes,
+                     std::span<const ecs::Entity> caster_entities,
+                     std::span<const Aabb> receiver_boxes) {
+  const ShadowSettings& s = out.settings;
+  std::vector<Aabb> boxes(caster_boxes.begin(), caster_boxes.end());
+  boxes.insert(boxes.end(), receiver_boxes.begin(), receiver_boxes.end());
+  const NearFar range = local_light_near_far(frame.origin, boxes, light.range);
+  if (range.empty) {
+    out.light = ecs::kNullEntity;  // nothing within range
+    return;
+  }
+  // Texels kept free at the map edges: the 3x3 PCF reach (1.5), the normal offset, 1 spare.
+  const float border = 2.5f + s.normal_offset_bias;
+  float tan_half = 0.0f;  // paraboloid maps clip by distance
+  if (light.type == LightType::spot)
+    tan_half = spot_tan_half_fov(light.outer_cone_deg, s.map_size, border);
+  else if (s.point_mode == PointShadowMode::cube)
+    tan_half = cube_tan_half_fov(s.map_size, border);
+  const float near = local_light_near(range, tan_half);
+  const float far = std::max(range.far * 1.001f, near * 1.01f);  // margin: corners on the far plane
+  out.splits[0] = near;
+  out.splits[1] = far;
+  auto finish_layer = [&](int i, auto&& overlaps) {
+    const auto c = std::size_t(i);
+    bool any_receiver = false;
+    for (const Aabb& b : receiver_boxes) any_receiver = any_receiver || overlaps(b);
+    out.skipped[c] = !any_receiver;
+    if (out.skipped[c]) return;
+    for (std::size_t k = 0; k < caster_boxes.size(); ++k)
+      if (overlaps(caster_boxes[k])) out.casters[c].push_back(caster_entities[k]);
+    std::sort(out.casters[c].begin(), out.casters[c].end(), entity_less);
+  };
+  auto frustum_overlaps = [&](int i) {
+    return [&, i](const Aabb& b) {
+      return !b.empty() && maybe_inside(clip_corners(out.view_proj[std::size_t(i)], b));
+    };
+  };
+  if (light.type == LightType::spot) {
+    out.projection = ShadowProjection::perspective;
+    out.cascade_count = 1;
+    const PerspectiveShadow map =
+        fit_spot_shadow(frame.origin, frame.direction, tan_half, near, far, s.map_size);
+    out.view_proj[0] = map.view_proj();
+    out.texel_size[0] = map.texel_at_unit_distance;
+    finish_layer(0, frustum_overlaps(0));
+  } else if (s.point_mode == PointShadowMode::cube) {
+    out.projection = ShadowProjection::cube;
+    out.cascade_count = kCubeFaces;
+    for (int f = 0; f < kCubeFaces; ++f) {
+      const PerspectiveShadow map =
+          cube_face_shadow(frame.origin, f, tan_half, near, far, s.map_size);
+      out.view_proj[std::size_t(f)] = map.view_proj();
+      out.texel_size[std::size_t(f)] = map.texel_at_unit_distance;
+      finish_layer(f, frustum_overlaps(f));
+    }
+  } else {
+    out.projection = ShadowProjection::dual_paraboloid;
+    out.cascade_count = 2;
+    const float margin = paraboloid_margin(s.map_size, border);
+    out.splits[2] = margin;  // read by the shaders beside near and far
+    const auto views = paraboloid_views(frame.origin, frame.direction);
+    for (int h = 0; h < 2; ++h) {
+      out.view_proj[std::size_t(h)] = views[std::size_t(h)];
+      out.texel_size[std::size_t(h)] = paraboloid_texel_at_unit_distance(s.map_size, margin);
+      finish_layer(h, [&, h](const Aabb& b) {
+        return !b.empty() && in_hemisphere(views[std::size_t(h)], b, margin);
+      });
+    }
+  }
+}
+
 }  // namespace
 
 std::uint8_t ShadowData::cascade_mask(ecs::Entity e) const {
@@ -85,16 +168,20 @@ std::vector<std::uint32_t> cull_casters(const glm::mat4& light_view_proj,
   return out;
 }
 
-ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& camera,
-                                  ShadowCascadeState& state) {
+namespace {
+
+// The maps of one shadowed light (entity `e`, null for none). Errors are logged when they differ
+// from `last_error`, which is updated. `previous` is this slot's last result (freeze_cascades).
+ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera, ecs::Entity e,
+                              const Light& light_component, const glm::mat4& light_matrix,
+                              const ShadowData& previous, std::string& last_error) {
   ShadowData out;
-  // 1. The light: the first shadowed directional light, its settings and a finite transform.
-  glm::mat4 light_matrix(1.0f);
-  out.light = first_shadowed_directional_light(world, light_matrix);
+  // 1. The light: its settings and a finite transform.
+  out.light = e;
   auto finish = [&]() -> ShadowData {
-    if (out.error != state.last_error) {
+    if (out.error != last_error) {
       if (!out.error.empty()) log::error("shadows: %s", out.error.c_str());
-      state.last_error = out.error;
+      last_error = out.error;
     }
     return std::move(out);
   };
@@ -136,6 +223,10 @@ ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& ca
       });
   if (scene.empty()) {
     out.light = ecs::kNullEntity;  // nothing to shadow
+    return finish();
+  }
+  if (light_component.type != LightType::directional) {
+    fit_local_light(light_component, light, out, caster_boxes, caster_entities, receiver_boxes);
     return finish();
   }
 
@@ -200,20 +291,105 @@ ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& ca
   options.depth = DepthFit::enclose_slice;
   const ShadowGeometry geometry{scene, caster_boxes, receiver_boxes};
   for (int i = 0; i <= s.cascade_count; ++i) out.splits[std::size_t(i)] = D[std::size_t(i)];
+  // Debug freeze (MJP's "freeze cascades"): last frame's splits and matrices stay while the
+  // camera moves on, so the cascades can be inspected from elsewhere; casters are still culled
+  // against the frozen volumes. Only when the previous result has the same light and layout.
+  const bool frozen =
+      s.freeze_cascades && previous.light == out.light &&
+      previous.projection == ShadowProjection::ortho && previous.cascade_count == s.cascade_count &&
+      previous.settings.fit_mode == s.fit_mode && previous.settings.map_size == s.map_size;
+  if (frozen) {
+    out.splits = previous.splits;
+    out.far_requested = previous.far_requested;
+    out.far_used = previous.far_used;
+  }
   for (int i = 0; i < s.cascade_count; ++i) {
     const auto c = std::size_t(i);
-    slice.near = D[c];
-    slice.far = D[c + 1];
-    const CascadeFit fit = fit_cascade(slice, light, options, geometry);
-    out.view_proj[c] = fit.view_proj();
-    out.texel_size[c] = fit.world_units_per_texel;
-    out.skipped[c] = fit.empty || receiver_boxes.empty();
+    if (frozen) {
+      out.view_proj[c] = previous.view_proj[c];
+      out.texel_size[c] = previous.texel_size[c];
+      out.skipped[c] = previous.skipped[c];
+    } else {
+      slice.near = D[c];
+      slice.far = D[c + 1];
+      const CascadeFit fit = fit_cascade(slice, light, options, geometry);
+      out.view_proj[c] = fit.view_proj();
+      out.texel_size[c] = fit.world_units_per_texel;
+      out.skipped[c] = fit.empty || receiver_boxes.empty();
+    }
     if (out.skipped[c]) continue;
     for (std::uint32_t k : cull_casters(out.view_proj[c], caster_boxes))
       out.casters[c].push_back(caster_entities[k]);
     std::sort(out.casters[c].begin(), out.casters[c].end(), entity_less);
   }
   return finish();
+}
+
+}  // namespace
+
+std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraState& camera,
+                                       ShadowCascadeState& state) {
+  struct Shadowed {
+    ecs::Entity entity;
+    Light light;
+    glm::mat4 matrix;
+  };
+  std::vector<Shadowed> lights;
+  world.view<Light, WorldTransform>().each(
+      [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {
+        if (l.cast_shadows) lights.push_back({e, l, wt.matrix});
+      });
+  std::vector<ShadowData> out;
+  std::string notice;
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    const Shadowed& l = lights[i];
+    const std::string name = "light " + std::to_string(l.entity.index);
+    if (i > 0 && l.light.type != LightType::directional) {
+      notice = name +
+               ": only the first shadowed light may be a spot or point light; it is lit "
+               "without shadows";
+      continue;
+    }
+    if (out.size() == std::size_t(kMaxShadowedLights)) {
+      notice = std::to_string(lights.size()) + " shadowed lights; only the first " +
+               std::to_string(kMaxShadowedLights) + " get shadow maps";
+      break;
+    }
+    const std::size_t slot = out.size();
+    ShadowData d = fit_shadowed_light(world, camera, l.entity, l.light, l.matrix,
+                                      state.previous[slot], state.last_errors[slot]);
+    state.previous[slot] = d;
+    if (i == 0) {
+      out.push_back(std::move(d));
+      if (!out[0].light.valid()) break;  // no primary: no extra lights either
+      continue;
+    }
+    if (!d.light.valid()) continue;  // its error is logged
+    // One depth texture array holds every light's layers: the first light's map size, format
+    // and filter apply to all, and its cascade selection (a frame feature of the shaders).
+    const ShadowSettings& first = out[0].settings;
+    if (d.settings.map_size != first.map_size || d.settings.depth_format != first.depth_format ||
+        d.settings.filter != first.filter || d.settings.selection != first.selection)
+      notice = name +
+               ": takes map_size, depth_format, filter and selection from the first "
+               "shadowed light (one shared texture array)";
+    d.settings.map_size = first.map_size;
+    d.settings.depth_format = first.depth_format;
+    d.settings.filter = first.filter;
+    d.settings.selection = first.selection;
+    out.push_back(std::move(d));
+  }
+  if (out.empty()) out.emplace_back();
+  if (notice != state.last_notice) {
+    if (!notice.empty()) log::warn("shadows: %s", notice.c_str());
+    state.last_notice = notice;
+  }
+  return out;
+}
+
+ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& camera,
+                                  ShadowCascadeState& state) {
+  return std::move(update_shadows(world, camera, state).front());
 }
 
 }  // namespace kaskad

@@ -1,6 +1,8 @@
-// Cascaded shadow maps of the first shadowed directional light (S0 with S2's stabilisation), the
-// frame's Cascades phase. Maths on the CPU only (cascade_math.h); the renderer draws one depth
-// layer per cascade from the ShadowData published here.
+// Shadow maps of the first shadowed light, the frame's Cascades phase: cascades of a directional
+// light (S0 with S2's stabilisation), one perspective map of a spot light, six cube faces or two
+// paraboloid hemispheres of a point light. Maths on the CPU only (cascade_math.h,
+// local_light_math.h); the renderer draws one depth layer per cascade (or face, or hemisphere)
+// from the ShadowData published here.
 #pragma once
 
 #include <array>
@@ -24,13 +26,23 @@ namespace kaskad {
 struct ShadowData {
   ecs::Entity light = ecs::kNullEntity;  ///< the shadowed light, null when there is none
   ShadowSettings settings;               ///< the light's own, else defaults
-  int cascade_count = 0;                 ///< cascades published (settings.cascade_count), 0: none
-  /// World -> light clip space per cascade (cascade 0 is the basic map with FitMode::scene).
+  /// ortho: a directional light's cascades; perspective: a spot light's map; cube or
+  /// dual_paraboloid: a point light's maps (settings.point_mode).
+  ShadowProjection projection = ShadowProjection::ortho;
+  /// Layers published, 0: none. Directional: the cascades (settings.cascade_count); spot: 1;
+  /// cube: 6 faces (+X, -X, +Y, -Y, +Z, -Z); dual_paraboloid: 2 hemispheres. "Cascade" below
+  /// means layer for the local lights.
+  int cascade_count = 0;
+  /// World -> light clip space per cascade (cascade 0 is the basic map with FitMode::scene);
+  /// dual_paraboloid: world -> hemisphere view (paraboloid_views(); the projection is not a
+  /// matrix).
   std::array<glm::mat4, kMaxCascades> view_proj{};
   /// S0's D: D[0] = camera near .. D[count] = the end of the last cascade, metres of view depth.
-  /// FitMode::scene: [0, 3.4e38] (one map covers every depth).
+  /// FitMode::scene: [0, 3.4e38] (one map covers every depth). Spot and point lights: [near, far]
+  /// of the maps, metres from the light (local_light_near_far()).
   std::array<float, kMaxCascades + 1> splits{};
-  /// Metres per shadow-map texel of each cascade (the larger of x and y).
+  /// Metres per shadow-map texel of each cascade (the larger of x and y). Spot and point lights:
+  /// metres per texel at 1 m from the light (the shader scales by the distance).
   std::array<float, kMaxCascades> texel_size{};
   /// No receiver lies in the cascade's volume: its layer is cleared, nothing drawn.
   std::array<bool, kMaxCascades> skipped{};
@@ -48,12 +60,23 @@ struct ShadowData {
   std::uint8_t cascade_mask(ecs::Entity e) const;
 };
 
-/// State the system owns between frames: the last error, so it is logged once, not every frame.
+/// Shadowed lights with maps at most: the first (any type) and up to 3 more directional lights.
+inline constexpr int kMaxShadowedLights = 4;  // change together with render::kMaxShadowedLights
+
+/// State the system owns between frames: the last error per shadowed light and the last notice,
+/// so each is logged once, not every frame.
 struct ShadowCascadeState {
-  std::string last_error;
+  std::array<std::string, kMaxShadowedLights> last_errors;
+  std::string last_notice;
+  /// Each slot's last result: ShadowSettings::freeze_cascades keeps its splits and matrices.
+  std::array<ShadowData, kMaxShadowedLights> previous;
 };
 
-/// Phase 3. Picks the first directional Light with cast_shadows (entity order) and fits its
+/// Phase 3. Picks the first Light with cast_shadows (entity order). A spot light gets one
+/// perspective map around its outer cone, a point light six cube faces or two paraboloid
+/// hemispheres (settings.point_mode), all with near/far fitted to the casters and receivers within
+/// the light's range (layers without receivers skipped, casters culled per layer; the cascade
+/// settings do not apply). A directional light: fits its
 /// cascades to `camera`: splits (S0 eq. (1)-(3)) between the camera near and min(camera far,
 /// max_distance, farthest visible receiver), each cascade by fit_cascade() (crop or stable) with
 /// the near plane pulled back to the casters; cascades without receivers are skipped; casters are
@@ -62,6 +85,16 @@ struct ShadowCascadeState {
 /// with non-finite bounds are left out. Needs current WorldTransform/WorldBounds.
 ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& camera,
                                   ShadowCascadeState& state);
+
+/// Phase 3 for every shadowed light: element 0 is update_shadow_cascades()'s result (light null
+/// when there is none); elements 1.. are further directional lights with cast_shadows (entity
+/// order), each fitted with its own settings and cascades, as S0 asks of several directional
+/// lights. They share the first light's map_size, depth_format, filter and selection (one
+/// texture array; a warning says so when theirs differ). Spot and point lights after the first
+/// shadowed light are lit without shadows, and lights beyond kMaxShadowedLights are left out,
+/// with a warning logged once. Extra lights are present only when the first one is valid.
+std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraState& camera,
+                                       ShadowCascadeState& state);
 
 // ---- Pure parts, exposed for tests -------------------------------------------------------------
 

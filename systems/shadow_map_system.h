@@ -33,7 +33,8 @@ struct BasicShadow {
 BasicShadow update_basic_shadow(const ecs::World& world);
 
 /// The first directional Light with cast_shadows (entity order) and its world matrix; a null
-/// entity when there is none. Both shadow systems shadow this light.
+/// entity when there is none. The basic map shadows this light (the cascade system shadows the
+/// first shadowed light of any type).
 ecs::Entity first_shadowed_directional_light(const ecs::World& world, glm::mat4& world_matrix);
 
 

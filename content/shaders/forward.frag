@@ -13,7 +13,8 @@ layout(location = 0) out vec4 o_color;
 #if VARIANT_HAS_AOVS
 layout(location = 1) out vec4 o_position;    // xyz world position, w mask (1 = geometry)
 layout(location = 2) out vec4 o_normal;      // xyz world normal facing the camera, w view depth
-layout(location = 3) out vec2 o_visibility;  // x shadow visibility of the shadowed light,
+layout(location = 3) out vec2 o_visibility;  // x shadow visibility of the shadowed light
+                                             // u_counts.w names (the first by default),
                                              // y its cascade (-1 outside every cascade)
 layout(location = 4) out vec4 o_reflection;  // rgb reflected colour C_t, a 1 with a map (else 0)
 #endif
@@ -98,6 +99,21 @@ void main() {
 #if MATERIAL_HAS_EMISSIVE
   if (ENABLED(BIT_EMISSIVE)) color += u_emissive;
 #endif
+  // Further shadowed directional lights; the AOV shows the one u_counts.w names.
+  float aov_visibility = visibility;
+  int aov_cascade = cascade;
+#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
+  float extra_visibility[MAX_EXTRA_SHADOWS] = float[MAX_EXTRA_SHADOWS](1.0, 1.0, 1.0);
+  if (ENABLED(BIT_RECEIVE_SHADOWS))
+    for (int k = 0; k < u_extra_count.x; ++k) {
+      int c;
+      extra_visibility[k] = extra_shadow_visibility(k, v_world_pos, geometric_n, view_depth, c);
+      if (k + 1 == u_counts.w) {
+        aov_visibility = extra_visibility[k];
+        aov_cascade = c;
+      }
+    }
+#endif
   for (int i = 0; i < u_counts.x; ++i) {
     int type = int(u_light_color[i].w);
     vec3 l;
@@ -124,6 +140,10 @@ void main() {
     vec3 h = normalize(l + v);
     vec3 spec = f0 * spec_norm * pow(max(dot(n, h), 0.0), shininess);
     float shadow = (i == u_counts.y) ? visibility : 1.0;
+#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
+    for (int k = 0; k < u_extra_count.x; ++k)
+      if (u_extra_light[k].x == i) shadow = extra_visibility[k];
+#endif
     color += (diffuse_color + spec) * u_light_color[i].rgb * ndl * attenuation * shadow;
   }
 
@@ -165,7 +185,7 @@ void main() {
 #if VARIANT_HAS_AOVS
   o_position = vec4(v_world_pos, 1.0);
   o_normal = vec4(geometric_n, view_depth);
-  o_visibility = vec2(visibility, float(cascade));
+  o_visibility = vec2(aov_visibility, float(aov_cascade));
   o_reflection = vec4(reflected, reflector);
 #endif
 }

@@ -9,18 +9,16 @@ layout(binding = 2) uniform sampler2DArrayShadow u_shadow_map;  // one layer per
 // shadowed (S4, with S0's cascades). Clamp-to-border with border depth 1 and the z > 1 test keep
 // everything outside a cascade's light frustum lit. Cascade selection and blending mirror
 // select_cascade_by_depth / select_cascade_by_map / cascade_blend_weight* in
-// systems/cascade_math.h (change together).
+// systems/cascade_math.h (change together). Spot and point lights
+// (VARIANT_SHADOW_PROJECTION != ORTHO) mirror systems/local_light_math.h: layers are the spot
+// map, cube faces or paraboloid hemispheres; cascade_split(0..2) hold near, far (metres from the
+// light) and the paraboloid margin; cascade_texel(i) is metres per texel at 1 m from the light.
 #if VARIANT_HAS_SHADOW
 #define CASCADES VARIANT_CASCADE_COUNT
 
-// One cascade's lookup. The point moves along the normal by normal_offset texels of this
-// cascade (MJP's normal offset), so the bias follows each cascade's resolution.
-float cascade_visibility(int cascade, vec3 p, vec3 n) {
-  vec3 q = p + n * (u_shadow_params.x * cascade_texel(cascade));
-  vec4 clip = u_cascade_view_proj[cascade] * vec4(q, 1.0);
-  vec3 c = clip.xyz / clip.w * 0.5 + 0.5;  // S0's M_bias
-  if (c.z > 1.0) return 1.0;
-  vec4 tc = vec4(c.xy, float(cascade), c.z);
+// The filtered depth compare of layer `layer` at c: xy texture coordinates, z depth in [0, 1].
+float shadow_taps(int layer, vec3 c) {
+  vec4 tc = vec4(c.xy, float(layer), c.z);
 #if VARIANT_SHADOW_FILTER == VARIANT_SHADOW_FILTER_PCF3X3
   // textureOffset needs constant offsets: the 3x3 kernel is written out.
   float sum = 0.0;
@@ -38,6 +36,69 @@ float cascade_visibility(int cascade, vec3 p, vec3 n) {
   return texture(u_shadow_map, tc);  // filtering (nearest / linear) is set on the texture
 #endif
 }
+
+// One cascade's lookup. The point moves along the normal by normal_offset texels of this
+// cascade (MJP's normal offset), so the bias follows each cascade's resolution.
+float cascade_visibility(int cascade, vec3 p, vec3 n) {
+  vec3 q = p + n * (u_shadow_params.x * cascade_texel(cascade));
+  vec4 clip = u_cascade_view_proj[cascade] * vec4(q, 1.0);
+  vec3 c = clip.xyz / clip.w * 0.5 + 0.5;  // S0's M_bias
+  if (c.z > 1.0) return 1.0;
+  return shadow_taps(cascade, c);
+}
+
+#if VARIANT_SHADOW_PROJECTION != VARIANT_SHADOW_PROJECTION_ORTHO
+// Spot and point lights: the normal offset in texels of `layer` at the point's distance (a
+// perspective texel grows with the distance from the light).
+vec3 local_offset_point(int layer, vec3 p, vec3 n) {
+  float dist = distance(p, u_light_pos[u_counts.y].xyz);
+  return p + n * (u_shadow_params.x * cascade_texel(layer) * dist);
+}
+#endif
+
+#if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_PERSPECTIVE || \
+    VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_CUBE
+// A spot map or one cube face: a perspective projection, otherwise as a cascade.
+float perspective_visibility(int layer, vec3 p, vec3 n) {
+  vec3 q = local_offset_point(layer, p, n);
+  vec4 clip = u_cascade_view_proj[layer] * vec4(q, 1.0);
+  if (clip.w <= 0.0) return 1.0;  // behind the light
+  vec3 c = clip.xyz / clip.w * 0.5 + 0.5;
+  if (c.z > 1.0) return 1.0;
+  return shadow_taps(layer, c);
+}
+#endif
+
+#if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_CUBE
+// The face of direction d (+X, -X, +Y, -Y, +Z, -Z): its major axis, ties prefer x then y.
+// Mirrors cube_face_of() in systems/local_light_math.cpp.
+int cube_face(vec3 d) {
+  vec3 a = abs(d);
+  if (a.x >= a.y && a.x >= a.z) return d.x >= 0.0 ? 0 : 1;
+  if (a.y >= a.z) return d.y >= 0.0 ? 2 : 3;
+  return d.z >= 0.0 ? 4 : 5;
+}
+#endif
+
+#if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_DUAL_PARABOLOID
+// Dual-paraboloid lookup (S0's earlier work): hemisphere 0 is z <= 0 of the view in
+// u_cascade_view_proj[0], hemisphere 1 the rest, seen from the same view turned 180 degrees about
+// y. Mirrors paraboloid_views() / paraboloid_project() (systems/local_light_math.h) and
+// shadow_depth.vert.
+float paraboloid_visibility(vec3 p, vec3 n, out int hemisphere) {
+  vec3 q = local_offset_point(0, p, n);
+  vec3 v = (u_cascade_view_proj[0] * vec4(q, 1.0)).xyz;
+  hemisphere = v.z <= 0.0 ? 0 : 1;
+  if (hemisphere == 1) v = vec3(-v.x, v.y, -v.z);
+  float d = length(v);
+  vec3 u = v / max(d, 1e-20);
+  float near = cascade_split(0), far = cascade_split(1), margin = cascade_split(2);
+  vec2 xy = u.xy / ((1.0 - u.z) * (1.0 + margin));
+  float z = (d - near) / (far - near);
+  if (z > 1.0) return 1.0;
+  return shadow_taps(hemisphere, vec3(xy * 0.5 + 0.5, z));
+}
+#endif
 
 #if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
 // Border kept free in NDC: the PCF kernel's reach plus the normal offset, in texels.
@@ -85,11 +146,63 @@ float blend_weight(int cascade, vec3 p, float depth) {
 }
 
 float shadow_visibility(vec3 p, vec3 n, float depth, out int cascade) {
+#if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_PERSPECTIVE
+  cascade = 0;
+  return perspective_visibility(0, p, n);
+#elif VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_CUBE
+  cascade = cube_face(p - u_light_pos[u_counts.y].xyz);
+  return perspective_visibility(cascade, p, n);
+#elif VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_DUAL_PARABOLOID
+  return paraboloid_visibility(p, n, cascade);
+#endif
   cascade = select_cascade(p, depth);
   if (cascade < 0) return 1.0;
   float v = cascade_visibility(cascade, p, n);
   float w = blend_weight(cascade, p, depth);
   if (w > 0.0) v = mix(v, cascade_visibility(cascade + 1, p, n), w);
+  return v;
+}
+
+// Further shadowed directional lights (S0: each has its own N maps): light k's cascades, with the
+// first light's filter and selection (frame features), its own matrices, splits, blend band and
+// normal offset (data). The same steps as cascade_visibility / select_cascade / blend_weight.
+float extra_cascade_visibility(int k, int c, vec3 p, vec3 n) {
+  vec3 q = p + n * (u_extra_params[k].x * extra_texel(k, c));
+  vec4 clip = u_extra_view_proj[k * MAX_CASCADES + c] * vec4(q, 1.0);
+  vec3 t = clip.xyz / clip.w * 0.5 + 0.5;
+  if (t.z > 1.0) return 1.0;
+  return shadow_taps(u_extra_light[k].y + c, t);
+}
+
+float extra_shadow_visibility(int k, vec3 p, vec3 n, float depth, out int cascade) {
+  int count = u_extra_light[k].z;
+  float band = u_extra_params[k].y;
+  float w = 0.0;
+  cascade = -1;
+#if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
+  float edge = 1.0 - 2.0 * (1.5 + u_extra_params[k].x) / u_extra_params[k].z;
+  for (int i = 0; i < count && cascade < 0; ++i) {
+    vec4 clip = u_extra_view_proj[k * MAX_CASCADES + i] * vec4(p, 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    if (abs(ndc.x) <= edge && abs(ndc.y) <= edge && abs(ndc.z) <= 1.0) {
+      cascade = i;
+      if (band > 0.0)
+        w = clamp((max(abs(ndc.x), abs(ndc.y)) - (edge - band * edge)) / (band * edge), 0.0, 1.0);
+    }
+  }
+  if (cascade < 0) return 1.0;
+#else
+  if (depth >= extra_split(k, count)) return 1.0;
+  cascade = 0;
+  for (int i = 1; i < count; ++i)
+    if (depth >= extra_split(k, i)) cascade = i;
+  if (band > 0.0) {
+    float d0 = extra_split(k, cascade), d1 = extra_split(k, cascade + 1);
+    w = clamp((depth - (d1 - band * (d1 - d0))) / (band * (d1 - d0)), 0.0, 1.0);
+  }
+#endif
+  float v = extra_cascade_visibility(k, cascade, p, n);
+  if (cascade < count - 1 && w > 0.0) v = mix(v, extra_cascade_visibility(k, cascade + 1, p, n), w);
   return v;
 }
 

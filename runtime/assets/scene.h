@@ -18,6 +18,9 @@ struct RenderSettings {
   glm::vec3 ambient{0.08f, 0.09f, 0.11f}; ///< linear ambient radiance added to every surface
   glm::vec3 clear_color{0.55f, 0.65f, 0.8f};  ///< linear background colour
   float exposure = 1.0f;                  ///< multiplies linear colour before sRGB encoding
+  /// Which shadowed light the AOV's visibility and cascade channels show: 0 the first, k the
+  /// k-th further shadowed directional light (a debug path; colour is not affected).
+  int aov_shadow_light = 0;
 };
 
 struct Scene {

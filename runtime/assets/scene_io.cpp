@@ -68,6 +68,8 @@ const std::vector<std::pair<const char*, FitMode>> kFitModes = {
     {"crop", FitMode::crop}, {"stable", FitMode::stable}, {"scene", FitMode::scene}};
 const std::vector<std::pair<const char*, CascadeSelection>> kSelections = {
     {"depth", CascadeSelection::depth}, {"map_bounds", CascadeSelection::map_bounds}};
+const std::vector<std::pair<const char*, PointShadowMode>> kPointModes = {
+    {"cube", PointShadowMode::cube}, {"dual_paraboloid", PointShadowMode::dual_paraboloid}};
 
 // Range checks here; combinations (fit_mode scene with several cascades) by
 // validate_shadow_settings(), whose message starts with the bad key.
@@ -88,6 +90,9 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
   r.number("blend_band", s.blend_band, 0.0f, 1.0f);
   r.enumeration("selection", s.selection, kSelections);
   r.boolean("debug_cascades", s.debug_cascades);
+  r.enumeration("point_mode", s.point_mode, kPointModes);
+  r.boolean("freeze_cascades", s.freeze_cascades);
+  r.boolean("layered", s.layered);
   r.finish();
   if (std::string bad = validate_shadow_settings(s); !bad.empty())
     fail(r.at(bad.substr(0, bad.find(' ')).c_str()), bad);
@@ -116,6 +121,9 @@ json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
   put("blend_band", num(s.blend_band), s.blend_band != d.blend_band);
   put("selection", enum_name(s.selection, kSelections), s.selection != d.selection);
   put("debug_cascades", s.debug_cascades, s.debug_cascades != d.debug_cascades);
+  put("point_mode", enum_name(s.point_mode, kPointModes), s.point_mode != d.point_mode);
+  put("freeze_cascades", s.freeze_cascades, s.freeze_cascades != d.freeze_cascades);
+  put("layered", s.layered, s.layered != d.layered);
   return j;
 }
 
@@ -274,6 +282,7 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
     lr.number("inner_cone_deg", l.inner_cone_deg, 0.0f, 90.0f);
     lr.number("outer_cone_deg", l.outer_cone_deg, 0.0f, 90.0f);
     lr.boolean("cast_shadows", l.cast_shadows);
+    lr.number("angular_size_deg", l.angular_size_deg, 0.0f, 45.0f);
     lr.finish();
     if (l.inner_cone_deg > l.outer_cone_deg)
       fail(r.at("light") + "/inner_cone_deg", "must not exceed outer_cone_deg");
@@ -357,7 +366,8 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
                   {"range", num(l->range)},
                   {"inner_cone_deg", num(l->inner_cone_deg)},
                   {"outer_cone_deg", num(l->outer_cone_deg)},
-                  {"cast_shadows", l->cast_shadows}};
+                  {"cast_shadows", l->cast_shadows},
+                  {"angular_size_deg", num(l->angular_size_deg)}};
     if (const auto* s = w.try_get<ShadowSettings>(e)) {
       json sj = write_shadow(*s, &scene.shadow_defaults);
       if (!sj.empty()) j["shadow"] = sj;
@@ -489,6 +499,7 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
       r.vector<3>("ambient", s.ambient, 0.0f, 1.0e4f);
       r.vector<3>("clear_color", s.clear_color, 0.0f, 1.0e4f);
       r.number("exposure", s.exposure, 0.0f, 1.0e4f);
+      r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
       r.finish();
     }
     if (root.has("shadow")) {
@@ -604,7 +615,8 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
                    {"height", r.height},
                    {"ambient", vec(r.ambient)},
                    {"clear_color", vec(r.clear_color)},
-                   {"exposure", num(r.exposure)}};
+                   {"exposure", num(r.exposure)},
+                   {"aov_shadow_light", r.aov_shadow_light}};
   doc["shadow"] = write_shadow(scene.shadow_defaults, nullptr);
   std::vector<ecs::Entity> authored;
   scene.world.view<Transform>().each([&](ecs::Entity e, const Transform&) {

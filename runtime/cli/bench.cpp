@@ -241,7 +241,11 @@ Status run_bench(const BenchOptions& options) {
       if (light.valid()) {
         if (const auto* s = scene->world.try_get<ShadowSettings>(light)) {
           const double bytes = s->depth_format == DepthFormat::d16 ? 2.0 : 4.0;
-          map_mib = double(s->map_size) * s->map_size * bytes * s->cascade_count / (1024.0 * 1024.0);
+          // Every layer of the array: cascades (or spot map, cube faces, hemispheres) of every
+          // shadowed light.
+          int layers = with_aovs->last.shadow.cascade_count;
+          for (const ShadowData& e : with_aovs->last.extra_shadows) layers += e.cascade_count;
+          map_mib = double(s->map_size) * s->map_size * bytes * layers / (1024.0 * 1024.0);
         }
         const std::uint64_t signature = geometry_signature(*scene);
         if (!tracer || signature != tracer_signature) {

@@ -242,6 +242,18 @@ int run_bench_command(const Args& a, bool frames_given) {
   return 0;
 }
 
+// Per-cascade (or per-layer) stats: world units per texel, casters drawn, their triangles,
+// receiver pixels (AOV pixels shaded from that cascade; 0 without AOVs).
+void print_cascade_table(const render::FrameStats& st, const ShadowData& sh) {
+  std::printf("          layer  m/texel   casters  triangles  receiver px\n");
+  for (int i = 0; i < st.cascades; ++i) {
+    const auto c = std::size_t(i);
+    std::printf("          %-5d  %-8.3g  %-7d  %-9zu  %zu%s\n", i, double(st.cascade_texel_size[c]),
+                st.cascade_draw_calls[c], st.cascade_triangles[c], st.cascade_receiver_pixels[c],
+                sh.skipped[c] ? "  (skipped)" : "");
+  }
+}
+
 int run_render(Args a) {
   const fs::path scene_path =
       a.scene.empty() ? content_dir() / "scenes" / "default.json" : fs::path(a.scene);
@@ -290,7 +302,15 @@ int run_render(Args a) {
               "material switches\n",
               st.draw_calls, st.frustum_culled, st.triangles, st.shadow_draw_calls, st.shadow_triangles,
               st.shadow_gpu_ms, st.forward_gpu_ms, st.program_switches, st.material_switches);
-  if (const ShadowData& sh = timings->last.shadow; sh.light.valid() && st.cascades > 0) {
+  if (const ShadowData& sh = timings->last.shadow;
+      sh.light.valid() && st.cascades > 0 && sh.projection != ShadowProjection::ortho) {
+    const char* kinds[] = {"", "spot: 1 perspective map", "point: 6 cube faces",
+                           "point: 2 paraboloid hemispheres"};
+    std::printf("shadow    %s (%d^2 each), near %.3g m, far %.3g m from the light\n",
+                kinds[int(sh.projection)], sh.settings.map_size, double(sh.splits[0]),
+                double(sh.splits[1]));
+    print_cascade_table(st, sh);
+  } else if (sh.light.valid() && st.cascades > 0) {
     const char* fits[] = {"crop", "stable", "scene"};
     std::printf("cascades  %d (%s fit, %d^2 each)", st.cascades, fits[int(sh.settings.fit_mode)],
                 sh.settings.map_size);
@@ -305,6 +325,13 @@ int run_render(Args a) {
       std::printf(" %d/%zu%s", st.cascade_draw_calls[std::size_t(i)],
                   st.cascade_triangles[std::size_t(i)], sh.skipped[std::size_t(i)] ? " (skipped)" : "");
     std::printf("\n");
+    print_cascade_table(st, sh);
+  }
+  for (const ShadowData& ex : timings->last.extra_shadows) {
+    std::printf("shadowed  light %u: %d cascades; splits", ex.light.index, ex.cascade_count);
+    for (int i = 0; i <= ex.cascade_count; ++i)
+      std::printf(" %.3g", double(ex.splits[std::size_t(i)]));
+    std::printf(" m\n");
   }
   if (const ProbeData& pd = timings->last.probes; !pd.probes.empty()) {
     std::printf("probes    %zu reflectors: %llu captures, %llu faces since load; last frame %d "

@@ -70,10 +70,13 @@ Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRu
     t.prewarm_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
+  t.last.shadow_state = std::move(player.shadow_state);
   for (int i = 0; i < std::max(1, run.frames); ++i) {
     ctx.index = std::uint64_t(i);
     const auto t0 = std::chrono::steady_clock::now();
-    KASKAD_TRY(run_frame(scene, *player.renderer, ctx, t.last));
+    const Status st = run_frame(scene, *player.renderer, ctx, t.last);
+    player.shadow_state = t.last.shadow_state;
+    KASKAD_TRY(st);
     player.renderer->finish();
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -84,6 +87,8 @@ Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRu
       t.frame_ms.push_back(ms);
     }
   }
+  if (run.write_aovs)
+    t.last.stats.cascade_receiver_pixels = player.renderer->cascade_pixel_counts();
   return t;
 }
 

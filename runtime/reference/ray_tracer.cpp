@@ -340,6 +340,7 @@ ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix
   r.right = perpendicular(r.direction, glm::vec3(world_matrix[0]));
   r.outer_cone_deg = light.type == LightType::spot ? light.outer_cone_deg : 180.0f;
   r.range = light.type == LightType::directional ? 0.0f : light.range;
+  r.angular_size_deg = light.type == LightType::directional ? light.angular_size_deg : 0.0f;
   return r;
 }
 

@@ -35,6 +35,8 @@ constexpr LayoutEntry kLayout[] = {
     {"aovs", VariantKey::kAovs, 0},
     {"cascade_selection", VariantKey::kCascadeSelection, 0},
     {"debug_cascades", VariantKey::kDebugCascades, 0},
+    {"shadow_projection", VariantKey::kShadowProjection, 0},
+    {"shadow_layered", VariantKey::kShadowLayered, 0},
 };
 
 std::vector<std::string> string_list(ObjectReader& r, const char* key) {

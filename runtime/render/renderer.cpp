@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <numeric>
@@ -16,6 +17,8 @@
 
 namespace kaskad::render {
 namespace {
+
+constexpr int kMaxExtra = kMaxShadowedLights - 1;
 
 // std140 mirror of FrameBlock in content/shaders/common.glsl (change together).
 struct alignas(16) FrameBlock {
@@ -32,9 +35,17 @@ struct alignas(16) FrameBlock {
   glm::vec4 light_dir[kMaxLights];
   glm::vec4 light_pos[kMaxLights];
   glm::vec4 light_cone[kMaxLights];
+  // Further shadowed directional lights (FrameInput::extra_shadows).
+  glm::ivec4 extra_count;             // x: how many
+  glm::ivec4 extra_light[kMaxExtra];  // x light index, y first layer, z cascades
+  glm::vec4 extra_params[kMaxExtra];  // x normal offset, y blend band, z map size
+  glm::mat4 extra_view_proj[kMaxExtra * kMaxCascades];
+  glm::vec4 extra_splits[kMaxExtra * 3];  // D[0..8] of light k: [3k .. 3k+2]
+  glm::vec4 extra_texel[kMaxExtra * 2];   // metres per texel of light k: [2k, 2k+1]
 };
-static_assert(sizeof(FrameBlock) ==
-              2 * 64 + 4 * 16 + kMaxCascades * 64 + 5 * 16 + 4 * kMaxLights * 16);
+static_assert(sizeof(FrameBlock) == 2 * 64 + 4 * 16 + kMaxCascades * 64 + 5 * 16 +
+                                        4 * kMaxLights * 16 + 16 +
+                                        kMaxExtra * (2 * 16 + kMaxCascades * 64 + 5 * 16));
 
 GLenum depth_internal_format(DepthFormat f) {
   switch (f) {
@@ -49,7 +60,10 @@ GLenum depth_internal_format(DepthFormat f) {
 constexpr GLuint kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
 constexpr GLint kUniModel = 0, kUniNormalMatrix = 4, kUniBaseColor = 8, kUniMaterial = 9,
                 kUniEmissive = 10, kUniOracleFeatures = 11, kUniLightViewProj = 12,
-                kUniTargetSize = 13, kUniReflection = 16, kUniReflectionBoxMin = 17, kUniReflectionBoxMax = 18,
+                // Per-program locations: shadow_points (13), shadow_depth layering (13, 14, 16+),
+                // forward reflections (16-19); no program has two of them.
+                kUniTargetSize = 13, kUniLayerMask = 13, kUniLayerBase = 14, kUniLayerViewProj = 16,
+                kUniReflection = 16, kUniReflectionBoxMin = 17, kUniReflectionBoxMax = 18,
                 kUniReflectionCentre = 19;
 constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2, kTexReflectionCube = 3,
                  kTexReflectionSphere = 4;
@@ -109,6 +123,14 @@ struct Renderer::Impl {
   bool timers_pending = false;
   std::uint64_t frames_rendered = 0;
   bool aovs_written = false;
+  bool layer_from_vertex = false;  // GL_ARB_shader_viewport_layer_array: gl_Layer in the VS
+
+  // The key as this driver can build it: without gl_Layer in vertex shaders the layered shadow
+  // pass falls back to one pass per layer (the same maps).
+  VariantKey supported(VariantKey k) const {
+    if (!layer_from_vertex) k.set(VariantKey::kShadowLayered, 0);
+    return k;
+  }
 
   const GpuMesh& mesh(MeshId id, const AssetStore& assets) {
     if (id >= meshes.size()) meshes.resize(std::size_t(id) + 1);
@@ -247,6 +269,11 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
   // Exactly (0.5, 0.5, 1): decodes to (0, 0, 1), so the cotangent frame leaves the normal as is.
   // An 8-bit 128 would tilt every normal by 0.2 degrees, with visible derivative noise.
   im.flat_normal = make_solid_texture({0.5f, 0.5f, 1, 1}, GL_RGBA16F);
+  im.layer_from_vertex = epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array");
+  if (!im.layer_from_vertex)
+    log::warn(
+        "GL_ARB_shader_viewport_layer_array missing: shadow maps are drawn one layer at a "
+        "time");
   im.frame_ubo = gpu::make_buffer();
   glNamedBufferStorage(im.frame_ubo.id(), sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   im.timers[0] = gpu::make_query(GL_TIME_ELAPSED);
@@ -273,7 +300,13 @@ VariantKey frame_variant(const FrameInput& frame) {
     const ShadowSettings& s = frame.shadow.settings;
     k.set(VariantKey::kShadow, 1);
     k.set(VariantKey::kShadowFilter, std::uint32_t(s.filter));
-    k.set(VariantKey::kCascadeCountMinus1, std::uint32_t(cascade_layers(frame.shadow) - 1));
+    k.set(VariantKey::kShadowProjection, std::uint32_t(frame.shadow.projection));
+    // Paraboloid hemispheres are projected in code, one pass each: no layered pass for them.
+    if (s.layered && frame.shadow.projection != ShadowProjection::dual_paraboloid)
+      k.set(VariantKey::kShadowLayered, 1);
+    // Layers of spot and point lights are faces, not cascades: no cascade selection code.
+    if (frame.shadow.projection == ShadowProjection::ortho)
+      k.set(VariantKey::kCascadeCountMinus1, std::uint32_t(cascade_layers(frame.shadow) - 1));
     k.set(VariantKey::kCascadeSelection, s.selection == CascadeSelection::map_bounds ? 1u : 0u);
     k.set(VariantKey::kDebugCascades, s.debug_cascades ? 1u : 0u);
   }
@@ -324,7 +357,8 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
 }
 
 Status Renderer::prewarm(const FrameInput& frame) {
-  const auto requests = required_programs(frame);
+  auto requests = required_programs(frame);
+  for (ProgramRequest& r : requests) r.key = impl_->supported(r.key);
   Status st = impl_->shaders->prewarm(requests);
   stats_.shaders = impl_->shaders->stats();
   return st;
@@ -361,12 +395,48 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     log::warn("%zu lights; only the first %d are shaded", frame.lights.size(), kMaxLights);
   const bool shadowed = frame.shadow.light_index >= 0 && frame.shadow.light_index < light_count;
   const int cascades = shadowed ? cascade_layers(frame.shadow) : 0;
-  fb.counts = glm::ivec4(light_count, shadowed ? frame.shadow.light_index : -1, cascades, 0);
+  // Further shadowed directional lights: their cascades follow the first light's layers.
+  std::vector<const ShadowPass*> extras;
+  std::array<int, kMaxShadowedLights> first_layer{};
+  int total_layers = cascades;
+  if (shadowed)
+    for (const ShadowPass& e : frame.extra_shadows) {
+      if (int(extras.size()) == kMaxExtra) break;
+      if (e.light_index < 0 || e.light_index >= light_count ||
+          e.projection != ShadowProjection::ortho)
+        continue;
+      first_layer[extras.size()] = total_layers;
+      total_layers += cascade_layers(e);
+      extras.push_back(&e);
+    }
+  const int aov_light = frame.aov_shadow_light >= 0 && frame.aov_shadow_light <= int(extras.size())
+                            ? frame.aov_shadow_light
+                            : 0;
+  fb.counts =
+      glm::ivec4(light_count, shadowed ? frame.shadow.light_index : -1, cascades, aov_light);
+  // The basic map (fit scene) is biased by polygon offset alone, as before the cascades.
+  auto normal_offset_of = [](const ShadowPass& sp) {
+    return sp.projection == ShadowProjection::ortho && sp.settings.fit_mode == FitMode::scene
+               ? 0.0f
+               : sp.settings.normal_offset_bias;
+  };
+  fb.extra_count = glm::ivec4(int(extras.size()), 0, 0, 0);
+  for (std::size_t k = 0; k < extras.size(); ++k) {
+    const ShadowPass& e = *extras[k];
+    const int n = cascade_layers(e);
+    fb.extra_light[k] = glm::ivec4(e.light_index, first_layer[k], n, 0);
+    fb.extra_params[k] = glm::vec4(normal_offset_of(e), e.settings.blend_band,
+                                   float(frame.shadow.settings.map_size), 0);
+    for (int i = 0; i < n; ++i) {
+      fb.extra_view_proj[k * kMaxCascades + std::size_t(i)] = e.view_proj[std::size_t(i)];
+      fb.extra_texel[k * 2 + std::size_t(i / 4)][i % 4] = e.texel_size[std::size_t(i)];
+    }
+    for (int i = 0; i <= n; ++i)
+      fb.extra_splits[k * 3 + std::size_t(i / 4)][i % 4] = e.splits[std::size_t(i)];
+  }
   if (shadowed) {
     const ShadowPass& sp = frame.shadow;
-    // The basic map (fit scene) is biased by polygon offset alone, as before the cascades.
-    const float normal_offset =
-        sp.settings.fit_mode == FitMode::scene ? 0.0f : sp.settings.normal_offset_bias;
+    const float normal_offset = normal_offset_of(sp);
     fb.shadow_params = glm::vec4(normal_offset, sp.settings.blend_band, float(sp.settings.map_size), 0);
     for (int i = 0; i < cascades; ++i) {
       fb.cascade_view_proj[i] = sp.view_proj[std::size_t(i)];
@@ -397,7 +467,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
 
   // Draw order: sorted by program (variant key), then by material, so program and material
   // state change as rarely as possible. Keys are computed once per draw.
-  const VariantKey frame_key = frame_variant(frame);
+  const VariantKey frame_key = im.supported(frame_variant(frame));
   im.frame_key = frame_key;
   std::vector<VariantKey> keys(frame.draws.size());
   for (std::size_t i = 0; i < frame.draws.size(); ++i)
@@ -453,55 +523,124 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.cascades = cascades;
   stats_.cascade_draw_calls.fill(0);
   stats_.cascade_triangles.fill(0);
+  stats_.cascade_texel_size.fill(0.0f);
+  stats_.cascade_receiver_pixels.fill(0);
+  for (int c = 0; c < cascades; ++c)
+    stats_.cascade_texel_size[std::size_t(c)] = frame.shadow.texel_size[std::size_t(c)];
   if (shadowed) {
     const ShadowSettings& s = frame.shadow.settings;
-    im.ensure_shadow_map(s.map_size, cascades, s.depth_format, s.filter);
+    im.ensure_shadow_map(s.map_size, total_layers, s.depth_format, s.filter);
     glBindFramebuffer(GL_FRAMEBUFFER, im.shadow_fbo.id());
     glViewport(0, 0, s.map_size, s.map_size);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     glClearDepth(1.0);
-    if (s.cull == CullMode::none) {
-      glDisable(GL_CULL_FACE);
-    } else {
-      glEnable(GL_CULL_FACE);
-      glCullFace(s.cull == CullMode::front ? GL_FRONT : GL_BACK);
-    }
     glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(s.slope_bias, s.constant_bias);
+    // Paraboloid hemispheres end at a clip distance (shadow_depth.vert).
+    const bool paraboloid = frame.shadow.projection == ShadowProjection::dual_paraboloid;
+    if (paraboloid) glEnable(GL_CLIP_DISTANCE0);
     const std::vector<std::uint32_t> order = sorted_by(Pass::depth, keys);
     GLuint current = 0;  // kept across layers: the light matrix is a per-draw uniform
-    for (int c = 0; c < cascades; ++c) {
-      glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0,
-                                     c);
+    // Layered: every layer attached at once and cleared together (skipped layers stay clear);
+    // each caster is drawn once per light, instanced over the layers it overlaps, and the vertex
+    // shader routes instance i to the i-th of them (shadow_depth.vert). The same maps as one pass
+    // per layer (render test), with fewer draw calls.
+    const bool layered = frame_key.has(VariantKey::kShadowLayered);
+    if (layered) {
+      glNamedFramebufferTexture(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0);
       glClear(GL_DEPTH_BUFFER_BIT);
-      if (frame.shadow.skipped[std::size_t(c)]) continue;
-      const glm::mat4& light_vp = frame.shadow.view_proj[std::size_t(c)];
-      for (std::uint32_t i : order) {
-        const DrawItem& d = frame.draws[i];
-        if (!d.cast_shadows || !(d.cascade_mask & (1u << c))) continue;
-        const GpuMesh& m = im.mesh(d.mesh, assets);
-        if (m.index_count == 0) continue;
-        if (Status st = use_program(Pass::depth, keys[i], current); !st) {
-          glDisable(GL_POLYGON_OFFSET_FILL);
-          glEndQuery(GL_TIME_ELAPSED);
-          return st;
+    }
+    // Light 0 is the first shadowed light, 1.. the extra directional ones; each with its own
+    // culling, bias and casters per cascade, into consecutive layers.
+    for (std::size_t light = 0; light <= extras.size(); ++light) {
+      const ShadowPass& pass = light == 0 ? frame.shadow : *extras[light - 1];
+      const int base = light == 0 ? 0 : first_layer[light - 1];
+      const int layers = light == 0 ? cascades : cascade_layers(pass);
+      if (pass.settings.cull == CullMode::none) {
+        glDisable(GL_CULL_FACE);
+      } else {
+        glEnable(GL_CULL_FACE);
+        glCullFace(pass.settings.cull == CullMode::front ? GL_FRONT : GL_BACK);
+      }
+      glPolygonOffset(pass.settings.slope_bias, pass.settings.constant_bias);
+      if (light > 0) glDisable(GL_CLIP_DISTANCE0);  // only paraboloid hemispheres clip
+      if (layered) {
+        std::uint32_t live = 0;
+        for (int c = 0; c < layers; ++c)
+          if (!pass.skipped[std::size_t(c)]) live |= 1u << c;
+        for (std::uint32_t i : order) {
+          const DrawItem& d = frame.draws[i];
+          const std::uint32_t mask =
+              live &
+              (light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu);
+          if (!d.cast_shadows || mask == 0) continue;
+          const GpuMesh& m = im.mesh(d.mesh, assets);
+          if (m.index_count == 0) continue;
+          if (Status st = use_program(Pass::depth, keys[i], current); !st) {
+            glDisable(GL_POLYGON_OFFSET_FILL);
+            glEndQuery(GL_TIME_ELAPSED);
+            return st;
+          }
+          if (keys[i].has(VariantKey::kAlphaMask) || im.oracle) bind_material(current, d, keys[i]);
+          glProgramUniform1ui(current, kUniLayerMask, mask);
+          glProgramUniform1i(current, kUniLayerBase, base);
+          glProgramUniformMatrix4fv(current, kUniLayerViewProj, layers, GL_FALSE,
+                                    &pass.view_proj[0][0][0]);
+          glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+          glBindVertexArray(m.vao.id());
+          const int instances = std::popcount(mask);
+          glDrawElementsInstanced(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr, instances);
+          ++stats_.shadow_draw_calls;
+          stats_.shadow_triangles += std::size_t(instances) * std::size_t(m.index_count / 3);
+          for (int c = 0; light == 0 && c < layers; ++c)
+            if (mask & (1u << c)) {
+              ++stats_.cascade_draw_calls[std::size_t(c)];
+              stats_.cascade_triangles[std::size_t(c)] += std::size_t(m.index_count / 3);
+            }
         }
-        // The oracle's one depth program reads the material bits from a uniform: set it for
-        // every draw, or an alpha-masked draw's bits leak into the next layer's opaque draws.
-        if (keys[i].has(VariantKey::kAlphaMask) || im.oracle) bind_material(current, d, keys[i]);
-        glProgramUniformMatrix4fv(current, kUniLightViewProj, 1, GL_FALSE, &light_vp[0][0]);
-        glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-        glBindVertexArray(m.vao.id());
-        glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
-        ++stats_.shadow_draw_calls;
-        stats_.shadow_triangles += std::size_t(m.index_count / 3);
-        ++stats_.cascade_draw_calls[std::size_t(c)];
-        stats_.cascade_triangles[std::size_t(c)] += std::size_t(m.index_count / 3);
+        continue;
+      }
+      for (int c = 0; c < layers; ++c) {
+        glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(),
+                                       0, base + c);
+        glClear(GL_DEPTH_BUFFER_BIT);
+        if (pass.skipped[std::size_t(c)]) continue;
+        const glm::mat4& light_vp = pass.view_proj[std::size_t(c)];
+        for (std::uint32_t i : order) {
+          const DrawItem& d = frame.draws[i];
+          const std::uint32_t mask =
+              light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu;
+          if (!d.cast_shadows || !(mask & (1u << c))) continue;
+          const GpuMesh& m = im.mesh(d.mesh, assets);
+          if (m.index_count == 0) continue;
+          // Extra lights are cascades: the plain depth program even after paraboloid maps.
+          VariantKey depth_key = keys[i];
+          if (light > 0) depth_key.set(VariantKey::kShadowProjection, 0);
+          if (Status st = use_program(Pass::depth, depth_key, current); !st) {
+            glDisable(GL_POLYGON_OFFSET_FILL);
+            glDisable(GL_CLIP_DISTANCE0);
+            glEndQuery(GL_TIME_ELAPSED);
+            return st;
+          }
+          // The oracle's one depth program reads the material bits from a uniform: set it for
+          // every draw, or an alpha-masked draw's bits leak into the next layer's opaque draws.
+          if (keys[i].has(VariantKey::kAlphaMask) || im.oracle) bind_material(current, d, keys[i]);
+          glProgramUniformMatrix4fv(current, kUniLightViewProj, 1, GL_FALSE, &light_vp[0][0]);
+          glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+          glBindVertexArray(m.vao.id());
+          glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+          ++stats_.shadow_draw_calls;
+          stats_.shadow_triangles += std::size_t(m.index_count / 3);
+          if (light == 0) {
+            ++stats_.cascade_draw_calls[std::size_t(c)];
+            stats_.cascade_triangles[std::size_t(c)] += std::size_t(m.index_count / 3);
+          }
+        }
       }
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
+    glDisable(GL_CLIP_DISTANCE0);
     im.shadow_valid = true;
   }
   glEndQuery(GL_TIME_ELAPSED);
@@ -800,6 +939,18 @@ Image Renderer::read_aovs() const {
     o[13] = refl[i * 4 + 3];
   }
   return img;
+}
+
+std::array<std::size_t, kMaxCascades> Renderer::cascade_pixel_counts() const {
+  const Impl& im = *impl_;
+  KASKAD_CHECK(im.aovs_written, "the last frame was rendered without write_aovs");
+  std::array<std::size_t, kMaxCascades> out{};
+  const auto vis = read_texture(im.visibility.id(), im.width, im.height, GL_RG, 2);
+  for (std::size_t i = 1; i < vis.size(); i += 2) {
+    const int c = int(vis[i]);
+    if (c >= 0 && c < kMaxCascades) ++out[std::size_t(c)];
+  }
+  return out;
 }
 
 Image Renderer::read_shadow_map() const {

@@ -52,6 +52,8 @@ struct DrawItem {
   /// probe's visible map, scaled by `reflection_scale` = k_s * p_r (S3 eq. (3)).
   std::uint32_t probe = kNoProbe;
   float reflection_scale = 0.0f;
+  /// Bit 8k + i: drawn into cascade i of FrameInput::extra_shadows[k].
+  std::uint32_t extra_cascade_masks = 0;
 };
 
 /// One reflection probe's GPU work this frame (systems/environment_probe_system.h). Each probe
@@ -91,15 +93,24 @@ struct LightItem {
 
 inline constexpr int kMaxCascades = 8;  // change together with systems/cascade_math.h and
                                         // MAX_CASCADES in common.glsl
+/// The first shadowed light plus up to 3 further directional ones. Change together with
+/// systems/shadow_cascade_system.h and MAX_EXTRA_SHADOWS (= this - 1) in common.glsl.
+inline constexpr int kMaxShadowedLights = 4;
 
 /// The shadowed light's cascades (systems/shadow_cascade_system.h, ShadowData).
 struct ShadowPass {
   int light_index = -1;          ///< index into FrameInput::lights; -1: no shadow pass
   ShadowSettings settings;
+  /// ortho cascades (directional), perspective (spot), cube (6 faces) or dual_paraboloid (2
+  /// hemispheres) for point lights; the layers below are faces or hemispheres then.
+  ShadowProjection projection = ShadowProjection::ortho;
   int cascade_count = 0;         ///< layers drawn; 0 with light_index >= 0 is treated as 1
-  std::array<glm::mat4, kMaxCascades> view_proj{};  ///< world -> light clip space per cascade
-  std::array<float, kMaxCascades + 1> splits{};     ///< S0's D, metres of view depth
-  std::array<float, kMaxCascades> texel_size{};     ///< metres per texel per cascade
+  /// World -> light clip space per cascade; dual_paraboloid: world -> hemisphere view.
+  std::array<glm::mat4, kMaxCascades> view_proj{};
+  /// S0's D, metres of view depth; spot/point: [near, far] metres from the light.
+  std::array<float, kMaxCascades + 1> splits{};
+  /// Metres per texel per cascade; spot/point: at 1 m from the light.
+  std::array<float, kMaxCascades> texel_size{};
   std::array<bool, kMaxCascades> skipped{};         ///< no receivers: cleared, nothing drawn
 };
 
@@ -109,7 +120,13 @@ struct FrameInput {
   CameraView camera;
   std::vector<DrawItem> draws;
   std::vector<LightItem> lights;  ///< at most kMaxLights are used
-  ShadowPass shadow;
+  ShadowPass shadow;              ///< the first shadowed light (any type)
+  /// Further shadowed directional lights (ortho cascades), at most kMaxShadowedLights - 1; their
+  /// layers follow the first light's in the same texture array, so map size, format, filter and
+  /// selection are the first light's. Ignored without `shadow`.
+  std::vector<ShadowPass> extra_shadows;
+  /// The AOV's visibility and cascade show this shadowed light: 0 `shadow`, k extra_shadows[k-1].
+  int aov_shadow_light = 0;
   std::vector<ProbeJob> probes;
   glm::vec3 ambient{0.05f};
   glm::vec3 clear_color{0.0f};
@@ -130,6 +147,14 @@ struct FrameStats {
   int cascades = 0;                   ///< cascade layers of the shadow map this frame
   std::array<int, kMaxCascades> cascade_draw_calls{};         ///< casters drawn per cascade
   std::array<std::size_t, kMaxCascades> cascade_triangles{};  ///< their triangles
+  /// World units (metres) per shadow-map texel of each cascade (of the first shadowed light;
+  /// spot/point layers: at 1 m from the light).
+  std::array<float, kMaxCascades> cascade_texel_size{};
+  /// Receiver pixels per cascade: pixels of the frame's AOV whose `cascade` channel is i (visible
+  /// shadow-receiving surfaces shaded from cascade i; the first one where blending). Counted by
+  /// cascade_pixel_counts(), which render_frames() calls after its last frame when AOVs are
+  /// written; 0 otherwise.
+  std::array<std::size_t, kMaxCascades> cascade_receiver_pixels{};
   /// GPU times are the previous frame's (queries are read a frame late); 0 until frame 3.
   double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
   double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)
@@ -197,6 +222,10 @@ class Renderer {
   /// Errors: sizes differ, or the pass's program fails to build.
   Result<std::vector<glm::vec2>> shadow_at_points(std::span<const glm::vec3> points,
                                                   std::span<const glm::vec3> normals);
+
+  /// Pixels of the last frame's AOV per cascade index (FrameStats::cascade_receiver_pixels).
+  /// Precondition: the last frame was rendered with write_aovs.
+  std::array<std::size_t, kMaxCascades> cascade_pixel_counts() const;
 
   /// Copies the colour target to the default framebuffer (windowed mode).
   void present(int window_width, int window_height) const;

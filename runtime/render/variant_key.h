@@ -10,9 +10,12 @@
 //   reflection_cube and reflection_sphere exclude each other
 //   reflection_box needs reflection_cube
 //   shadow_filter != 0 and cascade_count != 1 need shadow
-//   debug_cascades and cascade_selection need shadow
-// filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask), so every material
-// shares one or two shadow programs.
+//   debug_cascades, cascade_selection and shadow_projection need shadow
+//   shadow_projection != ortho has cascade_count 1 (cascades are directional only)
+//   shadow_layered needs shadow; the depth pass keeps it (its vertex shader picks the layer)
+// filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask, and the projection
+// when it is dual_paraboloid: its vertex shader differs), so every material shares one or two
+// shadow programs.
 #pragma once
 
 #include <cstdint>
@@ -59,6 +62,10 @@ class VariantKey {
   static constexpr Field kAovs{22, 1};
   static constexpr Field kDebugCascades{23, 1};
   static constexpr Field kCascadeSelection{24, 1};  ///< 0 depth (S0's D), 1 map bounds
+  /// ShadowProjection: 0 ortho, 1 perspective, 2 cube, 3 dual_paraboloid.
+  static constexpr Field kShadowProjection{25, 2};
+  static constexpr std::uint32_t kProjectionDualParaboloid = 3;
+  static constexpr Field kShadowLayered{27, 1};  ///< depth pass: all layers in one pass
   static constexpr std::uint32_t kFrameMask = 0xffff0000u;
 
   constexpr VariantKey() = default;
@@ -80,20 +87,21 @@ class VariantKey {
 
   /// The combination rules in the header comment. Unused bits must be zero.
   constexpr bool valid() const {
-    constexpr std::uint32_t used = kBaseColorTexture.mask() | kNormalMap.mask() | kAlphaMask.mask() |
-                                   kEmissive.mask() | kReflectionCube.mask() |
-                                   kReflectionSphere.mask() | kReceiveShadows.mask() |
-                                   kReflectionBox.mask() |
-                                   kShadow.mask() | kShadowFilter.mask() |
-                                   kCascadeCountMinus1.mask() | kAovs.mask() |
-                                   kDebugCascades.mask() | kCascadeSelection.mask();
+    constexpr std::uint32_t used =
+        kBaseColorTexture.mask() | kNormalMap.mask() | kAlphaMask.mask() | kEmissive.mask() |
+        kReflectionCube.mask() | kReflectionSphere.mask() | kReceiveShadows.mask() |
+        kReflectionBox.mask() |
+        kShadow.mask() | kShadowFilter.mask() | kCascadeCountMinus1.mask() | kAovs.mask() |
+        kDebugCascades.mask() | kCascadeSelection.mask() | kShadowProjection.mask() |
+        kShadowLayered.mask();
     if (bits_ & ~used) return false;
     if (has(kReflectionCube) && has(kReflectionSphere)) return false;
     if (has(kReflectionBox) && !has(kReflectionCube)) return false;
     if (get(kShadowFilter) > 2) return false;
     if (!has(kShadow) && (has(kShadowFilter) || has(kCascadeCountMinus1) || has(kDebugCascades) ||
-                        has(kCascadeSelection)))
+                          has(kCascadeSelection) || has(kShadowProjection) || has(kShadowLayered)))
       return false;
+    if (has(kShadowProjection) && has(kCascadeCountMinus1)) return false;
     return true;
   }
 
@@ -101,9 +109,17 @@ class VariantKey {
   /// shadow-points pass only the shadow lookup's frame features (a receiver, without AOVs or the
   /// debug tint); the forward pass needs everything.
   constexpr VariantKey filtered_for(Pass pass) const {
-    if (pass == Pass::depth) return VariantKey(bits_ & kAlphaMask.mask());
+    if (pass == Pass::depth) {
+      const std::uint32_t projection = get(kShadowProjection) == kProjectionDualParaboloid
+                                           ? kShadowProjection.mask() | kShadow.mask()
+                                           : 0u;
+      const std::uint32_t layered =
+          has(kShadowLayered) ? kShadowLayered.mask() | kShadow.mask() : 0u;
+      return VariantKey(bits_ & (kAlphaMask.mask() | projection | layered));
+    }
     if (pass == Pass::shadow_points)
-      return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask()) |
+      return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask() &
+                         ~kShadowLayered.mask()) |
                         kReceiveShadows.mask());
     return *this;
   }
@@ -119,5 +135,23 @@ static_assert(VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowFi
 static_assert(!VariantKey().set(VariantKey::kReflectionBox, 1).valid());
 static_assert(VariantKey().set(VariantKey::kReflectionBox, 1).set(VariantKey::kReflectionCube, 1).valid());
 static_assert(VariantKey().set(VariantKey::kNormalMap, 1).filtered_for(Pass::depth) == VariantKey());
+static_assert(!VariantKey().set(VariantKey::kShadowProjection, 1).valid());
+static_assert(
+    VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 2).valid());
+static_assert(!VariantKey()
+                   .set(VariantKey::kShadow, 1)
+                   .set(VariantKey::kShadowProjection, 2)
+                   .set(VariantKey::kCascadeCountMinus1, 5)
+                   .valid());
+static_assert(VariantKey()
+                  .set(VariantKey::kShadow, 1)
+                  .set(VariantKey::kShadowProjection, 2)
+                  .filtered_for(Pass::depth) == VariantKey());
+static_assert(VariantKey()
+                  .set(VariantKey::kShadow, 1)
+                  .set(VariantKey::kShadowProjection, 3)
+                  .set(VariantKey::kShadowFilter, 2)
+                  .filtered_for(Pass::depth) ==
+              VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 3));
 
 }  // namespace kaskad::render

@@ -43,12 +43,23 @@ check save_roundtrip 0 "wrote" -- "$KASKAD" save "$KASKAD_CONTENT/scenes/default
 check save_roundtrip2 0 "wrote" -- "$KASKAD" save "$tmp/a.json" -o "$tmp/b.json"
 if cmp -s "$tmp/a.json" "$tmp/b.json"; then echo "ok   save_identical"; passed=$((passed + 1)); else echo "FAIL save_identical"; failed=$((failed + 1)); fi
 check help 0 "usage" -- "$KASKAD" --help
+# Spot and point lights, several shadowed lights: the shadow lines and the per-layer table.
+check render_spot 0 "shadow +spot: 1 perspective map" -- "$KASKAD" render "$KASKAD_CONTENT/scenes/spot.json" \
+  --headless --size 96x64 --frames 1 -o "$tmp/spot.png"
+check render_point_dp 0 "point: 2 paraboloid hemispheres" -- "$KASKAD" render "$KASKAD_CONTENT/scenes/point.json" \
+  --headless --size 96x64 --frames 1 -o "$tmp/point.png" --set shadow.point_mode=dual_paraboloid
+check render_two_suns 0 "shadowed +light [0-9]+: 2 cascades" -- "$KASKAD" render "$KASKAD_CONTENT/scenes/two_suns.json" \
+  --headless --size 96x64 --frames 1 -o "$tmp/two.png"
+check cascade_table 0 "layer +m/texel +casters +triangles +receiver px" -- "$KASKAD" render --headless \
+  --size 96x64 --frames 1 -o "$tmp/t.png" --aov "$tmp/t.exr"
 
 # Bad input: clear errors, non-zero exits, no crashes.
 check unknown_command nonzero "unknown command" -- "$KASKAD" paint
 check bad_size nonzero "--size" -- "$KASKAD" render --size 12 --headless
 check bad_set_key nonzero "map_sise.*valid keys" -- "$KASKAD" render --headless --set shadow.map_sise=1
 check bad_set_value nonzero "map_size.*power of two" -- "$KASKAD" render --headless --set shadow.map_size=100
+check bad_point_mode nonzero "/shadow/point_mode.*sphere.*cube, dual_paraboloid" -- "$KASKAD" render --headless \
+  --set shadow.point_mode=sphere
 check missing_scene nonzero "nope.json.*cannot open" -- "$KASKAD" render "$tmp/nope.json" --headless
 printf '{ "entities": [ { "name": "x", "light": { "type": "laser" } } ] }' >"$tmp/bad.json"
 check bad_enum nonzero "bad.json.*/entities/0/light/type.*laser" -- "$KASKAD" render "$tmp/bad.json" --headless

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <set>
 
 #include "components/light.h"
 #include "components/mesh_renderer.h"
@@ -289,8 +290,10 @@ TEST_F(DefaultSceneTest, StableCascadesDoNotShimmerUnderSubTexelCameraMoves) {
 // Per-cascade stats: each layer draws exactly the casters the system kept for it; layers without
 // receivers draw nothing; the farthest receiver pulls the last split in from max_distance.
 TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
-  auto scene = load_scene(content_dir() / "scenes" / "default.json",
-                          {"render.width=160", "render.height=90", "shadow.cascade_count=8"});
+  // One pass per layer: one draw call per caster and cascade (the layered pass is below).
+  auto scene = load_scene(
+      content_dir() / "scenes" / "default.json",
+      {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=false"});
   ASSERT_TRUE(scene.ok()) << scene.error().to_string();
   auto t = render_frames(*player_, *scene, {});
   ASSERT_TRUE(t.ok()) << t.error().to_string();
@@ -316,6 +319,25 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
   EXPECT_FLOAT_EQ(sh.splits[8], sh.far_used);
   std::printf("[ 8 cascades ] last split pulled in from %.1f to %.1f m; %d of 64 caster draws culled\n",
               double(sh.far_requested), double(sh.far_used), culled);
+
+  // Layered: the same casters per cascade and the same triangles, but one instanced draw call
+  // per caster that is in any cascade.
+  auto layered_scene = load_scene(
+      content_dir() / "scenes" / "default.json",
+      {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=true"});
+  ASSERT_TRUE(layered_scene.ok()) << layered_scene.error().to_string();
+  auto lt = render_frames(*player_, *layered_scene, {});
+  ASSERT_TRUE(lt.ok()) << lt.error().to_string();
+  const render::FrameStats& ls = lt->last.stats;
+  std::set<std::uint32_t> casters_drawn;
+  for (std::size_t i = 0; i < 8; ++i) {
+    EXPECT_EQ(ls.cascade_draw_calls[i], st.cascade_draw_calls[i]) << "cascade " << i;
+    EXPECT_EQ(ls.cascade_triangles[i], st.cascade_triangles[i]) << "cascade " << i;
+    for (ecs::Entity e : lt->last.shadow.casters[i]) casters_drawn.insert(e.index);
+  }
+  EXPECT_EQ(ls.shadow_draw_calls, int(casters_drawn.size()));
+  EXPECT_LT(ls.shadow_draw_calls, st.shadow_draw_calls);
+  EXPECT_EQ(ls.shadow_triangles, st.shadow_triangles);
 }
 
 // Set-ups that used to be degenerate for one part or another: each renders without GL errors

@@ -127,10 +127,11 @@ TEST(SceneIo, CascadeFieldsLoadWithRangeChecksAndPerLightOverrides) {
   const fs::path p = temp_dir() / "cascades.json";
   std::ofstream(p) << R"({ "shadow": { "cascade_count": 3, "fit_mode": "crop", "lambda": 0.8,
       "split_scheme": "log", "max_distance": 60, "depth_format": "d32f", "normal_offset_bias": 2,
-      "blend_band": 0.2, "selection": "map_bounds", "debug_cascades": true, "beam_radius": 5 },
+      "blend_band": 0.2, "selection": "map_bounds", "debug_cascades": true, "beam_radius": 5,
+      "point_mode": "dual_paraboloid" },
     "entities": [
       { "name": "sun", "transform": { "direction": [0, -1, 0] },
-        "light": { "type": "directional", "cast_shadows": true },
+        "light": { "type": "directional", "cast_shadows": true, "angular_size_deg": 0.53 },
         "shadow": { "cascade_count": 1, "fit_mode": "scene" } } ] })";
   auto s = read_scene(p);
   ASSERT_TRUE(s.ok()) << s.error().to_string();
@@ -143,6 +144,7 @@ TEST(SceneIo, CascadeFieldsLoadWithRangeChecksAndPerLightOverrides) {
   EXPECT_EQ(d.depth_format, DepthFormat::d32f);
   EXPECT_EQ(d.selection, CascadeSelection::map_bounds);
   EXPECT_TRUE(d.debug_cascades);
+  EXPECT_EQ(d.point_mode, PointShadowMode::dual_paraboloid);
   const ShadowSettings& l = s->world.get<ShadowSettings>(find(*s, "sun"));
   EXPECT_EQ(l.cascade_count, 1);
   EXPECT_EQ(l.fit_mode, FitMode::scene);
@@ -153,7 +155,9 @@ TEST(SceneIo, CascadeFieldsLoadWithRangeChecksAndPerLightOverrides) {
   auto again = read_scene(out);
   ASSERT_TRUE(again.ok()) << again.error().to_string();
   EXPECT_EQ(again->world.get<ShadowSettings>(find(*again, "sun")).fit_mode, FitMode::scene);
+  EXPECT_FLOAT_EQ(again->world.get<Light>(find(*again, "sun")).angular_size_deg, 0.53f);
   EXPECT_EQ(again->shadow_defaults.depth_format, DepthFormat::d32f);
+  EXPECT_EQ(again->shadow_defaults.point_mode, PointShadowMode::dual_paraboloid);
 
   const fs::path def = kContent / "scenes" / "default.json";
   expect_error(read_scene(def, {"shadow.cascade_count=9"}), {"/shadow/cascade_count", "9"});
@@ -164,6 +168,9 @@ TEST(SceneIo, CascadeFieldsLoadWithRangeChecksAndPerLightOverrides) {
   expect_error(read_scene(def, {"shadow.blend_band=-0.1"}), {"/shadow/blend_band"});
   expect_error(read_scene(def, {"shadow.normal_offset_bias=17"}), {"/shadow/normal_offset_bias"});
   expect_error(read_scene(def, {"shadow.depth_format=d8"}), {"d8", "d16", "d24", "d32f"});
+  expect_error(read_scene(def, {"sun.light.angular_size_deg=50"}), {"/light/angular_size_deg"});
+  expect_error(read_scene(def, {"shadow.point_mode=sphere"}),
+               {"/shadow/point_mode", "sphere", "cube", "dual_paraboloid"});
 }
 
 TEST(SceneIo, OverrideErrorsListValidKeys) {

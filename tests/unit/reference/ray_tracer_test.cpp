@@ -455,6 +455,13 @@ TEST(RayTracer, ReferenceLightFromAComponent) {
   EXPECT_NEAR(glm::length(s.direction - glm::vec3(0, 0, -1)), 0.0f, 1e-6f);
   EXPECT_EQ(s.outer_cone_deg, 180.0f);
   EXPECT_EQ(s.range, 0.0f);
+  EXPECT_FALSE(s.is_area());
+  // The component's angular size makes the sun an area light; spot/point lights ignore it.
+  sun.angular_size_deg = 0.53f;
+  EXPECT_EQ(reference_light(sun, glm::mat4(1.0f)).angular_size_deg, 0.53f);
+  EXPECT_TRUE(reference_light(sun, glm::mat4(1.0f)).is_area());
+  spot.angular_size_deg = 2.0f;
+  EXPECT_FALSE(reference_light(spot, m).is_area());
 }
 
 // Area lights ------------------------------------------------------------------------------------

@@ -142,7 +142,7 @@ TEST(ShadowCascadeSystem, NanLightTransformIsRejectedWithAnError) {
   const ShadowData d = update_shadow_cascades(w, camera(w), state);
   EXPECT_FALSE(d.light.valid());
   EXPECT_NE(d.error.find("NaN"), std::string::npos) << d.error;
-  EXPECT_EQ(state.last_error, d.error);
+  EXPECT_EQ(state.last_errors[0], d.error);
 }
 
 TEST(ShadowCascadeSystem, NonFiniteBoundsAreLeftOutAndTheRestShadowed) {
