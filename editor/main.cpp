@@ -16,6 +16,7 @@
 #include <backends/imgui_impl_opengl3.h>
 
 #include "components/light.h"
+#include "components/reflector.h"
 #include "components/name.h"
 #include "components/shadow_settings.h"
 #include "runtime/assets/image_io.h"
@@ -194,6 +195,24 @@ int main(int argc, char** argv) {
           }
           ImGui::PopID();
         });
+    // Reflection probes (S3): the map type switches at runtime (takes effect next frame); amount,
+    // cadence and time slicing are live too.
+    scene->world.view<Reflector>().each([&](ecs::Entity e, Reflector& r) {
+      const Name* n = scene->world.try_get<Name>(e);
+      ImGui::PushID(int(e.index) + 0x10000);
+      const std::string title = std::string("reflector ") + (n ? n->value : "");
+      if (ImGui::CollapsingHeader(title.c_str())) {
+        int map = int(r.map);
+        const char* maps[] = {"cube map", "sphere map"};
+        if (ImGui::Combo("map", &map, maps, 2)) r.map = ReflectionMap(map);
+        ImGui::SliderFloat("amount p_r", &r.amount, 0.0f, 1.0f);
+        if (r.update == ProbeUpdate::every_n) ImGui::SliderInt("every n frames", &r.every_n, 1, 120);
+        ImGui::SliderInt("faces per frame", &r.faces_per_frame, 1, 6);
+        if (r.map == ReflectionMap::cube && r.box_max != r.box_min)  // an authored box only
+          ImGui::Checkbox("box projection", &r.box_projection);
+      }
+      ImGui::PopID();
+    });
     ImGui::End();
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
