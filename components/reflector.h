@@ -34,7 +34,7 @@ struct Reflector {
   int every_n = 10;
   /// Faces rendered per frame while a capture is in progress, in [1, 6]. 6: S3 (all at once);
   /// fewer spreads a capture over frames (time slicing) into a back buffer that becomes visible
-  /// only when all six faces are done.
+  /// only when all six faces are done. The first capture renders all six at once.
   int faces_per_frame = 6;
   /// Texels per cube face side, power of two in [8, 2048]. 128: engine choice (S3 does not say).
   int resolution = 128;

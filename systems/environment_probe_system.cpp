@@ -86,8 +86,10 @@ ProbeWork schedule_probe(const Reflector& r, ProbeState& s, std::uint64_t frame,
     s.signature = signature;
   }
   if (!s.capturing) return work;
-  // 3. The next faces in GL order into the back buffer; swap when all six are there.
-  const int per_frame = std::clamp(r.faces_per_frame, 1, 6);
+  // 3. The next faces in GL order into the back buffer; swap when all six are there. The first
+  // capture renders all six at once: until a map exists the reflector shows none, and slicing it
+  // would only delay the first reflection (time slicing spreads the cost of re-captures).
+  const int per_frame = s.has_map ? std::clamp(r.faces_per_frame, 1, 6) : 6;
   for (int f = 0, n = 0; f < 6 && n < per_frame; ++f) {
     const std::uint8_t bit = std::uint8_t(1u << f);
     if (s.faces_done & bit) continue;

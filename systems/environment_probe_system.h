@@ -62,7 +62,8 @@ struct ProbeWork {
 ///                capture is still running waits for it and starts on the next frame).
 ///   on_change    captures on the first frame, then whenever the signature changed.
 /// A capture renders min(faces_per_frame, remaining) faces per frame into the back buffer in
-/// GL face order and swaps only when all six are done.
+/// GL face order and swaps only when all six are done. The first capture renders all six on its
+/// first frame (no map exists yet to show meanwhile).
 ProbeWork schedule_probe(const Reflector& r, ProbeState& s, std::uint64_t frame,
                          std::uint64_t signature);
 

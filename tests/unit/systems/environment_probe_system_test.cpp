@@ -70,8 +70,9 @@ TEST(ProbeSchedule, StaticFileLoadsOnceAndNeverCaptures) {
   EXPECT_EQ(s.faces_rendered, 0u);
 }
 
-// Time slicing: every face exactly once per capture, at most faces_per_frame a frame, the
-// visible buffer only ever changes to a buffer with all six faces done.
+// Time slicing: every face exactly once per capture, at most faces_per_frame a frame (all six on
+// the first capture, when nothing is shown yet), the visible buffer only ever changes to a buffer
+// with all six faces done.
 TEST(ProbeSchedule, TimeSlicingNeverShowsAPartialCube) {
   for (int per_frame = 1; per_frame <= 6; ++per_frame) {
     SCOPED_TRACE("faces_per_frame " + std::to_string(per_frame));
@@ -81,8 +82,12 @@ TEST(ProbeSchedule, TimeSlicingNeverShowsAPartialCube) {
     int shown = -1;                         // buffer visible (-1: none yet)
     for (int k = 0; k < 60; ++k) {
       const int back = 1 - s.front;
+      const bool first_capture = !s.has_map;
       const ProbeWork w = schedule_probe(r, s, std::uint64_t(k), 0);
-      EXPECT_LE(std::popcount(unsigned(w.faces)), per_frame);
+      EXPECT_LE(std::popcount(unsigned(w.faces)), first_capture ? 6 : per_frame);
+      if (k == 0) {
+        EXPECT_TRUE(w.swap) << "the first capture is whole on its first frame";
+      }
       EXPECT_EQ(written[std::size_t(back)] & w.faces, 0) << "a face rendered twice in one capture";
       written[std::size_t(back)] |= w.faces;
       if (w.swap) {
@@ -103,11 +108,12 @@ TEST(ProbeSchedule, TimeSlicingNeverShowsAPartialCube) {
 }
 
 TEST(ProbeSchedule, EveryNShorterThanASlicedCaptureWaitsForIt) {
-  // 1 face per frame takes 6 frames; N = 2 triggers meanwhile. Each capture completes and the
-  // next starts right after, so the visible cube is always whole and captures never overlap.
+  // The first capture is whole on frame 0. Then 1 face per frame takes 6 frames and N = 2
+  // triggers meanwhile: each capture completes and the next starts right after (2-7, 8-13,
+  // 14-19), so the visible cube is always whole and captures never overlap.
   ProbeState s;
   const auto done = completions(with(ProbeUpdate::every_n, 1, 2), 20, s);
-  EXPECT_EQ(done, (std::vector<std::uint64_t>{5, 11, 17}));
+  EXPECT_EQ(done, (std::vector<std::uint64_t>{0, 7, 13, 19}));
 }
 
 TEST(ProbeSchedule, OnChangeCapturesWhenTheSignatureChanges) {
@@ -126,10 +132,11 @@ TEST(ProbeSchedule, OnChangeDuringASlicedCaptureCapturesAgain) {
   ProbeState s;
   std::vector<std::uint64_t> done;
   for (int k = 0; k < 12; ++k)
-    if (schedule_probe(r, s, std::uint64_t(k), k == 1 ? 5 : 6).swap) done.push_back(std::uint64_t(k));
-  // The capture started on frame 0 (signature 6) sees 5 on frame 1: that requests another
-  // capture, which starts when the running one completes (frame 3) and finishes on 5.
-  EXPECT_EQ(done, (std::vector<std::uint64_t>{2, 5}));
+    if (schedule_probe(r, s, std::uint64_t(k), k == 3 ? 5 : 6).swap) done.push_back(std::uint64_t(k));
+  // The first capture is whole on frame 0. Frame 3 sees signature 5: a sliced capture runs on
+  // frames 3-5. Frame 4 sees 6 again while it runs: that requests another capture, which starts
+  // when the running one completes and runs on frames 6-8.
+  EXPECT_EQ(done, (std::vector<std::uint64_t>{0, 5, 8}));
 }
 
 // GL 4.5 table 8.19: for face f, direction = (major axis) with s = sc/|ma|, t = tc/|ma| mapped
