@@ -244,13 +244,14 @@ TEST(ReflectionReference, ImageAndMetric) {
   EXPECT_NEAR(off->rmse, std::sqrt(0.09 / 6), 1e-6);
   EXPECT_NEAR(off->max_abs_error, 0.3, 1e-6);
   // A "reflector" channel limits the pixels to reflective ones.
-  method.channel_names.push_back("reflector");
-  method.channels += 1;
+  // (The pixels are re-laid out with the old channel count before the new channel is declared.)
   std::vector<float> px;
   for (int x = 0; x < 3; ++x) {
-    for (int c = 0; c < 5; ++c) px.push_back(method.at(x, 0, c));
+    for (int c = 0; c < method.channels; ++c) px.push_back(method.at(x, 0, c));
     px.push_back(x == 0 ? 1.0f : 0.0f);
   }
+  method.channel_names.push_back("reflector");
+  method.channels += 1;
   method.pixels = px;
   auto reflective = compare_reflections(method, img);
   ASSERT_TRUE(reflective.ok());
