@@ -132,8 +132,16 @@ std::uint64_t scene_signature(const ecs::World& world, ecs::Entity self, const g
   h.add(center);
   world.view<Light, WorldTransform>().each(
       [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {
+        // Field by field: a struct's padding bytes are not part of its value.
         h.add(e.index);
-        h.add(l);
+        h.add(l.type);
+        h.add(l.color);
+        h.add(l.intensity);
+        h.add(l.range);
+        h.add(l.inner_cone_deg);
+        h.add(l.outer_cone_deg);
+        h.add(l.cast_shadows);
+        h.add(l.angular_size_deg);
         h.add(wt.matrix);
       });
   const Material none;

@@ -172,9 +172,13 @@ namespace {
 
 // The maps of one shadowed light (entity `e`, null for none). Errors are logged when they differ
 // from `last_error`, which is updated. `previous` is this slot's last result (freeze_cascades).
+/// `shared`: for lights after the first, the first light's settings whose map_size,
+/// depth_format, filter and selection apply to every light (one shared texture array). They are
+/// applied before fitting, so texel sizes and the stable fit's snapping use the real map size.
 ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera, ecs::Entity e,
                               const Light& light_component, const glm::mat4& light_matrix,
-                              const ShadowData& previous, std::string& last_error) {
+                              const ShadowData& previous, std::string& last_error,
+                              const ShadowSettings* shared = nullptr) {
   ShadowData out;
   // 1. The light: its settings and a finite transform.
   out.light = e;
@@ -187,6 +191,12 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
   };
   if (!out.light.valid()) return finish();
   if (const auto* s = world.try_get<ShadowSettings>(out.light)) out.settings = *s;
+  if (shared) {
+    out.settings.map_size = shared->map_size;
+    out.settings.depth_format = shared->depth_format;
+    out.settings.filter = shared->filter;
+    out.settings.selection = shared->selection;
+  }
   const ShadowSettings& s = out.settings;
   if (std::string bad = validate_shadow_settings(s); !bad.empty()) {
     set_error(out, "light " + std::to_string(out.light.index) + ": " + bad);
@@ -357,7 +367,8 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
     }
     const std::size_t slot = out.size();
     ShadowData d = fit_shadowed_light(world, camera, l.entity, l.light, l.matrix,
-                                      state.previous[slot], state.last_errors[slot]);
+                                      state.previous[slot], state.last_errors[slot],
+                                      i == 0 ? nullptr : &out[0].settings);
     state.previous[slot] = d;
     if (i == 0) {
       out.push_back(std::move(d));
@@ -367,16 +378,14 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
     if (!d.light.valid()) continue;  // its error is logged
     // One depth texture array holds every light's layers: the first light's map size, format
     // and filter apply to all, and its cascade selection (a frame feature of the shaders).
+    // (fit_shadowed_light applied them; the light's own component may ask otherwise.)
     const ShadowSettings& first = out[0].settings;
-    if (d.settings.map_size != first.map_size || d.settings.depth_format != first.depth_format ||
-        d.settings.filter != first.filter || d.settings.selection != first.selection)
+    if (const auto* own = world.try_get<ShadowSettings>(l.entity);
+        own && (own->map_size != first.map_size || own->depth_format != first.depth_format ||
+                own->filter != first.filter || own->selection != first.selection))
       notice = name +
                ": takes map_size, depth_format, filter and selection from the first "
                "shadowed light (one shared texture array)";
-    d.settings.map_size = first.map_size;
-    d.settings.depth_format = first.depth_format;
-    d.settings.filter = first.filter;
-    d.settings.selection = first.selection;
     out.push_back(std::move(d));
   }
   if (out.empty()) out.emplace_back();

@@ -297,7 +297,11 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
     fail(r.at("shadow"), "shadow settings belong to an entity with a light");
   }
   if (r.has("reflector")) {
-    if (!has_primitive && !has_model) fail(r.at("reflector"), "a reflector needs a primitive or model");
+    // A model's meshes sit on imported child entities, which the probe system does not map
+    // back to the reflector: only primitives reflect for now.
+    if (!has_primitive)
+      fail(r.at("reflector"), has_model ? "a reflector needs a primitive (not supported on models yet)"
+                                        : "a reflector needs a primitive");
     Reflector refl;
     ObjectReader rr(r.raw("reflector"), r.at("reflector"));
     read_reflector(rr, refl);
@@ -601,6 +605,7 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
       if (imp.source == e) {
         mr.cast_shadows = flags.cast_shadows;
         mr.receive_shadows = flags.receive_shadows;
+        mr.layer = flags.layer;
       }
     });
   }

@@ -14,6 +14,7 @@
 #include "components/light.h"
 #include "components/shadow_settings.h"
 #include "components/transform.h"
+#include "components/material.h"
 #include "components/mesh_renderer.h"
 #include "runtime/cli/player.h"
 #include "runtime/cli/stability.h"
@@ -74,8 +75,8 @@ void progress(std::size_t done, std::size_t total, double elapsed_s, const std::
   std::fflush(stderr);
 }
 
-// What the reference BVH depends on: every MeshRenderer's mesh, flags and world matrix, and the
-// meshes' sizes. Configurations of one scene usually differ in settings only, so the BVH is
+// What the reference BVH depends on: every MeshRenderer's mesh, flags and world matrix, its
+// material's alpha cut-out (the tracer copies it), and the meshes' sizes. Configurations of one scene usually differ in settings only, so the BVH is
 // rebuilt only when this changes (a --set may move or hide geometry).
 std::uint64_t geometry_signature(const Scene& scene) {
   std::uint64_t h = 1469598103934665603ull;
@@ -91,6 +92,11 @@ std::uint64_t geometry_signature(const Scene& scene) {
         mix(&mr.mesh, sizeof mr.mesh);
         mix(&flags, 1);
         mix(&wt.matrix, sizeof wt.matrix);
+        if (const Material* m = scene.world.try_get<Material>(e); m && m->alpha_mask) {
+          const float cut[2] = {m->alpha_cutoff, m->base_color.a};
+          mix(cut, sizeof cut);
+          mix(&m->base_color_texture, sizeof m->base_color_texture);
+        }
       });
   for (const auto& m : scene.assets.meshes) {
     const std::size_t sizes[2] = {m.positions.size(), m.indices.size()};

@@ -330,8 +330,13 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   for (const DrawItem& d : frame.draws) {
     const VariantKey k = material_variant(d) | fk;
     out.push_back({Pass::forward, k.filtered_for(Pass::forward)});
-    if (fk.has(VariantKey::kShadow) && d.cast_shadows)
+    if (fk.has(VariantKey::kShadow) && d.cast_shadows) {
       out.push_back({Pass::depth, k.filtered_for(Pass::depth)});
+      // Extra (directional) lights draw with the plain depth program, whatever the first's is.
+      if (!frame.extra_shadows.empty())
+        out.push_back({Pass::depth,
+                       VariantKey(k).set(VariantKey::kShadowProjection, 0).filtered_for(Pass::depth)});
+    }
     std::vector<VariantKey> materials = {material_variant(d)};
     for (const ProbeJob& job : frame.probes)
       if (job.handle == d.probe)
@@ -492,10 +497,13 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.program_switches = stats_.material_switches = 0;
   // Material uniforms and textures for a draw; skipped when equal to the previous draw's.
   const Material* bound_material = nullptr;
+  VariantKey bound_key;  // the oracle's feature bits also differ between equal materials
   auto bind_material = [&](GLuint prog, const DrawItem& d, VariantKey key) {
     const Material& m = d.material;
-    if (bound_material && *bound_material == m) return;
+    if (bound_material && *bound_material == m && (!im.oracle || bound_key == key.material()))
+      return;
     bound_material = &m;
+    bound_key = key.material();
     ++stats_.material_switches;
     const glm::vec4 params(m.metallic, m.roughness, m.normal_scale, m.alpha_cutoff);
     glProgramUniform4fv(prog, kUniBaseColor, 1, &m.base_color[0]);
@@ -738,6 +746,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
         const int before = stats_.draw_calls;
         const std::size_t triangles_before = stats_.triangles;
         if (Status st = draw_forward(capture_keys, &job, face_fb.view_proj); !st) {
+          glNamedBufferSubData(im.frame_ubo.id(), 0, sizeof fb, &fb);  // the main view's block
           glEndQuery(GL_TIME_ELAPSED);
           return st;
         }

@@ -214,7 +214,8 @@ class Renderer {
   /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;
 
-  /// The shadowed light's visibility at fixed world points with unit normals (one per point),
+  /// The AOV's shadowed light's visibility (FrameInput::aov_shadow_light) at fixed world points
+  /// with unit normals (one per point),
   /// evaluated by the forward pass's own shadow lookup (content/shaders/shadow.glsl) against the
   /// shadow maps, camera and frame features of the last render(). One (visibility,
   /// cascade) pair per point, as the forward pass would shade a surface there: (1, -1) without a

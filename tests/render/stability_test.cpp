@@ -55,11 +55,27 @@ Player* StabilityTest::player_ = nullptr;
 // The points pass and the forward pass run the same lookup on the same inputs (the AOV stores the
 // interpolated position and the facing normal the forward pass used), so they agree per point.
 TEST_F(StabilityTest, PointsPassMatchesTheForwardPassAtTheSamePoints) {
-  for (const char* filter : {"none", "pcf3x3"}) {
-    Scene scene = load({std::string("shadow.filter=") + filter});
+  struct Case {
+    const char* scene;
+    std::vector<std::string> sets;
+  };
+  const std::vector<Case> cases = {
+      {"default", {"shadow.filter=none"}},
+      {"default", {"shadow.filter=pcf3x3"}},
+      {"two_suns", {"render.aov_shadow_light=1"}},  // the AOV shows the second light
+      {"spot", {}},
+      {"point", {"shadow.point_mode=cube"}},
+      {"point", {"shadow.point_mode=dual_paraboloid"}}};
+  for (const Case& c : cases) {
+    std::vector<std::string> sets = c.sets;
+    sets.push_back("render.width=320");
+    sets.push_back("render.height=180");
+    auto loaded = load_scene(content_dir() / "scenes" / (std::string(c.scene) + ".json"), sets);
+    ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+    Scene scene = std::move(loaded.value());
     Image aov;
     const StabilityPoints points = points_of(scene, &aov);
-    ASSERT_GT(points.positions.size(), 1000u);
+    ASSERT_GT(points.positions.size(), 1000u) << c.scene;
     auto values = player_->renderer->shadow_at_points(points.positions, points.normals);
     ASSERT_TRUE(values.ok()) << values.error().to_string();
     ASSERT_EQ(values->size(), points.positions.size());
@@ -70,10 +86,10 @@ TEST_F(StabilityTest, PointsPassMatchesTheForwardPassAtTheSamePoints) {
       same += std::abs((*values)[i].x - forward) < 1e-4f && (*values)[i].y == aov.at(px.x, px.y, 9);
       shadowed += forward < 0.5f;
     }
-    std::printf("[ %s ] %zu of %zu points agree (%zu shadowed)\n", filter, same,
-                points.positions.size(), shadowed);
-    EXPECT_GT(shadowed, 20u);  // the comparison covers shadowed points too
-    EXPECT_GE(double(same), 0.999 * double(points.positions.size()));
+    std::printf("[ %s %s ] %zu of %zu points agree (%zu shadowed)\n", c.scene,
+                c.sets.empty() ? "" : c.sets[0].c_str(), same, points.positions.size(), shadowed);
+    EXPECT_GT(shadowed, 20u) << c.scene;  // the comparison covers shadowed points too
+    EXPECT_GE(double(same), 0.999 * double(points.positions.size())) << c.scene;
   }
 }
 

@@ -216,6 +216,24 @@ TEST(SceneIo, MalformedFilesGiveErrorsNamingFileAndPlace) {
                {"/entities/0/primitive/tiles", "multiple"});
 }
 
+// A model entity's renderer flags, layer included, apply to every mesh imported under it.
+TEST(SceneIo, ModelRendererFlagsAndLayerReachImportedMeshes) {
+  const fs::path file = write_file("layered_model.json", R"({"entities": [{"name": "m",
+      "model": {"path": ")" + (kContent / "models/Box/glTF-Binary/Box.glb").string() + R"("},
+      "renderer": {"cast_shadows": false, "layer": 5}}]})");
+  auto scene = read_scene(file);
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  ASSERT_TRUE(instantiate_scene(*scene).ok());
+  int meshes = 0;
+  scene->world.view<MeshRenderer>().each([&](ecs::Entity, const MeshRenderer& mr) {
+    if (mr.mesh == kNoMesh) return;
+    ++meshes;
+    EXPECT_EQ(mr.layer, 5);
+    EXPECT_FALSE(mr.cast_shadows);
+  });
+  EXPECT_GT(meshes, 0);
+}
+
 // A tiled terrain instantiates one entity per tile (the authored one plus imported children with
 // its material and renderer flags), and saves back as the one primitive it was.
 TEST(SceneIo, TiledTerrainBecomesTileEntitiesAndSavesAsOnePrimitive) {
@@ -354,7 +372,12 @@ TEST(SceneIo, BadReflectorsNameTheKey) {
   auto s = read_scene(write_file("reflector_no_mesh.json",
                                  R"({"kaskad_scene": 1, "entities": [{"reflector": {}}]})"));
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.error().to_string().find("needs a primitive or model"), std::string::npos);
+  EXPECT_NE(s.error().to_string().find("needs a primitive"), std::string::npos);
+  auto m = read_scene(write_file("reflector_model.json",
+                                 R"({"kaskad_scene": 1, "entities": [{"model": {"path": "x.glb"}, "reflector": {}}]})"));
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.error().to_string().find("/entities/0/reflector"), std::string::npos) << m.error().to_string();
+  EXPECT_NE(m.error().to_string().find("not supported on models"), std::string::npos);
 }
 
 }  // namespace

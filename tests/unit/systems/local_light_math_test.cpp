@@ -249,6 +249,24 @@ TEST(ShadowCascadeSystem, SeveralDirectionalLightsEachGetCascadesUpToTheCap) {
     }
   }
   EXPECT_NE(state.last_notice.find("only the first 4"), std::string::npos) << state.last_notice;
+  // The shared map size applies before fitting: the second light's texel sizes (and the stable
+  // fit's snapping) are those of the same light fitted alone with a 512^2 map.
+  {
+    ecs::World alone;
+    box(alone, Aabb::from_corners({-10, -0.1f, -10}, {10, 0, 10}), false, true);
+    box(alone, Aabb::from_corners({-0.5f, 1, -0.5f}, {0.5f, 2, 0.5f}), true, true);
+    const float a = 0.7f;
+    const ecs::Entity sun = light(alone, LightType::directional, {0, 10, 0},
+                                  glm::normalize(glm::vec3(std::cos(a), -1.5f, std::sin(a))));
+    alone.get<ShadowSettings>(sun).cascade_count = 2;
+    alone.get<ShadowSettings>(sun).map_size = 512;
+    ShadowCascadeState alone_state;
+    const std::vector<ShadowData> single = update_shadows(alone, cam, alone_state);
+    for (int c = 0; c < 2; ++c) {
+      EXPECT_EQ(all[1].texel_size[std::size_t(c)], single[0].texel_size[std::size_t(c)]) << c;
+      EXPECT_EQ(all[1].view_proj[std::size_t(c)], single[0].view_proj[std::size_t(c)]) << c;
+    }
+  }
   // A spot light after the first shadowed light gets no maps.
   w.get<Light>(suns[1]).type = LightType::spot;
   const std::vector<ShadowData> some = update_shadows(w, cam, state);
