@@ -110,11 +110,11 @@ struct ShadowSettings {
   /// Draw every cascade (or cube face) of a light in one pass: one instanced draw per caster,
   /// the vertex shader picks the layer (gl_Layer, GL_ARB_shader_viewport_layer_array; drivers
   /// without it fall back to false). false: one pass per layer. Same maps either way (render
-  /// test, exact). true by default: on llvmpipe the shadow pass of content/scenes/terrain.json
-  /// took 8% less GPU time and the frame 4% less, default.json was even (README, "Layered
-  /// shadow pass"). Dual-paraboloid maps always draw per layer. Taken from the first shadowed
-  /// light for all.
-  bool layered = true;
+  /// test, exact). false by default: on llvmpipe, once the terrain was tiled (so casters overlap
+  /// few cascades), one pass per layer made content/scenes/terrain.json's frame about 12%
+  /// faster; default.json is even (README, "Layered shadow pass"). Dual-paraboloid maps always
+  /// draw per layer. Taken from the first shadowed light for all.
+  bool layered = false;
   /// Point lights only. cube by default: exact for any tessellation; dual_paraboloid draws 2
   /// maps instead of 6 (S0's earlier work).
   PointShadowMode point_mode = PointShadowMode::cube;

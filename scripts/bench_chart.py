@@ -3,7 +3,9 @@
 
 usage: /usr/bin/python3 scripts/bench_chart.py BENCH.csv OUT_DIR [ERROR_COLUMN]
 x: median frame ms; y: ERROR_COLUMN (default misclassified_pct); the Pareto front (no other
-configuration is both faster and more accurate) is highlighted and every point is labelled.
+configuration is both faster and more accurate) is highlighted. Points are numbered; the list
+beside the plot names each number's settings (values only, keys in the list's heading), and
+Pareto points also carry their settings on the plot.
 """
 import csv
 import math
@@ -28,6 +30,14 @@ def pareto(points):
     return sorted(front, key=lambda i: points[i][0])
 
 
+def short_label(config):
+    """'cascade_count=1 fit_mode=crop' -> ('cascade_count fit_mode', '1 crop')."""
+    parts = [p.split("=", 1) for p in config.split() if "=" in p]
+    if not parts:
+        return "", config
+    return " ".join(k for k, _ in parts), " ".join(v for _, v in parts)
+
+
 def main():
     if len(sys.argv) < 3:
         sys.exit(__doc__)
@@ -49,21 +59,30 @@ def main():
             if math.isfinite(x) and math.isfinite(y):
                 pts.append((x, y))
                 labels.append(r["config"])
-        fig, ax = plt.subplots(figsize=(9, 6), dpi=110)
+        fig, ax = plt.subplots(figsize=(12, 6.5), dpi=110)
+        keys = short_label(labels[0])[0] if labels else ""
+        names = [short_label(t)[1] for t in labels]
         if pts:
             front = pareto(pts)
             ax.scatter([p[0] for p in pts], [p[1] for p in pts], color="#8899aa", label="configuration")
             ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "-o", color="#d04020",
                     label="Pareto front")
-            for (x, y), text in zip(pts, labels):
-                ax.annotate(text, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+            for i, (x, y) in enumerate(pts):
+                text = f"{i + 1}: {names[i]}" if i in front else str(i + 1)
+                ax.annotate(text, (x, y), textcoords="offset points", xytext=(4, 4),
+                            fontsize=7 if i in front else 6,
+                            color="#a02010" if i in front else "#333333")
+            listing = "\n".join(f"{i + 1:>2}  {n}" + ("  *" if i in front else "")
+                                for i, n in enumerate(names))
+            fig.text(0.74, 0.95, f"{keys}\n\n{listing}\n\n* Pareto front", fontsize=7,
+                     family="monospace", va="top")
+            fig.subplots_adjust(right=0.72)
         ax.set_xlabel("frame time, median (ms)")
         ax.set_ylabel(column.replace("_", " "))
         ax.set_title(f"{scene}: speed against accuracy")
         ax.grid(True, alpha=0.3)
         ax.legend()
         out = os.path.join(out_dir, f"{scene}.png")
-        fig.tight_layout()
         fig.savefig(out)
         plt.close(fig)
         print(f"wrote     {os.path.abspath(out)}")
