@@ -14,6 +14,7 @@
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
 #include "runtime/cli/player.h"
+#include "tests/render/player_fixture.h"
 #include "runtime/gpu/context.h"
 #include "systems/shadow_map_system.h"
 
@@ -86,24 +87,8 @@ struct Agreement {
   double ratio() const { return compared ? double(agree) / compared : 0.0; }
 };
 
-class DefaultSceneTest : public ::testing::Test {
+class DefaultSceneTest : public PlayerTest {
  protected:
-  static void SetUpTestSuite() {
-    gpu::ContextOptions opt;
-    opt.headless = true;
-    render::RendererOptions ro;
-    ro.shader_cache_dir = std::filesystem::path(KASKAD_TEST_TMP) / "shader_cache";
-    auto p = Player::create(opt, ro);
-    ASSERT_TRUE(p.ok()) << p.error().to_string();
-    player_ = new Player(std::move(p.value()));
-  }
-  static void TearDownTestSuite() {
-    delete player_;
-    player_ = nullptr;
-  }
-  void SetUp() override { gpu::reset_debug_error_count(); }
-  void TearDown() override { EXPECT_EQ(gpu::debug_error_count(), 0) << "GL errors were logged"; }
-
   // Renders the default scene with overrides and compares visibility with the ray cast.
   Agreement render_and_compare(std::vector<std::string> sets, Image* aov_out = nullptr) {
     sets.push_back("render.width=400");
@@ -158,9 +143,7 @@ class DefaultSceneTest : public ::testing::Test {
     return a;
   }
 
-  static Player* player_;
 };
-Player* DefaultSceneTest::player_ = nullptr;
 
 struct Config {
   const char* name;

@@ -12,6 +12,7 @@
 #include "components/light.h"
 #include "components/transform.h"
 #include "runtime/cli/player.h"
+#include "tests/render/player_fixture.h"
 #include "runtime/gpu/context.h"
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
@@ -35,24 +36,8 @@ struct Rendered {
   std::set<int> layers_seen;  ///< AOV cascade (layer) values of receiver pixels
 };
 
-class LocalLightTest : public ::testing::Test {
+class LocalLightTest : public PlayerTest {
  protected:
-  static void SetUpTestSuite() {
-    gpu::ContextOptions opt;
-    opt.headless = true;
-    render::RendererOptions ro;
-    ro.shader_cache_dir = std::filesystem::path(KASKAD_TEST_TMP) / "shader_cache";
-    auto p = Player::create(opt, ro);
-    ASSERT_TRUE(p.ok()) << p.error().to_string();
-    player_ = new Player(std::move(p.value()));
-  }
-  static void TearDownTestSuite() {
-    delete player_;
-    player_ = nullptr;
-  }
-  void SetUp() override { gpu::reset_debug_error_count(); }
-  void TearDown() override { EXPECT_EQ(gpu::debug_error_count(), 0) << "GL errors were logged"; }
-
   // Renders `scene_file` at 400x225 with overrides and compares with the ray-traced reference of
   // shadowed light `reference_of` (0 the first, k the k-th extra directional light).
   static Rendered render_and_compare(const char* scene_file, std::vector<std::string> sets,
@@ -99,9 +84,7 @@ class LocalLightTest : public ::testing::Test {
     return out;
   }
 
-  static Player* player_;
 };
-Player* LocalLightTest::player_ = nullptr;
 
 // Enough receivers in shadow and in light that agreement means something.
 void expect_meaningful(const Rendered& r) {

@@ -16,6 +16,7 @@
 #include "components/reflector.h"
 #include "runtime/assets/env_map.h"
 #include "runtime/cli/player.h"
+#include "tests/render/player_fixture.h"
 #include "runtime/gpu/context.h"
 
 namespace kaskad {
@@ -49,24 +50,8 @@ std::string write_scene(const std::string& name, const std::string& entities) {
   return p.string();
 }
 
-class ProbeTest : public ::testing::Test {
+class ProbeTest : public PlayerTest {
  protected:
-  static void SetUpTestSuite() {
-    gpu::ContextOptions opt;
-    opt.headless = true;
-    render::RendererOptions ro;
-    ro.shader_cache_dir = fs::path(KASKAD_TEST_TMP) / "shader_cache";
-    auto p = Player::create(opt, ro);
-    ASSERT_TRUE(p.ok()) << p.error().to_string();
-    player_ = new Player(std::move(p.value()));
-  }
-  static void TearDownTestSuite() {
-    delete player_;
-    player_ = nullptr;
-  }
-  void SetUp() override { gpu::reset_debug_error_count(); }
-  void TearDown() override { EXPECT_EQ(gpu::debug_error_count(), 0) << "GL errors were logged"; }
-
   static Scene load(const std::string& file, std::vector<std::string> sets = {}) {
     auto s = load_scene(file, sets);
     EXPECT_TRUE(s.ok()) << s.error().to_string();
@@ -117,9 +102,7 @@ class ProbeTest : public ::testing::Test {
     return c;
   }
 
-  static Player* player_;
 };
-Player* ProbeTest::player_ = nullptr;
 
 constexpr const char* kMirrorMaterial =
     R"("material": {"base_color": [0, 0, 0, 1], "metallic": 0, "roughness": 1, "k_s": 0.5})";

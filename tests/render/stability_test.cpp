@@ -5,30 +5,15 @@
 #include <cmath>
 
 #include "runtime/cli/player.h"
+#include "tests/render/player_fixture.h"
 #include "runtime/cli/stability.h"
 #include "runtime/gpu/context.h"
 
 namespace kaskad {
 namespace {
 
-class StabilityTest : public ::testing::Test {
+class StabilityTest : public PlayerTest {
  protected:
-  static void SetUpTestSuite() {
-    gpu::ContextOptions opt;
-    opt.headless = true;
-    render::RendererOptions ro;
-    ro.shader_cache_dir = std::filesystem::path(KASKAD_TEST_TMP) / "shader_cache";
-    auto p = Player::create(opt, ro);
-    ASSERT_TRUE(p.ok()) << p.error().to_string();
-    player_ = new Player(std::move(p.value()));
-  }
-  static void TearDownTestSuite() {
-    delete player_;
-    player_ = nullptr;
-  }
-  void SetUp() override { gpu::reset_debug_error_count(); }
-  void TearDown() override { EXPECT_EQ(gpu::debug_error_count(), 0) << "GL errors were logged"; }
-
   static Scene load(std::vector<std::string> sets) {
     sets.push_back("render.width=320");
     sets.push_back("render.height=180");
@@ -48,9 +33,7 @@ class StabilityTest : public ::testing::Test {
     return points.ok() ? points.value() : StabilityPoints{};
   }
 
-  static Player* player_;
 };
-Player* StabilityTest::player_ = nullptr;
 
 // The points pass and the forward pass run the same lookup on the same inputs (the AOV stores the
 // interpolated position and the facing normal the forward pass used), so they agree per point.
