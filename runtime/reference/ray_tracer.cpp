@@ -26,6 +26,7 @@
 #include "components/material.h"
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
+#include "runtime/reference/row_workers.h"
 
 namespace kaskad::reference {
 namespace {
@@ -790,15 +791,7 @@ Result<ShadowReference> RayTracer::shadow_reference(const Image& aov,
     total_rays.fetch_add(count);
   };
 
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const int thread_count = std::min(aov.height, options.threads > 0 ? options.threads : int(hw));
-  const auto start = std::chrono::steady_clock::now();
-  {  // the pool joins at the end of this block
-    std::vector<std::jthread> pool;
-    for (int i = 1; i < thread_count; ++i) pool.emplace_back(worker);
-    worker();  // the calling thread works too
-  }
-  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.seconds = run_row_workers(aov.height, options.threads, worker);
   out.rays = total_rays.load();
   return out;
 }
