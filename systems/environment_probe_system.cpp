@@ -8,6 +8,7 @@
 #include "components/light.h"
 #include "components/material.h"
 #include "components/mesh_renderer.h"
+#include "components/model.h"
 #include "components/transform.h"
 #include "runtime/core/log.h"
 
@@ -148,6 +149,7 @@ std::uint64_t scene_signature(const ecs::World& world, ecs::Entity self, const g
   world.view<MeshRenderer, WorldTransform, WorldBounds>().each(
       [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt, const WorldBounds& b) {
         if (e == self || (exclude_layers & (1u << (mr.layer & 31)))) return;
+        if (const Imported* imp = world.try_get<Imported>(e); imp && imp->source == self) return;
         if (!sphere_intersects_box(center, far, b.box)) return;
         h.add(e.index);
         h.add(mr.mesh);
@@ -156,6 +158,15 @@ std::uint64_t scene_signature(const ecs::World& world, ecs::Entity self, const g
         hash_material(h, m ? *m : none);
       });
   return h.value();
+}
+
+Aabb reflector_bounds(const ecs::World& world, ecs::Entity e) {
+  if (const WorldBounds* wb = world.try_get<WorldBounds>(e); wb && !wb->box.empty()) return wb->box;
+  Aabb box;  // a model: the meshes imported under it
+  world.view<Imported, WorldBounds>().each([&](ecs::Entity, const Imported& imp, const WorldBounds& b) {
+    if (imp.source == e) box.expand(b.box);
+  });
+  return box;
 }
 
 ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool commit) {
@@ -171,13 +182,13 @@ ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool
     const Reflector& r = world.get<Reflector>(e);
     // 1. Capture centre: explicit, else the world-bounds centre (S3 wants the pivot there).
     const WorldTransform* wt = world.try_get<WorldTransform>(e);
-    const WorldBounds* wb = world.try_get<WorldBounds>(e);
     const glm::vec3 pivot = wt ? glm::vec3(wt->matrix[3]) : glm::vec3(0.0f);
+    const Aabb bounds = reflector_bounds(world, e);
     if (r.has_center) {
       s.center = r.center;
-    } else if (wb && !wb->box.empty()) {
-      s.center = wb->box.center();
-      const float diagonal = glm::length(wb->box.extent());
+    } else if (!bounds.empty()) {
+      s.center = bounds.center();
+      const float diagonal = glm::length(bounds.extent());
       if (!s.warned_off_centre && glm::length(pivot - s.center) > kOffCentreFraction * diagonal) {
         if (commit)
           log::warn("reflector entity %u: pivot (%g, %g, %g) is off the bounds centre (%g, %g, "

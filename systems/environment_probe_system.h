@@ -46,6 +46,10 @@ ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool
 
 // ---- Pure parts, exposed for tests -------------------------------------------------------------
 
+/// World bounds of a reflector: its own mesh's, or for a model entity (no mesh of its own) the
+/// union of the meshes imported under it. Empty when neither has bounds.
+Aabb reflector_bounds(const ecs::World& world, ecs::Entity e);
+
 /// What one probe does on one frame.
 struct ProbeWork {
   std::uint8_t faces = 0;  ///< faces of the back buffer to render now (bit f = GL face f)

@@ -6,6 +6,7 @@
 #include "components/light.h"
 #include "components/material.h"
 #include "components/mesh_renderer.h"
+#include "components/model.h"
 #include "components/transform.h"
 #include "systems/transform_system.h"
 
@@ -74,7 +75,11 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         d.material.features &= ~(render::VariantKey::kReflectionCube.mask() |
                                  render::VariantKey::kReflectionSphere.mask() |
                                  render::VariantKey::kReflectionBox.mask());
-        if (const ProbeData::Entry* p = probes.find(e)) {
+        // A mesh imported under a model reflects the model's probe (and stays out of it).
+        const ProbeData::Entry* p = probes.find(e);
+        if (!p)
+          if (const auto* imp = world.try_get<Imported>(e)) p = probes.find(imp->source);
+        if (p) {
           d.probe = p->job.handle;
           if (p->has_map) {
             d.material.features |= (p->sphere ? render::VariantKey::kReflectionSphere

@@ -297,11 +297,7 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
     fail(r.at("shadow"), "shadow settings belong to an entity with a light");
   }
   if (r.has("reflector")) {
-    // A model's meshes sit on imported child entities, which the probe system does not map
-    // back to the reflector: only primitives reflect for now.
-    if (!has_primitive)
-      fail(r.at("reflector"), has_model ? "a reflector needs a primitive (not supported on models yet)"
-                                        : "a reflector needs a primitive");
+    if (!has_primitive && !has_model) fail(r.at("reflector"), "a reflector needs a primitive or model");
     Reflector refl;
     ObjectReader rr(r.raw("reflector"), r.at("reflector"));
     read_reflector(rr, refl);

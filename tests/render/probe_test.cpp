@@ -150,6 +150,31 @@ TEST_F(ProbeTest, ColouredCubeInAMirrorSphereAndPlane) {
   }
 }
 
+// A glTF model as the reflector: its meshes (imported child entities) reflect the model's probe,
+// and the probe's centre is the centre of the meshes' bounds (the model entity has none).
+TEST_F(ProbeTest, ModelReflectorsShadeTheirImportedMeshes) {
+  const CubeMap env = coloured_cube(32);
+  ASSERT_TRUE(save_cube_faces(env, temp_dir() / "model_env_*.exr").ok());
+  const std::string box = (content_dir() / "models/Box/glTF-Binary/Box.glb").string();
+  Scene scene = load(write_scene("model_mirror.json",
+      R"({"name": "mirror", "transform": {"translation": [0.5, 0, 0], "euler_deg": [20, 35, 0], "scale": [2, 2, 2]},
+          "model": {"path": ")" + box + R"("},
+          "reflector": {"update": "static_file", "file": "model_env_*.exr", "resolution": 32}},
+         {"name": "camera", "transform": {"translation": [0.9, 0.8, 5.0], "look_at": [0.5, 0, 0]},
+          "camera": {"fov_y_deg": 40, "near": 0.1, "far": 50, "active": true}})"));
+  RenderRun run;
+  run.frames = 2;
+  auto t = render_frames(*player_, scene, run);
+  ASSERT_TRUE(t.ok()) << t.error().to_string();
+  const ProbeState& ps = scene.world.get<ProbeState>(named(scene, "mirror"));
+  EXPECT_NEAR(glm::length(ps.center - glm::vec3(0.5f, 0.0f, 0.0f)), 0.0f, 1e-4f);
+  const Comparison c =
+      compare_reflection(player_->renderer->read_aovs(), t->last.camera.position, env);
+  EXPECT_GT(c.compared, 3000);
+  EXPECT_EQ(c.bad, 0) << "max error " << c.max_error;
+  EXPECT_GE(c.faces.size(), 2u);
+}
+
 TEST_F(ProbeTest, ThreeDsMaxCubeIsConvertedOnLoad) {
   // Faces named by 3ds Max axes (Z up): px RIGHT, nx LEFT, py BACK, ny FRONT, pz UP, nz DOWN.
   CubeMap max_faces = coloured_cube(16);
