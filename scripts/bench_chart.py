@@ -2,6 +2,8 @@
 """Speed against accuracy charts for `kaskad bench`: one PNG per scene from bench.csv.
 
 usage: /usr/bin/python3 scripts/bench_chart.py BENCH.csv OUT_DIR [ERROR_COLUMN]
+Without ERROR_COLUMN: OUT_DIR/<scene>.png (misclassified_pct) and, when the CSV has stability
+results, OUT_DIR/<scene>_flicker.png (flicker: stability under camera motion).
 x: median frame ms; y: ERROR_COLUMN (default misclassified_pct); the Pareto front (no other
 configuration is both faster and more accurate) is highlighted. Points are numbered; the list
 beside the plot names each number's settings (values only, keys in the list's heading), and
@@ -38,20 +40,12 @@ def short_label(config):
     return " ".join(k for k, _ in parts), " ".join(v for _, v in parts)
 
 
-def main():
-    if len(sys.argv) < 3:
-        sys.exit(__doc__)
-    path, out_dir = sys.argv[1], sys.argv[2]
-    column = sys.argv[3] if len(sys.argv) > 3 else "misclassified_pct"
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
-    if not rows:
-        sys.exit(f"{path}: no rows")
-    if column not in rows[0]:
-        sys.exit(f"{path}: no column '{column}'")
+def chart(rows, column, out_dir, suffix):
+    """One chart per scene of `column` against frame ms; returns the files written."""
     by_scene = {}
     for r in rows:
         by_scene.setdefault(r["scene"], []).append(r)
+    written = []
     for scene, rs in by_scene.items():
         pts, labels = [], []
         for r in rs:
@@ -79,13 +73,33 @@ def main():
             fig.subplots_adjust(right=0.72)
         ax.set_xlabel("frame time, median (ms)")
         ax.set_ylabel(column.replace("_", " "))
-        ax.set_title(f"{scene}: speed against accuracy")
+        ax.set_title(f"{scene}: speed against {'stability' if column == 'flicker' else 'accuracy'}")
         ax.grid(True, alpha=0.3)
         ax.legend()
-        out = os.path.join(out_dir, f"{scene}.png")
+        out = os.path.join(out_dir, f"{scene}{suffix}.png")
         fig.savefig(out)
         plt.close(fig)
-        print(f"wrote     {os.path.abspath(out)}")
+        written.append(out)
+    return written
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit(__doc__)
+    path, out_dir = sys.argv[1], sys.argv[2]
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        sys.exit(f"{path}: no rows")
+    jobs = [(sys.argv[3], "")] if len(sys.argv) > 3 else [("misclassified_pct", "")]
+    if len(sys.argv) <= 3 and "flicker" in rows[0]:
+        if any(math.isfinite(float(r["flicker"])) for r in rows):
+            jobs.append(("flicker", "_flicker"))
+    for column, suffix in jobs:
+        if column not in rows[0]:
+            sys.exit(f"{path}: no column '{column}'")
+        for out in chart(rows, column, out_dir, suffix):
+            print(f"wrote     {os.path.abspath(out)}")
 
 
 if __name__ == "__main__":

@@ -99,6 +99,7 @@ check reflection_bad_env nonzero "nothing.hdr.*not found" -- "$KASKAD" render --
 check bench_runs 0 "wrote .*bench.csv \(8 rows\)" -- "$KASKAD" bench --size 200x112 --frames 2 --out "$tmp/bench" \
   --sweep "shadow.map_size=256,2048;shadow.slope_bias=0,3;shadow.constant_bias=0,2"
 if [ -s "$tmp/bench/default.png" ]; then echo "ok   bench_chart"; passed=$((passed + 1)); else echo "FAIL bench_chart: no default.png"; failed=$((failed + 1)); fi
+if [ -s "$tmp/bench/default_flicker.png" ]; then echo "ok   bench_flicker_chart"; passed=$((passed + 1)); else echo "FAIL bench_flicker_chart: no default_flicker.png"; failed=$((failed + 1)); fi
 check bench_csv 0 "bad worse than default" -- /usr/bin/python3 -c '
 import csv, math, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
