@@ -3,6 +3,8 @@
 // Shadow parameters live in ShadowSettings, a separate component on the same entity.
 #pragma once
 
+#include <cmath>
+
 #include <glm/glm.hpp>
 
 namespace kaskad {
@@ -30,6 +32,31 @@ inline glm::vec3 light_direction(const glm::mat4& world_matrix) {
   const glm::vec3 d = glm::vec3(world_matrix * glm::vec4(0.0f, 0.0f, -1.0f, 0.0f));
   const float len = glm::length(d);
   return len > 0.0f ? d / len : glm::vec3(0.0f, -1.0f, 0.0f);
+}
+
+/// A light as the shading model sees it: the forward pass's per-light uniforms (the renderer's
+/// LightItem) and the reflection reference's lights. `color` includes the intensity.
+struct LightShading {
+  LightType type = LightType::directional;
+  glm::vec3 color{1.0f};                   ///< linear colour * intensity
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};  ///< the way the light travels (unit)
+  glm::vec3 position{0.0f};                ///< spot/point: world position, metres
+  float range = 0.0f;                      ///< spot/point: KHR window radius; 0 = infinite
+  float cos_inner = 1.0f;                  ///< spot: cos(inner cone half-angle)
+  float cos_outer = 0.7f;                  ///< spot: cos(outer cone half-angle)
+};
+
+/// The shading parameters of a Light on an entity with this world matrix.
+inline LightShading light_shading(const Light& light, const glm::mat4& world_matrix) {
+  LightShading s;
+  s.type = light.type;
+  s.color = light.color * light.intensity;
+  s.direction = light_direction(world_matrix);
+  s.position = glm::vec3(world_matrix[3]);
+  s.range = light.range;
+  s.cos_inner = std::cos(glm::radians(light.inner_cone_deg));
+  s.cos_outer = std::cos(glm::radians(light.outer_cone_deg));
+  return s;
 }
 
 }  // namespace kaskad

@@ -94,14 +94,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
 
   world.view<Light, WorldTransform>().each(
       [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {
-        render::LightItem item;
-        item.type = l.type;
-        item.color = l.color * l.intensity;
-        item.direction = light_direction(wt.matrix);
-        item.position = glm::vec3(wt.matrix[3]);
-        item.range = l.range;
-        item.cos_inner = std::cos(glm::radians(l.inner_cone_deg));
-        item.cos_outer = std::cos(glm::radians(l.outer_cone_deg));
+        const render::LightItem item = light_shading(l, wt.matrix);
         if (e == shadow.light) in.shadow = shadow_pass(shadow, int(in.lights.size()));
         for (std::size_t k = 0; k < extra.size() && k + 1 < render::kMaxShadowedLights; ++k)
           if (e == extra[k].light) {

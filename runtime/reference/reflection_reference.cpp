@@ -117,17 +117,11 @@ ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment)
   out.ambient = scene.render.ambient;
   out.clear_color = scene.render.clear_color;
   out.environment = environment;
-  // As systems/frame.cpp build_frame_input() fills render::LightItem (change together).
+  // The same light_shading() as the renderer's lights (systems/frame.cpp).
   scene.world.view<Light, WorldTransform>().each(
       [&](ecs::Entity, const Light& l, const WorldTransform& wt) {
         ShadingLight s;
-        s.type = l.type;
-        s.radiance = l.color * l.intensity;
-        s.direction = light_direction(wt.matrix);
-        s.position = glm::vec3(wt.matrix[3]);
-        s.range = l.range;
-        s.cos_inner = std::cos(glm::radians(l.inner_cone_deg));
-        s.cos_outer = std::cos(glm::radians(l.outer_cone_deg));
+        static_cast<LightShading&>(s) = light_shading(l, wt.matrix);
         s.shadowed = l.cast_shadows;
         out.lights.push_back(s);
       });
@@ -182,7 +176,7 @@ glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
       shadow = tracer.hard_visibility(position, n, ref);
       if (rays) ++*rays;
     }
-    color += (diffuse_color + spec) * light.radiance * ndl * attenuation * shadow;
+    color += (diffuse_color + spec) * light.color * ndl * attenuation * shadow;
   }
   return color;
 }

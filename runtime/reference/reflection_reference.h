@@ -31,16 +31,10 @@
 
 namespace kaskad::reference {
 
-/// A light as forward.frag shades it (render::LightItem's fields: change together).
-struct ShadingLight {
-  LightType type = LightType::directional;
-  glm::vec3 radiance{1.0f};                ///< linear colour * intensity (u_light_color.rgb)
-  glm::vec3 direction{0.0f, -1.0f, 0.0f};  ///< the way light travels; normalised when used
-  glm::vec3 position{0.0f};                ///< spot/point: world position, metres
-  float range = 0.0f;                      ///< spot/point: KHR window radius; 0 = infinite
-  float cos_inner = 1.0f;                  ///< spot: cos(inner cone half-angle)
-  float cos_outer = 0.7f;                  ///< spot: cos(outer cone half-angle)
-  bool shadowed = false;                   ///< trace a hard shadow ray (Light::cast_shadows)
+/// A light as forward.frag shades it (light_shading(), the renderer's LightItem), plus whether
+/// the reference traces its shadow.
+struct ShadingLight : LightShading {
+  bool shadowed = false;  ///< trace a hard shadow ray (Light::cast_shadows)
 };
 
 /// Everything the reference needs besides the geometry.
@@ -60,7 +54,7 @@ struct ReflectionScene {
 };
 
 /// The ReflectionScene of a loaded scene (run the transform phase first): every Light with a
-/// WorldTransform, as systems/frame.cpp build_frame_input() turns them into LightItems (colour *
+/// WorldTransform through light_shading(), as systems/frame.cpp does for the renderer (colour *
 /// intensity, direction from the matrix's -Z, cones as cosines), shadowed = cast_shadows; the
 /// render settings' ambient and clear colour; world and assets point into `scene`.
 ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment = nullptr);

@@ -80,16 +80,8 @@ struct ProbeJob {
   std::uint32_t env_map = kNoProbe;
 };
 
-/// A light as the shaders see it. `color` already includes the intensity.
-struct LightItem {
-  LightType type = LightType::directional;
-  glm::vec3 color{1.0f};
-  glm::vec3 direction{0.0f, -1.0f, 0.0f};  ///< the way the light travels (unit)
-  glm::vec3 position{0.0f};
-  float range = 0.0f;
-  float cos_inner = 1.0f;
-  float cos_outer = 0.7f;
-};
+/// A light as the shaders see it (light_shading() in components/light.h makes one).
+using LightItem = LightShading;
 
 inline constexpr int kMaxCascades = 8;  // change together with systems/cascade_math.h and
                                         // MAX_CASCADES in common.glsl

@@ -79,7 +79,7 @@ ShadingLight sun_along_x(bool shadowed) {
   ShadingLight l;
   l.type = LightType::directional;
   l.direction = glm::vec3(1, 0, 0);
-  l.radiance = glm::vec3(2.0f, 1.5f, 1.0f);
+  l.color = glm::vec3(2.0f, 1.5f, 1.0f);
   l.shadowed = shadowed;
   return l;
 }
@@ -146,7 +146,7 @@ TEST(ReflectionReference, PointAndSpotLightsAttenuateAsTheForwardPass) {
   ShadingLight point;
   point.type = LightType::point;
   point.position = glm::vec3(1.0f, 3.0f, 0.0f);  // 2 m in front of the wall point: 1 / d^2 = 1/4
-  point.radiance = glm::vec3(4.0f);
+  point.color = glm::vec3(4.0f);
   ReflectionScene rs = lit_by(w.scene, point);
   expect_near(reflected_radiance(tracer, rs, kMirror, kMirrorNormal, kEye),
               expected_wall(rs.ambient, glm::vec3(4.0f), 0.25f));
@@ -375,7 +375,7 @@ TEST(ReflectionReference, SceneLightsAsTheFrameBuildsThem) {
   scene.render.ambient = glm::vec3(0.3f);
   const ReflectionScene rs = reflection_scene(scene);
   ASSERT_EQ(rs.lights.size(), 1u);
-  expect_near(rs.lights[0].radiance, glm::vec3(4.0f, 2.0f, 1.0f));
+  expect_near(rs.lights[0].color, glm::vec3(4.0f, 2.0f, 1.0f));
   expect_near(rs.lights[0].direction, glm::vec3(0, -1, 0));
   expect_near(rs.lights[0].position, glm::vec3(1, 5, 2));
   EXPECT_NEAR(rs.lights[0].cos_outer, std::cos(glm::radians(30.0f)), 1e-6f);
