@@ -18,7 +18,9 @@ struct Light {
   float range = 0.0f;           ///< metres; 0 = infinite (spot/point only)
   float inner_cone_deg = 0.0f;  ///< spot: full intensity inside this half-angle (degrees)
   float outer_cone_deg = 45.0f; ///< spot: zero intensity outside this half-angle (degrees)
-  bool cast_shadows = false;    ///< only shadowed lights get shadow maps
+  /// Only shadowed lights get shadow maps. Scene files and glTF imports turn it on for their
+  /// first directional light unless the file says false (scene_io, gltf_loader).
+  bool cast_shadows = false;
   /// Directional only: apex angle of the cone of directions the light arrives from, degrees, in
   /// [0, 45] (the sun: about 0.53). 0 = punctual. The ray-traced reference's area visibility uses
   /// it (reference_light()); the shadow maps are hard until soft shadows land.

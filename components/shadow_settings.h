@@ -20,6 +20,11 @@ enum class SplitScheme {
   uniform,  ///< S0 eq. (1): d_i = d_n + (d_f - d_n) i / N
   log,      ///< S0 eq. (2): d_i = d_n (d_f / d_n)^(i / N)
   mixed,    ///< S0 eq. (3): lambda * (2) + (1 - lambda) * (1)
+  /// "auto": sample-distribution splits (Lauritzen, Salvi, Lefohn, "Sample Distribution Shadow
+  /// Maps", I3D 2011): S0 eq. (2) over the view-depth range the visible receivers actually
+  /// occupy (the range every scheme uses, see ShadowSettings::max_distance). Log splits are
+  /// the right partition once that range is tight; lambda is not used.
+  automatic,
 };
 
 /// Depth attachment format of the shadow maps.
@@ -74,14 +79,18 @@ struct ShadowSettings {
   /// N, in [1, 8]. 4: S0 recommends 3..5 (fewer is barely better than one map; each more costs
   /// a scene render).
   int cascade_count = 4;
-  /// S0 eq. (3), the paper's choice.
-  SplitScheme split_scheme = SplitScheme::mixed;
+  /// auto by default: the splits follow the visible receivers at any scale (SDSM, above);
+  /// mixed (S0 eq. (3), the paper's choice) with a fixed max_distance is the fully
+  /// camera-independent alternative.
+  SplitScheme split_scheme = SplitScheme::automatic;
   /// Mixed-split weight of the log scheme, in [0, 1]. 0.5: S0's default.
   float lambda = 0.5f;
-  /// Metres from the camera where the last cascade ends at most; 0 = the camera's far plane.
-  /// 100: engine choice, half the default camera far (components/camera.h), so resolution is not
-  /// spent on the horizon. The system also stops at the farthest visible receiver.
-  float max_distance = 100.0f;
+  /// Scene units of view depth where the last cascade ends at most: a user cap. 0 (JSON also
+  /// "auto", the default) = no cap. Whatever the cap, the cascades span only the view depths of
+  /// the visible receivers, [nearest, farthest] (S0 step 3 and S2's tight near/far, taken to the
+  /// receivers; the range SDSM measures), clipped to the camera's near and far, so models from
+  /// millimetres to kilometres get shadows with no setting changed.
+  float max_distance = 0.0f;
   /// S2: 16 bits suffice when near/far are tight; 24 because S0 step 3 pulls the near plane back
   /// to distant casters, which loosens the range (and the basic map's format).
   DepthFormat depth_format = DepthFormat::d24;
@@ -148,12 +157,12 @@ inline std::string validate_shadow_settings(const ShadowSettings& s) {
   if (s.cascade_count < 1 || s.cascade_count > 8)
     return "cascade_count must be in [1, 8], was " + std::to_string(s.cascade_count);
   const int scheme = static_cast<int>(s.split_scheme);
-  if (scheme < 0 || scheme > static_cast<int>(SplitScheme::mixed))
-    return "split_scheme must be uniform, log or mixed, was " + std::to_string(scheme);
+  if (scheme < 0 || scheme > static_cast<int>(SplitScheme::automatic))
+    return "split_scheme must be auto, uniform, log or mixed, was " + std::to_string(scheme);
   if (!(s.lambda >= 0.0f && s.lambda <= 1.0f))  // also rejects NaN
     return "lambda must be in [0, 1], was " + str(s.lambda);
   if (!(s.max_distance >= 0.0f && std::isfinite(s.max_distance)))
-    return "max_distance must be finite and >= 0 (0 = camera far), was " + str(s.max_distance);
+    return "max_distance must be finite and >= 0 (0 = no cap), was " + str(s.max_distance);
   const int format = static_cast<int>(s.depth_format);
   if (format < 0 || format > static_cast<int>(DepthFormat::d32f))
     return "depth_format must be d16, d24 or d32f, was " + std::to_string(format);

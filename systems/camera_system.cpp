@@ -52,7 +52,21 @@ CameraState select_camera(const ecs::World& world, float output_aspect) {
   return out;
 }
 
-void frame_auto_cameras(ecs::World& world, const Aabb& bounds, float output_aspect) {
+glm::ivec2 fit_output_to_camera(const ecs::World& world, int width, int height) {
+  const glm::ivec2 request{width, height};
+  const CameraState cam = select_camera(world, float(width) / float(height));
+  if (!cam.entity.valid() || !(cam.camera.aspect > 0.0f)) return request;
+  const float a = cam.camera.aspect;
+  glm::ivec2 out = request;
+  if (a > float(width) / float(height))
+    out.y = std::max(1, int(std::lround(float(width) / a)));
+  else
+    out.x = std::max(1, int(std::lround(float(height) * a)));
+  return out;
+}
+
+void frame_auto_cameras(ecs::World& world, const Aabb& bounds, const Aabb& depth_bounds,
+                        float output_aspect) {
   if (bounds.empty()) return;
   const glm::vec3 center = bounds.center();
   const float radius = std::max(0.5f * glm::length(bounds.extent()), 1e-3f);
@@ -77,6 +91,12 @@ void frame_auto_cameras(ecs::World& world, const Aabb& bounds, float output_aspe
     t.translation = center - forward * distance;
     cam.near = std::max(distance - radius, distance * 1e-3f) * 0.9f;
     cam.far = (distance + radius) * 1.1f;
+    for (int i = 0; i < 8 && !depth_bounds.empty(); ++i) {
+      const glm::vec3 c{(i & 1) ? depth_bounds.max.x : depth_bounds.min.x,
+                        (i & 2) ? depth_bounds.max.y : depth_bounds.min.y,
+                        (i & 4) ? depth_bounds.max.z : depth_bounds.min.z};
+      cam.far = std::max(cam.far, glm::dot(c - t.translation, forward) * 1.01f);
+    }
   });
 }
 

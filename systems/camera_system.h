@@ -22,9 +22,17 @@ struct CameraState {
 /// `output_aspect` is used when the camera's own aspect is 0.
 CameraState select_camera(const ecs::World& world, float output_aspect);
 
+/// The output size for a requested `width` x `height` when the rendering camera has an aspect
+/// of its own (Camera::aspect > 0, e.g. a glTF camera's aspectRatio): the largest size of that
+/// aspect inside the request, so the image is never stretched. The request when the camera
+/// takes its aspect from the output.
+glm::ivec2 fit_output_to_camera(const ecs::World& world, int width, int height);
+
 /// Moves every auto_frame camera back along its view axis until `bounds` fits its field of view,
-/// and sets near/far to enclose the bounds. Updates Transform (root cameras only; a parented
-/// auto_frame camera is left alone with a warning).
-void frame_auto_cameras(ecs::World& world, const Aabb& bounds, float output_aspect);
+/// and sets near/far to enclose the bounds, far also the farthest corner of `depth_bounds` in
+/// front of the camera (a ground wider than the models). Updates Transform (root cameras only; a
+/// parented auto_frame camera is left alone with a warning).
+void frame_auto_cameras(ecs::World& world, const Aabb& bounds, const Aabb& depth_bounds,
+                        float output_aspect);
 
 }  // namespace kaskad

@@ -252,7 +252,7 @@ std::vector<float> split_distances(SplitScheme scheme, int count, float near, fl
     const double uniform = dn + (df - dn) * (i / n);   // S0 eq. (1)
     const double log = dn * std::pow(df / dn, i / n);  // S0 eq. (2)
     double v = uniform;
-    if (scheme == SplitScheme::log) v = log;
+    if (scheme == SplitScheme::log || scheme == SplitScheme::automatic) v = log;
     if (scheme == SplitScheme::mixed) v = lambda * log + (1.0 - lambda) * uniform;  // S0 eq. (3)
     // Strictly increasing even when rounding to float merges two neighbours.
     d[i] = std::max(static_cast<float>(v),

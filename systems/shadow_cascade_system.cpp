@@ -6,6 +6,7 @@
 
 #include "components/light.h"
 #include "components/mesh_renderer.h"
+#include "components/name.h"
 #include "components/transform.h"
 #include "runtime/core/log.h"
 #include "systems/local_light_math.h"
@@ -148,15 +149,82 @@ std::uint8_t ShadowData::cascade_mask(ecs::Entity e) const {
   return mask;
 }
 
-float farthest_visible_receiver(const glm::mat4& view, const glm::mat4& view_proj, float near,
-                                float far, std::span<const Aabb> receivers) {
-  float out = 0.0f;
+DepthRange visible_receiver_depths(const glm::mat4& view, const glm::mat4& view_proj,
+                                   std::span<const Aabb> receivers) {
+  // The frustum's 6 planes (a point p is inside when dot(plane, (p, 1)) >= 0 for all) and its
+  // 8 corners, in double precision: far/near ratios of 1e5 occur.
+  const glm::dmat4 m(view_proj);
+  const glm::dvec4 row[4] = {glm::dvec4(m[0][0], m[1][0], m[2][0], m[3][0]),
+                             glm::dvec4(m[0][1], m[1][1], m[2][1], m[3][1]),
+                             glm::dvec4(m[0][2], m[1][2], m[2][2], m[3][2]),
+                             glm::dvec4(m[0][3], m[1][3], m[2][3], m[3][3])};
+  std::array<glm::dvec4, 6> planes;
+  for (int a = 0; a < 3; ++a) {
+    planes[std::size_t(2 * a)] = row[3] + row[a];
+    planes[std::size_t(2 * a + 1)] = row[3] - row[a];
+  }
+  const glm::dmat4 inv = glm::inverse(m);
+  std::array<glm::dvec3, 8> frustum_corners;
+  for (int i = 0; i < 8; ++i) {
+    const glm::dvec4 c = inv * glm::dvec4((i & 1) ? 1 : -1, (i & 2) ? 1 : -1, (i & 4) ? 1 : -1, 1);
+    frustum_corners[std::size_t(i)] = glm::dvec3(c) / c.w;
+  }
+  const glm::dmat4 v(view);
+  DepthRange out{std::numeric_limits<float>::max(), 0.0f};
+  auto add = [&](const glm::dvec3& p) {
+    const float depth = float(-(v * glm::dvec4(p, 1.0)).z);
+    out.near = std::min(out.near, depth);
+    out.far = std::max(out.far, depth);
+  };
+  std::vector<glm::dvec3> poly, next;
   for (const Aabb& b : receivers) {
     if (b.empty() || !maybe_inside(clip_corners(view_proj, b))) continue;
-    const Aabb v = b.transformed(view);
-    out = std::max(out, std::clamp(-v.min.z, near, far));  // view space looks down -z
+    const glm::dvec3 lo(b.min), hi(b.max);
+    // Each face of the box as a quad, clipped by the 6 planes (Sutherland-Hodgman).
+    for (int axis = 0; axis < 3; ++axis)
+      for (int side = 0; side < 2; ++side) {
+        const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+        poly.clear();
+        for (int k = 0; k < 4; ++k) {
+          glm::dvec3 p;
+          p[axis] = side ? hi[axis] : lo[axis];
+          p[u] = (k == 1 || k == 2) ? hi[u] : lo[u];
+          p[w] = (k >= 2) ? hi[w] : lo[w];
+          poly.push_back(p);
+        }
+        for (const glm::dvec4& pl : planes) {
+          next.clear();
+          for (std::size_t k = 0; k < poly.size(); ++k) {
+            const glm::dvec3& p = poly[k];
+            const glm::dvec3& q = poly[(k + 1) % poly.size()];
+            const double dp = glm::dot(pl, glm::dvec4(p, 1.0)), dq = glm::dot(pl, glm::dvec4(q, 1.0));
+            if (dp >= 0.0) next.push_back(p);
+            if ((dp >= 0.0) != (dq >= 0.0)) next.push_back(p + (q - p) * (dp / (dp - dq)));
+          }
+          poly.swap(next);
+          if (poly.empty()) break;
+        }
+        for (const glm::dvec3& p : poly) add(p);
+      }
+    // Frustum corners inside the box are vertices of the intersection too.
+    const glm::dvec3 slack = 1e-9 * (glm::abs(lo) + glm::abs(hi)) + 1e-12;
+    for (const glm::dvec3& c : frustum_corners)
+      if (glm::all(glm::greaterThanEqual(c, lo - slack)) && glm::all(glm::lessThanEqual(c, hi + slack)))
+        add(c);
   }
+  if (out.far == 0.0f) return {};
   return out;
+}
+
+DepthRange quantize_depth_range(DepthRange r) {
+  KASKAD_CHECK(r.near > 0.0f && r.near <= r.far, "need 0 < near <= far");
+  constexpr double kSteps = 4.0;  // per octave: each step is 2^(1/4) = 1.19x
+  DepthRange q;
+  q.near = float(std::exp2(std::floor(std::log2(double(r.near)) * kSteps) / kSteps));
+  q.far = float(std::exp2(std::ceil(std::log2(double(r.far)) * kSteps) / kSteps));
+  q.near = std::min(q.near, r.near);  // float rounding must not move an end inwards
+  q.far = std::max(q.far, r.far);
+  return q;
 }
 
 std::vector<std::uint32_t> cull_casters(const glm::mat4& light_view_proj,
@@ -278,16 +346,25 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
     return finish();
   }
 
-  // 5. Where the last split ends: min(camera far, max_distance, farthest visible receiver).
-  const float near = slice.near;
+  // 5. The depth range (S0 step 3 and S2's tight near/far, taken to the receivers; SDSM's
+  // min/max): what the visible receivers occupy, rounded outwards so small camera moves keep
+  // it, within [camera near, min(camera far, max_distance)].
+  float near = slice.near;
   float far = slice.far;
   if (s.max_distance > 0.0f) far = std::min(far, s.max_distance);
+  out.near_requested = near;
   out.far_requested = far;
-  const float receiver_far = farthest_visible_receiver(camera.view, camera.proj * camera.view,
-                                                       near, far, receiver_boxes);
-  if (receiver_far > 0.0f) far = std::min(far, receiver_far);
+  const DepthRange seen =
+      visible_receiver_depths(camera.view, camera.proj * camera.view, receiver_boxes);
+  if (!seen.empty()) {
+    const DepthRange q = quantize_depth_range(
+        {std::max(seen.near, slice.near), std::max(seen.far, slice.near)});
+    near = std::clamp(q.near, slice.near, far);
+    far = std::clamp(q.far, near, far);
+  }
   // N distinct splits need some room (split_distances' precondition).
   far = std::max(far, near * (1.0f + 1e-3f * float(s.cascade_count)) + 1e-6f);
+  out.near_used = near;
   out.far_used = far;
   const std::vector<float> D =
       split_distances(s.split_scheme, s.cascade_count, near, far, s.lambda);
@@ -310,7 +387,9 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
       previous.settings.fit_mode == s.fit_mode && previous.settings.map_size == s.map_size;
   if (frozen) {
     out.splits = previous.splits;
+    out.near_requested = previous.near_requested;
     out.far_requested = previous.far_requested;
+    out.near_used = previous.near_used;
     out.far_used = previous.far_used;
   }
   for (int i = 0; i < s.cascade_count; ++i) {
@@ -353,7 +432,9 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
   std::string notice;
   for (std::size_t i = 0; i < lights.size(); ++i) {
     const Shadowed& l = lights[i];
-    const std::string name = "light " + std::to_string(l.entity.index);
+    const auto* named = world.try_get<Name>(l.entity);
+    const std::string name = "light " + (named ? "'" + named->value + "' (" : std::string("(")) +
+                             "entity " + std::to_string(l.entity.index) + ")";
     if (i > 0 && l.light.type != LightType::directional) {
       notice = name +
                ": only the first shadowed light may be a spot or point light; it is lit "
@@ -362,7 +443,8 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
     }
     if (out.size() == std::size_t(kMaxShadowedLights)) {
       notice = std::to_string(lights.size()) + " shadowed lights; only the first " +
-               std::to_string(kMaxShadowedLights) + " get shadow maps";
+               std::to_string(kMaxShadowedLights) + " get shadow maps, " + name +
+               " and the ones after it are lit without shadows";
       break;
     }
     const std::size_t slot = out.size();

@@ -49,9 +49,11 @@ struct ShadowData {
   /// Shadow casters overlapping each cascade's light volume, sorted: only these are drawn into
   /// that layer.
   std::array<std::vector<ecs::Entity>, kMaxCascades> casters{};
-  /// The end of the last split before and after clamping to the farthest visible receiver:
-  /// min(camera far, max_distance) and min(that, farthest receiver). Equal when nothing moved it.
-  float far_requested = 0.0f, far_used = 0.0f;
+  /// The view-depth range the cascades could span, [camera near, min(camera far,
+  /// max_distance)], and the one they span: the visible receivers' range
+  /// (visible_receiver_depths()) clipped to it and rounded outwards (quantize_depth_range()).
+  float near_requested = 0.0f, far_requested = 0.0f;
+  float near_used = 0.0f, far_used = 0.0f;
   /// Why there is no shadow (a non-finite transform, a bad camera), or an entity left out; empty
   /// when all is well.
   std::string error;
@@ -98,11 +100,25 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
 
 // ---- Pure parts, exposed for tests -------------------------------------------------------------
 
-/// The largest view depth (metres, -z of view space) of any box at least partly inside the
-/// frustum of `view_proj` (box corners against the 6 clip planes; conservative), clamped to
-/// [near, far]. 0 when no box is visible.
-float farthest_visible_receiver(const glm::mat4& view, const glm::mat4& view_proj, float near,
-                                float far, std::span<const Aabb> receivers);
+/// A view-depth interval (metres, -z of view space); empty when nothing was seen.
+struct DepthRange {
+  float near = 0.0f, far = 0.0f;
+  bool empty() const { return !(far >= near && far > 0.0f); }
+};
+
+/// The view depths that the visible parts of `receivers` occupy: every box is clipped exactly to
+/// the frustum of `view_proj` (the vertices of box-and-frustum: clipped box faces and the frustum
+/// corners inside the box), so a ground plane seen in part counts only where it is seen. This is
+/// the [min, max] of Sample Distribution Shadow Maps (Lauritzen et al. 2011) taken from the
+/// receivers' bounds on the CPU instead of a depth-buffer reduction: exact for the bounds, no
+/// frame of latency, no GPU read-back; conservative for what lies inside a box.
+DepthRange visible_receiver_depths(const glm::mat4& view, const glm::mat4& view_proj,
+                                   std::span<const Aabb> receivers);
+
+/// `r` rounded outwards to a geometric grid (4 steps per octave: near down, far up), so that a
+/// small camera move keeps the same range, splits and stable-fit sizes (S2: a stable cascade
+/// needs a fixed projection size). Needs 0 < near <= far.
+DepthRange quantize_depth_range(DepthRange r);
 
 /// Indices of the boxes that overlap the clip volume [-1, 1]^3 of `light_view_proj` (corner test
 /// against each plane; conservative), in order.

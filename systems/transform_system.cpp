@@ -4,11 +4,19 @@
 #include <vector>
 
 #include "components/mesh_renderer.h"
+#include "components/name.h"
 #include "components/transform.h"
 #include "runtime/core/log.h"
 
 namespace kaskad {
 namespace {
+
+// "entity 'name' (7)", or "entity 7" without a Name: how warnings name an entity.
+std::string entity_label(const ecs::World& world, ecs::Entity e) {
+  if (const auto* n = world.try_get<Name>(e))
+    return "entity '" + n->value + "' (" + std::to_string(e.index) + ")";
+  return "entity " + std::to_string(e.index);
+}
 
 // Resolves one entity's world matrix, walking up the parent chain; `state` marks entities as
 // 0 = unvisited, 1 = on the current chain (cycle detection), 2 = done.
@@ -19,9 +27,11 @@ glm::mat4 resolve(ecs::World& world, ecs::Entity e, std::vector<std::uint8_t>& s
   glm::mat4 parent_matrix(1.0f);
   if (t.parent.valid()) {
     if (!world.alive(t.parent) || !world.has<Transform>(t.parent)) {
-      log::warn("entity %u: parent %u is gone; treating it as a root", e.index, t.parent.index);
+      log::warn_once("%s: parent (entity %u) is gone; treating it as a root",
+                     entity_label(world, e).c_str(), t.parent.index);
     } else if (t.parent.index < state.size() && state[t.parent.index] == 1) {
-      log::warn("entity %u: parent cycle; treating it as a root", e.index);
+      log::warn_once("%s: parent cycle through %s; treating it as a root",
+                     entity_label(world, e).c_str(), entity_label(world, t.parent).c_str());
     } else {
       state[e.index] = 1;
       parent_matrix = resolve(world, t.parent, state);

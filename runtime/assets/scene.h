@@ -11,6 +11,13 @@
 
 namespace kaskad {
 
+/// Whether the load phase adds a ground under the models (add_ground()).
+enum class GroundMode {
+  automatic,  ///< "auto": on for a .gltf/.glb opened directly, none for a scene file
+  none,
+  on,
+};
+
 /// Frame-wide render settings (scene file section "render").
 struct RenderSettings {
   int width = 1280;                       ///< output image size, pixels
@@ -21,6 +28,9 @@ struct RenderSettings {
   /// Which shadowed light the AOV's visibility and cascade channels show: 0 the first, k the
   /// k-th further shadowed directional light (a debug path; colour is not affected).
   int aov_shadow_light = 0;
+  /// A receive-only plane in a neutral grey under the models, large enough to catch their
+  /// shadow, so that a bare model shows one.
+  GroundMode ground = GroundMode::automatic;
 };
 
 struct Scene {

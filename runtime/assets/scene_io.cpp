@@ -58,10 +58,14 @@ const std::vector<std::pair<const char*, PrimitiveShape>> kShapes = {
     {"cylinder", PrimitiveShape::cylinder}, {"cone", PrimitiveShape::cone},
     {"terrain", PrimitiveShape::terrain}};
 
+const std::vector<std::pair<const char*, GroundMode>> kGroundModes = {
+    {"auto", GroundMode::automatic}, {"none", GroundMode::none}, {"on", GroundMode::on}};
+
 constexpr float kBig = 1.0e7f;  // |coordinate| limit: beyond it float precision is meaningless
 
 const std::vector<std::pair<const char*, SplitScheme>> kSplitSchemes = {
-    {"uniform", SplitScheme::uniform}, {"log", SplitScheme::log}, {"mixed", SplitScheme::mixed}};
+    {"auto", SplitScheme::automatic}, {"uniform", SplitScheme::uniform}, {"log", SplitScheme::log},
+    {"mixed", SplitScheme::mixed}};
 const std::vector<std::pair<const char*, DepthFormat>> kDepthFormats = {
     {"d16", DepthFormat::d16}, {"d24", DepthFormat::d24}, {"d32f", DepthFormat::d32f}};
 const std::vector<std::pair<const char*, FitMode>> kFitModes = {
@@ -82,7 +86,10 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
   r.integer("cascade_count", s.cascade_count, 1, 8);
   r.enumeration("split_scheme", s.split_scheme, kSplitSchemes);
   r.number("lambda", s.lambda, 0.0f, 1.0f);
-  r.number("max_distance", s.max_distance, 0.0f, kBig);
+  if (r.has("max_distance") && r.raw("max_distance") == "auto")
+    s.max_distance = 0.0f;  // no cap, the same as 0
+  else
+    r.number("max_distance", s.max_distance, 0.0f, kBig);
   r.enumeration("depth_format", s.depth_format, kDepthFormats);
   r.enumeration("fit_mode", s.fit_mode, kFitModes);
   r.number("beam_radius", s.beam_radius, 0.0f, kBig);
@@ -180,14 +187,65 @@ Material read_inline_material(ObjectReader& mr) {
   return m;
 }
 
+// One reader per component block, shared by scene files and --set on imported entities.
+void read_transform(ObjectReader& tr, Transform& t) {
+  tr.vector<3>("translation", t.translation, -kBig, kBig);
+  tr.vector<3>("scale", t.scale, -kBig, kBig);
+  read_rotation(tr, t);
+}
+
+void read_renderer(ObjectReader& rr, MeshRenderer& m) {
+  rr.boolean("cast_shadows", m.cast_shadows);
+  rr.boolean("receive_shadows", m.receive_shadows);
+  rr.integer("layer", m.layer, 0, 31);
+  rr.finish();
+}
+
+// Returns whether the block says cast_shadows.
+bool read_light(ObjectReader& lr, Light& l) {
+  lr.enumeration("type", l.type, kLightTypes);
+  lr.vector<3>("color", l.color, 0.0f, 1.0e4f);
+  lr.number("intensity", l.intensity, 0.0f, 1.0e9f);
+  lr.number("range", l.range, 0.0f, kBig);
+  lr.number("inner_cone_deg", l.inner_cone_deg, 0.0f, 90.0f);
+  lr.number("outer_cone_deg", l.outer_cone_deg, 0.0f, 90.0f);
+  const bool cast_given = lr.has("cast_shadows");
+  lr.boolean("cast_shadows", l.cast_shadows);
+  lr.number("angular_size_deg", l.angular_size_deg, 0.0f, 45.0f);
+  lr.finish();
+  if (l.inner_cone_deg > l.outer_cone_deg)
+    fail(lr.at("inner_cone_deg"), "must not exceed outer_cone_deg");
+  return cast_given;
+}
+
+void read_camera(ObjectReader& cr, Camera& c) {
+  cr.enumeration("projection", c.projection, kProjections);
+  cr.number("fov_y_deg", c.fov_y_deg, 0.01f, 179.0f);
+  cr.number("ortho_height", c.ortho_height, 1e-6f, kBig);
+  cr.number("near", c.near, 1e-7f, kBig);
+  cr.number("far", c.far, 1e-6f, 1e12f);
+  cr.number("aspect", c.aspect, 0.0f, 1000.0f);
+  cr.boolean("active", c.active);
+  cr.boolean("auto_frame", c.auto_frame);
+  cr.finish();
+  if (!(c.far > c.near)) fail(cr.at("far"), "far must be greater than near");
+}
+
 struct Pending {
   ecs::Entity entity;
   std::string parent;
   std::string where;
 };
 
+// The first directional light of a file, and whether its block says cast_shadows.
+struct FirstSun {
+  ecs::Entity entity = ecs::kNullEntity;
+  bool cast_shadows_given = false;
+};
+
 void parse_entity(const json& j, const std::string& path, Scene& scene,
-                  std::map<std::string, ecs::Entity>& by_name, std::vector<Pending>& parents) {
+                  std::map<std::string, ecs::Entity>& by_name, std::vector<Pending>& parents,
+                  FirstSun& first_sun) {
   ecs::World& w = scene.world;
   ObjectReader r(j, path);
   const ecs::Entity e = w.create();
@@ -203,9 +261,7 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
   Transform t;
   if (r.has("transform")) {
     ObjectReader tr(r.raw("transform"), r.at("transform"));
-    tr.vector<3>("translation", t.translation, -kBig, kBig);
-    tr.vector<3>("scale", t.scale, -kBig, kBig);
-    read_rotation(tr, t);
+    read_transform(tr, t);
     std::string parent;
     tr.string("parent", parent);
     if (!parent.empty()) parents.push_back({e, parent, tr.at("parent")});
@@ -244,10 +300,7 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
     if (!has_primitive && !has_model) fail(r.at("renderer"), "renderer needs a primitive or model");
     MeshRenderer mrend;
     ObjectReader rr(r.raw("renderer"), r.at("renderer"));
-    rr.boolean("cast_shadows", mrend.cast_shadows);
-    rr.boolean("receive_shadows", mrend.receive_shadows);
-    rr.integer("layer", mrend.layer, 0, 31);
-    rr.finish();
+    read_renderer(rr, mrend);
     w.emplace<MeshRenderer>(e, mrend);
   } else if (has_primitive || has_model) {
     w.emplace<MeshRenderer>(e);
@@ -275,17 +328,9 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
   if (r.has("light")) {
     Light l;
     ObjectReader lr(r.raw("light"), r.at("light"));
-    lr.enumeration("type", l.type, kLightTypes);
-    lr.vector<3>("color", l.color, 0.0f, 1.0e4f);
-    lr.number("intensity", l.intensity, 0.0f, 1.0e9f);
-    lr.number("range", l.range, 0.0f, kBig);
-    lr.number("inner_cone_deg", l.inner_cone_deg, 0.0f, 90.0f);
-    lr.number("outer_cone_deg", l.outer_cone_deg, 0.0f, 90.0f);
-    lr.boolean("cast_shadows", l.cast_shadows);
-    lr.number("angular_size_deg", l.angular_size_deg, 0.0f, 45.0f);
-    lr.finish();
-    if (l.inner_cone_deg > l.outer_cone_deg)
-      fail(r.at("light") + "/inner_cone_deg", "must not exceed outer_cone_deg");
+    const bool cast_given = read_light(lr, l);
+    if (l.type == LightType::directional && !first_sun.entity.valid())
+      first_sun = {e, cast_given};
     w.emplace<Light>(e, l);
     ShadowSettings s = scene.shadow_defaults;
     if (r.has("shadow")) {
@@ -306,16 +351,7 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
   if (r.has("camera")) {
     Camera c;
     ObjectReader cr(r.raw("camera"), r.at("camera"));
-    cr.enumeration("projection", c.projection, kProjections);
-    cr.number("fov_y_deg", c.fov_y_deg, 0.01f, 179.0f);
-    cr.number("ortho_height", c.ortho_height, 1e-6f, kBig);
-    cr.number("near", c.near, 1e-7f, kBig);
-    cr.number("far", c.far, 1e-6f, 1e12f);
-    cr.number("aspect", c.aspect, 0.0f, 1000.0f);
-    cr.boolean("active", c.active);
-    cr.boolean("auto_frame", c.auto_frame);
-    cr.finish();
-    if (!(c.far > c.near)) fail(r.at("camera") + "/far", "far must be greater than near");
+    read_camera(cr, c);
     w.emplace<Camera>(e, c);
   }
   r.finish();
@@ -426,11 +462,9 @@ Result<json> read_scene_document(const fs::path& file) {
   return parse_json_file(file);
 }
 
-Status apply_override(json& doc, const std::string& assignment) {
-  const auto eq = assignment.find('=');
-  if (eq == std::string::npos || eq == 0)
-    return Error{"--set", assignment, "expected key=value, e.g. shadow.map_size=2048"};
-  const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+namespace {
+
+std::vector<std::string> split_key(const std::string& key) {
   std::vector<std::string> parts;
   for (std::size_t start = 0;;) {
     const auto dot = key.find('.', start);
@@ -438,34 +472,43 @@ Status apply_override(json& doc, const std::string& assignment) {
     if (dot == std::string::npos) break;
     start = dot + 1;
   }
-  auto keys_of = [](const json& j) {
-    std::vector<std::string> k;
-    if (j.is_object())
-      for (auto it = j.begin(); it != j.end(); ++it) k.push_back(it.key());
-    return join(k);
-  };
-  json* node = nullptr;
-  std::size_t i = 0;
-  if (doc.contains(parts[0]) && parts[0] != "entities" && parts[0] != "kaskad_scene") {
-    node = &doc[parts[0]];
-    i = 1;
-  } else {
-    std::vector<std::string> names;
-    for (auto& ent : doc["entities"]) {
-      if (ent.contains("name") && ent["name"] == parts[0]) node = &ent;
-      if (ent.contains("name")) names.push_back(ent["name"].get<std::string>());
-    }
-    if (!node)
-      return Error{"--set", key, "no setting section or entity named '" + parts[0] +
-                                     "'; sections: render, shadow; entities: " + join(names)};
-    i = 1;
-  }
-  if (i == parts.size()) return Error{"--set", key, "name a field; valid keys: " + keys_of(*node)};
-  for (; i < parts.size(); ++i) {
+  return parts;
+}
+
+std::string keys_of(const json& j) {
+  std::vector<std::string> k;
+  if (j.is_object())
+    for (auto it = j.begin(); it != j.end(); ++it) k.push_back(it.key());
+  return join(k);
+}
+
+// The ways of giving a transform's rotation; a scene file takes any one of them.
+constexpr std::array<const char*, 4> kRotationKeys = {"rotation", "euler_deg", "look_at",
+                                                     "direction"};
+
+// Sets the field at `parts` (below `node`, an entity or settings block) to the value `text`
+// (JSON, else a bare string). `key` is the whole --set key, for messages.
+Status set_field(json* node, const std::vector<std::string>& parts, const std::string& key,
+                 const std::string& text) {
+  if (parts.empty()) return Error{"--set", key, "name a field; valid keys: " + keys_of(*node)};
+  for (std::size_t i = 0; i < parts.size(); ++i) {
     const std::string& p = parts[i];
     if (node->is_object()) {
+      // A transform's rotation may be set in any form a scene file accepts: the new form
+      // replaces the old one.
+      const bool rotation_form =
+          i + 1 == parts.size() && i > 0 && parts[i - 1] == "transform" &&
+          std::find(kRotationKeys.begin(), kRotationKeys.end(), p) != kRotationKeys.end();
+      if (rotation_form) {
+        for (const char* k : kRotationKeys) node->erase(k);
+        (*node)[p] = nullptr;
+      }
       if (!node->contains(p))
-        return Error{"--set", key, "unknown key '" + p + "'; valid keys here: " + keys_of(*node)};
+        return Error{"--set", key,
+                     "unknown key '" + p + "'; valid keys here: " + keys_of(*node) +
+                         (i > 0 && parts[i - 1] == "transform"
+                              ? " (rotation also as euler_deg, look_at or direction)"
+                              : "")};
       node = &(*node)[p];
     } else if (node->is_array()) {
       std::size_t idx = 0;
@@ -481,6 +524,124 @@ Status apply_override(json& doc, const std::string& assignment) {
   json value = json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (value.is_discarded()) value = text;  // a bare word is a string
   *node = value;
+  return {};
+}
+
+// Whether the first part of `key` names a settings section or an entity of the document.
+bool document_holds(const json& doc, const std::string& key) {
+  const std::string first = key.substr(0, key.find('.'));
+  if (doc.contains(first) && first != "entities" && first != "kaskad_scene") return true;
+  if (doc.contains("entities") && doc["entities"].is_array())
+    for (const auto& ent : doc["entities"])
+      if (ent.is_object() && ent.contains("name") && ent["name"] == first) return true;
+  return false;
+}
+
+}  // namespace
+
+Status apply_override(json& doc, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    return Error{"--set", assignment, "expected key=value, e.g. shadow.map_size=2048"};
+  const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  std::vector<std::string> parts = split_key(key);
+  json* node = nullptr;
+  if (doc.contains(parts[0]) && parts[0] != "entities" && parts[0] != "kaskad_scene") {
+    node = &doc[parts[0]];
+  } else {
+    std::vector<std::string> names;
+    for (auto& ent : doc["entities"]) {
+      if (ent.contains("name") && ent["name"] == parts[0]) node = &ent;
+      if (ent.contains("name")) names.push_back(ent["name"].get<std::string>());
+    }
+    if (!node)
+      return Error{"--set", key, "no setting section or entity named '" + parts[0] +
+                                     "'; sections: render, shadow; entities: " + join(names)};
+  }
+  parts.erase(parts.begin());
+  return set_field(node, parts, key, text);
+}
+
+Status apply_entity_override(Scene& scene, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    return Error{"--set", assignment, "expected key=value, e.g. shadow.map_size=2048"};
+  const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  ecs::World& w = scene.world;
+  // The longest entity name followed by '.' that starts the key: glTF names may hold dots.
+  std::vector<std::pair<ecs::Entity, std::string>> named;
+  w.view<Name>().each([&](ecs::Entity e, const Name& n) { named.emplace_back(e, n.value); });
+  std::sort(named.begin(), named.end(),
+            [](const auto& a, const auto& b) { return a.first.index < b.first.index; });
+  std::vector<ecs::Entity> matches;
+  std::size_t best = 0;
+  for (const auto& [e, n] : named) {
+    if (n.empty() || key.size() <= n.size() + 1 || key.compare(0, n.size(), n) != 0 ||
+        key[n.size()] != '.')
+      continue;
+    if (n.size() > best) {
+      best = n.size();
+      matches.clear();
+    }
+    if (n.size() == best) matches.push_back(e);
+  }
+  if (matches.empty()) {
+    std::vector<std::string> names;
+    for (const auto& [e, n] : named)
+      if (names.size() < 40) names.push_back(n);
+    if (named.size() > names.size()) names.push_back("... (" + std::to_string(named.size()) +
+                                                     " in all; `kaskad info SCENE` lists them)");
+    return Error{"--set", key, "no setting section or entity named '" + key.substr(0, key.find('.')) +
+                                   "'; sections: render, shadow; entities: " + join(names)};
+  }
+  const std::string name = key.substr(0, best);
+  if (matches.size() > 1)
+    return Error{"--set", key, std::to_string(matches.size()) + " entities are named '" + name +
+                                   "'; only a unique name can be set"};
+  const ecs::Entity e = matches.front();
+  json ej = entity_to_json(scene, e, {});
+  if (const auto* s = w.try_get<ShadowSettings>(e)) ej["shadow"] = write_shadow(*s, nullptr);
+  ej.erase("name");
+  if (ej.contains("transform")) ej["transform"].erase("parent");  // kept as it is
+  const std::vector<std::string> parts = split_key(key.substr(best + 1));
+  KASKAD_TRY(set_field(&ej, parts, key, text));
+  const std::string& section = parts[0];
+  const std::string where = "/" + name + "/" + section;
+  try {
+    if (section == "transform") {
+      Transform t = w.get<Transform>(e);
+      ObjectReader tr(ej["transform"], where);
+      read_transform(tr, t);
+      tr.finish();
+      w.get<Transform>(e) = t;
+    } else if (section == "light") {
+      Light l = w.get<Light>(e);
+      ObjectReader lr(ej["light"], where);
+      read_light(lr, l);
+      w.get<Light>(e) = l;
+    } else if (section == "shadow") {
+      ShadowSettings s = w.get<ShadowSettings>(e);
+      ObjectReader sr(ej["shadow"], where);
+      read_shadow(sr, s);
+      w.get<ShadowSettings>(e) = s;
+    } else if (section == "camera") {
+      Camera c = w.get<Camera>(e);
+      ObjectReader cr(ej["camera"], where);
+      read_camera(cr, c);
+      w.get<Camera>(e) = c;
+    } else if (section == "renderer") {
+      MeshRenderer m = w.get<MeshRenderer>(e);
+      ObjectReader rr(ej["renderer"], where);
+      read_renderer(rr, m);
+      w.get<MeshRenderer>(e) = m;
+    } else {
+      return Error{"--set", key, "'" + section + "' of '" + name +
+                                     "' cannot be set on an imported entity; it takes transform, "
+                                     "light, shadow, camera and renderer"};
+    }
+  } catch (const ContentError& err) {
+    return Error{"--set", err.where, err.message};
+  }
   return {};
 }
 
@@ -500,6 +661,7 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
       r.vector<3>("clear_color", s.clear_color, 0.0f, 1.0e4f);
       r.number("exposure", s.exposure, 0.0f, 1.0e4f);
       r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
+      r.enumeration("ground", s.ground, kGroundModes);
       r.finish();
     }
     if (root.has("shadow")) {
@@ -508,18 +670,35 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
     }
     std::map<std::string, ecs::Entity> by_name;
     std::vector<Pending> parents;
+    FirstSun first_sun;
     if (root.has("entities")) {
       const json& ents = root.raw("entities");
       if (!ents.is_array()) fail("/entities", "expected an array, got " + type_name(ents));
       for (std::size_t i = 0; i < ents.size(); ++i)
-        parse_entity(ents[i], "/entities/" + std::to_string(i), scene, by_name, parents);
+        parse_entity(ents[i], "/entities/" + std::to_string(i), scene, by_name, parents,
+                     first_sun);
     }
+    // A scene's first directional light casts shadows unless its block says false: a new
+    // scene shows shadows before its author has found the field.
+    if (first_sun.entity.valid() && !first_sun.cast_shadows_given)
+      scene.world.get<Light>(first_sun.entity).cast_shadows = true;
     root.finish();
     for (const Pending& p : parents) {
       auto it = by_name.find(p.parent);
       if (it == by_name.end()) fail(p.where, "no entity named '" + p.parent + "'");
       if (it->second == p.entity) fail(p.where, "an entity cannot be its own parent");
       scene.world.get<Transform>(p.entity).parent = it->second;
+    }
+    // A parent chain that comes back to where it started is a content error, not a per-frame
+    // warning.
+    for (const Pending& p : parents) {
+      std::string chain = scene.world.get<Name>(p.entity).value;
+      ecs::Entity at = scene.world.get<Transform>(p.entity).parent;
+      for (std::size_t steps = 0; at.valid() && steps <= parents.size(); ++steps) {
+        chain += " -> " + scene.world.get<Name>(at).value;
+        if (at == p.entity) fail(p.where, "parent cycle: " + chain);
+        at = scene.world.get<Transform>(at).parent;
+      }
     }
   } catch (const ContentError& e) {
     return Error{file.string(), e.where, e.message};
@@ -604,8 +783,73 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
         mr.layer = flags.layer;
       }
     });
+    // The scene's shadow settings apply to the model's own lights as to any other (a glTF has
+    // none of its own); --set ENTITY.shadow.* on the imported light refines them afterwards.
+    std::vector<ecs::Entity> lights;
+    w.view<Light, Imported>().each([&](ecs::Entity l, Light&, Imported& imp) {
+      if (imp.source == e) lights.push_back(l);
+    });
+    for (ecs::Entity l : lights) {
+      if (w.has<ShadowSettings>(l))
+        w.get<ShadowSettings>(l) = scene.shadow_defaults;
+      else
+        w.emplace<ShadowSettings>(l, scene.shadow_defaults);
+    }
   }
   return {};
+}
+
+Aabb ground_extent(const Aabb& models, const glm::vec3& light_direction) {
+  KASKAD_CHECK(!models.empty(), "needs non-empty bounds");
+  const float y = models.min.y;
+  const float size = std::max(glm::length(models.extent()), 1e-6f);
+  // Where the corners' shadows land on the plane y = min.y; lights lower than about 14 degrees
+  // above the horizon are taken as 14 degrees (a shadow 4x the model's height long).
+  const glm::vec3 l = glm::length(light_direction) > 0.0f ? glm::normalize(light_direction)
+                                                           : glm::vec3(0, -1, 0);
+  const float down = std::max(-l.y, 0.25f);
+  const glm::vec2 along = glm::length(glm::vec2(l.x, l.z)) > 0.0f
+                              ? glm::normalize(glm::vec2(l.x, l.z)) * std::sqrt(1.0f - down * down)
+                              : glm::vec2(0.0f);
+  Aabb out;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 c{(i & 1) ? models.max.x : models.min.x, (i & 2) ? models.max.y : models.min.y,
+                      (i & 4) ? models.max.z : models.min.z};
+    const glm::vec2 hit = glm::vec2(c.x, c.z) + along * ((c.y - y) / down);
+    out.expand(glm::vec3(c.x, y, c.z));
+    out.expand(glm::vec3(hit.x, y, hit.y));
+  }
+  // A margin of a quarter of the model's size around footprint and shadow.
+  out.min -= glm::vec3(0.25f * size, 0.0f, 0.25f * size);
+  out.max += glm::vec3(0.25f * size, 0.0f, 0.25f * size);
+  // Just under the lowest point, so that a flat bottom does not fight with the ground.
+  out.min.y = out.max.y = y - 1e-4f * size;
+  return out;
+}
+
+ecs::Entity add_ground(Scene& scene, const Aabb& extent) {
+  ecs::World& w = scene.world;
+  bool taken = false;
+  w.view<Name>().each([&](ecs::Entity, const Name& n) { taken = taken || n.value == "ground"; });
+  const ecs::Entity e = w.create();
+  w.emplace<Name>(e, Name{taken ? "kaskad_ground" : "ground"});
+  Transform t;
+  t.translation = extent.center();
+  t.scale = {std::max(extent.max.x - extent.min.x, 1e-6f), 1.0f,
+             std::max(extent.max.z - extent.min.z, 1e-6f)};
+  w.emplace<Transform>(e, t);
+  MeshRenderer mr;
+  mr.mesh = scene.assets.add_mesh(make_primitive(PrimitiveShape::plane, PrimitiveMesh{}.segments));
+  mr.cast_shadows = false;  // nothing lies below it
+  mr.receive_shadows = true;
+  w.emplace<MeshRenderer>(e, mr);
+  Material m;
+  // Neutral grey, dark enough that the default glTF sun (2.5) does not clip it to white.
+  m.base_color = glm::vec4(0.25f, 0.25f, 0.25f, 1.0f);
+  m.roughness = 0.9f;
+  w.emplace<Material>(e, m);
+  w.emplace<Imported>(e, Imported{ecs::kNullEntity});  // made by the load, not saved
+  return e;
 }
 
 json scene_to_json(const Scene& scene, const fs::path& base_dir) {
@@ -617,7 +861,8 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
                    {"ambient", vec(r.ambient)},
                    {"clear_color", vec(r.clear_color)},
                    {"exposure", num(r.exposure)},
-                   {"aov_shadow_light", r.aov_shadow_light}};
+                   {"aov_shadow_light", r.aov_shadow_light},
+                   {"ground", enum_name(r.ground, kGroundModes)}};
   doc["shadow"] = write_shadow(scene.shadow_defaults, nullptr);
   std::vector<ecs::Entity> authored;
   scene.world.view<Transform>().each([&](ecs::Entity e, const Transform&) {
@@ -651,7 +896,8 @@ Status save_scene(const fs::path& file, const Scene& scene) {
   return {};
 }
 
-Result<Scene> read_scene(const fs::path& file, const std::vector<std::string>& overrides) {
+Result<Scene> read_scene(const fs::path& file, const std::vector<std::string>& overrides,
+                         std::vector<std::string>* deferred) {
   auto doc = read_scene_document(file);
   if (!doc) return doc.error();
   if (!overrides.empty()) {
@@ -659,7 +905,12 @@ Result<Scene> read_scene(const fs::path& file, const std::vector<std::string>& o
     auto first = parse_scene(*doc, file);
     if (!first) return first.error();
     json canonical = scene_to_json(*first);
-    for (const auto& o : overrides) KASKAD_TRY(apply_override(canonical, o));
+    for (const auto& o : overrides) {
+      if (deferred && !document_holds(canonical, o.substr(0, o.find('='))))
+        deferred->push_back(o);  // an imported entity, perhaps: apply_entity_override
+      else
+        KASKAD_TRY(apply_override(canonical, o));
+    }
     doc = std::move(canonical);
   }
   auto scene = parse_scene(*doc, file);

@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "components/bounds.h"
 #include "runtime/assets/scene.h"
 #include "runtime/core/result.h"
 #include "runtime/render/feature_manifest.h"
@@ -35,14 +36,33 @@ Status apply_override(nlohmann::json& document, const std::string& assignment);
 Result<Scene> parse_scene(const nlohmann::json& document, const std::filesystem::path& file);
 
 /// read_scene_document, then (when there are overrides) canonicalise and apply them in order,
-/// then parse_scene. Errors after overrides say so.
+/// then parse_scene. Errors after overrides say so. With `deferred`, overrides whose first part
+/// names no section or entity of the document are put there instead of failing: they may name
+/// an entity made later (a glTF node, the ground), for apply_entity_override().
 Result<Scene> read_scene(const std::filesystem::path& file,
-                         const std::vector<std::string>& overrides = {});
+                         const std::vector<std::string>& overrides = {},
+                         std::vector<std::string>* deferred = nullptr);
+
+/// Applies one "ENTITY.SECTION.FIELD=value" override to an entity of an instantiated scene by its
+/// Name (the longest name that starts the key, so glTF names with dots work): sections transform
+/// (rotation also as euler_deg, look_at or direction), light, shadow, camera and renderer, read
+/// and validated as in scene files. Unknown or ambiguous names are errors that list the names.
+Status apply_entity_override(Scene& scene, const std::string& assignment);
 
 /// Loads material files (validated against `manifest`; required when the scene has any), creates
 /// meshes for primitives and imports glTF references (paths relative to scene.file). Cameras with
 /// auto_frame are framed by the load phase (load_scene in runtime/cli/player.h).
 Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest = nullptr);
+
+/// Where a ground for `models` (their world bounds) goes: a flat box at min.y (a hair below)
+/// covering their footprint and the shadow their bounds cast along `light_direction` (lights
+/// below about 14 degrees of elevation count as 14), with a margin of a quarter of their size.
+Aabb ground_extent(const Aabb& models, const glm::vec3& light_direction);
+
+/// Adds a receive-only, non-casting plane in neutral grey over `extent`, named "ground" (or
+/// "kaskad_ground" when that name is taken), not written by scene_to_json (it is remade from
+/// render.ground at load).
+ecs::Entity add_ground(Scene& scene, const Aabb& extent);
 
 /// The canonical document of the authored entities and settings (imported entities excluded).
 /// With a `base_dir`, model paths are rewritten relative to it (for a file written there);

@@ -317,8 +317,14 @@ int run_render(Args a) {
     if (sh.settings.fit_mode != FitMode::scene) {
       std::printf("; splits");
       for (int i = 0; i <= sh.cascade_count; ++i) std::printf(" %.3g", double(sh.splits[std::size_t(i)]));
-      std::printf(" m; last split at %.3g m, pulled in from %.3g m by the farthest visible receiver",
-                  double(sh.far_used), double(sh.far_requested));
+      std::printf(" m; the visible receivers' depths");
+      if (sh.near_used > sh.near_requested)
+        std::printf(" moved the first split out from %.3g m", double(sh.near_requested));
+      if (sh.far_used < sh.far_requested)
+        std::printf("%s pulled the last split in from %.3g m",
+                    sh.near_used > sh.near_requested ? " and" : "", double(sh.far_requested));
+      if (!(sh.near_used > sh.near_requested) && !(sh.far_used < sh.far_requested))
+        std::printf(" fill [camera near, %.3g m]", double(sh.far_requested));
     }
     std::printf("\n          per cascade draws/triangles:");
     for (int i = 0; i < st.cascades; ++i)

@@ -5,6 +5,8 @@
 #include <cstdlib>
 
 #include "runtime/assets/scene_io.h"
+#include "components/light.h"
+#include "runtime/core/log.h"
 #include "systems/camera_system.h"
 #include "systems/transform_system.h"
 
@@ -19,16 +21,68 @@ std::filesystem::path content_dir() {
   return KASKAD_CONTENT_DIR;
 }
 
+namespace {
+
+bool is_gltf(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".gltf" || ext == ".glb";
+}
+
+// The direction of the first shadowed directional light (else the first directional light,
+// else straight down): the ground must catch its shadow.
+glm::vec3 sun_direction(const ecs::World& world) {
+  glm::vec3 any{0.0f}, shadowed{0.0f};
+  world.view<Light, WorldTransform>().each(
+      [&](ecs::Entity, const Light& l, const WorldTransform& wt) {
+        if (l.type != LightType::directional) return;
+        const glm::vec3 d = light_direction(wt.matrix);
+        if (any == glm::vec3(0.0f)) any = d;
+        if (l.cast_shadows && shadowed == glm::vec3(0.0f)) shadowed = d;
+      });
+  if (shadowed != glm::vec3(0.0f)) return shadowed;
+  return any != glm::vec3(0.0f) ? any : glm::vec3(0.0f, -1.0f, 0.0f);
+}
+
+}  // namespace
+
 Result<Scene> load_scene(const std::filesystem::path& file,
                          const std::vector<std::string>& overrides) {
-  auto scene = read_scene(file, overrides);
+  std::vector<std::string> later;  // overrides of entities the document does not hold
+  auto scene = read_scene(file, overrides, &later);
   if (!scene) return scene.error();
   auto manifest = render::FeatureManifest::load(content_dir() / "shaders" / "features.json");
   if (!manifest) return manifest.error();
   KASKAD_TRY(instantiate_scene(*scene, &manifest.value()));
   update_transforms(scene->world, scene->assets);
-  frame_auto_cameras(scene->world, scene_bounds(scene->world),
+  // The models' bounds, before a ground is added: what auto_frame cameras frame.
+  const Aabb models = scene_bounds(scene->world);
+  GroundMode& ground = scene->render.ground;
+  if (ground == GroundMode::automatic) ground = is_gltf(file) ? GroundMode::on : GroundMode::none;
+  ecs::Entity ground_entity = ecs::kNullEntity;
+  if (ground == GroundMode::on && !models.empty())
+    ground_entity = add_ground(*scene, ground_extent(models, sun_direction(scene->world)));
+  // Overrides of imported entities (glTF nodes by name) and of the ground.
+  for (const std::string& o : later) KASKAD_TRY(apply_entity_override(*scene, o));
+  update_transforms(scene->world, scene->assets);
+  // Cameras frame the models; their near/far also take in the ground.
+  Aabb framed;
+  scene->world.view<WorldBounds>().each([&](ecs::Entity e, const WorldBounds& b) {
+    if (e != ground_entity) framed.expand(b.box);
+  });
+  frame_auto_cameras(scene->world, framed, scene_bounds(scene->world),
                      float(scene->render.width) / float(scene->render.height));
+  // A camera with its own aspect gets an output of that aspect, never a stretched image.
+  const glm::ivec2 fitted =
+      fit_output_to_camera(scene->world, scene->render.width, scene->render.height);
+  if (fitted != glm::ivec2(scene->render.width, scene->render.height)) {
+    log::info("the camera's aspect ratio is %.4g: output %dx%d (fitted inside %dx%d)",
+              double(float(fitted.x) / float(fitted.y)), fitted.x, fitted.y,
+              scene->render.width, scene->render.height);
+    scene->render.width = fitted.x;
+    scene->render.height = fitted.y;
+  }
   return scene;
 }
 

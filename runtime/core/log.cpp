@@ -2,6 +2,8 @@
 
 #include <atomic>
 #include <cstdio>
+#include <mutex>
+#include <set>
 
 namespace kaskad::log {
 namespace {
@@ -37,6 +39,21 @@ void error(const char* fmt, ...) {
   va_start(args, fmt);
   vlog(Level::error, "error", fmt, args);
   va_end(args);
+}
+
+void warn_once(const char* fmt, ...) {
+  static std::mutex mutex;
+  static std::set<std::string> said;
+  char buf[1024];
+  va_list args;
+  va_start(args, fmt);
+  std::vsnprintf(buf, sizeof buf, fmt, args);
+  va_end(args);
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (!said.insert(buf).second) return;
+  }
+  warn("%s", buf);
 }
 
 int error_count() { return g_errors; }

@@ -17,6 +17,9 @@ void debug(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 void info(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 void warn(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 void error(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+/// warn(), but each distinct message only the first time: for conditions found again every
+/// frame (a parent cycle, too many lights).
+void warn_once(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 
 /// Number of error-level messages logged since start (or the last reset).
 int error_count();

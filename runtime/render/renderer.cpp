@@ -955,8 +955,10 @@ std::array<std::size_t, kMaxCascades> Renderer::cascade_pixel_counts() const {
   KASKAD_CHECK(im.aovs_written, "the last frame was rendered without write_aovs");
   std::array<std::size_t, kMaxCascades> out{};
   const auto vis = read_texture(im.visibility.id(), im.width, im.height, GL_RG, 2);
-  for (std::size_t i = 1; i < vis.size(); i += 2) {
-    const int c = int(vis[i]);
+  const auto pos = read_texture(im.position.id(), im.width, im.height, GL_RGBA, 4);
+  for (std::size_t i = 0; i < vis.size() / 2; ++i) {
+    if (pos[i * 4 + 3] != 1.0f) continue;  // AOV mask: only shadow-receiving surfaces count
+    const int c = int(vis[i * 2 + 1]);
     if (c >= 0 && c < kMaxCascades) ++out[std::size_t(c)];
   }
   return out;

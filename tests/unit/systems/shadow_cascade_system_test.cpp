@@ -58,7 +58,7 @@ bool contains(const std::vector<ecs::Entity>& v, ecs::Entity e) {
   return std::find(v.begin(), v.end(), e) != v.end();
 }
 
-TEST(ShadowCascadeSystem, LastSplitEndsAtTheFarthestVisibleReceiver) {
+TEST(ShadowCascadeSystem, CascadesSpanTheVisibleReceiversQuantisedOutwards) {
   ecs::World w;
   ShadowSettings s;
   s.max_distance = 100.0f;
@@ -70,11 +70,16 @@ TEST(ShadowCascadeSystem, LastSplitEndsAtTheFarthestVisibleReceiver) {
   const ShadowData d = update_shadow_cascades(w, camera(w), state);
   ASSERT_TRUE(d.light.valid()) << d.error;
   EXPECT_EQ(d.cascade_count, 4);
+  EXPECT_FLOAT_EQ(d.near_requested, 1.0f);
   EXPECT_FLOAT_EQ(d.far_requested, 100.0f);
-  EXPECT_NEAR(d.far_used, 20.0f, 1e-4f);
-  EXPECT_FLOAT_EQ(d.splits[0], 1.0f);
+  // [2, 20] on the 2^(1/4) grid: 2 stays, 20 rounds up to 2^4.5.
+  EXPECT_FLOAT_EQ(d.near_used, 2.0f);
+  EXPECT_NEAR(d.far_used, std::exp2(4.5f), 1e-3f);
+  EXPECT_FLOAT_EQ(d.splits[0], d.near_used);
   EXPECT_FLOAT_EQ(d.splits[4], d.far_used);
   for (int i = 0; i < 4; ++i) EXPECT_LT(d.splits[std::size_t(i)], d.splits[std::size_t(i) + 1]);
+  // auto: log splits (S0 eq. (2)) over the range.
+  EXPECT_NEAR(d.splits[2], std::sqrt(d.near_used * d.far_used), 1e-3f);
   // max_distance still wins when it is nearer.
   w.get<ShadowSettings>(d.light).max_distance = 10.0f;
   const ShadowData d2 = update_shadow_cascades(w, camera(w), state);
@@ -82,31 +87,76 @@ TEST(ShadowCascadeSystem, LastSplitEndsAtTheFarthestVisibleReceiver) {
   EXPECT_FLOAT_EQ(d2.far_used, 10.0f);
 }
 
-TEST(ShadowCascadeSystem, FarthestVisibleReceiverIgnoresBoxesOutsideTheFrustum) {
+TEST(ShadowCascadeSystem, TheRangeFollowsTheModelAtAnyScale) {
+  // The same receiver scaled by 10^k, seen by a camera scaled with it: the range scales too.
+  for (int k = -3; k <= 4; ++k) {
+    const float u = std::pow(10.0f, float(k));
+    ecs::World w;
+    sun(w, ShadowSettings{});
+    mesh(w, Aabb::from_corners(glm::vec3(-1, -1, -20) * u, glm::vec3(1, 0, -2) * u));
+    ShadowCascadeState state;
+    CameraState cs = camera(w);
+    cs.camera.near = 0.5f * u;
+    cs.camera.far = 1000.0f * u;
+    cs.proj = glm::perspective(glm::radians(cs.camera.fov_y_deg), cs.aspect, cs.camera.near,
+                               cs.camera.far);
+    const ShadowData d = update_shadow_cascades(w, cs, state);
+    ASSERT_TRUE(d.light.valid()) << d.error;
+    // [2, 20] u, rounded outwards by less than one 2^(1/4) step.
+    EXPECT_LE(d.near_used / u, 2.0f * 1.0001f) << "k " << k;
+    EXPECT_GT(d.near_used / u, 2.0f / 1.19f) << "k " << k;
+    EXPECT_GE(d.far_used / u, 20.0f * 0.9999f) << "k " << k;
+    EXPECT_LT(d.far_used / u, 20.0f * 1.19f) << "k " << k;
+    for (int i = 0; i < 4; ++i) EXPECT_FALSE(d.skipped[std::size_t(i)]) << "k " << k;
+  }
+}
+
+TEST(ShadowCascadeSystem, VisibleReceiverDepthsClipBoxesToTheFrustum) {
   const glm::mat4 view(1.0f), proj = glm::perspective(glm::radians(20.0f), 1.0f, 1.0f, 100.0f);
   const Aabb behind = Aabb::from_corners({-1, -1, 5}, {1, 1, 9});
   const Aabb aside = Aabb::from_corners({50, -1, -30}, {52, 1, -20});
   const Aabb front = Aabb::from_corners({-1, -1, -30}, {1, 1, -20});
-  EXPECT_EQ(farthest_visible_receiver(view, proj * view, 1, 100, std::array{behind, aside}), 0.0f);
-  EXPECT_FLOAT_EQ(farthest_visible_receiver(view, proj * view, 1, 100, std::array{behind, front}), 30.0f);
-  // Clamped to far.
+  EXPECT_TRUE(visible_receiver_depths(view, proj * view, std::array{behind, aside}).empty());
+  const DepthRange r = visible_receiver_depths(view, proj * view, std::array{behind, front});
+  EXPECT_FLOAT_EQ(r.near, 20.0f);
+  EXPECT_FLOAT_EQ(r.far, 30.0f);
+  // Clipped to far.
   const Aabb long_box = Aabb::from_corners({-1, -1, -300}, {1, 1, -20});
-  EXPECT_FLOAT_EQ(farthest_visible_receiver(view, proj * view, 1, 100, std::array{long_box}), 100.0f);
+  EXPECT_NEAR(visible_receiver_depths(view, proj * view, std::array{long_box}).far, 100.0f, 1e-3f);
+  // A wide ground 1 m below the eye: seen from where the lower frustum plane meets it,
+  // 1 / tan(10 deg), to the far plane; its box reaches the camera but is not seen there.
+  const Aabb ground = Aabb::from_corners({-1000, -1, -1000}, {1000, -1, 1000});
+  const DepthRange g = visible_receiver_depths(view, proj * view, std::array{ground});
+  EXPECT_NEAR(g.near, 1.0f / std::tan(glm::radians(10.0f)), 1e-3f);
+  EXPECT_NEAR(g.far, 100.0f, 1e-3f);
+}
+
+TEST(ShadowCascadeSystem, QuantisedRangesAreStableUnderSmallChanges) {
+  const DepthRange a = quantize_depth_range({3.0f, 700.0f});
+  EXPECT_LE(a.near, 3.0f);
+  EXPECT_GE(a.far, 700.0f);
+  EXPECT_GT(a.near, 3.0f / 1.19f);
+  EXPECT_LT(a.far, 700.0f * 1.19f);
+  // A few per cent either way lands on the same grid points.
+  const DepthRange b = quantize_depth_range({3.05f, 690.0f});
+  EXPECT_EQ(a.near, b.near);
+  EXPECT_EQ(a.far, b.far);
 }
 
 TEST(ShadowCascadeSystem, CascadesWithoutReceiversAreSkippedAndCastersCulledPerCascade) {
   ecs::World w;
   ShadowSettings s;
-  s.split_scheme = SplitScheme::uniform;  // 1, 13.25, 25.5, 37.75, 50
+  // Receivers span [1.5, 50]: on the 2^(1/4) grid [1.41, 53.8], so 1.41, 14.5, 27.6, 40.7, 53.8.
+  s.split_scheme = SplitScheme::uniform;
   s.cascade_count = 4;
   sun(w, s, {0.0f, -1.0f, 0.0f});
   const ecs::Entity near_box = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -2.0f}, {0.3f, 0.3f, -1.5f}));
   const ecs::Entity far_box = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -50.0f}, {0.3f, 0.3f, -49.0f}));
-  const ecs::Entity no_cast = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -45.0f}, {0.3f, 0.3f, -44.0f}), false, true);
+  const ecs::Entity no_cast = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -48.0f}, {0.3f, 0.3f, -47.0f}), false, true);
   ShadowCascadeState state;
   const ShadowData d = update_shadow_cascades(w, camera(w), state);
   ASSERT_TRUE(d.light.valid()) << d.error;
-  EXPECT_NEAR(d.far_used, 50.0f, 1e-4f);
+  EXPECT_NEAR(d.far_used, std::exp2(5.75f), 1e-3f);  // 50 on the 2^(1/4) grid
   EXPECT_FALSE(d.skipped[0]);
   EXPECT_TRUE(d.skipped[1]);
   EXPECT_TRUE(d.skipped[2]);

@@ -74,7 +74,7 @@ TEST(CameraSystem, ActiveCameraWinsAndAutoFrameFitsTheBounds) {
   Aabb bounds;
   bounds.expand(glm::vec3(-10, 0, -10));
   bounds.expand(glm::vec3(10, 2, 10));
-  frame_auto_cameras(w, bounds, 16.0f / 9.0f);
+  frame_auto_cameras(w, bounds, bounds, 16.0f / 9.0f);
   update_transforms(w, assets);
   const CameraState s = select_camera(w, 16.0f / 9.0f);
   ASSERT_EQ(s.entity, second);
