@@ -146,17 +146,17 @@ TEST(ShadowCascadeSystem, QuantisedRangesAreStableUnderSmallChanges) {
 TEST(ShadowCascadeSystem, CascadesWithoutReceiversAreSkippedAndCastersCulledPerCascade) {
   ecs::World w;
   ShadowSettings s;
-  // Receivers span [1.5, 50]: on the 2^(1/4) grid [1.41, 53.8], so 1.41, 14.5, 27.6, 40.7, 53.8.
+  // Receivers span [1.5, 53]: on the 2^(1/4) grid [1.41, 53.8], so 1.41, 14.5, 27.6, 40.7, 53.8.
   s.split_scheme = SplitScheme::uniform;
   s.cascade_count = 4;
   sun(w, s, {0.0f, -1.0f, 0.0f});
   const ecs::Entity near_box = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -2.0f}, {0.3f, 0.3f, -1.5f}));
-  const ecs::Entity far_box = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -50.0f}, {0.3f, 0.3f, -49.0f}));
-  const ecs::Entity no_cast = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -48.0f}, {0.3f, 0.3f, -47.0f}), false, true);
+  const ecs::Entity far_box = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -53.0f}, {0.3f, 0.3f, -52.0f}));
+  const ecs::Entity no_cast = mesh(w, Aabb::from_corners({-0.3f, -0.3f, -52.0f}, {0.3f, 0.3f, -51.0f}), false, true);
   ShadowCascadeState state;
   const ShadowData d = update_shadow_cascades(w, camera(w), state);
   ASSERT_TRUE(d.light.valid()) << d.error;
-  EXPECT_NEAR(d.far_used, std::exp2(5.75f), 1e-3f);  // 50 on the 2^(1/4) grid
+  EXPECT_NEAR(d.far_used, std::exp2(5.75f), 1e-3f);  // 53 on the 2^(1/4) grid
   EXPECT_FALSE(d.skipped[0]);
   EXPECT_TRUE(d.skipped[1]);
   EXPECT_TRUE(d.skipped[2]);
