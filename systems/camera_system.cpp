@@ -38,6 +38,15 @@ CameraState select_camera(const ecs::World& world, float output_aspect) {
         }
       });
   if (!out.entity.valid()) return out;
+  // A camera inside a scaled hierarchy (a glTF model scaled to the scene's units) sees what it
+  // saw before scaling: its uniform world scale (the cube root of the basis' volume) scales its
+  // near, far and ortho height; its view drops the scale.
+  const float scale = std::cbrt(std::abs(glm::determinant(glm::mat3(world_matrix))));
+  if (std::isfinite(scale) && scale > 0.0f && scale != 1.0f) {
+    out.camera.near *= scale;
+    out.camera.far *= scale;
+    out.camera.ortho_height *= scale;
+  }
   const Camera& c = out.camera;
   out.aspect = c.aspect > 0.0f ? c.aspect : output_aspect;
   const glm::mat4 m = rigid(world_matrix);

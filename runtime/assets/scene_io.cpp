@@ -452,7 +452,7 @@ Result<json> read_scene_document(const fs::path& file) {
     if (report->lights == 0) {
       doc["entities"].push_back(
           {{"name", "sun"},
-           {"transform", {{"direction", {-0.4, -0.8, -0.45}}}},
+           {"transform", {{"direction", {0.3, -0.75, -0.6}}}},
            {"light", {{"type", "directional"}, {"intensity", 2.5}, {"cast_shadows", true}}}});
     }
     return doc;

@@ -1,5 +1,6 @@
 // The `kaskad` command line: render scenes headless (or in a window), write images and AOVs,
 // and save canonical scene files. Run `kaskad --help`.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -7,7 +8,14 @@
 #include <string>
 #include <vector>
 
+#include "components/camera.h"
+#include "components/light.h"
+#include "components/mesh_renderer.h"
+#include "components/model.h"
 #include "components/name.h"
+#include "components/reflector.h"
+#include "components/shadow_settings.h"
+#include "components/transform.h"
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
@@ -44,7 +52,9 @@ usage:
                                     or a folder of faces; L: auto, faces, horizontal_cross,
                                     vertical_cross, equirect, sphere), print what was found, write
                                     its faces (OUT: a pattern with * or a folder) or S3 sphere map
-  kaskad info                       print the OpenGL context kaskad gets on this machine
+  kaskad info [SCENE] [--set K=V]   print the OpenGL context kaskad gets on this machine; with
+                                    a SCENE, its entities instead (name, parent, components): the
+                                    names --set addresses, a glTF file's own nodes included
 
 render options:
   -o, --output FILE      colour image (PNG, JPEG, EXR, ...); default out/<scene>.png
@@ -181,6 +191,32 @@ int fail(const Error& e) {
 }
 
 int run_info(const Args& a) {
+  if (!a.scene.empty()) {
+    auto scene = load_scene(a.scene, a.sets);
+    if (!scene) return fail(scene.error());
+    const ecs::World& w = scene->world;
+    std::vector<ecs::Entity> all;
+    w.view<Transform>().each([&](ecs::Entity e, const Transform&) { all.push_back(e); });
+    std::sort(all.begin(), all.end(), [](ecs::Entity x, ecs::Entity y) { return x.index < y.index; });
+    std::printf("%s: %zu entities (--set NAME.SECTION.FIELD=VALUE addresses them by name)\n",
+                a.scene.c_str(), all.size());
+    for (ecs::Entity e : all) {
+      const auto* n = w.try_get<Name>(e);
+      std::string parts;
+      if (w.has<Light>(e)) parts += " light";
+      if (w.has<ShadowSettings>(e)) parts += " shadow";
+      if (w.has<Camera>(e)) parts += " camera";
+      if (w.has<MeshRenderer>(e)) parts += " renderer";
+      if (w.has<Reflector>(e)) parts += " reflector";
+      if (w.has<ModelRef>(e)) parts += " model";
+      if (w.has<PrimitiveMesh>(e)) parts += " primitive";
+      const Transform& t = w.get<Transform>(e);
+      const auto* pn = t.parent.valid() && w.alive(t.parent) ? w.try_get<Name>(t.parent) : nullptr;
+      std::printf("  %-32s transform%s%s%s%s\n", n ? n->value.c_str() : "(unnamed)", parts.c_str(),
+                  pn ? "  (parent " : "", pn ? pn->value.c_str() : "", pn ? ")" : "");
+    }
+    return 0;
+  }
   gpu::ContextOptions opt;
   opt.headless = a.headless;
   auto ctx = gpu::Context::create(opt);

@@ -271,12 +271,15 @@ TEST_F(DefaultSceneTest, StableCascadesDoNotShimmerUnderSubTexelCameraMoves) {
 }
 
 // Per-cascade stats: each layer draws exactly the casters the system kept for it; layers without
-// receivers draw nothing; the farthest receiver pulls the last split in from max_distance.
+// receivers draw nothing; the farthest receiver pulls the last split in from the camera's far.
+// Crop fits: the stable fit's spheres are wide enough here for every cascade to see every caster
+// once the range starts at the nearest receiver.
 TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
   // One pass per layer: one draw call per caster and cascade (the layered pass is below).
   auto scene = load_scene(
       content_dir() / "scenes" / "default.json",
-      {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=false"});
+      {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=false",
+       "shadow.fit_mode=crop"});
   ASSERT_TRUE(scene.ok()) << scene.error().to_string();
   auto t = render_frames(*player_, *scene, {});
   ASSERT_TRUE(t.ok()) << t.error().to_string();
@@ -296,7 +299,7 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
   }
   EXPECT_EQ(draws, st.shadow_draw_calls);
   EXPECT_EQ(triangles, st.shadow_triangles);
-  EXPECT_GT(culled, 0);  // the near cascades do not see every caster
+  EXPECT_GT(culled, 0);  // the nearest and farthest cascades do not see every caster
   EXPECT_FLOAT_EQ(sh.far_requested, 100.0f);
   EXPECT_LT(sh.far_used, 60.0f);  // the ground ends about 40 m from the camera
   EXPECT_FLOAT_EQ(sh.splits[8], sh.far_used);
@@ -307,7 +310,8 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
   // per caster that is in any cascade.
   auto layered_scene = load_scene(
       content_dir() / "scenes" / "default.json",
-      {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=true"});
+      {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=true",
+       "shadow.fit_mode=crop"});
   ASSERT_TRUE(layered_scene.ok()) << layered_scene.error().to_string();
   auto lt = render_frames(*player_, *layered_scene, {});
   ASSERT_TRUE(lt.ok()) << lt.error().to_string();

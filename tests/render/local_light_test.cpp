@@ -106,12 +106,13 @@ TEST_F(LocalLightTest, PointLightCubeMapAgreesWithRayCastsAwayFromEdges) {
   EXPECT_EQ(r.shadow.projection, ShadowProjection::cube);
   EXPECT_EQ(r.shadow.cascade_count, 6);
   expect_meaningful(r);
-  // Stats: receiver pixels per layer are the AOV's cascade channel counted; texel sizes are the
-  // system's.
+  // Stats: receiver pixels per layer are the AOV's cascade channel counted where the mask is 1
+  // (drawn surfaces; the background is not a receiver); texel sizes are the system's.
   std::array<std::size_t, render::kMaxCascades> counted{};
   for (int y = 0; y < r.aov.height; ++y)
     for (int x = 0; x < r.aov.width; ++x)
-      if (const int c = int(r.aov.at(x, y, 9)); c >= 0) ++counted[std::size_t(c)];
+      if (const int c = int(r.aov.at(x, y, 9)); c >= 0 && r.aov.at(x, y, 8) == 1.0f)
+        ++counted[std::size_t(c)];
   EXPECT_EQ(r.stats.cascade_receiver_pixels, counted);
   for (int i = 0; i < 6; ++i)
     EXPECT_EQ(r.stats.cascade_texel_size[std::size_t(i)], r.shadow.texel_size[std::size_t(i)]);
