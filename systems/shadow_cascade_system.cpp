@@ -357,10 +357,26 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
   const DepthRange seen =
       visible_receiver_depths(camera.view, camera.proj * camera.view, receiver_boxes);
   if (!seen.empty()) {
-    const DepthRange q = quantize_depth_range(
-        {std::max(seen.near, slice.near), std::max(seen.far, slice.near)});
-    near = std::clamp(q.near, slice.near, far);
-    far = std::clamp(q.far, near, far);
+    const float cap = far;
+    const DepthRange need{std::clamp(seen.near, slice.near, cap),
+                          std::clamp(seen.far, slice.near, cap)};
+    const DepthRange q = quantize_depth_range(need);
+    near = std::clamp(q.near, slice.near, cap);
+    far = std::clamp(q.far, near, cap);
+    // Hysteresis: last frame's range stays while it still holds what is seen, lies within the
+    // camera's range and is at most two grid steps looser at either end, so a camera moving
+    // through the scene keeps its splits (and stable-fit sizes) instead of stepping whenever a
+    // receiver's edge crosses a grid point.
+    constexpr float kLooser = 1.4142135f;  // 2^(2/4): two steps of quantize_depth_range
+    const bool same_layout = previous.light == out.light &&
+                             previous.projection == ShadowProjection::ortho &&
+                             previous.cascade_count == s.cascade_count && previous.near_used > 0.0f;
+    if (same_layout && previous.near_used <= need.near && previous.far_used >= need.far &&
+        previous.near_used >= slice.near && previous.far_used <= cap &&
+        previous.near_used * kLooser >= near && previous.far_used <= far * kLooser) {
+      near = previous.near_used;
+      far = previous.far_used;
+    }
   }
   // N distinct splits need some room (split_distances' precondition).
   far = std::max(far, near * (1.0f + 1e-3f * float(s.cascade_count)) + 1e-6f);

@@ -11,6 +11,7 @@
 #include "components/model.h"
 #include "components/name.h"
 #include "components/reflector.h"
+#include "components/shadow_settings.h"
 #include "components/transform.h"
 #include "runtime/assets/scene_io.h"
 
@@ -373,6 +374,118 @@ TEST(SceneIo, BadReflectorsNameTheKey) {
                                  R"({"kaskad_scene": 1, "entities": [{"reflector": {}}]})"));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().to_string().find("needs a primitive or model"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace kaskad
+
+namespace kaskad {
+namespace {
+
+TEST(SceneIo, FirstDirectionalLightCastsShadowsUnlessTheFileSaysFalse) {
+  const char* two_suns = R"({"entities": [
+    {"name": "a", "light": {"type": "point"}},
+    {"name": "b", "light": {"type": "directional"}},
+    {"name": "c", "light": {"type": "directional"}}]})";
+  auto s = read_scene(write_file("two_suns_default.json", two_suns));
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  EXPECT_FALSE(s->world.get<Light>(find(*s, "a")).cast_shadows);  // not directional
+  EXPECT_TRUE(s->world.get<Light>(find(*s, "b")).cast_shadows);   // the first directional
+  EXPECT_FALSE(s->world.get<Light>(find(*s, "c")).cast_shadows);
+  auto off = read_scene(write_file("sun_off.json", R"({"entities": [
+    {"name": "b", "light": {"type": "directional", "cast_shadows": false}}]})"));
+  ASSERT_TRUE(off.ok()) << off.error().to_string();
+  EXPECT_FALSE(off->world.get<Light>(find(*off, "b")).cast_shadows);
+  // A saved scene says it explicitly, so it loads the same.
+  const fs::path out = temp_dir() / "two_suns_saved.json";
+  ASSERT_TRUE(save_scene(out, *s).ok());
+  auto again = read_scene(out);
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_TRUE(again->world.get<Light>(find(*again, "b")).cast_shadows);
+}
+
+TEST(SceneIo, OverridesTakeDirectionLookAtAndEulerForRotation) {
+  auto s = read_scene(kContent / "scenes" / "default.json",
+                      {"sun.transform.direction=[0,-1,0.0001]", "camera.transform.look_at=[0,0,0]",
+                       "box_resting.transform.euler_deg=[0,90,0]"});
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  const glm::vec3 sun_dir = s->world.get<Transform>(find(*s, "sun")).rotation * glm::vec3(0, 0, -1);
+  EXPECT_NEAR(sun_dir.y, -1.0f, 1e-4f);
+  const Transform& cam = s->world.get<Transform>(find(*s, "camera"));
+  const glm::vec3 to_origin = glm::normalize(-cam.translation);
+  const glm::vec3 cam_dir = cam.rotation * glm::vec3(0, 0, -1);
+  EXPECT_NEAR(glm::dot(cam_dir, to_origin), 1.0f, 1e-5f);
+  const glm::vec3 box_x = s->world.get<Transform>(find(*s, "box_resting")).rotation * glm::vec3(1, 0, 0);
+  EXPECT_NEAR(box_x.z, -1.0f, 1e-5f);
+  // A field that no form has is still an error that lists the forms.
+  expect_error(read_scene(kContent / "scenes" / "default.json", {"sun.transform.aim=[0,-1,0]"}),
+               {"aim", "direction", "look_at"});
+}
+
+// A glTF with a directional light on a node whose name has a dot, and no meshes.
+const char* kLitGltf = R"({"asset": {"version": "2.0"},
+  "extensionsUsed": ["KHR_lights_punctual"],
+  "extensions": {"KHR_lights_punctual": {"lights": [{"type": "directional", "intensity": 3}]}},
+  "nodes": [{"name": "Sun.001", "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+  "scenes": [{"nodes": [0]}], "scene": 0})";
+
+TEST(SceneIo, ImportedLightsTakeTheSceneShadowSettingsAndAnswerToSetByNodeName) {
+  write_file("lit.gltf", kLitGltf);
+  const fs::path file = write_file(
+      "lit_scene.json",
+      R"({"shadow": {"map_size": 1024}, "entities": [{"name": "m", "model": {"path": "lit.gltf"}}]})");
+  std::vector<std::string> later;
+  auto s = read_scene(file,
+                      {"shadow.cascade_count=3", "Sun.001.light.intensity=2",
+                       "Sun.001.shadow.filter=none", "Sun.001.transform.direction=[1,-1,0]"},
+                      &later);
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  ASSERT_EQ(later.size(), 3u);  // the node does not exist before instantiation
+  ASSERT_TRUE(instantiate_scene(*s).ok());
+  const ecs::Entity sun = find(*s, "Sun.001");
+  ASSERT_TRUE(sun.valid());
+  // Scene-wide settings, --set shadow.* included, reach the imported light.
+  EXPECT_EQ(s->world.get<ShadowSettings>(sun).map_size, 1024);
+  EXPECT_EQ(s->world.get<ShadowSettings>(sun).cascade_count, 3);
+  EXPECT_TRUE(s->world.get<Light>(sun).cast_shadows);
+  for (const std::string& o : later) ASSERT_TRUE(apply_entity_override(*s, o).ok()) << o;
+  EXPECT_FLOAT_EQ(s->world.get<Light>(sun).intensity, 2.0f);
+  EXPECT_EQ(s->world.get<ShadowSettings>(sun).filter, ShadowFilter::none);
+  EXPECT_EQ(s->world.get<ShadowSettings>(sun).map_size, 1024);  // the rest is kept
+  const glm::vec3 d = s->world.get<Transform>(sun).rotation * glm::vec3(0, 0, -1);
+  EXPECT_NEAR(d.x, std::sqrt(0.5f), 1e-5f);
+  // Bad values and unknown names are errors naming the key and listing what exists.
+  auto bad = apply_entity_override(*s, "Sun.001.light.intensity=-1");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().to_string().find("intensity"), std::string::npos) << bad.error().to_string();
+  auto unknown = apply_entity_override(*s, "Moon.light.intensity=1");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().to_string().find("Sun.001"), std::string::npos)
+      << unknown.error().to_string();
+  auto section = apply_entity_override(*s, "Sun.001.reflector.amount=1");
+  ASSERT_FALSE(section.ok());
+  EXPECT_NE(section.error().to_string().find("valid keys here: light, shadow, transform"),
+            std::string::npos)
+      << section.error().to_string();
+}
+
+TEST(SceneIo, GroundCoversTheFootprintAndTheShadowOfTheBounds) {
+  const Aabb model = Aabb::from_corners({-1, 2, -1}, {1, 4, 1});  // 2 m tall, floating at 2
+  // Straight down: the footprint plus a quarter of the size (|extent| = sqrt(12)) around.
+  const Aabb down = ground_extent(model, {0, -1, 0});
+  const float margin = 0.25f * std::sqrt(12.0f);
+  EXPECT_NEAR(down.min.x, -1.0f - margin, 1e-5f);
+  EXPECT_NEAR(down.max.z, 1.0f + margin, 1e-5f);
+  EXPECT_NEAR(down.min.y, 2.0f, 1e-3f);
+  EXPECT_LT(down.min.y, 2.0f);  // just under the lowest point
+  // 45 degrees towards +x: the top's shadow lands 2 m further along +x.
+  const Aabb slanted = ground_extent(model, glm::normalize(glm::vec3(1, -1, 0)));
+  EXPECT_NEAR(slanted.max.x, 1.0f + 2.0f + margin, 1e-4f);
+  EXPECT_NEAR(slanted.min.x, -1.0f - margin, 1e-4f);
+  // A grazing light is taken at about 14 degrees: a shadow 4x the height long, not infinite.
+  const Aabb grazing = ground_extent(model, glm::normalize(glm::vec3(1, -0.01f, 0)));
+  EXPECT_LT(grazing.max.x, 1.0f + 4.0f * 2.0f + margin + 1e-3f);
+  EXPECT_GT(grazing.max.x, 1.0f + 3.8f * 2.0f);
 }
 
 }  // namespace

@@ -131,6 +131,35 @@ TEST(ShadowCascadeSystem, VisibleReceiverDepthsClipBoxesToTheFrustum) {
   EXPECT_NEAR(g.far, 100.0f, 1e-3f);
 }
 
+TEST(ShadowCascadeSystem, TheRangeKeepsLastFramesWhileItStillFits) {
+  ecs::World w;
+  sun(w, ShadowSettings{});
+  const ecs::Entity box = mesh(w, Aabb::from_corners({-1, -1, -20}, {1, 0, -2.7f}));
+  ShadowCascadeState state;
+  const ShadowData first = update_shadow_cascades(w, camera(w), state);
+  ASSERT_TRUE(first.light.valid()) << first.error;
+  // [2.7, 20] -> [2^1.25 = 2.38, 2^4.5 = 22.6]. The receiver's near end moves past the grid
+  // point 2^1.5 = 2.83: a fresh fit takes [2.83, 22.6], the carried range stays while it fits.
+  w.get<WorldBounds>(box).box = Aabb::from_corners({-1, -1, -20.5f}, {1, 0, -2.95f});
+  ShadowCascadeState no_history;
+  EXPECT_NEAR(update_shadow_cascades(w, camera(w), no_history).near_used, 2.83f, 0.01f);
+  const ShadowData second = update_shadow_cascades(w, camera(w), state);
+  EXPECT_NEAR(first.near_used, 2.38f, 0.01f);
+  EXPECT_EQ(second.near_used, first.near_used);
+  EXPECT_EQ(second.far_used, first.far_used);
+  EXPECT_EQ(second.splits, first.splits);
+  // Past the carried range it must follow: the new far is seen.
+  w.get<WorldBounds>(box).box = Aabb::from_corners({-1, -1, -30}, {1, 0, -2.95f});
+  const ShadowData third = update_shadow_cascades(w, camera(w), state);
+  EXPECT_GE(third.far_used, 30.0f);
+  // Much tighter than the carried range: it shrinks again.
+  w.get<WorldBounds>(box).box = Aabb::from_corners({-1, -1, -8}, {1, 0, -2.95f});
+  const ShadowData fourth = update_shadow_cascades(w, camera(w), state);
+  EXPECT_LT(fourth.far_used, 10.0f);
+  ShadowCascadeState fresh;
+  EXPECT_EQ(update_shadow_cascades(w, camera(w), fresh).far_used, fourth.far_used);
+}
+
 TEST(ShadowCascadeSystem, QuantisedRangesAreStableUnderSmallChanges) {
   const DepthRange a = quantize_depth_range({3.0f, 700.0f});
   EXPECT_LE(a.near, 3.0f);
