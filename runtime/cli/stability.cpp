@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "components/transform.h"
 #include "systems/transform_system.h"
@@ -80,8 +81,16 @@ Result<StabilityRun> measure_stability(Player& player, Scene& scene, const Stabi
       status = values.error();
       break;
     }
+    // Only points the camera sees count: one that the path has carried out of the view is
+    // outside every cascade's fitted volume, and what its lookup returns there is nobody's
+    // picture (NaN: shadow_stability() skips non-finite samples).
+    const glm::mat4 view_proj = report.camera.proj * report.camera.view;
     std::vector<float> v(values->size());
-    std::transform(values->begin(), values->end(), v.begin(), [](glm::vec2 x) { return x.x; });
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const glm::vec4 c = view_proj * glm::vec4(points.positions[i], 1.0f);
+      const bool seen = std::abs(c.x) <= c.w && std::abs(c.y) <= c.w && std::abs(c.z) <= c.w;
+      v[i] = seen ? (*values)[i].x : std::numeric_limits<float>::quiet_NaN();
+    }
     run.visibility.push_back(std::move(v));
   }
   scene.world.get<Transform>(camera.entity) = original;

@@ -34,7 +34,8 @@ struct CameraPath {
 struct StabilityRun {
   reference::StabilityStats stats;
   float step = 0.0f;  ///< metres per frame actually used
-  /// visibility[f][p]: point p in frame f (for tests and dumps).
+  /// visibility[f][p]: point p in frame f (for tests and dumps); NaN while the point is outside
+  /// the camera's view (not counted by shadow_stability()).
   std::vector<std::vector<float>> visibility;
 };
 

@@ -230,7 +230,10 @@ TEST_F(DefaultSceneTest, StableCascadesDoNotShimmerUnderSubTexelCameraMoves) {
                              "camera.camera.projection=orthographic", "camera.camera.ortho_height=16",
                              tx, "camera.transform.rotation=[-0.70710678,0,0,0.70710678]",
                              "shadow.map_size=256", "shadow.cascade_count=4",
-                             std::string("shadow.fit_mode=") + fit});
+                             // The split scheme this test was written with: its thin auto
+                             // slabs put 3 of 195k PCF taps within float rounding of a texel
+                             // edge here (they flip n/9 with filter pcf3x3, none with none).
+                             "shadow.split_scheme=mixed", std::string("shadow.fit_mode=") + fit});
     EXPECT_TRUE(scene.ok()) << scene.error().to_string();
     auto t = render_frames(*player_, *scene, {});
     EXPECT_TRUE(t.ok()) << t.error().to_string();
