@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <cstdio>
 #include <string>
 
@@ -27,10 +29,10 @@ struct Case {
 };
 
 std::string case_name(const ::testing::TestParamInfo<Case>& info) {
-  std::string m = info.param.model;
-  m = m.substr(0, m.find('/'));
-  return m + "_k" + (info.param.k < 0 ? "m" + std::to_string(-info.param.k)
-                                       : std::to_string(info.param.k));
+  const std::string m = info.param.model;
+  char k[16];
+  std::snprintf(k, sizeof k, "_k%s%d", info.param.k < 0 ? "m" : "", std::abs(info.param.k));
+  return m.substr(0, m.find('/')) + k;
 }
 
 class ScaleSweepTest : public PlayerTest, public ::testing::WithParamInterface<Case> {};
@@ -102,6 +104,55 @@ std::vector<Case> cases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, ScaleSweepTest, ::testing::ValuesIn(cases()), case_name);
+
+}  // namespace
+}  // namespace kaskad
+
+namespace kaskad {
+namespace {
+
+class AspectTest : public PlayerTest {};
+
+// A camera with aspect 1 rendered at 16:9: the output is fitted to 180x180 and a sphere in the
+// middle of the view stays round (its mask is as wide as it is tall), never stretched 1.78x.
+TEST_F(AspectTest, ACameraWithItsOwnAspectIsFittedNotStretched) {
+  const std::filesystem::path dir = std::filesystem::path(KASKAD_TEST_TMP) / "aspect";
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path file = dir / "square_camera.json";
+  std::FILE* f = std::fopen(file.c_str(), "wb");
+  ASSERT_NE(f, nullptr);
+  std::fputs(R"({"entities": [
+    {"name": "ball", "primitive": {"shape": "sphere", "segments": 64}},
+    {"name": "sun", "transform": {"direction": [0, -1, -0.2]}, "light": {"type": "directional"}},
+    {"name": "camera", "transform": {"translation": [0, 0, 4], "look_at": [0, 0, 0]},
+     "camera": {"fov_y_deg": 30, "aspect": 1, "active": true}}]})",
+             f);
+  std::fclose(f);
+  auto scene = load_scene(file, {"render.width=320", "render.height=180"});
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  EXPECT_EQ(scene->render.width, 180);
+  EXPECT_EQ(scene->render.height, 180);
+  auto t = render_frames(*player_, *scene, {});
+  ASSERT_TRUE(t.ok()) << t.error().to_string();
+  const Image aov = player_->renderer->read_aovs();
+  ASSERT_EQ(aov.width, 180);
+  int x0 = aov.width, x1 = -1, y0 = aov.height, y1 = -1;
+  for (int y = 0; y < aov.height; ++y)
+    for (int x = 0; x < aov.width; ++x)
+      if (aov.at(x, y, 8) > 0.5f) {
+        x0 = std::min(x0, x);
+        x1 = std::max(x1, x);
+        y0 = std::min(y0, y);
+        y1 = std::max(y1, y);
+      }
+  ASSERT_GT(x1, x0);
+  EXPECT_NEAR(double(x1 - x0), double(y1 - y0), 1.0) << "the sphere is not round";
+  // The glTF camera of 2CylinderEngine (aspectRatio 1) the same way.
+  auto engine = load_scene(content_dir() / "models/2CylinderEngine/glTF-Draco/2CylinderEngine.gltf",
+                           {"render.width=320", "render.height=180"});
+  ASSERT_TRUE(engine.ok()) << engine.error().to_string();
+  EXPECT_EQ(engine->render.width, engine->render.height);
+}
 
 }  // namespace
 }  // namespace kaskad
