@@ -167,5 +167,23 @@ done
 check bad_reflector nonzero "reflections.json.*/entities/1/reflector/faces_per_frame.*\[1, 6\]" -- \
   "$KASKAD" render "$KASKAD_CONTENT/scenes/reflections.json" --headless --set mirror_sphere.reflector.faces_per_frame=9
 
+# Content at any scale: a bare glTF gets a ground, its shadow, splits that follow the model, and
+# its own nodes answer to --set by name; kaskad info SCENE lists them.
+check gltf_scaled_shadows 0 "splits 1[.0-9]*e\+05 [0-9.e+ ]*e\+05 m" -- "$KASKAD" render \
+  "$KASKAD_CONTENT/models/Fox/glTF/Fox.gltf" --headless --size 160x90 --frames 1 -o "$tmp/fox.png" \
+  --set "model.transform.scale=[1000,1000,1000]"
+check gltf_ground_listed 0 "^  ground +transform renderer" -- "$KASKAD" info \
+  "$KASKAD_CONTENT/models/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf"
+check gltf_node_set 0 "wrote" -- "$KASKAD" render \
+  "$KASKAD_CONTENT/models/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf" --headless --size 160x90 \
+  --frames 1 -o "$tmp/truck.png" --set "node_4.transform.scale=[2,2,2]" \
+  --set "sun.transform.direction=[0.2,-1,0.1]" --set ground.renderer.receive_shadows=false
+check gltf_node_unknown nonzero "no setting section or entity named 'wheels'.*node_4" -- "$KASKAD" \
+  render "$KASKAD_CONTENT/models/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf" --headless \
+  --set wheels.transform.scale=2
+check gltf_aspect_fitted 0 "output 90x90 \(fitted inside 160x90\)" -- "$KASKAD" render \
+  "$KASKAD_CONTENT/models/2CylinderEngine/glTF-Draco/2CylinderEngine.gltf" --headless \
+  --size 160x90 --frames 1 -o "$tmp/engine.png"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
