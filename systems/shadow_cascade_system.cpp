@@ -488,7 +488,7 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
   }
   if (out.empty()) out.emplace_back();
   if (notice != state.last_notice) {
-    if (!notice.empty()) log::warn("shadows: %s", notice.c_str());
+    if (!notice.empty()) log::warn_once("shadows: %s", notice.c_str());
     state.last_notice = notice;
   }
   return out;

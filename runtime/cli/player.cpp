@@ -49,6 +49,7 @@ glm::vec3 sun_direction(const ecs::World& world) {
 
 Result<Scene> load_scene(const std::filesystem::path& file,
                          const std::vector<std::string>& overrides) {
+  log::set_context(file.string());  // per-frame warnings name the scene they come from
   std::vector<std::string> later;  // overrides of entities the document does not hold
   auto scene = read_scene(file, overrides, &later);
   if (!scene) return scene.error();

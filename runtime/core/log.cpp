@@ -41,19 +41,30 @@ void error(const char* fmt, ...) {
   va_end(args);
 }
 
+namespace {
+std::mutex g_once_mutex;
+std::set<std::string> g_said;  // warn_once() messages already printed
+std::string g_context;
+}  // namespace
+
+void set_context(const std::string& context) {
+  const std::lock_guard<std::mutex> lock(g_once_mutex);
+  g_context = context;
+}
+
 void warn_once(const char* fmt, ...) {
-  static std::mutex mutex;
-  static std::set<std::string> said;
   char buf[1024];
   va_list args;
   va_start(args, fmt);
   std::vsnprintf(buf, sizeof buf, fmt, args);
   va_end(args);
+  std::string message;
   {
-    const std::lock_guard<std::mutex> lock(mutex);
-    if (!said.insert(buf).second) return;
+    const std::lock_guard<std::mutex> lock(g_once_mutex);
+    message = g_context.empty() ? std::string(buf) : g_context + ": " + buf;
+    if (!g_said.insert(message).second) return;
   }
-  warn("%s", buf);
+  warn("%s", message.c_str());
 }
 
 int error_count() { return g_errors; }

@@ -18,8 +18,12 @@ void info(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 void warn(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 void error(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 /// warn(), but each distinct message only the first time: for conditions found again every
-/// frame (a parent cycle, too many lights).
+/// frame (a parent cycle, too many lights). Prefixed with the context (set_context()).
 void warn_once(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+
+/// What warn_once() messages are about, e.g. the scene file being played ("" for none). The
+/// player sets it when it loads a scene; the systems know entities, not files.
+void set_context(const std::string& context);
 
 /// Number of error-level messages logged since start (or the last reset).
 int error_count();

@@ -4,6 +4,8 @@
 
 #include "components/camera.h"
 #include "components/mesh_renderer.h"
+#include "components/name.h"
+#include "runtime/core/log.h"
 #include "components/transform.h"
 #include "runtime/assets/primitives.h"
 #include "systems/camera_system.h"
@@ -40,6 +42,29 @@ TEST(TransformSystem, CyclesAndStaleParentsBecomeRoots) {
   EXPECT_TRUE(w.has<WorldTransform>(a));
   EXPECT_TRUE(w.has<WorldTransform>(b));
   EXPECT_FLOAT_EQ(w.get<WorldTransform>(c).matrix[3].z, 5.0f);
+}
+
+TEST(TransformSystem, ACycleIsReportedOnceWithTheNamesAndTheScene) {
+  ecs::World w;
+  AssetStore assets;
+  const ecs::Entity a = w.create(), b = w.create();
+  w.emplace<Transform>(a, Transform{{1, 0, 0}, {1, 0, 0, 0}, glm::vec3(1.0f), b});
+  w.emplace<Transform>(b, Transform{{0, 1, 0}, {1, 0, 0, 0}, glm::vec3(1.0f), a});
+  w.emplace<Name>(a, Name{"arm"});
+  w.emplace<Name>(b, Name{"hand"});
+  log::set_context("cycle_test.json");
+  ::testing::internal::CaptureStderr();
+  for (int frame = 0; frame < 5; ++frame) update_transforms(w, assets);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  log::set_context("");
+  std::size_t count = 0;
+  for (std::size_t at = err.find("parent cycle"); at != std::string::npos;
+       at = err.find("parent cycle", at + 1))
+    ++count;
+  EXPECT_EQ(count, 1u) << err;
+  EXPECT_NE(err.find("cycle_test.json: entity '"), std::string::npos) << err;
+  EXPECT_NE(err.find("'arm'"), std::string::npos) << err;
+  EXPECT_NE(err.find("'hand'"), std::string::npos) << err;
 }
 
 TEST(TransformSystem, WorldBoundsFollowTheMesh) {
