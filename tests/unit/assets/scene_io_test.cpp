@@ -469,6 +469,14 @@ TEST(SceneIo, ImportedLightsTakeTheSceneShadowSettingsAndAnswerToSetByNodeName) 
       << section.error().to_string();
 }
 
+TEST(SceneIo, AParentCycleIsALoadErrorNamingTheChain) {
+  expect_error(read_scene(write_file("cycle.json", R"({"entities": [
+    {"name": "a", "transform": {"parent": "c"}},
+    {"name": "b", "transform": {"parent": "a"}},
+    {"name": "c", "transform": {"parent": "b"}}]})")),
+               {"cycle.json", "/entities/0/transform/parent", "parent cycle: a -> c -> b -> a"});
+}
+
 TEST(SceneIo, GroundCoversTheFootprintAndTheShadowOfTheBounds) {
   const Aabb model = Aabb::from_corners({-1, 2, -1}, {1, 4, 1});  // 2 m tall, floating at 2
   // Straight down: the footprint plus a quarter of the size (|extent| = sqrt(12)) around.
