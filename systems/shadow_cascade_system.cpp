@@ -178,8 +178,19 @@ DepthRange visible_receiver_depths(const glm::mat4& view, const glm::mat4& view_
   };
   std::vector<glm::dvec3> poly, next;
   for (const Aabb& b : receivers) {
-    if (b.empty() || !maybe_inside(clip_corners(view_proj, b))) continue;
+    if (b.empty()) continue;
+    const auto clip = clip_corners(view_proj, b);
+    if (!maybe_inside(clip)) continue;
     const glm::dvec3 lo(b.min), hi(b.max);
+    // Wholly inside (the common case): its corners are the vertices.
+    bool inside = true;
+    for (const glm::vec4& c : clip)
+      inside = inside && std::abs(c.x) <= c.w && std::abs(c.y) <= c.w && std::abs(c.z) <= c.w;
+    if (inside) {
+      for (int i = 0; i < 8; ++i)
+        add({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
+      continue;
+    }
     // Each face of the box as a quad, clipped by the 6 planes (Sutherland-Hodgman).
     for (int axis = 0; axis < 3; ++axis)
       for (int side = 0; side < 2; ++side) {

@@ -160,6 +160,46 @@ TEST(ShadowCascadeSystem, TheRangeKeepsLastFramesWhileItStillFits) {
   EXPECT_EQ(update_shadow_cascades(w, camera(w), fresh).far_used, fourth.far_used);
 }
 
+TEST(ShadowCascadeSystem, VisibleReceiverDepthsMatchDenseSamplingOfRandomBoxes) {
+  // Invariant: the exact range holds every sampled point of box and frustum, and no sampled
+  // point lies more than a sample spacing inside either end.
+  const glm::mat4 view = glm::lookAt(glm::vec3(0, 2, 0), glm::vec3(3, 0, -10), glm::vec3(0, 1, 0));
+  const glm::mat4 proj = glm::perspective(glm::radians(40.0f), 1.6f, 0.5f, 60.0f);
+  std::uint32_t seed = 12345;
+  auto rnd = [&](float lo, float hi) {
+    seed = seed * 1664525u + 1013904223u;
+    return lo + (hi - lo) * float(seed >> 8) / float(1u << 24);
+  };
+  int compared = 0;
+  for (int n = 0; n < 200; ++n) {
+    const glm::vec3 c{rnd(-30, 30), rnd(-10, 10), rnd(-70, 5)};
+    const glm::vec3 h{rnd(0.1f, 15), rnd(0.0f, 5), rnd(0.1f, 15)};
+    const Aabb box = Aabb::from_corners(c - h, c + h);
+    const DepthRange exact = visible_receiver_depths(view, proj * view, std::array{box});
+    constexpr int kSteps = 24;
+    float lo = std::numeric_limits<float>::max(), hi = 0.0f;
+    for (int i = 0; i <= kSteps; ++i)
+      for (int j = 0; j <= kSteps; ++j)
+        for (int k = 0; k <= kSteps; ++k) {
+          const glm::vec3 p = box.min + (box.max - box.min) * glm::vec3(i, j, k) / float(kSteps);
+          const glm::vec4 q = proj * view * glm::vec4(p, 1.0f);
+          if (std::abs(q.x) > q.w || std::abs(q.y) > q.w || std::abs(q.z) > q.w) continue;
+          const float d = -(view * glm::vec4(p, 1.0f)).z;
+          lo = std::min(lo, d);
+          hi = std::max(hi, d);
+        }
+    if (hi == 0.0f) continue;  // no sample inside: nothing to compare
+    ++compared;
+    ASSERT_FALSE(exact.empty()) << n;
+    const float spacing = 1.01f * glm::length(box.max - box.min) / float(kSteps);
+    EXPECT_LE(exact.near, lo + 1e-3f) << n;
+    EXPECT_GE(exact.far, hi - 1e-3f) << n;
+    EXPECT_GE(exact.near, lo - spacing) << n;
+    EXPECT_LE(exact.far, hi + spacing) << n;
+  }
+  EXPECT_GT(compared, 50);
+}
+
 TEST(ShadowCascadeSystem, QuantisedRangesAreStableUnderSmallChanges) {
   const DepthRange a = quantize_depth_range({3.0f, 700.0f});
   EXPECT_LE(a.near, 3.0f);
