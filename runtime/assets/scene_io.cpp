@@ -439,7 +439,11 @@ Result<json> read_scene_document(const fs::path& file) {
     auto report = import_gltf(file, probe.world, probe.assets, ecs::kNullEntity, ecs::kNullEntity,
                               false);
     if (!report) return report.error();
-    json doc = {{"kaskad_scene", kFormatVersion}, {"entities", json::array()}};
+    // A bare model gets a ground to catch its shadow; saved as "on", so the saved scene file
+    // renders the same.
+    json doc = {{"kaskad_scene", kFormatVersion},
+                {"render", {{"ground", "on"}}},
+                {"entities", json::array()}};
     doc["entities"].push_back({{"name", "model"}, {"model", {{"path", file.filename().string()}}}});
     if (report->cameras == 0) {
       // Default camera: looks at the model from the front, slightly above; auto_frame backs it

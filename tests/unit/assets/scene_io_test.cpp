@@ -279,6 +279,8 @@ TEST(SceneIo, GltfFileIsWrappedWithDefaultCameraAndSun) {
   EXPECT_TRUE(find(*s, "camera").valid());
   EXPECT_TRUE(find(*s, "sun").valid());
   EXPECT_TRUE(s->world.get<Camera>(find(*s, "camera")).auto_frame);
+  EXPECT_TRUE(s->world.get<Light>(find(*s, "sun")).cast_shadows);
+  EXPECT_EQ(s->render.ground, GroundMode::on);  // saved as such: the saved file renders the same
   auto overridden = read_scene(kContent / "models/Box/glTF-Binary/Box.glb", {"sun.light.intensity=7"});
   ASSERT_TRUE(overridden.ok()) << overridden.error().to_string();
   EXPECT_FLOAT_EQ(overridden->world.get<Light>(find(*overridden, "sun")).intensity, 7.0f);
