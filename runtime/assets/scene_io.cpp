@@ -531,6 +531,16 @@ Status set_field(json* node, const std::vector<std::string>& parts, const std::s
   return {};
 }
 
+// Reads `block` over entity e's component C with the scene file's reader for it (validated,
+// the fields it does not name kept).
+template <typename C, typename Read>
+void reread(ecs::World& w, ecs::Entity e, const json& block, const std::string& where, Read read) {
+  C c = w.get<C>(e);
+  ObjectReader r(block, where);
+  read(r, c);
+  w.get<C>(e) = c;
+}
+
 // Whether the first part of `key` names a settings section or an entity of the document.
 bool document_holds(const json& doc, const std::string& key) {
   const std::string first = key.substr(0, key.find('.'));
@@ -612,32 +622,20 @@ Status apply_entity_override(Scene& scene, const std::string& assignment) {
   const std::string& section = parts[0];
   const std::string where = "/" + name + "/" + section;
   try {
+    const json& block = ej[section];
     if (section == "transform") {
-      Transform t = w.get<Transform>(e);
-      ObjectReader tr(ej["transform"], where);
-      read_transform(tr, t);
-      tr.finish();
-      w.get<Transform>(e) = t;
+      reread<Transform>(w, e, block, where, [](ObjectReader& r, Transform& t) {
+        read_transform(r, t);
+        r.finish();
+      });
     } else if (section == "light") {
-      Light l = w.get<Light>(e);
-      ObjectReader lr(ej["light"], where);
-      read_light(lr, l);
-      w.get<Light>(e) = l;
+      reread<Light>(w, e, block, where, [](ObjectReader& r, Light& l) { read_light(r, l); });
     } else if (section == "shadow") {
-      ShadowSettings s = w.get<ShadowSettings>(e);
-      ObjectReader sr(ej["shadow"], where);
-      read_shadow(sr, s);
-      w.get<ShadowSettings>(e) = s;
+      reread<ShadowSettings>(w, e, block, where, read_shadow);
     } else if (section == "camera") {
-      Camera c = w.get<Camera>(e);
-      ObjectReader cr(ej["camera"], where);
-      read_camera(cr, c);
-      w.get<Camera>(e) = c;
+      reread<Camera>(w, e, block, where, read_camera);
     } else if (section == "renderer") {
-      MeshRenderer m = w.get<MeshRenderer>(e);
-      ObjectReader rr(ej["renderer"], where);
-      read_renderer(rr, m);
-      w.get<MeshRenderer>(e) = m;
+      reread<MeshRenderer>(w, e, block, where, read_renderer);
     } else {
       return Error{"--set", key, "'" + section + "' of '" + name +
                                      "' cannot be set on an imported entity; it takes transform, "
