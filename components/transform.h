@@ -3,7 +3,10 @@
 #pragma once
 
 #include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
+
+#include <cmath>
 
 #include "runtime/ecs/entity.h"
 
@@ -15,6 +18,15 @@ struct Transform {
   glm::vec3 scale{1.0f};                           ///< per-axis scale factor
   ecs::Entity parent = ecs::kNullEntity;           ///< null for a root entity
 };
+
+/// The rotation that turns the local -Z axis (where lights shine and cameras look) to the unit
+/// `direction`, keeping +Y up (-Z up when looking straight up or down). The one definition of
+/// "direction" and "look_at" in scene files, --set and playback files.
+inline glm::quat look_rotation(const glm::vec3& direction) {
+  const glm::vec3 up = std::abs(direction.y) > 0.999f ? glm::vec3(0, 0, -1) : glm::vec3(0, 1, 0);
+  // lookAt builds world->view; its inverse rotation is the entity's orientation.
+  return glm::quat_cast(glm::inverse(glm::mat3(glm::lookAt(glm::vec3(0), direction, up))));
+}
 
 /// Derived by the TransformSystem: local-to-world matrix (parent chain applied).
 struct WorldTransform {

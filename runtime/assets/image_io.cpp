@@ -7,6 +7,8 @@
 #include "runtime/assets/image_io.h"
 
 #include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -367,6 +369,36 @@ std::vector<std::uint8_t> to_rgba8(const Image& image) {
     out[p * 4 + 2] = to_unorm8(c >= 3 ? s[2] : s[0]);
     out[p * 4 + 3] = to_unorm8(c == 2 ? s[1] : c >= 4 ? s[3] : 1.0f);
   }
+  return out;
+}
+
+Result<ImageDiff> compare_images(const Image& a, const Image& b, float fail_threshold,
+                                 float warn_threshold, float diff_scale) {
+  if (a.width != b.width || a.height != b.height || a.channels != b.channels)
+    return Error{"", "image compare",
+                 "sizes differ: " + std::to_string(a.width) + "x" + std::to_string(a.height) + "x" +
+                     std::to_string(a.channels) + " against " + std::to_string(b.width) + "x" +
+                     std::to_string(b.height) + "x" + std::to_string(b.channels)};
+  const OIIO::ImageSpec spec(a.width, a.height, a.channels, OIIO::TypeDesc::FLOAT);
+  // ImageBuf wraps the caller's memory: OIIO does not write through a const view.
+  OIIO::ImageBuf ba(spec, const_cast<float*>(a.pixels.data()));
+  OIIO::ImageBuf bb(spec, const_cast<float*>(b.pixels.data()));
+  const auto r = OIIO::ImageBufAlgo::compare(ba, bb, fail_threshold, warn_threshold);
+  // CompareResults::error is also set when pixels fail (OIIO 2.4): only the buffers' own
+  // errors mean the comparison itself failed.
+  if (ba.has_error() || bb.has_error())
+    return Error{"", "image compare", "OpenImageIO: " + ba.geterror() + bb.geterror()};
+  ImageDiff out;
+  out.max_error = r.maxerror;
+  out.mean_error = r.meanerror;
+  out.failing = std::size_t(r.nfail);
+  out.warning = std::size_t(r.nwarn);
+  out.pixels = std::size_t(a.width) * std::size_t(a.height);
+  out.diff = a;
+  for (std::size_t i = 0; i < out.diff.pixels.size(); ++i)
+    out.diff.pixels[i] = std::min(1.0f, std::abs(a.pixels[i] - b.pixels[i]) * diff_scale);
+  if (a.channels == 4)  // an opaque picture of the colour differences
+    for (std::size_t i = 3; i < out.diff.pixels.size(); i += 4) out.diff.pixels[i] = 1.0f;
   return out;
 }
 

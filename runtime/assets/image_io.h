@@ -43,4 +43,18 @@ std::vector<std::uint8_t> to_rgba8(const Image& image);
 /// reorder its channels (OIIO puts R, G, B, A first): look channels up by name.
 Status save_image(const std::filesystem::path& path, const Image& image);
 
+/// How two images of the same size differ (OpenImageIO's ImageBufAlgo::compare, as idiff).
+struct ImageDiff {
+  double max_error = 0.0;       ///< largest per-channel difference
+  double mean_error = 0.0;      ///< mean per-channel difference
+  std::size_t failing = 0;      ///< pixels with a channel difference above fail_threshold
+  std::size_t warning = 0;      ///< pixels above warn_threshold
+  std::size_t pixels = 0;
+  Image diff;                   ///< |a - b| per channel, scaled by `diff_scale` for viewing
+};
+
+/// Compares `a` with `b` (same width, height and channels, else an error naming both sizes).
+Result<ImageDiff> compare_images(const Image& a, const Image& b, float fail_threshold,
+                                 float warn_threshold, float diff_scale = 10.0f);
+
 }  // namespace kaskad

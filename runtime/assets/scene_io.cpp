@@ -166,10 +166,7 @@ void read_rotation(ObjectReader& r, Transform& t) {
     }
     const char* key = r.has("look_at") ? "look_at" : "direction";
     if (glm::length(dir) < 1e-6f) fail(r.at(key), "direction has zero length");
-    dir = glm::normalize(dir);
-    const glm::vec3 up = std::abs(dir.y) > 0.999f ? glm::vec3(0, 0, -1) : glm::vec3(0, 1, 0);
-    // lookAt builds world->view; its inverse rotation is the entity's orientation.
-    t.rotation = glm::quat_cast(glm::inverse(glm::mat3(glm::lookAt(glm::vec3(0), dir, up))));
+    t.rotation = look_rotation(glm::normalize(dir));
   }
 }
 
@@ -185,6 +182,17 @@ Material read_inline_material(ObjectReader& mr) {
   mr.finish();
   m.features = derive_material_features(m);
   return m;
+}
+
+void read_render(ObjectReader& r, RenderSettings& s) {
+  r.integer("width", s.width, 1, 16384);
+  r.integer("height", s.height, 1, 16384);
+  r.vector<3>("ambient", s.ambient, 0.0f, 1.0e4f);
+  r.vector<3>("clear_color", s.clear_color, 0.0f, 1.0e4f);
+  r.number("exposure", s.exposure, 0.0f, 1.0e4f);
+  r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
+  r.enumeration("ground", s.ground, kGroundModes);
+  r.finish();
 }
 
 // One reader per component block, shared by scene files and --set on imported entities.
@@ -576,6 +584,42 @@ Status apply_override(json& doc, const std::string& assignment) {
   return set_field(node, parts, key, text);
 }
 
+Status apply_live_override(Scene& scene, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    return Error{"--set", assignment, "expected key=value, e.g. shadow.map_size=2048"};
+  const std::string section = assignment.substr(0, assignment.find('.'));
+  if (section != "render" && section != "shadow") return apply_entity_override(scene, assignment);
+  json doc = scene_to_json(scene);
+  KASKAD_TRY(apply_override(doc, assignment));
+  try {
+    if (section == "render") {
+      RenderSettings r = scene.render;
+      ObjectReader rr(doc["render"], "/render");
+      read_render(rr, r);
+      scene.render = r;
+      return {};
+    }
+    // Scene-wide shadow defaults: every light takes the new value unless it overrides that
+    // field itself, as when the file is loaded.
+    ShadowSettings defaults;
+    ObjectReader sr(doc["shadow"], "/shadow");
+    read_shadow(sr, defaults);
+    std::vector<std::pair<ecs::Entity, ShadowSettings>> lights;
+    scene.world.view<ShadowSettings>().each([&](ecs::Entity e, const ShadowSettings& own) {
+      ShadowSettings s = defaults;
+      ObjectReader lr(write_shadow(own, &scene.shadow_defaults), "/shadow");
+      read_shadow(lr, s);
+      lights.emplace_back(e, s);
+    });
+    for (auto& [e, s] : lights) scene.world.get<ShadowSettings>(e) = s;
+    scene.shadow_defaults = defaults;
+  } catch (const ContentError& err) {
+    return Error{"--set", err.where, err.message};
+  }
+  return {};
+}
+
 Status apply_entity_override(Scene& scene, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
@@ -636,10 +680,12 @@ Status apply_entity_override(Scene& scene, const std::string& assignment) {
       reread<Camera>(w, e, block, where, read_camera);
     } else if (section == "renderer") {
       reread<MeshRenderer>(w, e, block, where, read_renderer);
+    } else if (section == "reflector" && w.has<Reflector>(e)) {
+      reread<Reflector>(w, e, block, where, read_reflector);
     } else {
       return Error{"--set", key, "'" + section + "' of '" + name +
-                                     "' cannot be set on an imported entity; it takes transform, "
-                                     "light, shadow, camera and renderer"};
+                                     "' cannot be set on a loaded entity; it takes transform, "
+                                     "light, shadow, camera, renderer and reflector"};
     }
   } catch (const ContentError& err) {
     return Error{"--set", err.where, err.message};
@@ -656,15 +702,7 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
     root.integer("kaskad_scene", version, 1, kFormatVersion);
     if (root.has("render")) {
       ObjectReader r(root.raw("render"), "/render");
-      RenderSettings& s = scene.render;
-      r.integer("width", s.width, 1, 16384);
-      r.integer("height", s.height, 1, 16384);
-      r.vector<3>("ambient", s.ambient, 0.0f, 1.0e4f);
-      r.vector<3>("clear_color", s.clear_color, 0.0f, 1.0e4f);
-      r.number("exposure", s.exposure, 0.0f, 1.0e4f);
-      r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
-      r.enumeration("ground", s.ground, kGroundModes);
-      r.finish();
+      read_render(r, scene.render);
     }
     if (root.has("shadow")) {
       ObjectReader r(root.raw("shadow"), "/shadow");

@@ -54,6 +54,13 @@ Status apply_entity_override(Scene& scene, const std::string& assignment);
 /// auto_frame are framed by the load phase (load_scene in runtime/cli/player.h).
 Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest = nullptr);
 
+/// One --set assignment on a loaded scene, between frames (playback timelines, the editor):
+/// "render.FIELD" and "shadow.FIELD" (every light takes a new scene-wide shadow value unless it
+/// overrides that field, as at load) by a round trip through the canonical document, entity
+/// keys by apply_entity_override(). Validated as in scene files; the scene is unchanged on error.
+/// render.width/height change the setting only (the player's targets keep their size).
+Status apply_live_override(Scene& scene, const std::string& assignment);
+
 /// Where a ground for `models` (their world bounds) goes: a flat box at min.y (a hair below)
 /// covering their footprint and the shadow their bounds cast along `light_direction` (lights
 /// below about 14 degrees of elevation count as 14), with a margin of a quarter of their size.

@@ -65,7 +65,7 @@ std::string clock_text(double seconds) {
   return buf;
 }
 
-void progress(std::size_t done, std::size_t total, double elapsed_s, const std::string& what) {
+void progress_line(std::size_t done, std::size_t total, double elapsed_s, const std::string& what) {
   const int width = 28;
   const int filled = total ? int(double(done) / double(total) * width) : width;
   const double eta = done ? elapsed_s / double(done) * double(total - done) : 0.0;
@@ -106,6 +106,11 @@ std::uint64_t geometry_signature(const Scene& scene) {
 }
 
 }  // namespace
+
+void print_progress(std::size_t done, std::size_t total, double elapsed_s,
+                    const std::string& what) {
+  progress_line(done, total, elapsed_s, what);
+}
 
 std::string default_sweep() {
   // Cascade count x fit x map size x filter: 24 configurations, the trade-offs that matter most.
@@ -208,7 +213,7 @@ Status run_bench(const BenchOptions& options) {
   for (const fs::path& scene_path : scenes) {
     for (const BenchConfig& config : *configs) {
       if (g_interrupted) break;
-      progress(done, total, std::chrono::duration<double>(Clock::now() - t0).count(),
+      progress_line(done, total, std::chrono::duration<double>(Clock::now() - t0).count(),
                scene_path.stem().string() + ": " + config.label);
       std::vector<std::string> sets = config.sets;
       sets.push_back("render.width=" + std::to_string(options.width));
@@ -338,7 +343,7 @@ Status run_bench(const BenchOptions& options) {
     if (!result.ok() || g_interrupted) break;
   }
   std::signal(SIGINT, previous);
-  progress(done, total, std::chrono::duration<double>(Clock::now() - t0).count(),
+  progress_line(done, total, std::chrono::duration<double>(Clock::now() - t0).count(),
            g_interrupted ? "interrupted" : "done");
   std::fprintf(stderr, "\n");
   if (!result.ok()) return result;

@@ -34,6 +34,9 @@ struct BenchConfig {
   std::vector<std::string> sets;
 };
 
+/// One progress line on stderr (bar, done/total, elapsed, ETA, what), rewritten in place.
+void print_progress(std::size_t done, std::size_t total, double elapsed_s, const std::string& what);
+
 /// The sweep used when none is given: the settings whose speed/accuracy trade-off matters.
 std::string default_sweep();
 

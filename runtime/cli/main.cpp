@@ -21,6 +21,7 @@
 #include "runtime/assets/scene_io.h"
 #include "runtime/cli/bench.h"
 #include "runtime/cli/envmap_command.h"
+#include "runtime/cli/playback.h"
 #include "runtime/cli/player.h"
 #include "runtime/core/log.h"
 #include "runtime/gpu/context.h"
@@ -52,6 +53,10 @@ usage:
                                     or a folder of faces; L: auto, faces, horizontal_cross,
                                     vertical_cross, equirect, sphere), print what was found, write
                                     its faces (OUT: a pattern with * or a folder) or S3 sphere map
+  kaskad play FILE|DIR... [--out DIR] [--update-goldens] [--shard i/n]
+                                    replay playback files (camera keys, timeline, captures) and
+                                    check their expectations (README "Scene playback"); writes
+                                    DIR/<file>/frame_NNNN.png, frames.csv, diffs, DIR/summary.json
   kaskad info [SCENE] [--set K=V]   print the OpenGL context kaskad gets on this machine; with
                                     a SCENE, its entities instead (name, parent, components): the
                                     names --set addresses, a glTF file's own nodes included
@@ -446,6 +451,7 @@ int run_render(Args a) {
 
 int main(int argc, char** argv) {
   if (argc >= 2 && std::strcmp(argv[1], "envmap") == 0) return run_envmap_command(argc, argv);
+  if (argc >= 2 && std::strcmp(argv[1], "play") == 0) return run_play_command(argc, argv);
   const Args a = parse_args(argc, argv);
   if (a.command == "info") return run_info(a);
   if (a.command == "save") return run_save(a);

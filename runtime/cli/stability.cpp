@@ -45,6 +45,24 @@ Result<StabilityPoints> stability_points(const Image& aov, int max_points) {
   return out;
 }
 
+Result<std::vector<float>> visibility_at_seen_points(render::Renderer& renderer,
+                                                     const CameraState& camera,
+                                                     const StabilityPoints& points) {
+  auto values = renderer.shadow_at_points(points.positions, points.normals);
+  if (!values) return values.error();
+  // Only points the camera sees count: one that a path has carried out of the view is outside
+  // every cascade's fitted volume, and what its lookup returns there is nobody's picture (NaN:
+  // shadow_stability() skips non-finite samples).
+  const glm::mat4 view_proj = camera.proj * camera.view;
+  std::vector<float> v(values->size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const glm::vec4 c = view_proj * glm::vec4(points.positions[i], 1.0f);
+    const bool seen = std::abs(c.x) <= c.w && std::abs(c.y) <= c.w && std::abs(c.z) <= c.w;
+    v[i] = seen ? (*values)[i].x : std::numeric_limits<float>::quiet_NaN();
+  }
+  return v;
+}
+
 Result<StabilityRun> measure_stability(Player& player, Scene& scene, const StabilityPoints& points,
                                        const CameraPath& path) {
   FrameContext ctx;
@@ -76,22 +94,12 @@ Result<StabilityRun> measure_stability(Player& player, Scene& scene, const Stabi
     ctx.index = std::uint64_t(f);
     status = run_frame(scene, *player.renderer, ctx, report);
     if (!status) break;
-    auto values = player.renderer->shadow_at_points(points.positions, points.normals);
-    if (!values) {
-      status = values.error();
+    auto v = visibility_at_seen_points(*player.renderer, report.camera, points);
+    if (!v) {
+      status = v.error();
       break;
     }
-    // Only points the camera sees count: one that the path has carried out of the view is
-    // outside every cascade's fitted volume, and what its lookup returns there is nobody's
-    // picture (NaN: shadow_stability() skips non-finite samples).
-    const glm::mat4 view_proj = report.camera.proj * report.camera.view;
-    std::vector<float> v(values->size());
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      const glm::vec4 c = view_proj * glm::vec4(points.positions[i], 1.0f);
-      const bool seen = std::abs(c.x) <= c.w && std::abs(c.y) <= c.w && std::abs(c.z) <= c.w;
-      v[i] = seen ? (*values)[i].x : std::numeric_limits<float>::quiet_NaN();
-    }
-    run.visibility.push_back(std::move(v));
+    run.visibility.push_back(std::move(v.value()));
   }
   scene.world.get<Transform>(camera.entity) = original;
   update_transforms(scene.world, scene.assets);

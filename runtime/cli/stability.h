@@ -42,6 +42,12 @@ struct StabilityRun {
 /// Renders the path (colour only, AOVs off) and evaluates the points every frame. The camera's
 /// Transform is restored afterwards. Errors: no camera, a root-less (parented) camera, GL/shader
 /// errors.
+/// The engine's visibility at `points` after the last frame (Renderer::shadow_at_points), NaN
+/// for points outside the view of `camera` (that frame's camera).
+Result<std::vector<float>> visibility_at_seen_points(render::Renderer& renderer,
+                                                     const CameraState& camera,
+                                                     const StabilityPoints& points);
+
 Result<StabilityRun> measure_stability(Player& player, Scene& scene, const StabilityPoints& points,
                                        const CameraPath& path = {});
 

@@ -1,0 +1,865 @@
+#include "runtime/cli/playback.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "components/camera.h"
+#include "components/light.h"
+#include "components/name.h"
+#include "components/transform.h"
+#include "runtime/assets/image_io.h"
+#include "runtime/assets/scene_io.h"
+#include "runtime/cli/bench.h"
+#include "runtime/cli/player.h"
+#include "runtime/cli/stability.h"
+#include "runtime/core/json_reader.h"
+#include "runtime/gpu/context.h"
+#include "runtime/reference/ray_tracer.h"
+#include "runtime/reference/shadow_metrics.h"
+#include "systems/camera_system.h"
+#include "systems/transform_system.h"
+
+namespace kaskad {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using namespace json_reader;
+
+constexpr int kFormatVersion = 1;
+constexpr int kMaxFrames = 1000000;
+constexpr float kBig = 1.0e7f;
+
+const std::vector<std::pair<const char*, Interpolation>> kInterpolations = {
+    {"linear", Interpolation::linear}, {"catmull_rom", Interpolation::catmull_rom}};
+
+// A list of frame indices in [0, frames).
+std::vector<int> read_frames(const json& j, const std::string& where, int frames) {
+  if (!j.is_array()) fail(where, "expected an array of frame numbers, got " + type_name(j));
+  std::vector<int> out;
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const std::string at = where + "/" + std::to_string(i);
+    if (!j[i].is_number_integer()) fail(at, "expected a frame number, got " + type_name(j[i]));
+    const long long f = j[i].get<long long>();
+    if (f < 0 || f >= frames)
+      fail(at, "frame must be in [0, " + std::to_string(frames - 1) + "], was " + std::to_string(f));
+    out.push_back(int(f));
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+// The frame an event or range end names: "frame" (an index) or "t" (seconds, rounded to the
+// nearest frame).
+int read_when(ObjectReader& r, const Playback& pb, const std::string& where) {
+  const bool has_frame = r.has("frame"), has_t = r.has("t");
+  if (has_frame == has_t) fail(where, "give exactly one of frame and t");
+  if (has_frame) {
+    int f = 0;
+    r.integer("frame", f, 0, pb.frames - 1);
+    return f;
+  }
+  float t = 0.0f;
+  r.number("t", t, 0.0f, float(pb.dt * (pb.frames - 1)) + 1e-6f);
+  return int(std::lround(double(t) / pb.dt));
+}
+
+Track read_track(const json& j, const std::string& where, bool camera) {
+  Track track;
+  ObjectReader r(j, where);
+  if (!camera) {
+    r.string("entity", track.entity);
+    if (track.entity.empty()) fail(r.at("entity"), "name the entity the keys move");
+  }
+  r.enumeration("interpolation", track.interpolation, kInterpolations);
+  if (!r.has("keys") || !r.raw("keys").is_array() || r.raw("keys").empty())
+    fail(r.at("keys"), "expected a non-empty array of keys");
+  const json& keys = r.raw("keys");
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const std::string at = r.at("keys") + "/" + std::to_string(i);
+    ObjectReader k(keys[i], at);
+    PoseKey key;
+    float t = 0.0f;
+    if (!k.has("t")) fail(at, "a key needs a time t (seconds)");
+    k.number("t", t, 0.0f, 1.0e6f);
+    key.t = t;
+    glm::vec3 v;
+    if (k.has("position") && k.has("move")) fail(at, "give only one of position and move");
+    if (k.has("position")) {
+      k.vector<3>("position", v, -kBig, kBig);
+      key.position = v;
+    }
+    if (k.has("move")) {
+      k.vector<3>("move", v, -kBig, kBig);
+      key.position = v;
+      if (i > 0 && !track.relative) fail(at + "/move", "a track's keys all use position or all move");
+      track.relative = true;
+    } else if (track.relative && key.position) {
+      fail(at + "/position", "a track's keys all use position or all move");
+    }
+    if (k.has("look_at") && k.has("rotation")) fail(at, "give only one of look_at and rotation");
+    if (k.has("look_at") && track.relative) fail(at + "/look_at", "look_at needs absolute positions");
+    if (k.has("look_at")) {
+      k.vector<3>("look_at", v, -kBig, kBig);
+      key.look_at = v;
+      if (!key.position) fail(at + "/look_at", "look_at needs a position in the same key");
+      if (glm::length(v - *key.position) < 1e-6f) fail(at + "/look_at", "looks at its own position");
+    }
+    if (k.has("rotation")) {
+      glm::vec4 q;
+      k.vector<4>("rotation", q, -2.0f, 2.0f);
+      if (glm::length(q) < 1e-6f) fail(at + "/rotation", "quaternion has zero length");
+      q = glm::normalize(q);
+      key.rotation = glm::quat(q.w, q.x, q.y, q.z);
+    }
+    if (k.has("scale")) {
+      k.vector<3>("scale", v, -kBig, kBig);
+      key.scale = v;
+    }
+    if (k.has("fov_y_deg")) {
+      if (!camera) fail(at + "/fov_y_deg", "only camera keys have a field of view");
+      float fov = 0.0f;
+      k.number("fov_y_deg", fov, 0.01f, 179.0f);
+      key.fov_y_deg = fov;
+    }
+    k.finish();
+    if (!track.keys.empty() && !(key.t > track.keys.back().t))
+      fail(at + "/t", "key times must increase");
+    track.keys.push_back(key);
+  }
+  r.finish();
+  return track;
+}
+
+void read_expect(ObjectReader& r, Playback& pb, const fs::path& base) {
+  if (r.has("golden")) {
+    GoldenExpect g;
+    g.dir = base / "goldens" / pb.file.stem();
+    ObjectReader gr(r.raw("golden"), r.at("golden"));
+    std::string dir;
+    gr.string("dir", dir);
+    if (!dir.empty()) g.dir = base / dir;
+    gr.number("fail_threshold", g.fail_threshold, 0.0f, 1.0f);
+    gr.number("fail_percent", g.fail_percent, 0.0f, 100.0f);
+    gr.number("warn_threshold", g.warn_threshold, 0.0f, 1.0f);
+    gr.boolean("portable", g.portable);
+    gr.finish();
+    if (pb.capture.empty()) fail(r.at("golden"), "goldens compare captured frames: capture some");
+    pb.golden = g;
+  }
+  if (r.has("misclassified_pct")) {
+    MisclassifiedExpect m;
+    ObjectReader mr(r.raw("misclassified_pct"), r.at("misclassified_pct"));
+    if (!mr.has("frames")) fail(mr.at("frames"), "name the frames to check");
+    m.frames = read_frames(mr.raw("frames"), mr.at("frames"), pb.frames);
+    float max = 0.0f;
+    mr.number("max", max, 0.0f, 100.0f);
+    m.max_pct = max;
+    mr.finish();
+    pb.misclassified = m;
+  }
+  if (r.has("flicker")) {
+    FlickerExpect f;
+    ObjectReader fr(r.raw("flicker"), r.at("flicker"));
+    fr.integer("from", f.from, 0, pb.frames - 1);
+    f.to = pb.frames - 1;
+    fr.integer("to", f.to, 0, pb.frames - 1);
+    if (f.to <= f.from) fail(fr.at("to"), "the range needs two frames at least (to > from)");
+    float v = 0.0f;
+    if (fr.has("max")) {
+      fr.number("max", v, 0.0f, 1.0f);
+      f.max = v;
+    }
+    if (fr.has("min")) {
+      fr.number("min", v, 0.0f, 1.0f);
+      f.min = v;
+    }
+    if (fr.has("max_changed_pct")) {
+      fr.number("max_changed_pct", v, 0.0f, 100.0f);
+      f.max_changed_pct = v;
+    }
+    if (!f.max && !f.min && !f.max_changed_pct)
+      fail(r.at("flicker"), "give max, min or max_changed_pct");
+    fr.finish();
+    pb.flicker = f;
+  }
+  if (r.has("compiles_after_prewarm")) {
+    int n = 0;
+    r.integer("compiles_after_prewarm", n, 0, 100000);
+    pb.max_compiles_after_prewarm = n;
+  }
+  if (r.has("probe_captures")) {
+    ProbeExpect p;
+    ObjectReader pr(r.raw("probe_captures"), r.at("probe_captures"));
+    if (pr.has("count")) {
+      int n = 0;
+      pr.integer("count", n, 0, kMaxFrames);
+      p.captures = std::uint64_t(n);
+    }
+    if (pr.has("frames")) p.frames = read_frames(pr.raw("frames"), pr.at("frames"), pb.frames);
+    pr.finish();
+    pb.probes = p;
+  }
+  r.integer("gl_errors", pb.max_gl_errors, 0, 1000000);
+  if (r.has("frame_time_ratio")) {
+    RatioExpect q;
+    ObjectReader qr(r.raw("frame_time_ratio"), r.at("frame_time_ratio"));
+    auto range = [&](const char* key, int& from, int& to) {
+      if (!qr.has(key)) fail(qr.at(key), "expected [from, to] frame numbers");
+      const std::vector<int> v = read_frames(qr.raw(key), qr.at(key), pb.frames);
+      if (v.size() != 2) fail(qr.at(key), "expected [from, to] with from < to");
+      from = v[0];
+      to = v[1];
+    };
+    range("a", q.a_from, q.a_to);
+    range("b", q.b_from, q.b_to);
+    float max = 0.0f;
+    qr.number("max", max, 0.0f, 1.0e6f);
+    q.max = max;
+    qr.finish();
+    pb.frame_time_ratio = q;
+  }
+  r.finish();
+}
+
+// Syntax errors as line and column of the text.
+Result<json> parse_text(const std::string& text, const fs::path& file) {
+  try {
+    return json::parse(text, nullptr, true, /*ignore_comments=*/false);
+  } catch (const json::parse_error& e) {
+    std::size_t line = 1, col = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      col = text[i] == '\n' ? 1 : col + 1;
+      line += text[i] == '\n';
+    }
+    std::string msg = e.what();
+    if (auto p = msg.find("parse error"); p != std::string::npos) msg = msg.substr(p);
+    return Error{file.string(), "line " + std::to_string(line) + ", column " + std::to_string(col),
+                 "malformed JSON: " + msg};
+  } catch (const json::exception& e) {
+    return Error{file.string(), "", std::string("malformed JSON: ") + e.what()};
+  }
+}
+
+glm::vec3 catmull_rom(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2,
+                      const glm::vec3& p3, float u) {
+  // Uniform Catmull-Rom: passes through p1 at u = 0 and p2 at u = 1.
+  const float u2 = u * u, u3 = u2 * u;
+  return 0.5f * ((2.0f * p1) + (-p0 + p2) * u + (2.0f * p0 - 5.0f * p1 + 4.0f * p2 - p3) * u2 +
+                 (-p0 + 3.0f * p1 - 3.0f * p2 + p3) * u3);
+}
+
+// The orientation a key gives, if any.
+std::optional<glm::quat> key_rotation(const PoseKey& k) {
+  if (k.rotation) return k.rotation;
+  if (k.look_at && k.position) return look_rotation(glm::normalize(*k.look_at - *k.position));
+  return std::nullopt;
+}
+
+}  // namespace
+
+Result<Playback> parse_playback(const std::string& text, const fs::path& file) {
+  auto doc = parse_text(text, file);
+  if (!doc) return doc.error();
+  Playback pb;
+  pb.file = file;
+  const fs::path base = file.parent_path();
+  try {
+    ObjectReader r(*doc, "");
+    int version = kFormatVersion;
+    r.integer("kaskad_playback", version, 1, kFormatVersion);
+    std::string scene;
+    r.string("scene", scene);
+    if (scene.empty()) fail("/scene", "name the scene file (.json, .gltf or .glb)");
+    pb.scene = base / scene;
+    if (r.has("size")) {
+      glm::vec2 size;
+      r.vector<2>("size", size, 1.0f, 16384.0f);
+      if (size.x != std::floor(size.x) || size.y != std::floor(size.y))
+        fail("/size", "expected whole pixels");
+      pb.width = int(size.x);
+      pb.height = int(size.y);
+    }
+    r.integer("frames", pb.frames, 1, kMaxFrames);
+    float dt = float(pb.dt);
+    r.number("dt", dt, 1e-6f, 10.0f);
+    pb.dt = dt;
+    if (r.has("set")) {
+      const json& sets = r.raw("set");
+      if (!sets.is_array()) fail("/set", "expected an array of \"key=value\" strings");
+      for (std::size_t i = 0; i < sets.size(); ++i) {
+        if (!sets[i].is_string() || sets[i].get<std::string>().find('=') == std::string::npos)
+          fail("/set/" + std::to_string(i), "expected a \"key=value\" string");
+        pb.sets.push_back(sets[i].get<std::string>());
+      }
+    }
+    if (r.has("camera")) pb.camera = read_track(r.raw("camera"), "/camera", true);
+    if (r.has("timeline")) {
+      const json& tl = r.raw("timeline");
+      if (!tl.is_array()) fail("/timeline", "expected an array of events and tracks");
+      for (std::size_t i = 0; i < tl.size(); ++i) {
+        const std::string at = "/timeline/" + std::to_string(i);
+        if (tl[i].is_object() && tl[i].contains("keys")) {
+          pb.tracks.push_back(read_track(tl[i], at, false));
+          continue;
+        }
+        ObjectReader er(tl[i], at);
+        SetEvent ev;
+        ev.frame = read_when(er, pb, at);
+        er.string("set", ev.assignment);
+        if (ev.assignment.find('=') == std::string::npos)
+          fail(er.at("set"), "an event sets a \"key=value\" (or give keys to move an entity)");
+        er.finish();
+        pb.events.push_back(ev);
+      }
+      std::stable_sort(pb.events.begin(), pb.events.end(),
+                       [](const SetEvent& a, const SetEvent& b) { return a.frame < b.frame; });
+    }
+    if (r.has("capture")) {
+      ObjectReader cr(r.raw("capture"), "/capture");
+      if (cr.has("frames")) pb.capture = read_frames(cr.raw("frames"), "/capture/frames", pb.frames);
+      int every = 0;
+      cr.integer("every", every, 0, kMaxFrames);
+      for (int f = 0; every > 0 && f < pb.frames; f += every) pb.capture.push_back(f);
+      cr.boolean("aovs", pb.capture_aovs);
+      cr.finish();
+      std::sort(pb.capture.begin(), pb.capture.end());
+      pb.capture.erase(std::unique(pb.capture.begin(), pb.capture.end()), pb.capture.end());
+    }
+    if (r.has("expect")) {
+      ObjectReader er(r.raw("expect"), "/expect");
+      read_expect(er, pb, base);
+    }
+    r.finish();
+  } catch (const ContentError& e) {
+    return Error{file.string(), e.where, e.message};
+  } catch (const json::exception& e) {
+    return Error{file.string(), "", e.what()};
+  }
+  return pb;
+}
+
+Result<Playback> read_playback(const fs::path& file) {
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) return Error{file.string(), "", "is a directory, not a playback file"};
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return Error{file.string(), "", "cannot open file"};
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in && !in.eof()) return Error{file.string(), "", "cannot read file"};
+  return parse_playback(text.str(), file);
+}
+
+PoseKey sample_track(const Track& track, double t) {
+  PoseKey out;
+  out.t = t;
+  const auto& k = track.keys;
+  if (k.empty()) return out;
+  // The segment [i, i + 1] holding t (clamped to the ends).
+  std::size_t i = 0;
+  while (i + 1 < k.size() && k[i + 1].t <= t) ++i;
+  const std::size_t j = std::min(i + 1, k.size() - 1);
+  // Each field between the nearest keys that have it (a key may leave fields out), by the
+  // fraction of the time between those two keys.
+  struct Span {
+    std::size_t a = 0, b = 0;
+    float u = 0.0f;
+    bool found = false;
+  };
+  auto span = [&](auto has) {
+    Span sp;
+    for (std::size_t n = 0; n <= i; ++n)
+      if (has(k[n])) sp.a = n, sp.found = true;
+    sp.b = sp.a;
+    for (std::size_t n = j; n < k.size(); ++n)
+      if (has(k[n])) {
+        if (!sp.found) sp.a = n;
+        sp.b = n;
+        sp.found = true;
+        break;
+      }
+    if (sp.b != sp.a)
+      sp.u = float(std::clamp((t - k[sp.a].t) / (k[sp.b].t - k[sp.a].t), 0.0, 1.0));
+    return sp;
+  };
+  if (const Span sp = span([](const PoseKey& p) { return bool(p.position); }); sp.found) {
+    const glm::vec3 a = *k[sp.a].position, b = *k[sp.b].position;
+    if (track.interpolation == Interpolation::catmull_rom && sp.a == i && sp.b == j && j != i) {
+      const glm::vec3 p0 = i > 0 && k[i - 1].position ? *k[i - 1].position : a;
+      const glm::vec3 p3 = j + 1 < k.size() && k[j + 1].position ? *k[j + 1].position : b;
+      out.position = catmull_rom(p0, a, b, p3, sp.u);
+    } else {
+      out.position = glm::mix(a, b, sp.u);
+    }
+  }
+  if (const Span sp = span([](const PoseKey& p) { return bool(key_rotation(p)); }); sp.found)
+    out.rotation = glm::slerp(*key_rotation(k[sp.a]), *key_rotation(k[sp.b]), sp.u);
+  if (const Span sp = span([](const PoseKey& p) { return bool(p.scale); }); sp.found)
+    out.scale = glm::mix(*k[sp.a].scale, *k[sp.b].scale, sp.u);
+  if (const Span sp = span([](const PoseKey& p) { return bool(p.fov_y_deg); }); sp.found)
+    out.fov_y_deg = *k[sp.a].fov_y_deg + (*k[sp.b].fov_y_deg - *k[sp.a].fov_y_deg) * sp.u;
+  return out;
+}
+
+std::vector<std::size_t> shard_files(std::size_t count, int index, int n) {
+  std::vector<std::size_t> out;
+  for (std::size_t i = std::size_t(index); n > 0 && i < count; i += std::size_t(n)) out.push_back(i);
+  return out;
+}
+
+namespace {
+
+struct FrameRow {
+  int frame = 0;
+  double t = 0.0, frame_ms = 0.0;
+  FrameReport report;
+  int compiles = 0;  ///< programs built after pre-warm, so far
+  double misclassified_pct = -1.0;
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+ecs::Entity find_named(const ecs::World& w, const std::string& name) {
+  ecs::Entity found = ecs::kNullEntity;
+  w.view<Name>().each([&](ecs::Entity e, const Name& n) {
+    if (n.value == name && !found.valid()) found = e;
+  });
+  return found;
+}
+
+// `start` is the entity's transform at load: relative tracks move from it along its axes.
+void apply_pose(ecs::World& w, ecs::Entity e, const Track& track, const PoseKey& pose,
+                const Transform& start) {
+  Transform& t = w.get<Transform>(e);
+  if (pose.position && track.relative) {
+    const glm::vec3 m = *pose.position;
+    t.translation = start.translation + start.rotation * glm::vec3(m.x, m.y, -m.z);
+  } else if (pose.position) {
+    t.translation = *pose.position;
+  }
+  if (pose.rotation) t.rotation = *pose.rotation;
+  if (pose.scale) t.scale = *pose.scale;
+  if (pose.fov_y_deg && w.has<Camera>(e)) w.get<Camera>(e).fov_y_deg = *pose.fov_y_deg;
+}
+
+std::string frame_name(const char* prefix, int f, const char* ext) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%s_%04d.%s", prefix, f, ext);
+  return buf;
+}
+
+// Loads the scene of `pb` with its sets and size, and checks every timeline event and track
+// against a second copy first, so that a bad key fails before the first frame. With a
+// renderer, every state the timeline reaches is pre-warmed on that copy: toggles mid-run
+// compile nothing.
+Result<Scene> load_checked(const Playback& pb, render::Renderer* prewarm = nullptr,
+                           const FrameContext* ctx = nullptr) {
+  std::vector<std::string> sets = pb.sets;
+  sets.push_back("render.width=" + std::to_string(pb.width));
+  sets.push_back("render.height=" + std::to_string(pb.height));
+  auto scene = load_scene(pb.scene, sets);
+  if (!scene) return scene.error();
+  auto trial = load_scene(pb.scene, sets);
+  if (!trial) return trial.error();
+  if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx));
+  for (const SetEvent& ev : pb.events) {
+    if (auto st = apply_live_override(*trial, ev.assignment); !st) {
+      Error e = st.error();
+      e.message += " (timeline event at frame " + std::to_string(ev.frame) + " of " +
+                   pb.file.string() + ")";
+      return e;
+    }
+    if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx));
+  }
+  for (const Track& tr : pb.tracks)
+    if (!find_named(scene->world, tr.entity).valid())
+      return Error{pb.file.string(), "/timeline", "no entity named '" + tr.entity + "' in " +
+                                                      pb.scene.string()};
+  if (pb.camera) {
+    const CameraState cam = select_camera(scene->world, 1.0f);
+    if (!cam.entity.valid()) return Error{pb.file.string(), "/camera", "the scene has no camera"};
+    if (scene->world.get<Transform>(cam.entity).parent.valid())
+      return Error{pb.file.string(), "/camera", "the camera has a parent; keys move root cameras"};
+  }
+  return scene;
+}
+
+struct FileResult {
+  std::vector<PlayFailure> failures;
+  int frames = 0;
+  double wall_s = 0.0;
+  int captured = 0;
+};
+
+Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOptions& options) {
+  FileResult result;
+  const auto t_start = std::chrono::steady_clock::now();
+  auto fail_at = [&](int frame, const std::string& message) {
+    result.failures.push_back({pb.file.string(), frame, message});
+  };
+  FrameContext ctx;
+  ctx.width = pb.width;
+  ctx.height = pb.height;
+  // AOVs for every frame when any frame needs them: one program set, no compiles mid-run.
+  ctx.write_aovs = pb.capture_aovs || pb.misclassified || pb.flicker;
+  const int gl_errors_before = gpu::debug_error_count();
+  auto scene = load_checked(pb, player.renderer.get(), &ctx);
+  if (!scene) return scene.error();
+  const fs::path out = options.out_dir / pb.file.stem();
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) return Error{out.string(), "", "cannot create the output folder: " + ec.message()};
+
+  // The output size the camera allows (an own aspect fits inside the playback's size).
+  ctx.width = scene->render.width;
+  ctx.height = scene->render.height;
+  player.renderer->shaders().first_frame_done();
+  // Every program made from here on counts, compiled or loaded from the binary cache: either
+  // is a hitch in the middle of the run.
+  auto programs_made = [&] {
+    const render::ShaderStats& s = player.renderer->shaders().stats();
+    return s.programs_compiled + s.cache_hits;
+  };
+  const int compiles_before = programs_made();
+
+  const ecs::Entity camera = pb.camera ? select_camera(scene->world, 1.0f).entity : ecs::kNullEntity;
+  const Transform camera_start = pb.camera ? scene->world.get<Transform>(camera) : Transform{};
+  struct Moved {
+    ecs::Entity entity;
+    const Track* track;
+    Transform start;
+  };
+  std::vector<Moved> moved;
+  for (const Track& tr : pb.tracks) {
+    const ecs::Entity e = find_named(scene->world, tr.entity);
+    moved.push_back({e, &tr, scene->world.get<Transform>(e)});
+  }
+
+  std::ofstream csv(out / "frames.csv", std::ios::trunc);
+  csv << "frame,t,frame_ms,cpu_transforms_ms,cpu_camera_ms,cpu_shadows_ms,cpu_probes_ms,"
+         "cpu_draw_list_ms,cpu_render_ms,gpu_shadow_ms,gpu_forward_ms,gpu_probe_ms,draw_calls,"
+         "shadow_draw_calls,shadow_triangles,probe_faces,probe_captures,compiles_after_prewarm,"
+         "misclassified_pct\n";
+  std::vector<double> frame_ms;
+  std::vector<int> capture_frames;
+  std::vector<std::vector<float>> flicker_values;
+  StabilityPoints points;
+  FrameReport report;
+  std::size_t next_event = 0;
+  const std::set<int> capture(pb.capture.begin(), pb.capture.end());
+  const std::set<int> checked =
+      pb.misclassified ? std::set<int>(pb.misclassified->frames.begin(), pb.misclassified->frames.end())
+                       : std::set<int>{};
+  for (int f = 0; f < pb.frames; ++f) {
+    const double t = f * pb.dt;
+    // 1. Timeline: events due now, then the tracks' poses.
+    for (; next_event < pb.events.size() && pb.events[next_event].frame <= f; ++next_event)
+      KASKAD_TRY(apply_live_override(*scene, pb.events[next_event].assignment));
+    if (pb.camera)
+      apply_pose(scene->world, camera, *pb.camera, sample_track(*pb.camera, t), camera_start);
+    for (const Moved& m : moved)
+      apply_pose(scene->world, m.entity, *m.track, sample_track(*m.track, t), m.start);
+    // 2. The frame, timed with the GPU waited on.
+    ctx.index = std::uint64_t(f);
+    const auto t0 = std::chrono::steady_clock::now();
+    KASKAD_TRY(run_frame(*scene, *player.renderer, ctx, report));
+    player.renderer->finish();
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    frame_ms.push_back(ms);
+    FrameRow row;
+    row.frame = f;
+    row.t = t;
+    row.frame_ms = ms;
+    row.compiles = programs_made() - compiles_before;
+    if (report.probes.captures_this_frame > 0) capture_frames.push_back(f);
+    // 3. Outputs and the checks of this frame.
+    if (capture.count(f)) {
+      const fs::path png = out / frame_name("frame", f, "png");
+      KASKAD_TRY(save_image(png, player.renderer->read_color()));
+      ++result.captured;
+      if (pb.capture_aovs)
+        KASKAD_TRY(save_image(out / frame_name("aov", f, "exr"), player.renderer->read_aovs()));
+      if (pb.golden) {
+        const fs::path golden = pb.golden->dir / frame_name("frame", f, "png");
+        if (options.update_goldens) {
+          fs::create_directories(pb.golden->dir, ec);
+          auto img = load_image(png);
+          if (!img) return img.error();
+          auto old = load_image(golden);
+          const bool same = old && old->pixels == img->pixels && old->width == img->width;
+          if (!same) {
+            KASKAD_TRY(save_image(golden, *img));
+            std::printf("golden    %s %s\n", golden.string().c_str(), old ? "updated" : "created");
+          }
+        } else {
+          auto want = load_image(golden);
+          auto got = load_image(png);
+          if (!got) return got.error();
+          if (!want) {
+            fail_at(f, "no golden image " + golden.string() + " (run with --update-goldens)");
+          } else if (auto d = compare_images(*got, *want, pb.golden->fail_threshold,
+                                             pb.golden->warn_threshold);
+                     !d) {
+            fail_at(f, d.error().message + " (" + golden.string() + ")");
+          } else {
+            const double pct = 100.0 * double(d->failing) / double(std::max<std::size_t>(1, d->pixels));
+            if (pct > pb.golden->fail_percent) {
+              const fs::path diff = out / frame_name("diff", f, "png");
+              KASKAD_TRY(save_image(diff, d->diff));
+              char msg[512];
+              std::snprintf(msg, sizeof msg,
+                            "golden: %.3f%% of pixels differ by more than %g (allowed %.3f%%), max "
+                            "error %.4f; diff image %s",
+                            pct, double(pb.golden->fail_threshold), double(pb.golden->fail_percent),
+                            d->max_error, diff.string().c_str());
+              fail_at(f, msg);
+            } else if (d->warning > 0) {
+              std::printf("warning   %s frame %d: %zu pixels differ by more than %g from the golden\n",
+                          pb.file.string().c_str(), f, d->warning, double(pb.golden->warn_threshold));
+            }
+          }
+        }
+      }
+    }
+    if (checked.count(f)) {
+      const Image aov = player.renderer->read_aovs();
+      if (!report.shadow.light.valid()) {
+        fail_at(f, "misclassified_pct: no shadowed light this frame");
+      } else {
+        auto tracer = reference::RayTracer::build(*scene);
+        if (!tracer) return tracer.error();
+        const auto light = reference::reference_light(
+            scene->world.get<Light>(report.shadow.light),
+            scene->world.get<WorldTransform>(report.shadow.light).matrix);
+        auto ref = tracer->shadow_reference(aov, light, {});
+        if (!ref) return ref.error();
+        auto m = reference::compare_shadows(aov, ref->image);
+        if (!m) return m.error();
+        row.misclassified_pct = m->outside_edges.misclassified_pct;
+        if (row.misclassified_pct > pb.misclassified->max_pct) {
+          char msg[256];
+          std::snprintf(msg, sizeof msg,
+                        "misclassified_pct: %.3f%% of receivers away from edges disagree with the "
+                        "ray-traced reference (max %.3f%%)",
+                        row.misclassified_pct, pb.misclassified->max_pct);
+          fail_at(f, msg);
+        }
+      }
+    }
+    if (pb.flicker && f >= pb.flicker->from && f <= pb.flicker->to) {
+      if (f == pb.flicker->from) {
+        auto p = stability_points(player.renderer->read_aovs());
+        if (!p) return p.error();
+        points = std::move(p.value());
+      }
+      auto v = visibility_at_seen_points(*player.renderer, report.camera, points);
+      if (!v) return v.error();
+      flicker_values.push_back(std::move(v.value()));
+      if (f == pb.flicker->to) {
+        const auto s = reference::shadow_stability(flicker_values);
+        char msg[256];
+        if (pb.flicker->max && s.flicker > *pb.flicker->max) {
+          std::snprintf(msg, sizeof msg, "flicker over frames %d-%d: %.6g (max %g; %.3f%% of samples changed)",
+                        pb.flicker->from, pb.flicker->to, s.flicker, *pb.flicker->max, s.changed_pct);
+          fail_at(f, msg);
+        }
+        if (pb.flicker->max_changed_pct && s.changed_pct > *pb.flicker->max_changed_pct) {
+          std::snprintf(msg, sizeof msg,
+                        "flicker over frames %d-%d: %.3f%% of samples changed by more than an "
+                        "8-bit step (max %g%%)",
+                        pb.flicker->from, pb.flicker->to, s.changed_pct, *pb.flicker->max_changed_pct);
+          fail_at(f, msg);
+        }
+        if (pb.flicker->min && !(s.flicker > *pb.flicker->min)) {
+          std::snprintf(msg, sizeof msg, "flicker over frames %d-%d: %.6g, expected above %g",
+                        pb.flicker->from, pb.flicker->to, s.flicker, *pb.flicker->min);
+          fail_at(f, msg);
+        }
+        std::printf("flicker   %s frames %d-%d: %.6g (%zu points, %.3f%% of samples changed)\n",
+                    pb.file.filename().string().c_str(), pb.flicker->from, pb.flicker->to,
+                    s.flicker, s.points, s.changed_pct);
+      }
+    }
+    const auto& st = report.stats;
+    char line[640];
+    std::snprintf(line, sizeof line,
+                  "%d,%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%d,%zu,%d,%d,%d,%s\n", f,
+                  t, ms, report.transforms_ms, report.camera_ms, report.shadows_ms, report.probes_ms,
+                  report.draw_list_ms, report.render_ms, st.shadow_gpu_ms, st.forward_gpu_ms,
+                  st.probe_gpu_ms, st.draw_calls, st.shadow_draw_calls, st.shadow_triangles,
+                  st.probe_faces, report.probes.captures_this_frame, row.compiles,
+                  row.misclassified_pct < 0 ? "" : std::to_string(row.misclassified_pct).c_str());
+    csv << line;
+    print_progress(std::size_t(f + 1), std::size_t(pb.frames),
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count(),
+                   pb.file.filename().string());
+  }
+  std::fprintf(stderr, "\n");
+  csv.close();
+  if (!csv) return Error{(out / "frames.csv").string(), "", "write failed"};
+
+  // 4. Whole-run expectations.
+  const int compiles = programs_made() - compiles_before;
+  if (pb.max_compiles_after_prewarm && compiles > *pb.max_compiles_after_prewarm)
+    fail_at(-1, std::to_string(compiles) + " shader programs compiled or loaded after pre-warm (max " +
+                    std::to_string(*pb.max_compiles_after_prewarm) + ")");
+  const int gl_errors = gpu::debug_error_count() - gl_errors_before;
+  if (gl_errors > pb.max_gl_errors)
+    fail_at(-1, std::to_string(gl_errors) + " GL errors (max " + std::to_string(pb.max_gl_errors) + ")");
+  if (pb.probes) {
+    if (pb.probes->captures && report.probes.captures_total != *pb.probes->captures)
+      fail_at(-1, "probe captures: " + std::to_string(report.probes.captures_total) + ", expected " +
+                      std::to_string(*pb.probes->captures));
+    if (!pb.probes->frames.empty() && capture_frames != pb.probes->frames) {
+      std::string got;
+      for (int f : capture_frames) got += (got.empty() ? "" : " ") + std::to_string(f);
+      std::string want;
+      for (int f : pb.probes->frames) want += (want.empty() ? "" : " ") + std::to_string(f);
+      fail_at(-1, "probe captures on frames [" + got + "], expected [" + want + "]");
+    }
+  }
+  if (pb.frame_time_ratio) {
+    const auto& q = *pb.frame_time_ratio;
+    auto range_median = [&](int from, int to) {
+      return median(std::vector<double>(frame_ms.begin() + from, frame_ms.begin() + to + 1));
+    };
+    const double a = range_median(q.a_from, q.a_to), b = range_median(q.b_from, q.b_to);
+    const double ratio = a > 0.0 ? b / a : 0.0;
+    if (ratio > q.max) {
+      char msg[256];
+      std::snprintf(msg, sizeof msg,
+                    "frame time ratio: frames %d-%d take %.3g ms (median), %.3gx frames %d-%d's "
+                    "%.3g ms (max %.3gx)",
+                    q.b_from, q.b_to, b, ratio, q.a_from, q.a_to, a, q.max);
+      fail_at(-1, msg);
+    }
+  }
+  result.frames = pb.frames;
+  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return result;
+}
+
+}  // namespace
+
+Result<std::vector<PlayFailure>> run_playbacks(const std::vector<fs::path>& files,
+                                               const PlayOptions& options) {
+  if (options.shard_count < 1 || options.shard_index < 0 ||
+      options.shard_index >= options.shard_count)
+    return Error{"--shard", "", "expected i/n with 0 <= i < n"};
+  std::vector<fs::path> sorted = files;
+  std::sort(sorted.begin(), sorted.end());
+  // Every file of the shard is read before anything renders: a bad file fails at once.
+  std::vector<Playback> playbacks;
+  for (std::size_t i : shard_files(sorted.size(), options.shard_index, options.shard_count)) {
+    auto pb = read_playback(sorted[i]);
+    if (!pb) return pb.error();
+    playbacks.push_back(std::move(pb.value()));
+  }
+  std::error_code ec;
+  fs::create_directories(options.out_dir, ec);
+  if (ec) return Error{options.out_dir.string(), "", "cannot create the output folder: " + ec.message()};
+  gpu::ContextOptions opt;
+  opt.headless = options.headless;
+  auto player = Player::create(opt);
+  if (!player) return player.error();
+
+  std::vector<PlayFailure> failures;
+  json summary = {{"kaskad_play_summary", 1},
+                  {"shard", std::to_string(options.shard_index) + "/" + std::to_string(options.shard_count)},
+                  {"files", json::array()}};
+  for (const Playback& pb : playbacks) {
+    auto r = play_one(*player, pb, options);
+    if (!r) return r.error();
+    json failed = json::array();
+    for (const PlayFailure& f : r->failures) {
+      failed.push_back({{"frame", f.frame}, {"message", f.message}});
+      failures.push_back(f);
+    }
+    summary["files"].push_back({{"file", pb.file.string()},
+                                {"frames", r->frames},
+                                {"captured", r->captured},
+                                {"wall_s", r->wall_s},
+                                {"ok", r->failures.empty()},
+                                {"failures", failed}});
+    std::printf("play      %-40s %6d frames %8.1f s  %s\n", pb.file.filename().string().c_str(),
+                r->frames, r->wall_s,
+                r->failures.empty() ? "ok" : ("FAILED (" + std::to_string(r->failures.size()) + ")").c_str());
+    for (const PlayFailure& f : r->failures)
+      std::printf("  %s%s: %s\n", f.file.c_str(),
+                  f.frame >= 0 ? (" frame " + std::to_string(f.frame)).c_str() : "", f.message.c_str());
+  }
+  const fs::path summary_path = options.out_dir / "summary.json";
+  std::ofstream out(summary_path, std::ios::trunc);
+  out << summary.dump(2) << "\n";
+  out.close();
+  if (!out) return Error{summary_path.string(), "", "write failed"};
+  return failures;
+}
+
+int run_play_command(int argc, char** argv) {
+  auto usage = [](const std::string& msg) {
+    std::fprintf(stderr, "kaskad play: %s\n(run `kaskad --help` for usage)\n", msg.c_str());
+    return 2;
+  };
+  PlayOptions options;
+  options.headless = !gpu::display_available();
+  std::vector<fs::path> files;
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--out" || arg == "--shard") {
+      if (i + 1 >= argc) return usage(arg + " needs a value");
+      const std::string v = argv[++i];
+      if (arg == "--out") {
+        options.out_dir = v;
+        continue;
+      }
+      int idx = -1, n = 0;
+      char tail = 0;
+      if (std::sscanf(v.c_str(), "%d/%d%c", &idx, &n, &tail) != 2 || n < 1 || idx < 0 || idx >= n)
+        return usage("--shard expects i/n with 0 <= i < n, e.g. 0/4; got '" + v + "'");
+      options.shard_index = idx;
+      options.shard_count = n;
+    } else if (arg == "--update-goldens") {
+      options.update_goldens = true;
+    } else if (arg == "--headless") {
+      options.headless = true;
+    } else if (arg == "--window") {
+      options.headless = false;
+    } else if (!arg.empty() && arg[0] == '-') {
+      return usage("unknown option '" + arg + "'");
+    } else {
+      std::error_code ec;
+      if (fs::is_directory(arg, ec)) {
+        for (const auto& entry : fs::directory_iterator(arg, ec))
+          if (entry.path().extension() == ".json") files.push_back(entry.path());
+      } else {
+        files.push_back(arg);
+      }
+    }
+  }
+  if (files.empty()) return usage("name playback files or folders of them");
+  auto failures = run_playbacks(files, options);
+  if (!failures) {
+    std::fprintf(stderr, "kaskad: error: %s\n", failures.error().to_string().c_str());
+    return 1;
+  }
+  std::printf("summary   %s: %zu failed expectation(s)\n",
+              (options.out_dir / "summary.json").string().c_str(), failures->size());
+  return failures->empty() ? 0 : 1;
+}
+
+}  // namespace kaskad
