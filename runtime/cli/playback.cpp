@@ -9,6 +9,8 @@
 #include <set>
 #include <sstream>
 
+#include <unistd.h>
+
 #include <nlohmann/json.hpp>
 
 #include "components/camera.h"
@@ -22,6 +24,7 @@
 #include "runtime/cli/stability.h"
 #include "runtime/core/json_reader.h"
 #include "runtime/gpu/context.h"
+#include "runtime/gpu/gl_handles.h"
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
 #include "systems/camera_system.h"
@@ -81,6 +84,7 @@ Track read_track(const json& j, const std::string& where, bool camera) {
     if (track.entity.empty()) fail(r.at("entity"), "name the entity the keys move");
   }
   r.enumeration("interpolation", track.interpolation, kInterpolations);
+  r.boolean("loop", track.loop);
   if (!r.has("keys") || !r.raw("keys").is_array() || r.raw("keys").empty())
     fail(r.at("keys"), "expected a non-empty array of keys");
   const json& keys = r.raw("keys");
@@ -228,6 +232,19 @@ void read_expect(ObjectReader& r, Playback& pb, const fs::path& base) {
     qr.finish();
     pb.frame_time_ratio = q;
   }
+  if (r.has("flat_resources")) {
+    FlatExpect q;
+    ObjectReader qr(r.raw("flat_resources"), r.at("flat_resources"));
+    qr.integer("after", q.after, 0, pb.frames - 1);
+    float mib = float(q.max_rss_growth_mib);
+    qr.number("max_rss_growth_mib", mib, 0.0f, 1.0e6f);
+    q.max_rss_growth_mib = mib;
+    int objects = 0;
+    qr.integer("max_gl_object_growth", objects, 0, 1000000);
+    q.max_gl_object_growth = objects;
+    qr.finish();
+    pb.flat_resources = q;
+  }
   r.finish();
 }
 
@@ -318,8 +335,13 @@ Result<Playback> parse_playback(const std::string& text, const fs::path& file) {
         er.string("set", ev.assignment);
         if (ev.assignment.find('=') == std::string::npos)
           fail(er.at("set"), "an event sets a \"key=value\" (or give keys to move an entity)");
+        int every = 0;
+        er.integer("every", every, 0, kMaxFrames);
         er.finish();
-        pb.events.push_back(ev);
+        for (int f = ev.frame; f < pb.frames; f += every) {
+          pb.events.push_back({f, ev.assignment});
+          if (every == 0) break;
+        }
       }
       std::stable_sort(pb.events.begin(), pb.events.end(),
                        [](const SetEvent& a, const SetEvent& b) { return a.frame < b.frame; });
@@ -364,6 +386,8 @@ PoseKey sample_track(const Track& track, double t) {
   out.t = t;
   const auto& k = track.keys;
   if (k.empty()) return out;
+  if (track.loop && k.back().t > k.front().t && t > k.back().t)
+    t = k.front().t + std::fmod(t - k.front().t, k.back().t - k.front().t);
   // The segment [i, i + 1] holding t (clamped to the ends).
   std::size_t i = 0;
   while (i + 1 < k.size() && k[i + 1].t <= t) ++i;
@@ -431,6 +455,14 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Resident set size of this process, MiB (Linux /proc/self/statm; 0 elsewhere).
+double resident_mib() {
+  std::ifstream statm("/proc/self/statm");
+  long pages_total = 0, pages_resident = 0;
+  if (!(statm >> pages_total >> pages_resident)) return 0.0;
+  return double(pages_resident) * double(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
 }
 
 ecs::Entity find_named(const ecs::World& w, const std::string& name) {
@@ -553,7 +585,9 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
   csv << "frame,t,frame_ms,cpu_transforms_ms,cpu_camera_ms,cpu_shadows_ms,cpu_probes_ms,"
          "cpu_draw_list_ms,cpu_render_ms,gpu_shadow_ms,gpu_forward_ms,gpu_probe_ms,draw_calls,"
          "shadow_draw_calls,shadow_triangles,probe_faces,probe_captures,compiles_after_prewarm,"
-         "misclassified_pct\n";
+         "misclassified_pct,rss_mib,gl_objects\n";
+  double rss_warm = 0.0, rss_max_after = 0.0, rss_end = 0.0;
+  long gl_warm = 0, gl_max_after = 0;
   std::vector<double> frame_ms;
   std::vector<int> capture_frames;
   std::vector<std::vector<float>> flicker_values;
@@ -694,15 +728,30 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
                     s.flicker, s.points, s.changed_pct);
       }
     }
+    const double rss = resident_mib();
+    rss_end = rss;
+    const long gl_objects = gpu::live_gl_objects();
+    if (pb.flat_resources && f == pb.flat_resources->after) {
+      rss_warm = rss_max_after = rss;
+      gl_warm = gl_max_after = gl_objects;
+    } else if (pb.flat_resources && f > pb.flat_resources->after) {
+      rss_max_after = std::max(rss_max_after, rss);
+      gl_max_after = std::max(gl_max_after, gl_objects);
+    }
+    if (pb.flat_resources && (f == 0 || f == pb.flat_resources->after || f + 1 == pb.frames))
+      std::printf("resources %s frame %d: %.1f MiB resident (peak since warm-up %.1f), %ld GL "
+                  "objects\n",
+                  pb.file.filename().string().c_str(), f, rss, rss_max_after, gl_objects);
     const auto& st = report.stats;
     char line[640];
     std::snprintf(line, sizeof line,
-                  "%d,%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%d,%zu,%d,%d,%d,%s\n", f,
+                  "%d,%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%d,%zu,%d,%d,%d,%s,%.2f,%ld\n", f,
                   t, ms, report.transforms_ms, report.camera_ms, report.shadows_ms, report.probes_ms,
                   report.draw_list_ms, report.render_ms, st.shadow_gpu_ms, st.forward_gpu_ms,
                   st.probe_gpu_ms, st.draw_calls, st.shadow_draw_calls, st.shadow_triangles,
                   st.probe_faces, report.probes.captures_this_frame, row.compiles,
-                  row.misclassified_pct < 0 ? "" : std::to_string(row.misclassified_pct).c_str());
+                  row.misclassified_pct < 0 ? "" : std::to_string(row.misclassified_pct).c_str(),
+                  rss, gl_objects);
     csv << line;
     print_progress(std::size_t(f + 1), std::size_t(pb.frames),
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count(),
@@ -747,6 +796,25 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
                     q.b_from, q.b_to, b, ratio, q.a_from, q.a_to, a, q.max);
       fail_at(-1, msg);
     }
+  }
+  if (pb.flat_resources) {
+    const auto& q = *pb.flat_resources;
+    // Memory at the end against the warm-up frame: settings toggled on the way reallocate
+    // maps and the driver keeps freed pages a while, so peaks between say nothing of leaks.
+    if (rss_end - rss_warm > q.max_rss_growth_mib) {
+      char msg[256];
+      std::snprintf(msg, sizeof msg,
+                    "resident memory grew by %.1f MiB from frame %d to the end (max %.1f MiB): "
+                    "%.1f -> %.1f MiB (peak %.1f)",
+                    rss_end - rss_warm, q.after, q.max_rss_growth_mib, rss_warm, rss_end,
+                    rss_max_after);
+      fail_at(-1, msg);
+    }
+    if (gl_max_after - gl_warm > q.max_gl_object_growth)
+      fail_at(-1, "live GL objects grew by " + std::to_string(gl_max_after - gl_warm) +
+                      " after frame " + std::to_string(q.after) + " (max " +
+                      std::to_string(q.max_gl_object_growth) + "): " + std::to_string(gl_warm) +
+                      " -> " + std::to_string(gl_max_after));
   }
   result.frames = pb.frames;
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -810,6 +878,45 @@ Result<std::vector<PlayFailure>> run_playbacks(const std::vector<fs::path>& file
   return failures;
 }
 
+Result<std::size_t> merge_summaries(const std::vector<fs::path>& dirs, const fs::path& out_dir) {
+  json merged = {{"kaskad_play_summary", 1}, {"merged_from", json::array()}, {"files", json::array()}};
+  std::size_t failed = 0, files = 0;
+  for (const fs::path& dir : dirs) {
+    const fs::path file = dir / "summary.json";
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return Error{file.string(), "", "cannot open (is this a kaskad play --out folder?)"};
+    std::ostringstream text;
+    text << in.rdbuf();
+    auto doc = parse_text(text.str(), file);
+    if (!doc) return doc.error();
+    if (!doc->is_object() || !doc->contains("files") || !(*doc)["files"].is_array())
+      return Error{file.string(), "/files", "not a kaskad play summary"};
+    merged["merged_from"].push_back(file.string());
+    for (const json& f : (*doc)["files"]) {
+      if (!f.is_object() || !f.contains("ok") || !f["ok"].is_boolean() || !f.contains("file"))
+        return Error{file.string(), "/files", "an entry lacks file or ok"};
+      ++files;
+      if (!f["ok"].get<bool>()) {
+        ++failed;
+        std::printf("FAILED    %s\n", f["file"].dump().c_str());
+        if (f.contains("failures") && f["failures"].is_array())
+          for (const json& x : f["failures"]) std::printf("  %s\n", x.dump().c_str());
+      }
+      merged["files"].push_back(f);
+    }
+  }
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  const fs::path path = out_dir / "summary.json";
+  std::ofstream out(path, std::ios::trunc);
+  out << merged.dump(2) << "\n";
+  out.close();
+  if (!out) return Error{path.string(), "", "write failed"};
+  std::printf("merged    %zu summaries, %zu files, %zu failed -> %s\n", dirs.size(), files, failed,
+              path.string().c_str());
+  return failed;
+}
+
 int run_play_command(int argc, char** argv) {
   auto usage = [](const std::string& msg) {
     std::fprintf(stderr, "kaskad play: %s\n(run `kaskad --help` for usage)\n", msg.c_str());
@@ -818,8 +925,13 @@ int run_play_command(int argc, char** argv) {
   PlayOptions options;
   options.headless = !gpu::display_available();
   std::vector<fs::path> files;
+  bool merge = false;
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
+    if (arg == "--merge") {
+      merge = true;
+      continue;
+    }
     if (arg == "--out" || arg == "--shard") {
       if (i + 1 >= argc) return usage(arg + " needs a value");
       const std::string v = argv[++i];
@@ -850,6 +962,15 @@ int run_play_command(int argc, char** argv) {
         files.push_back(arg);
       }
     }
+  }
+  if (merge) {
+    if (files.empty()) return usage("--merge needs the output folders of the shards");
+    auto failed = merge_summaries(files, options.out_dir);
+    if (!failed) {
+      std::fprintf(stderr, "kaskad: error: %s\n", failed.error().to_string().c_str());
+      return 1;
+    }
+    return *failed == 0 ? 0 : 1;
   }
   if (files.empty()) return usage("name playback files or folders of them");
   auto failures = run_playbacks(files, options);

@@ -44,10 +44,12 @@ struct Track {
   /// forward (-Z) axes from its pose at load, so one path suits any scene (PoseKey::position
   /// then holds the move).
   bool relative = false;
+  bool loop = false;  ///< times wrap at the last key (periodic motion for long runs)
   std::vector<PoseKey> keys;
 };
 
-/// A --set assignment applied before the frame with this index is rendered.
+/// A --set assignment applied before the frame with this index is rendered (events with
+/// "every" are expanded into one per repeat when the file is read).
 struct SetEvent {
   int frame = 0;
   std::string assignment;
@@ -84,6 +86,13 @@ struct ProbeExpect {
   std::vector<int> frames;                ///< the frames on which a capture completed, exactly
 };
 
+/// Resident memory and live GL objects stay flat after warm-up (soak runs).
+struct FlatExpect {
+  int after = 100;               ///< the warm-up frame the rest is measured against
+  double max_rss_growth_mib = 16.0;  ///< end of the run against frame `after`
+  long max_gl_object_growth = 0;
+};
+
 struct Playback {
   std::filesystem::path file;   ///< where it was read from
   std::filesystem::path scene;  ///< resolved against the playback file
@@ -103,6 +112,7 @@ struct Playback {
   std::optional<ProbeExpect> probes;
   int max_gl_errors = 0;
   std::optional<RatioExpect> frame_time_ratio;
+  std::optional<FlatExpect> flat_resources;
 };
 
 /// Reads and validates a playback file. Errors name the file and the JSON path, and list the
@@ -141,6 +151,11 @@ Result<std::vector<PlayFailure>> run_playbacks(const std::vector<std::filesystem
 
 /// Which of `count` sorted files shard i of n runs: i, i + n, i + 2n, ...
 std::vector<std::size_t> shard_files(std::size_t count, int index, int n);
+
+/// `kaskad play --merge DIR...`: combines the summary.json of shard output folders into
+/// OUT/summary.json and lists the failed files; returns how many failed.
+Result<std::size_t> merge_summaries(const std::vector<std::filesystem::path>& dirs,
+                                    const std::filesystem::path& out_dir);
 
 /// `kaskad play FILE|DIR... [--out DIR] [--update-goldens] [--shard i/n] [--headless|--window]`
 /// (a DIR stands for its *.json files). argv[1] is "play". Exit status: 0 all expectations

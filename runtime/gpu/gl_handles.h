@@ -4,6 +4,7 @@
 
 #include <epoxy/gl.h>
 
+#include <atomic>
 #include <utility>
 
 namespace kaskad::gpu {
@@ -13,7 +14,9 @@ template <class Deleter>
 class GlObject {
  public:
   GlObject() = default;
-  explicit GlObject(GLuint id) : id_(id) {}
+  explicit GlObject(GLuint id) : id_(id) {
+    if (id_ != 0) ++live_;
+  }
   ~GlObject() { reset(); }
   GlObject(GlObject&& o) noexcept : id_(std::exchange(o.id_, 0)) {}
   GlObject& operator=(GlObject&& o) noexcept {
@@ -30,12 +33,18 @@ class GlObject {
   GLuint id() const { return id_; }
   explicit operator bool() const { return id_ != 0; }
   void reset() {
-    if (id_ != 0) Deleter::destroy(id_);
+    if (id_ != 0) {
+      Deleter::destroy(id_);
+      --live_;
+    }
     id_ = 0;
   }
+  /// Objects of this kind alive now (leak checks: the count stays flat while frames repeat).
+  static long live() { return live_; }
 
  private:
   GLuint id_ = 0;
+  static inline std::atomic<long> live_{0};
 };
 
 namespace detail {
@@ -59,6 +68,12 @@ using Program = GlObject<detail::ProgramDeleter>;
 using Shader = GlObject<detail::ShaderDeleter>;
 using Query = GlObject<detail::QueryDeleter>;
 using Sampler = GlObject<detail::SamplerDeleter>;
+
+/// GL objects alive through these owners, all kinds together.
+inline long live_gl_objects() {
+  return Buffer::live() + Texture::live() + Framebuffer::live() + Renderbuffer::live() +
+         VertexArray::live() + Program::live() + Shader::live() + Query::live() + Sampler::live();
+}
 
 // DSA creation helpers (OpenGL 4.5).
 inline Buffer make_buffer() { GLuint id = 0; glCreateBuffers(1, &id); return Buffer(id); }
