@@ -13,6 +13,7 @@
 #include "components/reflector.h"
 #include "components/transform.h"
 #include "runtime/assets/scene_io.h"
+#include "runtime/assets/material_file.h"
 
 namespace kaskad {
 namespace {
