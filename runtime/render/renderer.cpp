@@ -463,8 +463,14 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   if (assets.uid != im.assets_uid) {
     im.meshes.clear();
     im.textures.clear();
-    im.probes->clear();  // probe handles are entity indices of that scene
+    im.probes->clear();  // probe handles name entities of that scene
     im.assets_uid = assets.uid;
+  }
+  {  // Maps of reflectors that no longer exist (destroyed entities) are dropped.
+    std::vector<ProbeHandle> live;
+    for (const ProbeJob& job : frame.probes) live.push_back(job.handle);
+    std::sort(live.begin(), live.end());
+    im.probes->retain(live);
   }
   for (const DrawItem& d : frame.draws)
     if (d.mesh >= assets.meshes.size())
@@ -656,7 +662,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   // Forward draws: the main view and every probe face go through this one path. Draws reflecting
   // a probe get its map (`visible_before`: the map as of before this frame's captures, so a probe
   // never sees a cube that is being captured) and k_s * p_r.
-  std::map<std::uint32_t, const ProbeJob*> probe_jobs;
+  std::map<ProbeHandle, const ProbeJob*> probe_jobs;
   for (const ProbeJob& job : frame.probes) probe_jobs[job.handle] = &job;
   auto bind_reflection = [&](GLuint prog, const DrawItem& d, VariantKey key, bool capture) {
     if (!key.has(VariantKey::kReflectionCube) && !key.has(VariantKey::kReflectionSphere)) return;
@@ -980,11 +986,11 @@ Image Renderer::read_shadow_map() const {
   return img;
 }
 
-CubeMap Renderer::read_probe_cube(std::uint32_t handle, int buffer) const {
+CubeMap Renderer::read_probe_cube(ProbeHandle handle, int buffer) const {
   return impl_->probes->read_cube(handle, buffer);
 }
 
-SphereMap Renderer::read_probe_sphere(std::uint32_t handle) const {
+SphereMap Renderer::read_probe_sphere(ProbeHandle handle) const {
   return impl_->probes->read_sphere(handle);
 }
 

@@ -47,10 +47,10 @@ struct DrawItem {
   int layer = 0;                     ///< MeshRenderer::layer (probes may exclude layers)
   /// World bounds, for culling against the main view and each probe face; empty: always drawn.
   Aabb bounds;
-  /// The reflection probe this draw reflects (its own Reflector; kNoProbe: none). The draw is
+  /// The reflection probe this draw reflects (its own Reflector; none by default). The draw is
   /// never drawn into that probe. With a reflection material feature on, it is shaded with the
   /// probe's visible map, scaled by `reflection_scale` = k_s * p_r (S3 eq. (3)).
-  std::uint32_t probe = kNoProbe;
+  ProbeHandle probe;
   float reflection_scale = 0.0f;
   /// Bit 8k + i: drawn into cascade i of FrameInput::extra_shadows[k].
   std::uint32_t extra_cascade_masks = 0;
@@ -62,7 +62,7 @@ struct DrawItem {
 /// probe's own and excluded layers; reflective draws in them use their probes' visible maps as
 /// of before this frame's captures (no recursion).
 struct ProbeJob {
-  std::uint32_t handle = kNoProbe;
+  ProbeHandle handle;
   glm::vec3 center{0.0f};
   float near = 0.05f, far = 100.0f;
   int resolution = 128;
@@ -200,8 +200,8 @@ class Renderer {
   Image read_aovs() const;
   /// A probe's cube buffer (0 or 1; level 0) or its sphere map (row 0 at the top) as last
   /// rendered; empty when the probe has none. Tests and `kaskad render --probe-maps`.
-  CubeMap read_probe_cube(std::uint32_t handle, int buffer) const;
-  SphereMap read_probe_sphere(std::uint32_t handle) const;
+  CubeMap read_probe_cube(ProbeHandle handle, int buffer) const;
+  SphereMap read_probe_sphere(ProbeHandle handle) const;
   /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom; with
   /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;
