@@ -281,6 +281,26 @@ TEST_F(ProbeTest, EveryNCapturesOnExactlyTheScheduledFrames) {
   EXPECT_EQ(scene.world.get<ProbeState>(probe).captures, 3u);
 }
 
+// The editor renders one frame per render_frames() call (editor/main.cpp): the frame index must
+// carry on across calls (Scene::frames_rendered), so every_n = 3 still captures on every third
+// frame, not on every call.
+TEST_F(ProbeTest, EveryNHoldsWhenDrivenOneFramePerCall) {
+  Scene scene = load(walls_scene("every_n"), {"probe.reflector.every_n=3"});
+  RenderRun run;
+  run.frames = 1;
+  run.width = 64;
+  run.height = 48;
+  run.write_aovs = false;
+  for (int k = 0; k < 8; ++k) {
+    run.prewarm = k == 0;
+    auto t = render_frames(*player_, scene, run);
+    ASSERT_TRUE(t.ok()) << t.error().to_string();
+    EXPECT_EQ(t->last.stats.probe_faces, k % 3 == 0 ? 6 : 0) << "call " << k;
+  }
+  EXPECT_EQ(scene.frames_rendered, 8u);
+  EXPECT_EQ(scene.world.get<ProbeState>(named(scene, "probe")).captures, 3u);
+}
+
 TEST_F(ProbeTest, TimeSlicedCaptureNeverShowsAPartialCube) {
   // on_change, one face per frame. After the first capture (whole at once) the walls change
   // colour; the visible cube must keep the old colours on all faces until the new capture has all
