@@ -314,6 +314,13 @@ VariantKey frame_variant(const FrameInput& frame) {
   return k;
 }
 
+VariantKey capture_frame_variant(VariantKey frame) {
+  VariantKey k = VariantKey(frame.bits() & ~VariantKey::kAovs.mask());
+  if (k.has(VariantKey::kShadow) && k.get(VariantKey::kShadowProjection) == 0)  // ortho cascades
+    k.set(VariantKey::kCascadeSelection, 1);
+  return k;
+}
+
 VariantKey material_variant(const DrawItem& d) {
   // receive_shadows is a per-object flag, but it selects code like a material feature.
   VariantKey k = VariantKey(d.material.features & VariantKey::kMaterialMask & ~VariantKey::kReceiveShadows.mask());
@@ -325,7 +332,7 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   const VariantKey fk = frame_variant(frame);
   // Probe captures draw without AOVs; a reflector's draw gets its map feature once its first
   // capture completes (possibly frames later when time-sliced): compile those up front too.
-  const VariantKey capture_fk = VariantKey(fk.bits() & ~VariantKey::kAovs.mask());
+  const VariantKey capture_fk = capture_frame_variant(fk);
   std::vector<ProgramRequest> out;
   for (const DrawItem& d : frame.draws) {
     const VariantKey k = material_variant(d) | fk;
@@ -718,15 +725,16 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
 
   // Pass 2: reflection probes (S3): each scheduled face of a probe's back cube is rendered by a
   // 90° camera at the probe centre through the forward path, shadows included, without AOVs and
-  // without exposure (the cube holds linear radiance). u_view stays the main camera's: cascade
-  // selection and sphere-map lookups are the main view's. Then mips, then sphere maps.
+  // without exposure (the cube holds linear radiance), with cascades selected by map bounds
+  // (capture_frame_variant()). u_view stays the main camera's: sphere-map lookups are the main
+  // view's. Then mips, then sphere maps.
   stats_.probe_faces = 0;
   stats_.probe_draw_calls = 0;
   stats_.probe_culled = 0;
   stats_.frustum_culled = 0;
   glBeginQuery(GL_TIME_ELAPSED, im.timers[2].id());
   if (!frame.probes.empty()) {
-    const VariantKey capture_frame = VariantKey(frame_key.bits() & ~VariantKey::kAovs.mask());
+    const VariantKey capture_frame = capture_frame_variant(frame_key);
     std::vector<VariantKey> capture_keys(frame.draws.size());
     for (std::size_t i = 0; i < frame.draws.size(); ++i)
       capture_keys[i] = material_variant(frame.draws[i]) | capture_frame;

@@ -88,7 +88,6 @@ inline constexpr int kMaxCascades = 8;  // change together with systems/cascade_
 /// The first shadowed light plus up to 3 further directional ones. Change together with
 /// systems/shadow_cascade_system.h and MAX_EXTRA_SHADOWS (= this - 1) in common.glsl.
 inline constexpr int kMaxShadowedLights = 4;
-
 /// The shadowed light's cascades (systems/shadow_cascade_system.h, ShadowData).
 struct ShadowPass {
   int light_index = -1;          ///< index into FrameInput::lights; -1: no shadow pass
@@ -162,6 +161,11 @@ struct FrameStats {
 
 /// The frame features of a frame (shadow, filter, AOVs): the VARIANT_* part of every key.
 VariantKey frame_variant(const FrameInput& frame);
+/// The frame features of a probe capture of a frame with features `frame`: no AOVs, and cascades
+/// selected by map bounds. S0's view-depth selection measures the main camera's depth, which
+/// says nothing about a point behind it or beside it that a probe face sees: that point would
+/// fall into cascade 0, whose map does not hold it, and come out lit.
+VariantKey capture_frame_variant(VariantKey frame);
 /// The material features of a draw (MATERIAL_* part): from the material's data.
 VariantKey material_variant(const DrawItem& draw);
 /// Every (pass, key) a frame draws with, sorted and unique: what prewarm compiles and what
