@@ -27,6 +27,7 @@
 #include "runtime/core/result.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/render/shader_library.h"
+#include "runtime/render/shadow_limits.h"
 #include "runtime/render/variant_key.h"
 
 namespace kaskad::render {
@@ -85,9 +86,7 @@ using LightItem = LightShading;
 
 inline constexpr int kMaxCascades = 8;  // change together with systems/cascade_math.h and
                                         // MAX_CASCADES in common.glsl
-/// The first shadowed light plus up to 3 further directional ones. Change together with
-/// systems/shadow_cascade_system.h and MAX_EXTRA_SHADOWS (= this - 1) in common.glsl.
-inline constexpr int kMaxShadowedLights = 4;
+
 /// The shadowed light's cascades (systems/shadow_cascade_system.h, ShadowData).
 struct ShadowPass {
   int light_index = -1;          ///< index into FrameInput::lights; -1: no shadow pass
