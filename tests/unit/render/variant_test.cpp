@@ -2,10 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <cstdlib>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include "runtime/assets/material_file.h"
 #include "runtime/render/feature_manifest.h"
+#include "runtime/render/renderer.h"
 #include "runtime/render/variant_key.h"
 
 namespace kaskad::render {
@@ -160,6 +164,21 @@ TEST(FeatureManifest, BadManifestsAreRejected) {
   auto r4 = bad(R"({"textures": [{"name": "glow", "feature": "glowing"}]})");
   ASSERT_FALSE(r4.ok());
   EXPECT_NE(r4.error().to_string().find("glowing"), std::string::npos) << r4.error().to_string();
+}
+
+// common.glsl sizes the frame block's arrays with its own defines; they must match the
+// renderer's FrameBlock limits (written twice: GLSL cannot include a C++ header).
+TEST(ShaderConstants, CommonGlslMatchesTheRendererLimits) {
+  std::ifstream in(kShaders / "common.glsl");
+  ASSERT_TRUE(in) << "cannot open common.glsl";
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto define = [&](const std::string& name) {
+    const std::string key = "#define " + name + " ";
+    const auto at = text.find(key);
+    return at == std::string::npos ? -1 : std::atoi(text.c_str() + at + key.size());
+  };
+  EXPECT_EQ(define("MAX_CASCADES"), kMaxCascades);
+  EXPECT_EQ(define("MAX_EXTRA_SHADOWS"), kMaxShadowedLights - 1);
 }
 
 struct BadMaterial {
