@@ -25,21 +25,11 @@ struct Material {
   /// Used only on entities with a Reflector. 1: a mirror.
   float k_s = 1.0f;
   /// Shader features this material uses, as VariantKey material bits (runtime/render/
-  /// variant_key.h). Material files list them; other loaders call derive_material_features().
+  /// variant_key.h). Material files list them; other loaders call derive_material_features()
+  /// (runtime/assets/material_file.h).
   std::uint32_t features = 0;
 
   bool operator==(const Material&) const = default;
 };
-
-/// Feature bits implied by a material's data: textures present, alpha mask, non-zero emission.
-/// Bit positions: VariantKey's material fields (change together).
-inline std::uint32_t derive_material_features(const Material& m) {
-  std::uint32_t bits = 0;
-  if (m.base_color_texture != kNoTexture) bits |= 1u << 0;
-  if (m.normal_texture != kNoTexture) bits |= 1u << 1;
-  if (m.alpha_mask) bits |= 1u << 2;
-  if (m.emissive.r > 0.0f || m.emissive.g > 0.0f || m.emissive.b > 0.0f) bits |= 1u << 3;
-  return bits;
-}
 
 }  // namespace kaskad

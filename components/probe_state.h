@@ -9,11 +9,24 @@
 namespace kaskad {
 
 inline constexpr std::uint32_t kNoProbe = 0xffffffffu;
+
+/// The renderer's name for one probe's maps: its Reflector entity's index and generation, so a
+/// reflector created in a reused entity slot gets fresh maps, never its predecessor's.
+struct ProbeHandle {
+  std::uint64_t value = ~std::uint64_t(0);  ///< generation << 32 | index; all ones: none
+
+  static constexpr ProbeHandle of(std::uint32_t index, std::uint32_t generation) {
+    return {(std::uint64_t(generation) << 32) | index};
+  }
+  constexpr bool valid() const { return value != ~std::uint64_t(0); }
+  constexpr auto operator<=>(const ProbeHandle&) const = default;
+};
+inline constexpr ProbeHandle kNoProbeHandle{};
 /// All six cube faces, bit f = GL face f (+X, -X, +Y, -Y, +Z, -Z).
 inline constexpr std::uint8_t kAllFaces = 0x3f;
 
 struct ProbeState {
-  std::uint32_t handle = kNoProbe;  ///< the renderer's name for this probe's maps
+  ProbeHandle handle;               ///< the renderer's name for this probe's maps
   glm::vec3 center{0.0f};           ///< capture centre used this frame, world space
   /// Two cube maps per probe: `front` is shown, captures render into the other one (the back
   /// buffer) and it becomes the front only when all six faces are done.

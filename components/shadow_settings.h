@@ -62,6 +62,10 @@ enum class CascadeSelection {
   map_bounds,  ///< the first cascade whose map contains the point (uses the stable fit's slack)
 };
 
+/// Per shadowed light, except map_size, depth_format, filter, selection, layered and
+/// debug_cascades: every light's layers share one texture array and the shader features are per
+/// frame, so the first shadowed light's values of these apply to all (update_shadows() warns
+/// once, naming the fields, when another light's own differ).
 struct ShadowSettings {
   /// Texels per side of the map (of each cascade); power of two in [64, 16384]. 2048: engine
   /// choice, the size of the first basic map.

@@ -175,7 +175,8 @@ ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool
   world.view<Reflector>().each([&](ecs::Entity e, const Reflector&) {
     const ProbeState* s = world.try_get<ProbeState>(e);
     ProbeState st = s ? *s : ProbeState{};
-    st.handle = e.index;  // entity indices are unique among live entities of one world
+    // Index and generation: a reflector in a reused entity slot must not get the old maps.
+    st.handle = ProbeHandle::of(e.index, e.generation);
     states.emplace_back(e, st);
   });
   for (auto& [e, s] : states) {

@@ -456,22 +456,23 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
         if (l.cast_shadows) lights.push_back({e, l, wt.matrix});
       });
   std::vector<ShadowData> out;
-  std::string notice;
+  std::string notice;  // every notice of this frame, logged once while it stays the same
+  auto add_notice = [&](const std::string& n) { notice += (notice.empty() ? "" : "; ") + n; };
   for (std::size_t i = 0; i < lights.size(); ++i) {
     const Shadowed& l = lights[i];
     const auto* named = world.try_get<Name>(l.entity);
     const std::string name = "light " + (named ? "'" + named->value + "' (" : std::string("(")) +
                              "entity " + std::to_string(l.entity.index) + ")";
     if (i > 0 && l.light.type != LightType::directional) {
-      notice = name +
-               ": only the first shadowed light may be a spot or point light; it is lit "
-               "without shadows";
+      add_notice(name +
+                 ": only the first shadowed light may be a spot or point light; it is lit "
+                 "without shadows");
       continue;
     }
     if (out.size() == std::size_t(kMaxShadowedLights)) {
-      notice = std::to_string(lights.size()) + " shadowed lights; only the first " +
-               std::to_string(kMaxShadowedLights) + " get shadow maps, " + name +
-               " and the ones after it are lit without shadows";
+      add_notice(std::to_string(lights.size()) + " shadowed lights; only the first " +
+                 std::to_string(kMaxShadowedLights) + " get shadow maps, " + name +
+                 " and the ones after it are lit without shadows");
       break;
     }
     const std::size_t slot = out.size();
@@ -486,15 +487,26 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
     }
     if (!d.light.valid()) continue;  // its error is logged
     // One depth texture array holds every light's layers: the first light's map size, format
-    // and filter apply to all, and its cascade selection (a frame feature of the shaders).
-    // (fit_shadowed_light applied them; the light's own component may ask otherwise.)
+    // and filter apply to all, and its cascade selection, layered pass and debug tint (frame
+    // features of the shaders). fit_shadowed_light applied the first four; say which of them
+    // the light's own component asks otherwise.
     const ShadowSettings& first = out[0].settings;
-    if (const auto* own = world.try_get<ShadowSettings>(l.entity);
-        own && (own->map_size != first.map_size || own->depth_format != first.depth_format ||
-                own->filter != first.filter || own->selection != first.selection))
-      notice = name +
-               ": takes map_size, depth_format, filter and selection from the first "
-               "shadowed light (one shared texture array)";
+    if (const auto* own = world.try_get<ShadowSettings>(l.entity)) {
+      std::string differ;
+      auto check = [&](bool same, const char* field) {
+        if (!same) differ += std::string(differ.empty() ? "" : ", ") + field;
+      };
+      check(own->map_size == first.map_size, "map_size");
+      check(own->depth_format == first.depth_format, "depth_format");
+      check(own->filter == first.filter, "filter");
+      check(own->selection == first.selection, "selection");
+      check(own->layered == first.layered, "layered");
+      check(own->debug_cascades == first.debug_cascades, "debug_cascades");
+      if (!differ.empty())
+        add_notice(name + ": its " + differ +
+                   " differ from the first shadowed light's, whose values apply (one shared "
+                   "texture array, one set of shader features)");
+    }
     out.push_back(std::move(d));
   }
   if (out.empty()) out.emplace_back();

@@ -16,6 +16,7 @@
 #include "components/bounds.h"
 #include "components/shadow_settings.h"
 #include "runtime/ecs/world.h"
+#include "runtime/render/shadow_limits.h"
 #include "systems/camera_system.h"
 #include "systems/cascade_math.h"
 #include "systems/shadow_map_system.h"
@@ -62,8 +63,9 @@ struct ShadowData {
   std::uint8_t cascade_mask(ecs::Entity e) const;
 };
 
-/// Shadowed lights with maps at most: the first (any type) and up to 3 more directional lights.
-inline constexpr int kMaxShadowedLights = 4;  // change together with render::kMaxShadowedLights
+/// Shadowed lights with maps at most: the first (any type) and up to 3 more directional lights
+/// (the renderer's limit, one definition).
+using render::kMaxShadowedLights;
 
 /// State the system owns between frames: the last error per shadowed light and the last notice,
 /// so each is logged once, not every frame.
@@ -91,8 +93,9 @@ ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& ca
 /// Phase 3 for every shadowed light: element 0 is update_shadow_cascades()'s result (light null
 /// when there is none); elements 1.. are further directional lights with cast_shadows (entity
 /// order), each fitted with its own settings and cascades, as S0 asks of several directional
-/// lights. They share the first light's map_size, depth_format, filter and selection (one
-/// texture array; a warning says so when theirs differ). Spot and point lights after the first
+/// lights. They share the first light's map_size, depth_format, filter, selection, layered and
+/// debug_cascades (one texture array, one set of frame features; a warning logged once names
+/// the fields when theirs differ). Spot and point lights after the first
 /// shadowed light are lit without shadows, and lights beyond kMaxShadowedLights are left out,
 /// with a warning logged once. Extra lights are present only when the first one is valid.
 std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraState& camera,

@@ -9,12 +9,5 @@ layout(location = 11) uniform uint u_oracle_features;  // VariantKey material bi
 #define ENABLED(bit) true
 #endif
 
-// Material feature bit offsets (runtime/render/variant_key.h; change together).
-#define BIT_BASE_COLOR_TEXTURE 0
-#define BIT_NORMAL_MAP 1
-#define BIT_ALPHA_MASK 2
-#define BIT_EMISSIVE 3
-#define BIT_REFLECTION_CUBE 4
-#define BIT_REFLECTION_SPHERE 5
-#define BIT_RECEIVE_SHADOWS 6
-#define BIT_REFLECTION_BOX 7
+// BIT_BASE_COLOR_TEXTURE, BIT_NORMAL_MAP, ...: the material features' key bits, defined in every
+// program by FeatureManifest::defines() from kFeatureTable (runtime/render/variant_key.h).

@@ -47,6 +47,7 @@
 #include "components/shadow_settings.h"
 #include "components/transform.h"
 #include "runtime/assets/image_io.h"
+#include "runtime/assets/material_file.h"
 #include "runtime/assets/tinygltf_config.h"
 #include "runtime/core/file_io.h"
 

@@ -1,7 +1,8 @@
 // Material files (JSON, content/materials/): features, typed parameters and textures, validated
-// against the feature manifest (content/shaders/features.json). Format in README.md ("Materials").
+// against the feature manifest (kFeatureTable and content/shaders/features.json). Format in README.md ("Materials").
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 
 #include "components/material.h"
@@ -17,5 +18,18 @@ namespace kaskad {
 /// not listed, a listed texture feature without its texture, unreadable texture images.
 Result<Material> load_material_file(const std::filesystem::path& file,
                                     const render::FeatureManifest& manifest, AssetStore& assets);
+
+/// VariantKey material bits implied by a material's data (loaders without a material file: glTF,
+/// inline scene materials): textures present, alpha mask, non-zero emission.
+inline std::uint32_t derive_material_features(const Material& m) {
+  using render::VariantKey;
+  std::uint32_t bits = 0;
+  if (m.base_color_texture != kNoTexture) bits |= VariantKey::kBaseColorTexture.mask();
+  if (m.normal_texture != kNoTexture) bits |= VariantKey::kNormalMap.mask();
+  if (m.alpha_mask) bits |= VariantKey::kAlphaMask.mask();
+  if (m.emissive.r > 0.0f || m.emissive.g > 0.0f || m.emissive.b > 0.0f)
+    bits |= VariantKey::kEmissive.mask();
+  return bits;
+}
 
 }  // namespace kaskad

@@ -1,6 +1,7 @@
 // A loaded scene: the ECS world, its CPU assets and its render settings.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 
 #include <glm/glm.hpp>
@@ -41,6 +42,10 @@ struct Scene {
   /// overrides individual fields.
   ShadowSettings shadow_defaults;
   std::filesystem::path file;  ///< where it was loaded from (relative paths resolve against it)
+  /// Frames run since the scene was loaded: the next frame's FrameContext::index. render_frames()
+  /// advances it, so a caller that renders one frame per call (the editor) still counts frames
+  /// (every_n probes, for one).
+  std::uint64_t frames_rendered = 0;
 };
 
 }  // namespace kaskad

@@ -127,7 +127,7 @@ Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRu
   }
   t.last.shadow_state = std::move(player.shadow_state);
   for (int i = 0; i < std::max(1, run.frames); ++i) {
-    ctx.index = std::uint64_t(i);
+    ctx.index = scene.frames_rendered++;  // carries on across calls (the editor: one per call)
     const auto t0 = std::chrono::steady_clock::now();
     const Status st = run_frame(scene, *player.renderer, ctx, t.last);
     player.shadow_state = t.last.shadow_state;

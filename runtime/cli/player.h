@@ -55,6 +55,7 @@ struct RenderTimings {
 };
 
 /// Renders `run.frames` frames of `scene`, waiting for the GPU after each so the times are honest.
+/// Frame indices continue from scene.frames_rendered, which advances by `run.frames`.
 Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRun& run);
 
 }  // namespace kaskad

@@ -14,44 +14,6 @@ using json_reader::join;
 using json_reader::ObjectReader;
 using json_reader::type_name;
 
-// Where each feature lives in the VariantKey. The manifest must name exactly these features.
-struct LayoutEntry {
-  const char* name;
-  VariantKey::Field field;
-  int bias;
-};
-constexpr LayoutEntry kLayout[] = {
-    {"base_color_texture", VariantKey::kBaseColorTexture, 0},
-    {"normal_map", VariantKey::kNormalMap, 0},
-    {"alpha_mask", VariantKey::kAlphaMask, 0},
-    {"emissive", VariantKey::kEmissive, 0},
-    {"reflection_cube", VariantKey::kReflectionCube, 0},
-    {"reflection_sphere", VariantKey::kReflectionSphere, 0},
-    {"receive_shadows", VariantKey::kReceiveShadows, 0},
-    {"reflection_box", VariantKey::kReflectionBox, 0},
-    {"shadow", VariantKey::kShadow, 0},
-    {"shadow_filter", VariantKey::kShadowFilter, 0},
-    {"cascade_count", VariantKey::kCascadeCountMinus1, 1},
-    {"aovs", VariantKey::kAovs, 0},
-    {"cascade_selection", VariantKey::kCascadeSelection, 0},
-    {"debug_cascades", VariantKey::kDebugCascades, 0},
-    {"shadow_projection", VariantKey::kShadowProjection, 0},
-    {"shadow_layered", VariantKey::kShadowLayered, 0},
-};
-
-std::vector<std::string> string_list(ObjectReader& r, const char* key) {
-  std::vector<std::string> out;
-  if (!r.has(key)) return out;
-  const auto& v = r.raw(key);
-  if (!v.is_array()) fail(r.at(key), "expected an array of strings, got " + type_name(v));
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (!v[i].is_string())
-      fail(r.at(key) + "/" + std::to_string(i), "expected a string, got " + type_name(v[i]));
-    out.push_back(v[i].get<std::string>());
-  }
-  return out;
-}
-
 std::vector<double> numbers(const nlohmann::json& v, const std::string& where, std::size_t n) {
   std::vector<double> out;
   if (n == 1 && v.is_boolean()) return {v.get<bool>() ? 1.0 : 0.0};
@@ -67,6 +29,27 @@ std::vector<double> numbers(const nlohmann::json& v, const std::string& where, s
 
 }  // namespace
 
+FeatureManifest::FeatureManifest() {
+  for (const FeatureSpec& spec : kFeatureTable) {
+    Feature f;
+    f.name = spec.name;
+    f.kind = spec.kind;
+    f.define = spec.define;
+    f.stages = spec.stages;
+    for (std::string_view r : spec.requires_)
+      if (!r.empty()) f.requires_.emplace_back(r);
+    for (std::string_view x : spec.excludes)
+      if (!x.empty()) f.excludes.emplace_back(x);
+    for (std::string_view v : spec.values)
+      if (!v.empty()) f.values.emplace_back(v);
+    f.min = spec.min;
+    f.max = spec.value_max();
+    f.field = spec.field();
+    f.key_bias = spec.min;
+    features_.push_back(std::move(f));
+  }
+}
+
 Result<FeatureManifest> FeatureManifest::load(const std::filesystem::path& file) {
   auto doc = json_reader::parse_json_file(file);
   if (!doc) return doc.error();
@@ -75,62 +58,9 @@ Result<FeatureManifest> FeatureManifest::load(const std::filesystem::path& file)
     ObjectReader root(*doc, "");
     std::string comment;
     root.string("comment", comment);
-    if (!root.has("features")) fail("/features", "missing");
-    const auto& feats = root.raw("features");
-    if (!feats.is_array()) fail("/features", "expected an array, got " + type_name(feats));
-    for (std::size_t i = 0; i < feats.size(); ++i) {
-      const std::string at = "/features/" + std::to_string(i);
-      ObjectReader r(feats[i], at);
-      Feature f;
-      r.string("name", f.name);
-      std::string kind = "material";
-      r.string("kind", kind);
-      if (kind != "material" && kind != "frame")
-        fail(r.at("kind"), "expected material or frame, was '" + kind + "'");
-      f.kind = kind == "material" ? FeatureKind::material : FeatureKind::frame;
-      r.string("define", f.define);
-      const std::string prefix = f.kind == FeatureKind::material ? "MATERIAL_" : "VARIANT_";
-      if (f.define.rfind(prefix, 0) != 0)
-        fail(r.at("define"), kind + " feature defines start with " + prefix + ", was '" + f.define + "'");
-      for (const auto& s : string_list(r, "stages")) {
-        if (s == "vertex") f.stages |= std::uint8_t(ShaderStage::vertex);
-        else if (s == "fragment") f.stages |= std::uint8_t(ShaderStage::fragment);
-        else fail(r.at("stages"), "unknown stage '" + s + "'; expected vertex or fragment");
-      }
-      if (f.stages == 0) fail(r.at("stages"), "a feature needs at least one stage");
-      f.requires_ = string_list(r, "requires");
-      f.excludes = string_list(r, "excludes");
-      f.values = string_list(r, "values");
-      if (!f.values.empty()) f.max = int(f.values.size()) - 1;
-      if (r.has("range")) {
-        auto range = numbers(r.raw("range"), r.at("range"), 2);
-        f.min = int(range[0]);
-        f.max = int(range[1]);
-        if (f.min > f.max) fail(r.at("range"), "min exceeds max");
-      }
-      r.finish();
-      const auto* layout = std::find_if(std::begin(kLayout), std::end(kLayout),
-                                        [&](const LayoutEntry& e) { return f.name == e.name; });
-      if (layout == std::end(kLayout))
-        fail(at + "/name", "feature '" + f.name + "' has no place in the variant key "
-                           "(runtime/render/variant_key.h)");
-      f.field = layout->field;
-      f.key_bias = layout->bias;
-      if (f.min - f.key_bias < 0 || std::uint32_t(f.max - f.key_bias) > f.field.max())
-        fail(at, "value range [" + std::to_string(f.min) + ", " + std::to_string(f.max) +
-                     "] does not fit its " + std::to_string(f.field.width) + "-bit key field");
-      if (m.find(f.name)) fail(at + "/name", "duplicate feature '" + f.name + "'");
-      m.features_.push_back(std::move(f));
-    }
-    for (const LayoutEntry& e : kLayout)
-      if (!m.find(e.name)) fail("/features", std::string("the variant key has feature '") + e.name +
-                                                 "', which the manifest does not describe");
-    for (std::size_t i = 0; i < m.features_.size(); ++i)
-      for (const auto* list : {&m.features_[i].requires_, &m.features_[i].excludes})
-        for (const auto& other : *list)
-          if (!m.find(other))
-            fail("/features/" + std::to_string(i), "refers to unknown feature '" + other + "'");
-
+    if (root.has("features"))
+      fail("/features", "features are declared in kFeatureTable (runtime/render/variant_key.h), "
+                        "not in the manifest");
     if (root.has("parameters")) {
       const auto& params = root.raw("parameters");
       if (!params.is_array()) fail("/parameters", "expected an array");
@@ -210,22 +140,15 @@ VariantKey FeatureManifest::with(VariantKey key, const Feature& f, int v) const 
 }
 
 std::string FeatureManifest::check(VariantKey key) const {
-  std::uint32_t described = 0;
-  for (const auto& f : features_) described |= f.field.mask();
-  if (key.bits() & ~described) return "key has bits no feature describes";
-  auto on = [&](const Feature& f) { return key.get(f.field) != 0; };
-  for (const auto& f : features_) {
-    const int v = value(f, key);
-    if (v < f.min || v > f.max)
-      return f.name + " must be in [" + std::to_string(f.min) + ", " + std::to_string(f.max) +
-             "], was " + std::to_string(v);
-    if (!on(f)) continue;
-    for (const auto& r : f.requires_)
-      if (!on(*find(r))) return f.name + " requires " + r;
-    for (const auto& x : f.excludes)
-      if (on(*find(x))) return f.name + " excludes " + x;
-  }
-  return {};
+  const BrokenRule broken = key.broken_rule();
+  if (broken.kind == BrokenRule::none) return {};
+  if (broken.kind == BrokenRule::unused_bits) return "key has bits no feature describes";
+  const Feature& f = features_[std::size_t(broken.feature)];
+  if (broken.kind == BrokenRule::range)
+    return f.name + " must be in [" + std::to_string(f.min) + ", " + std::to_string(f.max) +
+           "], was " + std::to_string(value(f, key));
+  const std::string& other = features_[std::size_t(broken.other)].name;
+  return f.name + (broken.kind == BrokenRule::requires_ ? " requires " : " excludes ") + other;
 }
 
 std::vector<std::pair<std::string, std::string>> FeatureManifest::defines(VariantKey key,
@@ -239,6 +162,13 @@ std::vector<std::pair<std::string, std::string>> FeatureManifest::defines(Varian
       out.emplace_back(f.define + "_" + upper, std::to_string(i));
     }
     out.emplace_back(f.define, std::to_string(value(f, key)));
+  }
+  // Material feature bit numbers for ENABLED(BIT_*) (features.glsl), in every stage.
+  for (const auto& f : features_) {
+    if (f.kind != FeatureKind::material) continue;
+    std::string upper = f.name;
+    for (auto& c : upper) c = char(std::toupper(static_cast<unsigned char>(c)));
+    out.emplace_back("BIT_" + upper, std::to_string(f.field.offset));
   }
   return out;
 }

@@ -1,8 +1,8 @@
-// The feature manifest (content/shaders/features.json): each shader feature's name, define,
-// stages, what it requires and excludes, and its value range; plus the typed material parameters
-// and textures, with defaults, ranges and the feature each one belongs to. The manifest turns a
-// VariantKey into defines (the one function that produces both MATERIAL_* and VARIANT_* defines)
-// and checks material files against the declared parameters.
+// The feature manifest: the shader features of kFeatureTable (runtime/render/variant_key.h, the
+// one place they are declared) as runtime values, plus the typed material parameters and textures
+// of content/shaders/features.json, with defaults, ranges and the feature each one belongs to.
+// The manifest turns a VariantKey into defines (the one function that produces both MATERIAL_*
+// and VARIANT_* defines) and checks material files against the declared parameters.
 #pragma once
 
 #include <cstdint>
@@ -16,9 +16,7 @@
 
 namespace kaskad::render {
 
-enum class FeatureKind { material, frame };
-enum class ShaderStage : std::uint8_t { vertex = 1, fragment = 2 };
-
+/// A row of kFeatureTable with owned strings.
 struct Feature {
   std::string name;
   FeatureKind kind = FeatureKind::material;
@@ -29,7 +27,7 @@ struct Feature {
   std::vector<std::string> values;       ///< enumerated feature: value names (index = value)
   int min = 0, max = 1;                  ///< integer range of the value (switch: 0..1)
   VariantKey::Field field{0, 0};         ///< where the value lives in the key
-  int key_bias = 0;                      ///< stored = value - key_bias (cascade_count: 1)
+  int key_bias = 0;                      ///< stored = value - key_bias (= min)
 };
 
 enum class ParamType { float_, vec3, vec4, bool_ };
@@ -50,10 +48,13 @@ struct MaterialTextureSlot {
 
 class FeatureManifest {
  public:
-  /// Reads and validates a manifest. Errors name the file and JSON path: unknown keys, unknown
-  /// feature references, features that do not exist in the VariantKey layout (or layout features
-  /// missing from the file), ranges that do not fit their key field.
+  /// Reads and validates the parameters and textures of a manifest. Errors name the file and
+  /// JSON path: unknown keys, unknown feature references, a "features" section (features are
+  /// declared in kFeatureTable, not in the file).
   static Result<FeatureManifest> load(const std::filesystem::path& file);
+
+  /// The features of kFeatureTable, no parameters or textures.
+  FeatureManifest();
 
   const std::vector<Feature>& features() const { return features_; }
   const std::vector<MaterialParameter>& parameters() const { return parameters_; }
@@ -72,7 +73,8 @@ class FeatureManifest {
   std::string check(VariantKey key) const;
 
   /// One `#define NAME VALUE` pair per feature for `stage` (every feature is always defined, so
-  /// shaders use `#if`), plus NAME_VALUENAME constants for enumerated features.
+  /// shaders use `#if`), plus NAME_VALUENAME constants for enumerated features, plus BIT_NAME =
+  /// the key bit of every material feature (features.glsl's ENABLED() reads them).
   std::vector<std::pair<std::string, std::string>> defines(VariantKey key, ShaderStage stage) const;
 
   /// "normal_map shadow shadow_filter=pcf3x3 cascade_count=4": the features that are on.

@@ -2,6 +2,7 @@
 
 #include <epoxy/gl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -43,7 +44,7 @@ Result<std::unique_ptr<ProbeMaps>> ProbeMaps::create(const std::filesystem::path
   return m;
 }
 
-GLuint ProbeMaps::cube(std::uint32_t handle, int buffer, int resolution) {
+GLuint ProbeMaps::cube(ProbeHandle handle, int buffer, int resolution) {
   Probe& p = probes_[handle];
   if (p.resolution != resolution || !p.cubes[0]) {
     p.resolution = resolution;
@@ -54,12 +55,12 @@ GLuint ProbeMaps::cube(std::uint32_t handle, int buffer, int resolution) {
   return p.cubes[buffer & 1].id();
 }
 
-GLuint ProbeMaps::existing_cube(std::uint32_t handle, int buffer) const {
+GLuint ProbeMaps::existing_cube(ProbeHandle handle, int buffer) const {
   auto it = probes_.find(handle);
   return it == probes_.end() ? 0 : it->second.cubes[buffer & 1].id();
 }
 
-void ProbeMaps::begin_face(std::uint32_t handle, int buffer, int face, const glm::vec3& clear) {
+void ProbeMaps::begin_face(ProbeHandle handle, int buffer, int face, const glm::vec3& clear) {
   const Probe& p = probes_.at(handle);
   if (!depth_ || depth_size_ != p.resolution) {
     GLuint id = 0;
@@ -81,11 +82,17 @@ void ProbeMaps::begin_face(std::uint32_t handle, int buffer, int face, const glm
   ++faces_rendered;
 }
 
-void ProbeMaps::finish_cube(std::uint32_t handle, int buffer) {
+void ProbeMaps::retain(const std::vector<ProbeHandle>& live) {
+  std::erase_if(probes_, [&](const auto& entry) {
+    return !std::binary_search(live.begin(), live.end(), entry.first);
+  });
+}
+
+void ProbeMaps::finish_cube(ProbeHandle handle, int buffer) {
   glGenerateTextureMipmap(probes_.at(handle).cubes[buffer & 1].id());
 }
 
-void ProbeMaps::upload(std::uint32_t handle, int buffer, const CubeMap& cube_map) {
+void ProbeMaps::upload(ProbeHandle handle, int buffer, const CubeMap& cube_map) {
   const GLuint tex = cube(handle, buffer, cube_map.size);
   for (int f = 0; f < 6; ++f)
     glTextureSubImage3D(tex, 0, 0, 0, f, cube_map.size, cube_map.size, 1, GL_RGBA, GL_FLOAT,
@@ -93,7 +100,7 @@ void ProbeMaps::upload(std::uint32_t handle, int buffer, const CubeMap& cube_map
   glGenerateTextureMipmap(tex);
 }
 
-GLuint ProbeMaps::update_sphere(std::uint32_t handle, int buffer, const glm::mat3& view_rotation) {
+GLuint ProbeMaps::update_sphere(ProbeHandle handle, int buffer, const glm::mat3& view_rotation) {
   Probe& p = probes_.at(handle);
   if (!p.sphere) {
     p.sphere = gpu::make_texture(GL_TEXTURE_2D);
@@ -120,12 +127,12 @@ GLuint ProbeMaps::update_sphere(std::uint32_t handle, int buffer, const glm::mat
   return p.sphere.id();
 }
 
-GLuint ProbeMaps::existing_sphere(std::uint32_t handle) const {
+GLuint ProbeMaps::existing_sphere(ProbeHandle handle) const {
   auto it = probes_.find(handle);
   return it == probes_.end() ? 0 : it->second.sphere.id();
 }
 
-CubeMap ProbeMaps::read_cube(std::uint32_t handle, int buffer) const {
+CubeMap ProbeMaps::read_cube(ProbeHandle handle, int buffer) const {
   CubeMap out;
   auto it = probes_.find(handle);
   if (it == probes_.end() || !it->second.cubes[buffer & 1]) return out;
@@ -141,7 +148,7 @@ CubeMap ProbeMaps::read_cube(std::uint32_t handle, int buffer) const {
   return out;
 }
 
-SphereMap ProbeMaps::read_sphere(std::uint32_t handle) const {
+SphereMap ProbeMaps::read_sphere(ProbeHandle handle) const {
   SphereMap out;
   auto it = probes_.find(handle);
   if (it == probes_.end() || !it->second.sphere) return out;

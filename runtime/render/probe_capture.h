@@ -10,9 +10,11 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <vector>
 
 #include <glm/glm.hpp>
 
+#include "components/probe_state.h"
 #include "runtime/assets/env_map.h"
 #include "runtime/core/result.h"
 #include "runtime/gpu/gl_handles.h"
@@ -26,30 +28,32 @@ class ProbeMaps {
 
   /// The GL name of cube buffer `buffer` (0 or 1) of probe `handle`, created (black) on first
   /// use and recreated when `resolution` changes (both buffers: a resize drops the old maps).
-  GLuint cube(std::uint32_t handle, int buffer, int resolution);
+  GLuint cube(ProbeHandle handle, int buffer, int resolution);
   /// The cube buffer if it exists, else 0 (for lookups: a probe that was never made has none).
-  GLuint existing_cube(std::uint32_t handle, int buffer) const;
+  GLuint existing_cube(ProbeHandle handle, int buffer) const;
 
   /// Binds face `face` (GL order) of the cube as the colour target of the capture framebuffer,
   /// with a depth buffer of the cube's size, sets the viewport and clears to `clear` (linear).
-  void begin_face(std::uint32_t handle, int buffer, int face, const glm::vec3& clear);
+  void begin_face(ProbeHandle handle, int buffer, int face, const glm::vec3& clear);
   /// After the last face of a capture: rebuilds the cube's mip chain.
-  void finish_cube(std::uint32_t handle, int buffer);
+  void finish_cube(ProbeHandle handle, int buffer);
   /// Uploads a CPU cube map (faces as GL expects them, env_map.h) into a buffer, with mips.
-  void upload(std::uint32_t handle, int buffer, const CubeMap& cube);
+  void upload(ProbeHandle handle, int buffer, const CubeMap& cube);
 
   /// Renders probe `handle`'s sphere map from cube `buffer` for a camera with world -> view
   /// rotation `view_rotation` (S3 eq. (2) in that view space); returns the 2D texture.
-  GLuint update_sphere(std::uint32_t handle, int buffer, const glm::mat3& view_rotation);
-  GLuint existing_sphere(std::uint32_t handle) const;
+  GLuint update_sphere(ProbeHandle handle, int buffer, const glm::mat3& view_rotation);
+  GLuint existing_sphere(ProbeHandle handle) const;
 
   /// Read-back (tests, debug dumps): a cube buffer as a CubeMap (level 0), the sphere map with
   /// row 0 at the top (SphereMap's convention). Empty when the probe has no such map.
-  CubeMap read_cube(std::uint32_t handle, int buffer) const;
-  SphereMap read_sphere(std::uint32_t handle) const;
+  CubeMap read_cube(ProbeHandle handle, int buffer) const;
+  SphereMap read_sphere(ProbeHandle handle) const;
 
-  /// Forgets every probe (another scene: handles are entity indices of one world).
+  /// Forgets every probe (another scene: handles name entities of one world).
   void clear() { probes_.clear(); }
+  /// Drops the maps of every probe not in `live` (sorted): reflectors that were destroyed.
+  void retain(const std::vector<ProbeHandle>& live);
 
   int faces_rendered = 0;  ///< faces begun since creation (tests compare with the system)
 
@@ -65,7 +69,7 @@ class ProbeMaps {
   gpu::Framebuffer fbo_;
   gpu::Renderbuffer depth_;
   int depth_size_ = 0;
-  std::map<std::uint32_t, Probe> probes_;
+  std::map<ProbeHandle, Probe> probes_;
 };
 
 }  // namespace kaskad::render

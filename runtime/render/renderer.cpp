@@ -314,6 +314,13 @@ VariantKey frame_variant(const FrameInput& frame) {
   return k;
 }
 
+VariantKey capture_frame_variant(VariantKey frame) {
+  VariantKey k = VariantKey(frame.bits() & ~VariantKey::kAovs.mask());
+  if (k.has(VariantKey::kShadow) && k.get(VariantKey::kShadowProjection) == 0)  // ortho cascades
+    k.set(VariantKey::kCascadeSelection, 1);
+  return k;
+}
+
 VariantKey material_variant(const DrawItem& d) {
   // receive_shadows is a per-object flag, but it selects code like a material feature.
   VariantKey k = VariantKey(d.material.features & VariantKey::kMaterialMask & ~VariantKey::kReceiveShadows.mask());
@@ -325,7 +332,7 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   const VariantKey fk = frame_variant(frame);
   // Probe captures draw without AOVs; a reflector's draw gets its map feature once its first
   // capture completes (possibly frames later when time-sliced): compile those up front too.
-  const VariantKey capture_fk = VariantKey(fk.bits() & ~VariantKey::kAovs.mask());
+  const VariantKey capture_fk = capture_frame_variant(fk);
   std::vector<ProgramRequest> out;
   for (const DrawItem& d : frame.draws) {
     const VariantKey k = material_variant(d) | fk;
@@ -463,8 +470,14 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   if (assets.uid != im.assets_uid) {
     im.meshes.clear();
     im.textures.clear();
-    im.probes->clear();  // probe handles are entity indices of that scene
+    im.probes->clear();  // probe handles name entities of that scene
     im.assets_uid = assets.uid;
+  }
+  {  // Maps of reflectors that no longer exist (destroyed entities) are dropped.
+    std::vector<ProbeHandle> live;
+    for (const ProbeJob& job : frame.probes) live.push_back(job.handle);
+    std::sort(live.begin(), live.end());
+    im.probes->retain(live);
   }
   for (const DrawItem& d : frame.draws)
     if (d.mesh >= assets.meshes.size())
@@ -656,7 +669,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   // Forward draws: the main view and every probe face go through this one path. Draws reflecting
   // a probe get its map (`visible_before`: the map as of before this frame's captures, so a probe
   // never sees a cube that is being captured) and k_s * p_r.
-  std::map<std::uint32_t, const ProbeJob*> probe_jobs;
+  std::map<ProbeHandle, const ProbeJob*> probe_jobs;
   for (const ProbeJob& job : frame.probes) probe_jobs[job.handle] = &job;
   auto bind_reflection = [&](GLuint prog, const DrawItem& d, VariantKey key, bool capture) {
     if (!key.has(VariantKey::kReflectionCube) && !key.has(VariantKey::kReflectionSphere)) return;
@@ -712,15 +725,16 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
 
   // Pass 2: reflection probes (S3): each scheduled face of a probe's back cube is rendered by a
   // 90° camera at the probe centre through the forward path, shadows included, without AOVs and
-  // without exposure (the cube holds linear radiance). u_view stays the main camera's: cascade
-  // selection and sphere-map lookups are the main view's. Then mips, then sphere maps.
+  // without exposure (the cube holds linear radiance), with cascades selected by map bounds
+  // (capture_frame_variant()). u_view stays the main camera's: sphere-map lookups are the main
+  // view's. Then mips, then sphere maps.
   stats_.probe_faces = 0;
   stats_.probe_draw_calls = 0;
   stats_.probe_culled = 0;
   stats_.frustum_culled = 0;
   glBeginQuery(GL_TIME_ELAPSED, im.timers[2].id());
   if (!frame.probes.empty()) {
-    const VariantKey capture_frame = VariantKey(frame_key.bits() & ~VariantKey::kAovs.mask());
+    const VariantKey capture_frame = capture_frame_variant(frame_key);
     std::vector<VariantKey> capture_keys(frame.draws.size());
     for (std::size_t i = 0; i < frame.draws.size(); ++i)
       capture_keys[i] = material_variant(frame.draws[i]) | capture_frame;
@@ -982,11 +996,11 @@ Image Renderer::read_shadow_map() const {
   return img;
 }
 
-CubeMap Renderer::read_probe_cube(std::uint32_t handle, int buffer) const {
+CubeMap Renderer::read_probe_cube(ProbeHandle handle, int buffer) const {
   return impl_->probes->read_cube(handle, buffer);
 }
 
-SphereMap Renderer::read_probe_sphere(std::uint32_t handle) const {
+SphereMap Renderer::read_probe_sphere(ProbeHandle handle) const {
   return impl_->probes->read_sphere(handle);
 }
 

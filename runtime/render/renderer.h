@@ -27,6 +27,7 @@
 #include "runtime/core/result.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/render/shader_library.h"
+#include "runtime/render/shadow_limits.h"
 #include "runtime/render/variant_key.h"
 
 namespace kaskad::render {
@@ -47,10 +48,10 @@ struct DrawItem {
   int layer = 0;                     ///< MeshRenderer::layer (probes may exclude layers)
   /// World bounds, for culling against the main view and each probe face; empty: always drawn.
   Aabb bounds;
-  /// The reflection probe this draw reflects (its own Reflector; kNoProbe: none). The draw is
+  /// The reflection probe this draw reflects (its own Reflector; none by default). The draw is
   /// never drawn into that probe. With a reflection material feature on, it is shaded with the
   /// probe's visible map, scaled by `reflection_scale` = k_s * p_r (S3 eq. (3)).
-  std::uint32_t probe = kNoProbe;
+  ProbeHandle probe;
   float reflection_scale = 0.0f;
   /// Bit 8k + i: drawn into cascade i of FrameInput::extra_shadows[k].
   std::uint32_t extra_cascade_masks = 0;
@@ -62,7 +63,7 @@ struct DrawItem {
 /// probe's own and excluded layers; reflective draws in them use their probes' visible maps as
 /// of before this frame's captures (no recursion).
 struct ProbeJob {
-  std::uint32_t handle = kNoProbe;
+  ProbeHandle handle;
   glm::vec3 center{0.0f};
   float near = 0.05f, far = 100.0f;
   int resolution = 128;
@@ -85,9 +86,6 @@ using LightItem = LightShading;
 
 inline constexpr int kMaxCascades = 8;  // change together with systems/cascade_math.h and
                                         // MAX_CASCADES in common.glsl
-/// The first shadowed light plus up to 3 further directional ones. Change together with
-/// systems/shadow_cascade_system.h and MAX_EXTRA_SHADOWS (= this - 1) in common.glsl.
-inline constexpr int kMaxShadowedLights = 4;
 
 /// The shadowed light's cascades (systems/shadow_cascade_system.h, ShadowData).
 struct ShadowPass {
@@ -162,6 +160,11 @@ struct FrameStats {
 
 /// The frame features of a frame (shadow, filter, AOVs): the VARIANT_* part of every key.
 VariantKey frame_variant(const FrameInput& frame);
+/// The frame features of a probe capture of a frame with features `frame`: no AOVs, and cascades
+/// selected by map bounds. S0's view-depth selection measures the main camera's depth, which
+/// says nothing about a point behind it or beside it that a probe face sees: that point would
+/// fall into cascade 0, whose map does not hold it, and come out lit.
+VariantKey capture_frame_variant(VariantKey frame);
 /// The material features of a draw (MATERIAL_* part): from the material's data.
 VariantKey material_variant(const DrawItem& draw);
 /// Every (pass, key) a frame draws with, sorted and unique: what prewarm compiles and what
@@ -200,8 +203,8 @@ class Renderer {
   Image read_aovs() const;
   /// A probe's cube buffer (0 or 1; level 0) or its sphere map (row 0 at the top) as last
   /// rendered; empty when the probe has none. Tests and `kaskad render --probe-maps`.
-  CubeMap read_probe_cube(std::uint32_t handle, int buffer) const;
-  SphereMap read_probe_sphere(std::uint32_t handle) const;
+  CubeMap read_probe_cube(ProbeHandle handle, int buffer) const;
+  SphereMap read_probe_sphere(ProbeHandle handle) const;
   /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom; with
   /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;

@@ -1,15 +1,20 @@
 // The variant key: which compile-time features a program has. A 32-bit value with named bits
 // and small integer fields (Filament's Variant, Bevy's MeshPipelineKey), split into
-//   material features  (bits 0-15)  what a material uses      -> MATERIAL_HAS_* defines
+//   material features  (bits 0-15)  what a material uses      -> MATERIAL_* defines
 //   frame features     (bits 16-31) what the frame needs      -> VARIANT_* defines
-// Defines are produced from a key by one function (ShaderLibrary / FeatureManifest::defines),
-// driven by content/shaders/features.json, which names every field below; the manifest loader
-// checks that it matches this layout.
 //
-// Valid combinations (valid()):
+// kFeatureTable below is the one place a feature is declared: its name, define, stages, bit
+// offset, value range or value names, and what it requires or excludes. Everything else is
+// derived from it: VariantKey's field constants, valid(), FeatureManifest (defines, rule
+// messages, `kaskad variants`), the GLSL BIT_* numbers of the material features (defines from
+// FeatureManifest::defines(), read by features.glsl's ENABLED()) and material files' checks.
+// Adding a feature: one row here, its `#if` block in the shaders, and where its value comes from.
+//
+// Valid combinations (valid(), from the table's requires/excludes and ranges; a feature is "on"
+// when its stored field is non-zero):
 //   reflection_cube and reflection_sphere exclude each other
 //   reflection_box needs reflection_cube
-//   shadow_filter != 0 and cascade_count != 1 need shadow
+//   shadow_filter != none and cascade_count != 1 need shadow
 //   debug_cascades, cascade_selection and shadow_projection need shadow
 //   shadow_projection != ortho has cascade_count 1 (cascades are directional only)
 //   shadow_layered needs shadow; the depth pass keeps it (its vertex shader picks the layer)
@@ -18,8 +23,11 @@
 // shadow programs.
 #pragma once
 
+#include <array>
+#include <bit>
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 namespace kaskad::render {
 
@@ -36,36 +44,188 @@ constexpr const char* pass_name(Pass pass) {
   return "forward";
 }
 
+/// material: from the material (MATERIAL_* defines); frame: from frame settings (VARIANT_*).
+enum class FeatureKind : std::uint8_t { material, frame };
+enum class ShaderStage : std::uint8_t { vertex = 1, fragment = 2 };
+
+/// Where a feature's value lives in the key: bit offset and width.
+struct KeyField {
+  std::uint8_t offset;
+  std::uint8_t width;
+  constexpr std::uint32_t mask() const { return ((1u << width) - 1u) << offset; }
+  constexpr std::uint32_t max() const { return (1u << width) - 1u; }
+};
+
+/// One shader feature (a row of kFeatureTable).
+struct FeatureSpec {
+  std::string_view name;
+  FeatureKind kind = FeatureKind::material;
+  std::string_view define;  ///< MATERIAL_* for material features, VARIANT_* for frame ones
+  std::uint8_t stages = 0;  ///< ShaderStage bits: the stages that get the define
+  std::uint8_t offset = 0;  ///< first bit in the key; the width follows from the value range
+  /// Integer features: the value range (a switch: 0..1). Enumerated features: `values` names
+  /// the values 0..n-1 and `max` is ignored. The key stores value - min.
+  int min = 0, max = 1;
+  std::array<std::string_view, 4> values{};
+  std::array<std::string_view, 2> requires_{};  ///< features that must be on when this one is
+  std::array<std::string_view, 2> excludes{};   ///< features that must be off when this one is
+
+  constexpr int value_count() const {
+    int n = 0;
+    while (n < int(values.size()) && !values[std::size_t(n)].empty()) ++n;
+    return n;
+  }
+  constexpr int value_max() const { return value_count() > 0 ? value_count() - 1 : max; }
+  constexpr KeyField field() const {
+    return {offset, std::uint8_t(std::bit_width(unsigned(value_max() - min)))};
+  }
+};
+
+inline constexpr std::uint8_t kVertexStage = std::uint8_t(ShaderStage::vertex);
+inline constexpr std::uint8_t kFragmentStage = std::uint8_t(ShaderStage::fragment);
+
+/// Every shader feature, in the order defines and descriptions list them.
+inline constexpr FeatureSpec kFeatureTable[] = {
+    // Material features (bits 0-15).
+    {.name = "base_color_texture", .define = "MATERIAL_HAS_BASE_COLOR_TEXTURE",
+     .stages = kFragmentStage, .offset = 0},
+    {.name = "normal_map", .define = "MATERIAL_HAS_NORMAL_MAP", .stages = kFragmentStage,
+     .offset = 1},
+    {.name = "alpha_mask", .define = "MATERIAL_HAS_ALPHA_MASK",
+     .stages = kVertexStage | kFragmentStage, .offset = 2},
+    {.name = "emissive", .define = "MATERIAL_HAS_EMISSIVE", .stages = kFragmentStage, .offset = 3},
+    {.name = "reflection_cube", .define = "MATERIAL_HAS_REFLECTION_CUBE", .stages = kFragmentStage,
+     .offset = 4, .excludes = {"reflection_sphere"}},
+    {.name = "reflection_sphere", .define = "MATERIAL_HAS_REFLECTION_SPHERE",
+     .stages = kFragmentStage, .offset = 5, .excludes = {"reflection_cube"}},
+    {.name = "reflection_box", .define = "MATERIAL_HAS_REFLECTION_BOX", .stages = kFragmentStage,
+     .offset = 7, .requires_ = {"reflection_cube"}},
+    {.name = "receive_shadows", .define = "MATERIAL_RECEIVES_SHADOWS", .stages = kFragmentStage,
+     .offset = 6},
+    // Frame features (bits 16-31).
+    {.name = "shadow", .kind = FeatureKind::frame, .define = "VARIANT_HAS_SHADOW",
+     .stages = kFragmentStage, .offset = 16},
+    {.name = "shadow_filter", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_FILTER",
+     .stages = kFragmentStage, .offset = 17, .values = {"none", "bilinear", "pcf3x3"},
+     .requires_ = {"shadow"}},
+    {.name = "cascade_count", .kind = FeatureKind::frame, .define = "VARIANT_CASCADE_COUNT",
+     .stages = kVertexStage | kFragmentStage, .offset = 19, .min = 1, .max = 8,
+     .requires_ = {"shadow"}},
+    {.name = "aovs", .kind = FeatureKind::frame, .define = "VARIANT_HAS_AOVS",
+     .stages = kFragmentStage, .offset = 22},
+    {.name = "cascade_selection", .kind = FeatureKind::frame, .define = "VARIANT_CASCADE_SELECTION",
+     .stages = kFragmentStage, .offset = 24, .values = {"depth", "map_bounds"},
+     .requires_ = {"shadow"}},
+    {.name = "shadow_projection", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_PROJECTION",
+     .stages = kVertexStage | kFragmentStage, .offset = 25,
+     .values = {"ortho", "perspective", "cube", "dual_paraboloid"}, .requires_ = {"shadow"},
+     .excludes = {"cascade_count"}},
+    {.name = "shadow_layered", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_LAYERED",
+     .stages = kVertexStage, .offset = 27, .requires_ = {"shadow"}},
+    {.name = "debug_cascades", .kind = FeatureKind::frame, .define = "VARIANT_DEBUG_CASCADES",
+     .stages = kFragmentStage, .offset = 23, .requires_ = {"shadow"}},
+};
+inline constexpr int kFeatureCount = int(std::size(kFeatureTable));
+
+/// Index of a feature in kFeatureTable; -1 when there is none.
+constexpr int feature_index(std::string_view name) {
+  for (int i = 0; i < kFeatureCount; ++i)
+    if (kFeatureTable[i].name == name) return i;
+  return -1;
+}
+
+/// A feature's key field by name; a name not in the table does not compile.
+consteval KeyField feature_field(std::string_view name) {
+  const int i = feature_index(name);
+  if (i < 0) throw "feature_field: no such feature in kFeatureTable";
+  return kFeatureTable[i].field();
+}
+
+/// The first rule a key breaks (valid() and FeatureManifest::check() both read this).
+struct BrokenRule {
+  enum Kind : std::uint8_t { none, unused_bits, range, requires_, excludes } kind = none;
+  int feature = -1;  ///< index into kFeatureTable
+  int other = -1;    ///< requires_/excludes: the other feature's index
+};
+
+namespace feature_detail {
+// The table compiled into masks once, so valid() costs a few dozen bit operations.
+struct Rule {
+  std::uint32_t mask = 0;
+  std::uint8_t offset = 0;
+  std::uint32_t max_stored = 0;  ///< value_max - min
+  std::array<int, 2> requires_{-1, -1};
+  std::array<int, 2> excludes{-1, -1};
+};
+consteval std::array<Rule, kFeatureCount> make_rules() {
+  std::array<Rule, kFeatureCount> rules{};
+  std::uint32_t taken = 0;
+  for (int i = 0; i < kFeatureCount; ++i) {
+    const FeatureSpec& f = kFeatureTable[i];
+    Rule& r = rules[std::size_t(i)];
+    const KeyField field = f.field();
+    // Checks on the table itself: a bad row is a compile error here.
+    if (f.name.empty() || f.define.empty() || f.stages == 0) throw "feature without name, define or stage";
+    if (feature_index(f.name) != i) throw "duplicate feature name";
+    if (f.value_max() < f.min || field.width == 0) throw "empty value range";
+    if (unsigned(field.offset) + field.width > 32u) throw "field past bit 31";
+    if (taken & field.mask()) throw "features overlap in the key";
+    const bool material = f.kind == FeatureKind::material;
+    if (material ? (field.mask() & 0xffff0000u) : (field.mask() & 0x0000ffffu))
+      throw "material features live in bits 0-15, frame features in bits 16-31";
+    if (!f.define.starts_with(material ? "MATERIAL_" : "VARIANT_"))
+      throw "material defines start with MATERIAL_, frame defines with VARIANT_";
+    taken |= field.mask();
+    r.mask = field.mask();
+    r.offset = field.offset;
+    r.max_stored = std::uint32_t(f.value_max() - f.min);
+    for (std::size_t k = 0; k < 2; ++k) {
+      if (!f.requires_[k].empty()) {
+        r.requires_[k] = feature_index(f.requires_[k]);
+        if (r.requires_[k] < 0) throw "requires an unknown feature";
+      }
+      if (!f.excludes[k].empty()) {
+        r.excludes[k] = feature_index(f.excludes[k]);
+        if (r.excludes[k] < 0) throw "excludes an unknown feature";
+      }
+    }
+  }
+  return rules;
+}
+inline constexpr std::array<Rule, kFeatureCount> kRules = make_rules();
+consteval std::uint32_t used_bits() {
+  std::uint32_t used = 0;
+  for (const Rule& r : kRules) used |= r.mask;
+  return used;
+}
+}  // namespace feature_detail
+
 class VariantKey {
  public:
-  // Layout: bit offset and width of each field. Change together with features.json.
-  struct Field {
-    std::uint8_t offset;
-    std::uint8_t width;
-    constexpr std::uint32_t mask() const { return ((1u << width) - 1u) << offset; }
-    constexpr std::uint32_t max() const { return (1u << width) - 1u; }
-  };
+  using Field = KeyField;
+  // Named fields, looked up in kFeatureTable at compile time.
   // Material features.
-  static constexpr Field kBaseColorTexture{0, 1};
-  static constexpr Field kNormalMap{1, 1};
-  static constexpr Field kAlphaMask{2, 1};
-  static constexpr Field kEmissive{3, 1};
-  static constexpr Field kReflectionCube{4, 1};
-  static constexpr Field kReflectionSphere{5, 1};
-  static constexpr Field kReceiveShadows{6, 1};
-  static constexpr Field kReflectionBox{7, 1};
+  static constexpr Field kBaseColorTexture = feature_field("base_color_texture");
+  static constexpr Field kNormalMap = feature_field("normal_map");
+  static constexpr Field kAlphaMask = feature_field("alpha_mask");
+  static constexpr Field kEmissive = feature_field("emissive");
+  static constexpr Field kReflectionCube = feature_field("reflection_cube");
+  static constexpr Field kReflectionSphere = feature_field("reflection_sphere");
+  static constexpr Field kReceiveShadows = feature_field("receive_shadows");
+  static constexpr Field kReflectionBox = feature_field("reflection_box");
   static constexpr std::uint32_t kMaterialMask = 0x0000ffffu;
   // Frame features.
-  static constexpr Field kShadow{16, 1};
-  static constexpr Field kShadowFilter{17, 2};   ///< 0 none, 1 bilinear, 2 pcf3x3
-  static constexpr Field kCascadeCountMinus1{19, 3};  ///< cascade count - 1 (1..8 cascades)
-  static constexpr Field kAovs{22, 1};
-  static constexpr Field kDebugCascades{23, 1};
-  static constexpr Field kCascadeSelection{24, 1};  ///< 0 depth (S0's D), 1 map bounds
+  static constexpr Field kShadow = feature_field("shadow");
+  static constexpr Field kShadowFilter = feature_field("shadow_filter");  ///< 0 none, 1 bilinear, 2 pcf3x3
+  /// cascade count - 1 (1..8 cascades)
+  static constexpr Field kCascadeCountMinus1 = feature_field("cascade_count");
+  static constexpr Field kAovs = feature_field("aovs");
+  static constexpr Field kDebugCascades = feature_field("debug_cascades");
+  static constexpr Field kCascadeSelection = feature_field("cascade_selection");  ///< 0 depth (S0's D), 1 map bounds
   /// ShadowProjection: 0 ortho, 1 perspective, 2 cube, 3 dual_paraboloid.
-  static constexpr Field kShadowProjection{25, 2};
+  static constexpr Field kShadowProjection = feature_field("shadow_projection");
   static constexpr std::uint32_t kProjectionDualParaboloid = 3;
-  static constexpr Field kShadowLayered{27, 1};  ///< depth pass: all layers in one pass
+  static constexpr Field kShadowLayered = feature_field("shadow_layered");  ///< depth pass: all layers in one pass
   static constexpr std::uint32_t kFrameMask = 0xffff0000u;
 
   constexpr VariantKey() = default;
@@ -85,25 +245,25 @@ class VariantKey {
   constexpr bool operator==(const VariantKey&) const = default;
   constexpr auto operator<=>(const VariantKey&) const = default;
 
-  /// The combination rules in the header comment. Unused bits must be zero.
-  constexpr bool valid() const {
-    constexpr std::uint32_t used =
-        kBaseColorTexture.mask() | kNormalMap.mask() | kAlphaMask.mask() | kEmissive.mask() |
-        kReflectionCube.mask() | kReflectionSphere.mask() | kReceiveShadows.mask() |
-        kReflectionBox.mask() |
-        kShadow.mask() | kShadowFilter.mask() | kCascadeCountMinus1.mask() | kAovs.mask() |
-        kDebugCascades.mask() | kCascadeSelection.mask() | kShadowProjection.mask() |
-        kShadowLayered.mask();
-    if (bits_ & ~used) return false;
-    if (has(kReflectionCube) && has(kReflectionSphere)) return false;
-    if (has(kReflectionBox) && !has(kReflectionCube)) return false;
-    if (get(kShadowFilter) > 2) return false;
-    if (!has(kShadow) && (has(kShadowFilter) || has(kCascadeCountMinus1) || has(kDebugCascades) ||
-                          has(kCascadeSelection) || has(kShadowProjection) || has(kShadowLayered)))
-      return false;
-    if (has(kShadowProjection) && has(kCascadeCountMinus1)) return false;
-    return true;
+  /// The first rule of kFeatureTable this key breaks (unused bits set, a value out of its
+  /// range, a requires or excludes rule), or kind none.
+  constexpr BrokenRule broken_rule() const {
+    using feature_detail::kRules;
+    if (bits_ & ~feature_detail::used_bits()) return {BrokenRule::unused_bits};
+    for (int i = 0; i < kFeatureCount; ++i) {
+      const feature_detail::Rule& r = kRules[std::size_t(i)];
+      const std::uint32_t stored = (bits_ & r.mask) >> r.offset;
+      if (stored > r.max_stored) return {BrokenRule::range, i};
+      if (stored == 0) continue;
+      for (int j : r.requires_)
+        if (j >= 0 && !(bits_ & kRules[std::size_t(j)].mask)) return {BrokenRule::requires_, i, j};
+      for (int j : r.excludes)
+        if (j >= 0 && (bits_ & kRules[std::size_t(j)].mask)) return {BrokenRule::excludes, i, j};
+    }
+    return {};
   }
+  /// The combination rules in the header comment. Unused bits must be zero.
+  constexpr bool valid() const { return broken_rule().kind == BrokenRule::none; }
 
   /// The part of the key a pass's shaders read. The depth pass only needs alpha masking; the
   /// shadow-points pass only the shadow lookup's frame features (a receiver, without AOVs or the

@@ -17,7 +17,9 @@ check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
   if [ "$rc" -ge 128 ]; then
     echo "FAIL $name: crashed (exit $rc)"; echo "$out" | tail -5; failed=$((failed + 1)); return
   fi
-  if [ "$want" = "nonzero" ] && [ "$rc" -eq 0 ] || [ "$want" = "0" ] && [ "$rc" -ne 0 ]; then
+  # Grouped: a bare `A && B || C && D` parses as `((A && B) || C) && D`, which lets a bad-input
+  # check pass when the command exits 0.
+  if { [ "$want" = "nonzero" ] && [ "$rc" -eq 0 ]; } || { [ "$want" = "0" ] && [ "$rc" -ne 0 ]; }; then
     echo "FAIL $name: exit $rc, expected $want"; echo "$out" | tail -5; failed=$((failed + 1)); return
   fi
   if ! grep -qE -- "$pattern" <<<"$out"; then

@@ -14,6 +14,7 @@
 #include "components/shadow_settings.h"
 #include "components/transform.h"
 #include "runtime/assets/scene_io.h"
+#include "runtime/assets/material_file.h"
 
 namespace kaskad {
 namespace {

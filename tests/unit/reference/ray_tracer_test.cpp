@@ -16,6 +16,7 @@
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
 #include "runtime/assets/primitives.h"
+#include "runtime/assets/material_file.h"
 #include "runtime/reference/shadow_metrics.h"
 
 namespace kaskad::reference {

@@ -2,10 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <cstdlib>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include "runtime/assets/material_file.h"
 #include "runtime/render/feature_manifest.h"
+#include "runtime/render/renderer.h"
 #include "runtime/render/variant_key.h"
 
 namespace kaskad::render {
@@ -27,24 +31,86 @@ fs::path temp(const std::string& name, const std::string& text) {
   return dir / name;
 }
 
-TEST(VariantKey, ManifestRulesAgreeWithTheConstexprRules) {
+// The rules of variant_key.h's header comment, written out independently of kFeatureTable.
+bool documented_rules_hold(VariantKey k) {
+  using V = VariantKey;
+  const std::uint32_t used =
+      V::kBaseColorTexture.mask() | V::kNormalMap.mask() | V::kAlphaMask.mask() |
+      V::kEmissive.mask() | V::kReflectionCube.mask() | V::kReflectionSphere.mask() |
+      V::kReceiveShadows.mask() | V::kReflectionBox.mask() | V::kShadow.mask() |
+      V::kShadowFilter.mask() | V::kCascadeCountMinus1.mask() | V::kAovs.mask() |
+      V::kDebugCascades.mask() | V::kCascadeSelection.mask() | V::kShadowProjection.mask() |
+      V::kShadowLayered.mask();
+  if (k.bits() & ~used) return false;
+  if (k.get(V::kShadowFilter) > 2) return false;  // none, bilinear, pcf3x3
+  if (k.has(V::kReflectionCube) && k.has(V::kReflectionSphere)) return false;
+  if (k.has(V::kReflectionBox) && !k.has(V::kReflectionCube)) return false;
+  const bool needs_shadow = k.has(V::kShadowFilter) || k.has(V::kCascadeCountMinus1) ||
+                            k.has(V::kDebugCascades) || k.has(V::kCascadeSelection) ||
+                            k.has(V::kShadowProjection) || k.has(V::kShadowLayered);
+  if (needs_shadow && !k.has(V::kShadow)) return false;
+  if (k.has(V::kShadowProjection) && k.has(V::kCascadeCountMinus1)) return false;
+  return true;
+}
+
+TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   const FeatureManifest m = manifest();
   std::uint32_t used = 0;
   for (const auto& f : m.features()) used |= f.field.mask();
-  // Every key over the used bits: both rule sets give the same verdict, and a valid key
-  // filters to itself for the forward pass (it reads everything).
-  int valid = 0;
-  for (std::uint32_t bits = 0; bits < (1u << 24); bits = ((bits | ~used) + 1) & used) {
+  // Every key over the used bits (every subset of them: all values of every field, selection,
+  // projection and layered included): valid() (kFeatureTable's rules) agrees with the rules
+  // written out above, the manifest names a broken rule exactly when valid() is false, and a
+  // valid key filters to itself for the forward pass (it reads everything) and to valid keys
+  // for the others.
+  int valid = 0, disagree = 0;
+  for (std::uint32_t bits = 0;; bits = ((bits | ~used) + 1) & used) {
     const VariantKey k(bits);
-    EXPECT_EQ(k.valid(), m.check(k).empty()) << std::hex << bits << ": " << m.check(k);
+    if ((k.valid() != documented_rules_hold(k) || k.valid() != m.check(k).empty()) &&
+        disagree++ < 5)
+      ADD_FAILURE() << "key 0x" << std::hex << bits << ": valid() " << k.valid()
+                    << ", documented rules " << documented_rules_hold(k) << ", manifest: '"
+                    << m.check(k) << "' (" << m.describe(k) << ")";
     if (k.valid()) {
       ++valid;
       EXPECT_EQ(k.filtered_for(Pass::forward), k);
       EXPECT_TRUE(k.filtered_for(Pass::depth).valid());
+      EXPECT_TRUE(k.filtered_for(Pass::shadow_points).valid());
     }
     if (bits == used) break;
   }
-  EXPECT_GT(valid, 100);
+  EXPECT_EQ(disagree, 0);
+  // Material keys: 2^5 free bits x 4 of the 8 reflection cube/sphere/box combinations = 128.
+  // Frame keys: 2 without shadow (aovs), and with shadow 3 filters x 2 aovs x 2 debug x
+  // 2 selection x 2 layered x (8 ortho cascade counts + 3 other projections) = 528.
+  EXPECT_EQ(valid, 128 * 530);
+}
+
+// The table is the one source: the manifest's features, their fields and the GLSL bit numbers
+// all come from it.
+TEST(VariantKey, FeatureTableDrivesTheManifestAndTheGlslBits) {
+  const FeatureManifest m = manifest();
+  ASSERT_EQ(m.features().size(), std::size(kFeatureTable));
+  for (std::size_t i = 0; i < m.features().size(); ++i) {
+    EXPECT_EQ(m.features()[i].name, kFeatureTable[i].name);
+    EXPECT_EQ(m.features()[i].field.mask(), kFeatureTable[i].field().mask());
+  }
+  EXPECT_EQ(m.find("cascade_count")->field.mask(), VariantKey::kCascadeCountMinus1.mask());
+  EXPECT_EQ(m.check(m.with(m.with(m.with(VariantKey(), *m.find("shadow"), 1),
+                                  *m.find("shadow_projection"), 2),
+                           *m.find("cascade_count"), 3)),
+            "shadow_projection excludes cascade_count");
+  int bits = 0;
+  for (const auto& [name, value] : m.defines(VariantKey(), ShaderStage::vertex)) {
+    if (name.rfind("BIT_", 0) != 0) continue;
+    ++bits;
+    if (name == "BIT_NORMAL_MAP") {
+      EXPECT_EQ(value, std::to_string(VariantKey::kNormalMap.offset));
+    }
+    if (name == "BIT_REFLECTION_BOX") {
+      EXPECT_EQ(value, std::to_string(VariantKey::kReflectionBox.offset));
+    }
+  }
+  EXPECT_EQ(bits, 8);  // every material feature, in every stage
 }
 
 TEST(VariantKey, DefinesComeFromOneFunctionForBothKinds) {
@@ -67,6 +133,7 @@ TEST(VariantKey, DefinesComeFromOneFunctionForBothKinds) {
   EXPECT_EQ(value("VARIANT_SHADOW_FILTER_PCF3X3"), "2");
   EXPECT_EQ(value("VARIANT_CASCADE_COUNT"), "4");
   EXPECT_EQ(m.describe(k), "normal_map shadow shadow_filter=pcf3x3 cascade_count=4");
+  EXPECT_EQ(value("BIT_NORMAL_MAP"), "1");
   // Stages: normal_map is fragment-only.
   for (const auto& [n, v] : m.defines(k, ShaderStage::vertex)) EXPECT_NE(n, "MATERIAL_HAS_NORMAL_MAP");
 }
@@ -83,26 +150,35 @@ TEST(VariantKey, InvalidCombinationsAreNamed) {
 
 TEST(FeatureManifest, BadManifestsAreRejected) {
   auto bad = [](const std::string& text) { return FeatureManifest::load(temp("features.json", text)); };
-  auto r1 = bad(R"({"features": [{"name": "sparkles", "kind": "material", "define": "MATERIAL_HAS_SPARKLES", "stages": ["fragment"]}]})");
+  // Features are declared in C++ only.
+  auto r1 = bad(R"({"features": [{"name": "sparkles", "kind": "material"}]})");
   ASSERT_FALSE(r1.ok());
-  EXPECT_NE(r1.error().to_string().find("sparkles"), std::string::npos) << r1.error().to_string();
-  auto r2 = bad(R"({"features": [{"name": "normal_map", "kind": "material", "define": "VARIANT_X", "stages": ["fragment"]}]})");
+  EXPECT_NE(r1.error().to_string().find("kFeatureTable"), std::string::npos) << r1.error().to_string();
+  auto r2 = bad(R"({"parameters": [{"name": "glitter", "type": "float", "default": 0, "feature": "sparkles"}]})");
   ASSERT_FALSE(r2.ok());
-  EXPECT_NE(r2.error().to_string().find("MATERIAL_"), std::string::npos);
+  EXPECT_NE(r2.error().to_string().find("/parameters/0/feature"), std::string::npos) << r2.error().to_string();
+  EXPECT_NE(r2.error().to_string().find("sparkles"), std::string::npos);
   auto r3 = bad("{ not json");
   ASSERT_FALSE(r3.ok());
   EXPECT_NE(r3.error().to_string().find("features.json"), std::string::npos);
-  // A manifest missing a feature the key layout has.
-  auto real = manifest();
-  std::ifstream in(kShaders / "features.json");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto pos = text.find("    { \"name\": \"debug_cascades\"");
-  ASSERT_NE(pos, std::string::npos);
-  std::string cut = text;
-  cut.erase(text.rfind(",\n", pos), text.find('\n', pos) - text.rfind(",\n", pos));
-  auto r4 = bad(cut);
+  auto r4 = bad(R"({"textures": [{"name": "glow", "feature": "glowing"}]})");
   ASSERT_FALSE(r4.ok());
-  EXPECT_NE(r4.error().to_string().find("debug_cascades"), std::string::npos) << r4.error().to_string();
+  EXPECT_NE(r4.error().to_string().find("glowing"), std::string::npos) << r4.error().to_string();
+}
+
+// common.glsl sizes the frame block's arrays with its own defines; they must match the
+// renderer's FrameBlock limits (written twice: GLSL cannot include a C++ header).
+TEST(ShaderConstants, CommonGlslMatchesTheRendererLimits) {
+  std::ifstream in(kShaders / "common.glsl");
+  ASSERT_TRUE(in) << "cannot open common.glsl";
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto define = [&](const std::string& name) {
+    const std::string key = "#define " + name + " ";
+    const auto at = text.find(key);
+    return at == std::string::npos ? -1 : std::atoi(text.c_str() + at + key.size());
+  };
+  EXPECT_EQ(define("MAX_CASCADES"), kMaxCascades);
+  EXPECT_EQ(define("MAX_EXTRA_SHADOWS"), kMaxShadowedLights - 1);
 }
 
 struct BadMaterial {

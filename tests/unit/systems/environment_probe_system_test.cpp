@@ -240,6 +240,43 @@ TEST(EnvironmentProbeSystem, PlanningDoesNotAdvanceState) {
   EXPECT_EQ(pw.frame(1).faces_this_frame, 0);
 }
 
+// A reflector destroyed and another created in its entity slot: the renderer's maps are named
+// by index and generation, so the new probe never inherits the old one's maps; it captures all
+// six faces on its first frame.
+TEST(EnvironmentProbeSystem, AReflectorInAReusedSlotGetsAFreshCapture) {
+  ProbeWorld pw(ProbeUpdate::every_n);
+  pw.w.get<Reflector>(pw.mirror).every_n = 100;
+  const ProbeData first = pw.frame(0);
+  ASSERT_EQ(first.probes.size(), 1u);
+  EXPECT_EQ(first.faces_this_frame, 6);
+  EXPECT_EQ(pw.frame(1).faces_this_frame, 0);
+  const ProbeHandle old_handle = first.probes[0].job.handle;
+  ASSERT_TRUE(old_handle.valid());
+
+  const ecs::Entity old_entity = pw.mirror;
+  pw.w.destroy(old_entity);
+  const ecs::Entity reused = pw.w.create();
+  ASSERT_EQ(reused.index, old_entity.index);  // the precondition of this test: the slot is reused
+  ASSERT_NE(reused.generation, old_entity.generation);
+  pw.w.emplace<Transform>(reused, Transform{{0, 1, 0}, {1, 0, 0, 0}, glm::vec3(1.0f)});
+  MeshRenderer mr;
+  mr.mesh = pw.w.get<MeshRenderer>(pw.near_box).mesh;
+  pw.w.emplace<MeshRenderer>(reused, mr);
+  Reflector r;
+  r.update = ProbeUpdate::every_n;
+  r.every_n = 100;
+  pw.w.emplace<Reflector>(reused, r);
+
+  const ProbeData next = pw.frame(2);
+  ASSERT_EQ(next.probes.size(), 1u);
+  EXPECT_EQ(next.probes[0].entity, reused);
+  EXPECT_NE(next.probes[0].job.handle, old_handle);
+  EXPECT_EQ(next.probes[0].job.handle, pw.w.get<ProbeState>(reused).handle);
+  EXPECT_EQ(next.faces_this_frame, 6);  // a fresh capture (frame 2 is no multiple of 100)
+  EXPECT_EQ(next.captures_this_frame, 1);
+  EXPECT_TRUE(next.probes[0].has_map);
+}
+
 TEST(EnvironmentProbeSystem, CentreIsTheBoundsCentreUnlessGiven) {
   ProbeWorld pw(ProbeUpdate::first_frame);
   // A mesh whose local bounds are centred at (1, 0, 0): the pivot sits off the geometric centre.

@@ -267,11 +267,52 @@ TEST(ShadowCascadeSystem, SeveralDirectionalLightsEachGetCascadesUpToTheCap) {
       EXPECT_EQ(all[1].view_proj[std::size_t(c)], single[0].view_proj[std::size_t(c)]) << c;
     }
   }
+  // Lights 2.. asked for other map sizes: the notice names the field (with the light count).
+  EXPECT_NE(state.last_notice.find("map_size differ from the first shadowed light's"),
+            std::string::npos)
+      << state.last_notice;
   // A spot light after the first shadowed light gets no maps.
   w.get<Light>(suns[1]).type = LightType::spot;
   const std::vector<ShadowData> some = update_shadows(w, cam, state);
   ASSERT_EQ(some.size(), std::size_t(kMaxShadowedLights));
   EXPECT_EQ(some[1].light, suns[2]);
+}
+
+// Settings shared by every shadowed light (one texture array, one set of frame features) come
+// from the first; a later light that asks otherwise is told which fields (logged once).
+TEST(ShadowCascadeSystem, SharedSettingsOfLaterLightsAreNamedInTheNotice) {
+  ecs::World w;
+  box(w, Aabb::from_corners({-10, -0.1f, -10}, {10, 0, 10}), false, true);
+  box(w, Aabb::from_corners({-0.5f, 1, -0.5f}, {0.5f, 2, 0.5f}), true, true);
+  light(w, LightType::directional, {0, 10, 0}, glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f)));
+  const ecs::Entity second =
+      light(w, LightType::directional, {0, 10, 0}, glm::normalize(glm::vec3(-0.3f, -1.0f, 0.1f)));
+  CameraState cam;
+  cam.entity = w.create();
+  cam.camera.near = 0.5f;
+  cam.camera.far = 60.0f;
+  cam.view = glm::lookAt(glm::vec3(0, 5, 12), glm::vec3(0), glm::vec3(0, 1, 0));
+  cam.proj = glm::perspective(glm::radians(cam.camera.fov_y_deg), 1.0f, 0.5f, 60.0f);
+  ShadowCascadeState state;
+  ASSERT_EQ(update_shadows(w, cam, state).size(), 2u);
+  EXPECT_EQ(state.last_notice, "");  // same settings: nothing to say
+  ShadowSettings& s = w.get<ShadowSettings>(second);
+  s.filter = ShadowFilter::none;
+  s.layered = !s.layered;
+  s.debug_cascades = true;
+  s.cascade_count = 2;  // per light: not named
+  const std::vector<ShadowData> out = update_shadows(w, cam, state);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[1].settings.filter, out[0].settings.filter);
+  EXPECT_EQ(out[1].cascade_count, 2);
+  // The light is named (by its entity index) and exactly the differing shared fields are listed.
+  EXPECT_NE(state.last_notice.find(std::to_string(second.index)), std::string::npos)
+      << state.last_notice;
+  EXPECT_NE(state.last_notice.find(": its filter, layered, debug_cascades differ from the first "
+                                   "shadowed light's, whose values apply (one shared texture "
+                                   "array, one set of shader features)"),
+            std::string::npos)
+      << state.last_notice;
 }
 
 // freeze_cascades keeps the splits and matrices while the camera moves, and unfreezing fits
