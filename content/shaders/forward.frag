@@ -99,13 +99,14 @@ void main() {
 #if MATERIAL_HAS_EMISSIVE
   if (ENABLED(BIT_EMISSIVE)) color += u_emissive;
 #endif
-  // Further shadowed directional lights; the AOV shows the one u_counts.w names.
+  // Further shadowed directional lights (as many as the variant has: none is no code); the AOV
+  // shows the one u_counts.w names.
   float aov_visibility = visibility;
   int aov_cascade = cascade;
-#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
+#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS && EXTRA_SHADOWS > 0
   float extra_visibility[MAX_EXTRA_SHADOWS] = float[MAX_EXTRA_SHADOWS](1.0, 1.0, 1.0);
   if (ENABLED(BIT_RECEIVE_SHADOWS))
-    for (int k = 0; k < u_extra_count.x; ++k) {
+    for (int k = 0; k < EXTRA_SHADOWS; ++k) {
       int c;
       extra_visibility[k] = extra_shadow_visibility(k, v_world_pos, geometric_n, view_depth, c);
       if (k + 1 == u_counts.w) {
@@ -140,8 +141,8 @@ void main() {
     vec3 h = normalize(l + v);
     vec3 spec = f0 * spec_norm * pow(max(dot(n, h), 0.0), shininess);
     float shadow = (i == u_counts.y) ? visibility : 1.0;
-#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
-    for (int k = 0; k < u_extra_count.x; ++k)
+#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS && EXTRA_SHADOWS > 0
+    for (int k = 0; k < EXTRA_SHADOWS; ++k)
       if (u_extra_light[k].x == i) shadow = extra_visibility[k];
 #endif
     color += (diffuse_color + spec) * u_light_color[i].rgb * ndl * attenuation * shadow;

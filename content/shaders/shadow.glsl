@@ -15,6 +15,10 @@ layout(binding = 2) uniform sampler2DArrayShadow u_shadow_map;  // one layer per
 // light) and the paraboloid margin; cascade_texel(i) is metres per texel at 1 m from the light.
 #if VARIANT_HAS_SHADOW
 #define CASCADES VARIANT_CASCADE_COUNT
+// Further shadowed directional lights of this variant (u_extra_count.x holds the same number).
+// A compile-time count: on llvmpipe a loop whose uniform bound is 0 still runs its body once
+// with every lane masked off, which cost a quarter of the default scene's frame.
+#define EXTRA_SHADOWS (VARIANT_SHADOW_LIGHTS - 1)
 
 // The filtered depth compare of layer `layer` at c: xy texture coordinates, z depth in [0, 1].
 float shadow_taps(int layer, vec3 c) {
@@ -163,6 +167,7 @@ float shadow_visibility(vec3 p, vec3 n, float depth, out int cascade) {
   return v;
 }
 
+#if EXTRA_SHADOWS > 0
 // Further shadowed directional lights (S0: each has its own N maps): light k's cascades, with the
 // first light's filter and selection (frame features), its own matrices, splits, blend band and
 // normal offset (data). The same steps as cascade_visibility / select_cascade / blend_weight.
@@ -205,6 +210,7 @@ float extra_shadow_visibility(int k, vec3 p, vec3 n, float depth, out int cascad
   if (cascade < count - 1 && w > 0.0) v = mix(v, extra_cascade_visibility(k, cascade + 1, p, n), w);
   return v;
 }
+#endif
 
 #if VARIANT_DEBUG_CASCADES
 // Tints per cascade: red, green, blue, yellow, magenta, cyan, orange, violet.

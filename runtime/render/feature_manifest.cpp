@@ -37,6 +37,7 @@ constexpr LayoutEntry kLayout[] = {
     {"debug_cascades", VariantKey::kDebugCascades, 0},
     {"shadow_projection", VariantKey::kShadowProjection, 0},
     {"shadow_layered", VariantKey::kShadowLayered, 0},
+    {"shadow_lights", VariantKey::kShadowLightsMinus1, 1},
 };
 
 std::vector<std::string> string_list(ObjectReader& r, const char* key) {

@@ -290,15 +290,39 @@ ShaderLibrary& Renderer::shaders() { return *impl_->shaders; }
 
 namespace {
 int cascade_layers(const ShadowPass& p) { return std::clamp(p.cascade_count, 1, kMaxCascades); }
+
+int shaded_lights(const FrameInput& frame) {
+  return std::min<int>(int(frame.lights.size()), kMaxLights);
+}
+
+bool has_shadow(const FrameInput& frame) {
+  return frame.shadow.light_index >= 0 && frame.shadow.light_index < shaded_lights(frame);
+}
+
+// The further shadowed directional lights the frame draws and shades: of
+// FrameInput::extra_shadows those with a shaded light and orthographic cascades, at most
+// kMaxExtra; none without the first shadowed light. Their number is a variant field
+// (shadow_lights), so render() and frame_variant() must agree: both call this.
+std::vector<const ShadowPass*> drawn_extra_shadows(const FrameInput& frame) {
+  std::vector<const ShadowPass*> out;
+  if (!has_shadow(frame)) return out;
+  for (const ShadowPass& e : frame.extra_shadows) {
+    if (int(out.size()) == kMaxExtra) break;
+    if (e.light_index < 0 || e.light_index >= shaded_lights(frame) ||
+        e.projection != ShadowProjection::ortho)
+      continue;
+    out.push_back(&e);
+  }
+  return out;
+}
 }  // namespace
 
 VariantKey frame_variant(const FrameInput& frame) {
   VariantKey k;
-  const bool shadowed = frame.shadow.light_index >= 0 &&
-                        frame.shadow.light_index < std::min<int>(int(frame.lights.size()), kMaxLights);
-  if (shadowed) {
+  if (has_shadow(frame)) {
     const ShadowSettings& s = frame.shadow.settings;
     k.set(VariantKey::kShadow, 1);
+    k.set(VariantKey::kShadowLightsMinus1, std::uint32_t(drawn_extra_shadows(frame).size()));
     k.set(VariantKey::kShadowFilter, std::uint32_t(s.filter));
     k.set(VariantKey::kShadowProjection, std::uint32_t(frame.shadow.projection));
     // Paraboloid hemispheres are projected in code, one pass each: no layered pass for them.
@@ -398,22 +422,16 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   const int light_count = std::min<int>(int(frame.lights.size()), kMaxLights);
   if (int(frame.lights.size()) > kMaxLights)
     log::warn("%zu lights; only the first %d are shaded", frame.lights.size(), kMaxLights);
-  const bool shadowed = frame.shadow.light_index >= 0 && frame.shadow.light_index < light_count;
+  const bool shadowed = has_shadow(frame);
   const int cascades = shadowed ? cascade_layers(frame.shadow) : 0;
   // Further shadowed directional lights: their cascades follow the first light's layers.
-  std::vector<const ShadowPass*> extras;
+  const std::vector<const ShadowPass*> extras = drawn_extra_shadows(frame);
   std::array<int, kMaxShadowedLights> first_layer{};
   int total_layers = cascades;
-  if (shadowed)
-    for (const ShadowPass& e : frame.extra_shadows) {
-      if (int(extras.size()) == kMaxExtra) break;
-      if (e.light_index < 0 || e.light_index >= light_count ||
-          e.projection != ShadowProjection::ortho)
-        continue;
-      first_layer[extras.size()] = total_layers;
-      total_layers += cascade_layers(e);
-      extras.push_back(&e);
-    }
+  for (std::size_t k = 0; k < extras.size(); ++k) {
+    first_layer[k] = total_layers;
+    total_layers += cascade_layers(*extras[k]);
+  }
   const int aov_light = frame.aov_shadow_light >= 0 && frame.aov_shadow_light <= int(extras.size())
                             ? frame.aov_shadow_light
                             : 0;

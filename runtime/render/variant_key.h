@@ -13,6 +13,7 @@
 //   debug_cascades, cascade_selection and shadow_projection need shadow
 //   shadow_projection != ortho has cascade_count 1 (cascades are directional only)
 //   shadow_layered needs shadow; the depth pass keeps it (its vertex shader picks the layer)
+//   shadow_lights != 1 needs shadow (the lookups of lights that do not exist are not compiled)
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask, and the projection
 // when it is dual_paraboloid: its vertex shader differs), so every material shares one or two
 // shadow programs.
@@ -66,6 +67,10 @@ class VariantKey {
   static constexpr Field kShadowProjection{25, 2};
   static constexpr std::uint32_t kProjectionDualParaboloid = 3;
   static constexpr Field kShadowLayered{27, 1};  ///< depth pass: all layers in one pass
+  /// Shadowed lights - 1 (1..4): the first plus the further directional ones the frame has.
+  /// A count, not a switch, so loops over shadowed lights have a compile-time bound and a light
+  /// that does not exist costs nothing (llvmpipe runs a zero-trip loop's body once, masked).
+  static constexpr Field kShadowLightsMinus1{28, 2};
   static constexpr std::uint32_t kFrameMask = 0xffff0000u;
 
   constexpr VariantKey() = default;
@@ -93,13 +98,14 @@ class VariantKey {
         kReflectionBox.mask() |
         kShadow.mask() | kShadowFilter.mask() | kCascadeCountMinus1.mask() | kAovs.mask() |
         kDebugCascades.mask() | kCascadeSelection.mask() | kShadowProjection.mask() |
-        kShadowLayered.mask();
+        kShadowLayered.mask() | kShadowLightsMinus1.mask();
     if (bits_ & ~used) return false;
     if (has(kReflectionCube) && has(kReflectionSphere)) return false;
     if (has(kReflectionBox) && !has(kReflectionCube)) return false;
     if (get(kShadowFilter) > 2) return false;
     if (!has(kShadow) && (has(kShadowFilter) || has(kCascadeCountMinus1) || has(kDebugCascades) ||
-                          has(kCascadeSelection) || has(kShadowProjection) || has(kShadowLayered)))
+                          has(kCascadeSelection) || has(kShadowProjection) || has(kShadowLayered) ||
+                          has(kShadowLightsMinus1)))
       return false;
     if (has(kShadowProjection) && has(kCascadeCountMinus1)) return false;
     return true;
@@ -136,6 +142,11 @@ static_assert(!VariantKey().set(VariantKey::kReflectionBox, 1).valid());
 static_assert(VariantKey().set(VariantKey::kReflectionBox, 1).set(VariantKey::kReflectionCube, 1).valid());
 static_assert(VariantKey().set(VariantKey::kNormalMap, 1).filtered_for(Pass::depth) == VariantKey());
 static_assert(!VariantKey().set(VariantKey::kShadowProjection, 1).valid());
+static_assert(!VariantKey().set(VariantKey::kShadowLightsMinus1, 1).valid());
+static_assert(VariantKey()
+                  .set(VariantKey::kShadow, 1)
+                  .set(VariantKey::kShadowLightsMinus1, 3)
+                  .filtered_for(Pass::depth) == VariantKey());
 static_assert(
     VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 2).valid());
 static_assert(!VariantKey()

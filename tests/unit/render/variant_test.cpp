@@ -1,11 +1,13 @@
 // Variant keys, the feature manifest and material files: no GL needed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
 #include "runtime/assets/material_file.h"
 #include "runtime/render/feature_manifest.h"
+#include "runtime/render/renderer.h"
 #include "runtime/render/variant_key.h"
 
 namespace kaskad::render {
@@ -103,6 +105,58 @@ TEST(FeatureManifest, BadManifestsAreRejected) {
   auto r4 = bad(cut);
   ASSERT_FALSE(r4.ok());
   EXPECT_NE(r4.error().to_string().find("debug_cascades"), std::string::npos) << r4.error().to_string();
+}
+
+// The number of shadowed lights is a frame feature: a frame compiles the lookups of the lights
+// it shades and no others (issue 13: dormant extra-light code cost a quarter of the frame).
+TEST(FrameVariant, ShadowLightsCountsTheShadowedLightsTheFrameShades) {
+  const FeatureManifest m = manifest();
+  const Feature& lights = *m.find("shadow_lights");
+  FrameInput frame;
+  frame.lights.resize(4);
+  EXPECT_EQ(m.value(lights, frame_variant(frame)), 1);  // no shadow: the field is off
+  EXPECT_FALSE(frame_variant(frame).has(VariantKey::kShadowLightsMinus1));
+  // Extra lights without a first shadowed light are not drawn.
+  frame.extra_shadows.resize(1);
+  frame.extra_shadows[0].light_index = 1;
+  EXPECT_FALSE(frame_variant(frame).has(VariantKey::kShadow));
+  EXPECT_FALSE(frame_variant(frame).has(VariantKey::kShadowLightsMinus1));
+
+  frame.shadow.light_index = 0;
+  frame.extra_shadows.clear();
+  EXPECT_EQ(m.value(lights, frame_variant(frame)), 1);
+  // Drawn: a directional light in range. Not drawn: a light index past the shaded lights, a
+  // spot projection (extras are directional cascades).
+  ShadowPass extra;
+  extra.light_index = 1;
+  frame.extra_shadows.push_back(extra);
+  extra.light_index = 9;
+  frame.extra_shadows.push_back(extra);
+  extra.light_index = 2;
+  extra.projection = ShadowProjection::perspective;
+  frame.extra_shadows.push_back(extra);
+  VariantKey k = frame_variant(frame);
+  EXPECT_EQ(m.value(lights, k), 2);
+  EXPECT_TRUE(k.valid());
+  EXPECT_EQ(m.check(k), "");
+  EXPECT_NE(m.describe(k).find("shadow_lights=2"), std::string::npos) << m.describe(k);
+  // At most kMaxShadowedLights in all.
+  extra.projection = ShadowProjection::ortho;
+  for (int i = 0; i < 5; ++i) frame.extra_shadows.push_back(extra);
+  k = frame_variant(frame);
+  EXPECT_EQ(m.value(lights, k), kMaxShadowedLights);
+  // The forward and points passes read it; the depth pass does not.
+  EXPECT_EQ(k.filtered_for(Pass::shadow_points).get(VariantKey::kShadowLightsMinus1), 3u);
+  EXPECT_EQ(k.filtered_for(Pass::depth).get(VariantKey::kShadowLightsMinus1), 0u);
+  const auto defs = m.defines(k, ShaderStage::fragment);
+  EXPECT_NE(std::find(defs.begin(), defs.end(), std::pair<std::string, std::string>(
+                                                    "VARIANT_SHADOW_LIGHTS", "4")),
+            defs.end());
+  // Without a shadow the count is an invalid key, named by the manifest.
+  const VariantKey orphan = VariantKey().set(VariantKey::kShadowLightsMinus1, 1);
+  EXPECT_FALSE(orphan.valid());
+  EXPECT_NE(m.check(orphan).find("shadow_lights requires shadow"), std::string::npos)
+      << m.check(orphan);
 }
 
 struct BadMaterial {
