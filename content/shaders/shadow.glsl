@@ -24,17 +24,20 @@ layout(binding = 2) uniform sampler2DArrayShadow u_shadow_map;  // one layer per
 float shadow_taps(int layer, vec3 c) {
   vec4 tc = vec4(c.xy, float(layer), c.z);
 #if VARIANT_SHADOW_FILTER == VARIANT_SHADOW_FILTER_PCF3X3
-  // textureOffset needs constant offsets: the 3x3 kernel is written out.
-  float sum = 0.0;
-  sum += textureOffset(u_shadow_map, tc, ivec2(-1, -1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(0, -1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(1, -1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(-1, 0));
-  sum += texture(u_shadow_map, tc);
-  sum += textureOffset(u_shadow_map, tc, ivec2(1, 0));
-  sum += textureOffset(u_shadow_map, tc, ivec2(-1, 1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(0, 1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(1, 1));
+  // S4's 3x3 PCF: the nine nearest-filtered compares of the texels t-1 .. t+1 around the point's
+  // texel t, as four compare-gathers over the 4x4 block t-1 .. t+2 (the t+2 row and column are
+  // left out). A gather at texel coordinate t returns texels t-1 and t (its footprint starts at
+  // floor(t - 0.5)), half a texel from either edge, so rounding cannot shift it. Components:
+  // x (i0, j1), y (i1, j1), z (i1, j0), w (i0, j0). Equal to nine textureOffset taps
+  // (tests/render/shadow_lookup_test.cpp).
+  vec2 size = vec2(textureSize(u_shadow_map, 0).xy);
+  vec2 t = floor(c.xy * size);
+  vec2 lo = t / size, hi = (t + 2.0) / size;
+  vec4 g00 = textureGather(u_shadow_map, vec3(lo, tc.z), c.z);        // t-1, t  x  t-1, t
+  vec4 g10 = textureGather(u_shadow_map, vec3(hi.x, lo.y, tc.z), c.z);  // t+1     x  t-1, t
+  vec4 g01 = textureGather(u_shadow_map, vec3(lo.x, hi.y, tc.z), c.z);  // t-1, t  x  t+1
+  vec4 g11 = textureGather(u_shadow_map, vec3(hi, tc.z), c.z);        // t+1     x  t+1
+  float sum = g00.x + g00.y + g00.z + g00.w + g10.x + g10.w + g01.z + g01.w + g11.w;
   return sum / 9.0;
 #else
   return texture(u_shadow_map, tc);  // filtering (nearest / linear) is set on the texture
