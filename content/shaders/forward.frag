@@ -91,8 +91,19 @@ void main() {
   int cascade = -1;
   float view_depth = -(u_view * vec4(v_world_pos, 1.0)).z;
 #if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
-  if (ENABLED(BIT_RECEIVE_SHADOWS))
+  if (ENABLED(BIT_RECEIVE_SHADOWS)) {
+#if VARIANT_HAS_AOVS
     visibility = shadow_visibility(v_world_pos, geometric_n, view_depth, cascade);
+#else
+    // No AOV shows it: where the geometric surface faces away from the light it shadows itself,
+    // so the lookup is skipped (visibility 0; only a normal-mapped normal can still face the
+    // light there). With AOVs the lookup runs everywhere: the AOV contract and its tests keep
+    // today's values on such pixels. llvmpipe runs the masked lookup anyway (no gain there).
+    visibility = 0.0;
+    if (faces_light(u_counts.y, v_world_pos, geometric_n))
+      visibility = shadow_visibility(v_world_pos, geometric_n, view_depth, cascade);
+#endif
+  }
 #endif
 
   vec3 color = u_ambient.rgb * diffuse_color;

@@ -170,6 +170,14 @@ float blended_visibility(int cascade, float w, vec3 p, vec3 n) {
   return v;
 }
 
+// Whether the surface at p with geometric normal n faces light `light` (an index into u_light_*).
+// One facing away shadows itself: forward.frag skips its lookup where no AOV shows it.
+bool faces_light(int light, vec3 p, vec3 n) {
+  vec3 to_light = int(u_light_color[light].w) == LIGHT_DIRECTIONAL ? -u_light_dir[light].xyz
+                                                                    : u_light_pos[light].xyz - p;
+  return dot(n, to_light) > 0.0;
+}
+
 float shadow_visibility(vec3 p, vec3 n, float depth, out int cascade) {
 #if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_PERSPECTIVE
   cascade = 0;

@@ -1,4 +1,4 @@
-// The shadow lookup's filter kernel (shadow_taps() in content/shaders/shadow.glsl) in GL, against
+// The shadow lookup (content/shaders/shadow.glsl) in GL. First its filter kernel, shadow_taps(), against
 // the 3x3 PCF as first written (S4): nine nearest-filtered compares at constant texel offsets
 // around the lookup point. shadow_taps() may compute the same box differently (issue 13: four
 // compare-gathers instead of nine taps); this test pins that it is the same kernel. A random
@@ -17,10 +17,12 @@
 #include <vector>
 
 #include "components/shadow_settings.h"
+#include "runtime/cli/player.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/gpu/shader.h"
 #include "runtime/render/feature_manifest.h"
 #include "tests/render/headless_gl.h"
+#include "tests/render/player_fixture.h"
 
 namespace kaskad {
 namespace {
@@ -156,6 +158,36 @@ INSTANTIATE_TEST_SUITE_P(Formats, ShadowLookupTest,
                                            Format{"d24", GL_DEPTH_COMPONENT24},
                                            Format{"d32f", GL_DEPTH_COMPONENT32F}),
                          [](const auto& info) { return std::string(info.param.name); });
+
+
+// Without AOVs the forward pass skips the lookup where the geometric surface faces away from the
+// shadowed light (forward.frag); with AOVs it looks up everywhere, as the AOV contract shows. The
+// colour must not change: such surfaces get no direct light from it (no normal maps here).
+// Directional (default, two suns) and spot (spot.json) lights.
+class ForwardLookupTest : public PlayerTest {};
+
+TEST_F(ForwardLookupTest, SkippingTheLookupOnSurfacesFacingAwayKeepsTheColour) {
+  for (const char* name : {"default.json", "two_suns.json", "spot.json"}) {
+    auto scene = load_scene(content_dir() / "scenes" / name, {});
+    ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+    Image colour[2];
+    for (int aovs = 0; aovs < 2; ++aovs) {
+      RenderRun run;
+      run.width = 320;
+      run.height = 180;
+      run.write_aovs = aovs == 1;
+      auto t = render_frames(*player_, *scene, run);
+      ASSERT_TRUE(t.ok()) << name << ": " << t.error().to_string();
+      ASSERT_GT(t->last.stats.shadow_draw_calls, 0) << name;
+      colour[aovs] = player_->renderer->read_color();
+    }
+    ASSERT_EQ(colour[0].pixels.size(), colour[1].pixels.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < colour[0].pixels.size(); ++i)
+      differ += colour[0].pixels[i] != colour[1].pixels[i];
+    EXPECT_EQ(differ, 0u) << name << ": colour values differ with and without AOVs";
+  }
+}
 
 }  // namespace
 }  // namespace kaskad
