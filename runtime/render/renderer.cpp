@@ -10,6 +10,7 @@
 #include <numeric>
 #include <optional>
 #include <tuple>
+#include <type_traits>
 
 #include "runtime/core/log.h"
 #include "runtime/gpu/shader.h"
@@ -79,6 +80,20 @@ struct GpuTexture {
   gpu::Texture texture;
 };
 
+// FNV-1a over the bytes of plain values: the inputs of a shadow layer (shadow caching).
+struct InputHash {
+  std::uint64_t h = 14695981039346656037ull;
+  template <typename T>
+  InputHash& add(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    unsigned char bytes[sizeof(T)];
+    std::memcpy(bytes, &v, sizeof(T));
+    for (unsigned char b : bytes) h = (h ^ b) * 1099511628211ull;
+    return *this;
+  }
+  std::uint64_t value() const { return h | 1u; }  // never 0, which means "nothing drawn"
+};
+
 // A 1x1 texture standing in for a missing material texture.
 gpu::Texture make_solid_texture(const std::array<float, 4>& rgba, GLenum internal_format) {
   gpu::Texture t = gpu::make_texture(GL_TEXTURE_2D);
@@ -111,6 +126,9 @@ struct Renderer::Impl {
   gpu::Framebuffer shadow_fbo;
   gpu::Texture shadow_map;
   bool shadow_valid = false;
+  /// Per layer of shadow_map: a hash of what its depth was last drawn from (layer_inputs()); 0
+  /// = nothing valid. A layer whose inputs hash the same is kept, not re-rendered.
+  std::vector<std::uint64_t> layer_drawn_from;
 
   // Shadow-points pass target (one pixel per point) and its point buffer.
   int points_width = 0, points_height = 0;
@@ -239,6 +257,7 @@ struct Renderer::Impl {
       glTextureParameterfv(shadow_map.id(), GL_TEXTURE_BORDER_COLOR, border);
       glTextureParameteri(shadow_map.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
       glTextureParameteri(shadow_map.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+      layer_drawn_from.assign(std::size_t(layers), 0);  // new storage: nothing to keep
       shadow_fbo = gpu::make_framebuffer();
       glNamedFramebufferTextureLayer(shadow_fbo.id(), GL_DEPTH_ATTACHMENT, shadow_map.id(), 0, 0);
       glNamedFramebufferDrawBuffer(shadow_fbo.id(), GL_NONE);
@@ -551,6 +570,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.cascade_triangles.fill(0);
   stats_.cascade_texel_size.fill(0.0f);
   stats_.cascade_receiver_pixels.fill(0);
+  stats_.shadow_layers_rendered = 0;
+  stats_.shadow_layers = 0;
   for (int c = 0; c < cascades; ++c)
     stats_.cascade_texel_size[std::size_t(c)] = frame.shadow.texel_size[std::size_t(c)];
   if (shadowed) {
@@ -573,16 +594,71 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     // shader routes instance i to the i-th of them (shadow_depth.vert). The same maps as one pass
     // per layer (render test), with fewer draw calls.
     const bool layered = frame_key.has(VariantKey::kShadowLayered);
-    if (layered) {
+    // Light 0 is the first shadowed light, 1.. the extra directional ones; each with its own
+    // culling, bias and casters per cascade, into consecutive layers.
+    auto pass_of = [&](std::size_t light) -> const ShadowPass& {
+      return light == 0 ? frame.shadow : *extras[light - 1];
+    };
+    auto base_of = [&](std::size_t light) { return light == 0 ? 0 : first_layer[light - 1]; };
+    auto layers_of = [&](std::size_t light) {
+      return light == 0 ? cascades : cascade_layers(pass_of(light));
+    };
+    auto caster_mask = [&](std::size_t light, const DrawItem& d) -> std::uint32_t {
+      if (!d.cast_shadows) return 0;
+      return light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu;
+    };
+    // Extra lights are cascades: the plain depth program even after paraboloid maps.
+    auto depth_key = [&](std::size_t light, std::uint32_t i) {
+      VariantKey k = keys[i];
+      if (light > 0) k.set(VariantKey::kShadowProjection, 0);
+      return k;
+    };
+    // Shadow caching (issue 13): a layer keeps last frame's depth when it would be drawn from the
+    // same inputs: its matrix, projection data, bias and culling, pass mode, and the same casters
+    // (mesh, model matrix, depth program, alpha-mask parameters) in the same order. A moved
+    // caster changes its matrix, a moved camera the layer's matrix or casters; other assets
+    // (another scene) change assets.uid. New map storage invalidates every layer.
+    auto layer_inputs = [&](std::size_t light, int c) {
+      const ShadowPass& pass = pass_of(light);
+      InputHash h;
+      h.add(assets.uid).add(layered).add(pass.projection).add(pass.settings.cull);
+      h.add(pass.settings.slope_bias).add(pass.settings.constant_bias);
+      h.add(pass.view_proj[std::size_t(c)]).add(pass.splits).add(pass.skipped[std::size_t(c)]);
+      if (pass.skipped[std::size_t(c)]) return h.value();
+      for (std::uint32_t i : order) {
+        const DrawItem& d = frame.draws[i];
+        if (!(caster_mask(light, d) & (1u << c))) continue;
+        h.add(d.mesh).add(d.model).add(depth_key(light, i).filtered_for(Pass::depth).bits());
+        if (d.material.alpha_mask || im.oracle)
+          h.add(d.material.base_color.a).add(d.material.alpha_cutoff)
+              .add(d.material.base_color_texture);
+      }
+      return h.value();
+    };
+    std::vector<std::uint64_t> inputs(std::size_t(total_layers), 0);
+    bool any_dirty = false;
+    for (std::size_t light = 0; light <= extras.size(); ++light)
+      for (int c = 0; c < layers_of(light); ++c) {
+        const std::size_t layer = std::size_t(base_of(light) + c);
+        inputs[layer] = layer_inputs(light, c);
+        if (inputs[layer] != im.layer_drawn_from[layer]) {
+          stats_.shadow_layers_rendered |= 1u << layer;
+          any_dirty = true;
+        }
+      }
+    // The layered pass draws every layer at once: it redraws all of them or none.
+    if (layered && any_dirty) stats_.shadow_layers_rendered = (1u << total_layers) - 1u;
+    stats_.shadow_layers = total_layers;
+    auto redraw = [&](int layer) { return (stats_.shadow_layers_rendered >> layer) & 1u; };
+    if (layered && any_dirty) {
       glNamedFramebufferTexture(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0);
       glClear(GL_DEPTH_BUFFER_BIT);
     }
-    // Light 0 is the first shadowed light, 1.. the extra directional ones; each with its own
-    // culling, bias and casters per cascade, into consecutive layers.
+    // Stats count the casters each layer holds, whether drawn now or kept from an earlier frame.
     for (std::size_t light = 0; light <= extras.size(); ++light) {
-      const ShadowPass& pass = light == 0 ? frame.shadow : *extras[light - 1];
-      const int base = light == 0 ? 0 : first_layer[light - 1];
-      const int layers = light == 0 ? cascades : cascade_layers(pass);
+      const ShadowPass& pass = pass_of(light);
+      const int base = base_of(light);
+      const int layers = layers_of(light);
       if (pass.settings.cull == CullMode::none) {
         glDisable(GL_CULL_FACE);
       } else {
@@ -597,26 +673,28 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
           if (!pass.skipped[std::size_t(c)]) live |= 1u << c;
         for (std::uint32_t i : order) {
           const DrawItem& d = frame.draws[i];
-          const std::uint32_t mask =
-              live &
-              (light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu);
-          if (!d.cast_shadows || mask == 0) continue;
+          const std::uint32_t mask = live & caster_mask(light, d);
+          if (mask == 0) continue;
           const GpuMesh& m = im.mesh(d.mesh, assets);
           if (m.index_count == 0) continue;
-          if (Status st = use_program(Pass::depth, keys[i], current); !st) {
-            glDisable(GL_POLYGON_OFFSET_FILL);
-            glEndQuery(GL_TIME_ELAPSED);
-            return st;
-          }
-          if (keys[i].has(VariantKey::kAlphaMask) || im.oracle) bind_material(current, d, keys[i]);
-          glProgramUniform1ui(current, kUniLayerMask, mask);
-          glProgramUniform1i(current, kUniLayerBase, base);
-          glProgramUniformMatrix4fv(current, kUniLayerViewProj, layers, GL_FALSE,
-                                    &pass.view_proj[0][0][0]);
-          glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-          glBindVertexArray(m.vao.id());
           const int instances = std::popcount(mask);
-          glDrawElementsInstanced(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr, instances);
+          if (any_dirty) {
+            if (Status st = use_program(Pass::depth, keys[i], current); !st) {
+              glDisable(GL_POLYGON_OFFSET_FILL);
+              glEndQuery(GL_TIME_ELAPSED);
+              return st;
+            }
+            if (keys[i].has(VariantKey::kAlphaMask) || im.oracle)
+              bind_material(current, d, keys[i]);
+            glProgramUniform1ui(current, kUniLayerMask, mask);
+            glProgramUniform1i(current, kUniLayerBase, base);
+            glProgramUniformMatrix4fv(current, kUniLayerViewProj, layers, GL_FALSE,
+                                      &pass.view_proj[0][0][0]);
+            glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+            glBindVertexArray(m.vao.id());
+            glDrawElementsInstanced(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
+                                    instances);
+          }
           ++stats_.shadow_draw_calls;
           stats_.shadow_triangles += std::size_t(instances) * std::size_t(m.index_count / 3);
           for (int c = 0; light == 0 && c < layers; ++c)
@@ -628,34 +706,35 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
         continue;
       }
       for (int c = 0; c < layers; ++c) {
-        glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(),
-                                       0, base + c);
-        glClear(GL_DEPTH_BUFFER_BIT);
+        const bool draw = redraw(base + c);
+        if (draw) {
+          glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT,
+                                         im.shadow_map.id(), 0, base + c);
+          glClear(GL_DEPTH_BUFFER_BIT);
+        }
         if (pass.skipped[std::size_t(c)]) continue;
         const glm::mat4& light_vp = pass.view_proj[std::size_t(c)];
         for (std::uint32_t i : order) {
           const DrawItem& d = frame.draws[i];
-          const std::uint32_t mask =
-              light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu;
-          if (!d.cast_shadows || !(mask & (1u << c))) continue;
+          if (!(caster_mask(light, d) & (1u << c))) continue;
           const GpuMesh& m = im.mesh(d.mesh, assets);
           if (m.index_count == 0) continue;
-          // Extra lights are cascades: the plain depth program even after paraboloid maps.
-          VariantKey depth_key = keys[i];
-          if (light > 0) depth_key.set(VariantKey::kShadowProjection, 0);
-          if (Status st = use_program(Pass::depth, depth_key, current); !st) {
-            glDisable(GL_POLYGON_OFFSET_FILL);
-            glDisable(GL_CLIP_DISTANCE0);
-            glEndQuery(GL_TIME_ELAPSED);
-            return st;
+          if (draw) {
+            if (Status st = use_program(Pass::depth, depth_key(light, i), current); !st) {
+              glDisable(GL_POLYGON_OFFSET_FILL);
+              glDisable(GL_CLIP_DISTANCE0);
+              glEndQuery(GL_TIME_ELAPSED);
+              return st;
+            }
+            // The oracle's one depth program reads the material bits from a uniform: set it for
+            // every draw, or an alpha-masked draw's bits leak into the next layer's opaque draws.
+            if (keys[i].has(VariantKey::kAlphaMask) || im.oracle)
+              bind_material(current, d, keys[i]);
+            glProgramUniformMatrix4fv(current, kUniLightViewProj, 1, GL_FALSE, &light_vp[0][0]);
+            glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+            glBindVertexArray(m.vao.id());
+            glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
           }
-          // The oracle's one depth program reads the material bits from a uniform: set it for
-          // every draw, or an alpha-masked draw's bits leak into the next layer's opaque draws.
-          if (keys[i].has(VariantKey::kAlphaMask) || im.oracle) bind_material(current, d, keys[i]);
-          glProgramUniformMatrix4fv(current, kUniLightViewProj, 1, GL_FALSE, &light_vp[0][0]);
-          glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-          glBindVertexArray(m.vao.id());
-          glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
           ++stats_.shadow_draw_calls;
           stats_.shadow_triangles += std::size_t(m.index_count / 3);
           if (light == 0) {
@@ -667,6 +746,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
     glDisable(GL_CLIP_DISTANCE0);
+    for (std::size_t layer = 0; layer < inputs.size(); ++layer)
+      if (redraw(int(layer))) im.layer_drawn_from[layer] = inputs[layer];
     im.shadow_valid = true;
   }
   glEndQuery(GL_TIME_ELAPSED);
