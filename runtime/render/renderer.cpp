@@ -614,16 +614,18 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
       return k;
     };
     // Shadow caching (issue 13): a layer keeps last frame's depth when it would be drawn from the
-    // same inputs: its matrix, projection data, bias and culling, pass mode, and the same casters
-    // (mesh, model matrix, depth program, alpha-mask parameters) in the same order. A moved
-    // caster changes its matrix, a moved camera the layer's matrix or casters; other assets
-    // (another scene) change assets.uid. New map storage invalidates every layer.
+    // same inputs: its matrix (and paraboloid data), bias and culling, pass mode, and the same
+    // casters (mesh, model matrix, depth program, alpha-mask parameters) in the same order. A
+    // moved caster changes its matrix, a moved camera the layer's matrix or casters; other
+    // assets (another scene) change assets.uid. New map storage invalidates every layer.
     auto layer_inputs = [&](std::size_t light, int c) {
       const ShadowPass& pass = pass_of(light);
       InputHash h;
       h.add(assets.uid).add(layered).add(pass.projection).add(pass.settings.cull);
       h.add(pass.settings.slope_bias).add(pass.settings.constant_bias);
-      h.add(pass.view_proj[std::size_t(c)]).add(pass.splits).add(pass.skipped[std::size_t(c)]);
+      h.add(pass.view_proj[std::size_t(c)]).add(pass.skipped[std::size_t(c)]);
+      // Only the paraboloid depth pass reads splits (near, far, margin: shadow_depth.vert).
+      if (pass.projection == ShadowProjection::dual_paraboloid) h.add(pass.splits);
       if (pass.skipped[std::size_t(c)]) return h.value();
       for (std::uint32_t i : order) {
         const DrawItem& d = frame.draws[i];

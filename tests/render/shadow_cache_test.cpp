@@ -60,7 +60,8 @@ class ShadowCacheTest : public PlayerTest {
     EXPECT_TRUE(copy.ok()) << copy.error().to_string();
     if (!copy.ok()) return {};
     for (const char* name : {"box_floating", "camera", "sun"})
-      copy->world.get<Transform>(named(*copy, name)) = scene.world.get<Transform>(named(scene, name));
+      copy->world.get<Transform>(named(*copy, name)) =
+          scene.world.get<Transform>(named(scene, name));
     Frame f = render(*player_, *copy);
     EXPECT_EQ(f.stats.shadow_layers_rendered, (1u << f.stats.shadow_layers) - 1u);
     return f;
@@ -85,7 +86,8 @@ TEST_F(ShadowCacheTest, LayersAreRedrawnOnlyWhenTheirInputsChange) {
 
   // A caster moves: the layers that hold it are redrawn, and the maps are those drawn with
   // nothing cached.
-  scene.world.get<Transform>(named(scene, "box_floating")).translation += glm::vec3(0.3f, 0.2f, 0.1f);
+  Transform& box = scene.world.get<Transform>(named(scene, "box_floating"));
+  box.translation += glm::vec3(0.3f, 0.2f, 0.1f);
   const Frame moved = render(*player_, scene);
   EXPECT_NE(moved.stats.shadow_layers_rendered, 0u);
   EXPECT_NE(moved.map, first.map);
