@@ -232,8 +232,16 @@ float extra_shadow_visibility(int k, vec3 p, vec3 n, float depth, out int cascad
     w = clamp((depth - (d1 - band * (d1 - d0))) / (band * (d1 - d0)), 0.0, 1.0);
   }
 #endif
-  float v = extra_cascade_visibility(k, cascade, p, n);
-  if (cascade < count - 1 && w > 0.0) v = mix(v, extra_cascade_visibility(k, cascade + 1, p, n), w);
+  if (cascade >= count - 1) w = 0.0;
+  // As blended_visibility(): a loop that ends on a value, so only SIMD vectors in the band pay
+  // for the second lookup on llvmpipe.
+  float v = 0.0, weight = 1.0 - w;
+  int c = cascade;
+  do {
+    v += weight * extra_cascade_visibility(k, c, p, n);
+    weight = c == cascade ? w : 0.0;
+    ++c;
+  } while (weight > 0.0);
   return v;
 }
 #endif

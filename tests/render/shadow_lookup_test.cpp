@@ -17,6 +17,7 @@
 #include <fstream>
 #include <ostream>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "components/shadow_settings.h"
@@ -84,7 +85,9 @@ class ShadowLookupTest : public HeadlessGlTest, public ::testing::WithParamInter
 TEST_P(ShadowLookupTest, Pcf3x3IsTheNineNearestComparesAroundThePoint) {
   // The shaders as shipped, plus the test's own, in a scratch folder (includes resolve there).
   const fs::path shaders = fs::path(KASKAD_CONTENT_DIR) / "shaders";
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "shadow_lookup";
+  // One folder per format: ctest runs the instances in parallel.
+  const fs::path dir =
+      fs::path(KASKAD_TEST_TMP) / (std::string("shadow_lookup_") + GetParam().name);
   fs::create_directories(dir);
   for (const char* f : {"common.glsl", "features.glsl", "shadow.glsl", "fullscreen.vert"})
     fs::copy_file(shaders / f, dir / f, fs::copy_options::overwrite_existing);
