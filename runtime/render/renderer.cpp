@@ -20,6 +20,8 @@ namespace kaskad::render {
 namespace {
 
 constexpr int kMaxExtra = kMaxShadowedLights - 1;
+// FrameStats::shadow_layers_rendered has one bit per layer of the shadow map.
+static_assert(kMaxShadowedLights * kMaxCascades <= 32);
 
 // std140 mirror of FrameBlock in content/shaders/common.glsl (change together).
 struct alignas(16) FrameBlock {
@@ -649,7 +651,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
         }
       }
     // The layered pass draws every layer at once: it redraws all of them or none.
-    if (layered && any_dirty) stats_.shadow_layers_rendered = (1u << total_layers) - 1u;
+    if (layered && any_dirty)  // up to 32 layers (4 lights x 8 cascades): no 1u << 32
+      stats_.shadow_layers_rendered = ~0u >> (32 - total_layers);
     stats_.shadow_layers = total_layers;
     auto redraw = [&](int layer) { return (stats_.shadow_layers_rendered >> layer) & 1u; };
     if (layered && any_dirty) {

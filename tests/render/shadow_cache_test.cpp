@@ -6,6 +6,7 @@
 // state. Fails when the layer's inputs leave out the caster matrices or the light matrix.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <string>
 #include <vector>
@@ -54,8 +55,12 @@ class ShadowCacheTest : public PlayerTest {
   }
 
   // The same scene state drawn with nothing cached: the scene loaded again (new assets, so no
-  // layer's inputs match) with `scene`'s transforms.
+  // layer's inputs match) with `scene`'s transforms, into new map storage (a frame with another
+  // map size first), so that nothing of an earlier frame's maps can survive in it.
   static Frame fresh(const Scene& scene) {
+    auto other = load_scene(content_dir() / "scenes" / "default.json", {"shadow.map_size=1024"});
+    EXPECT_TRUE(other.ok()) << other.error().to_string();
+    if (other.ok()) render(*player_, *other);
     auto copy = load_scene(content_dir() / "scenes" / "default.json", {});
     EXPECT_TRUE(copy.ok()) << copy.error().to_string();
     if (!copy.ok()) return {};
@@ -76,6 +81,9 @@ TEST_F(ShadowCacheTest, LayersAreRedrawnOnlyWhenTheirInputsChange) {
   const Frame first = render(*player_, scene);
   ASSERT_EQ(first.stats.shadow_layers, 4);
   EXPECT_EQ(first.stats.shadow_layers_rendered, 0xfu);
+  // A real map: lit and shadowed receivers.
+  EXPECT_NE(std::count(first.visibility.begin(), first.visibility.end(), 1.0f), 0);
+  EXPECT_NE(std::count(first.visibility.begin(), first.visibility.end(), 0.0f), 0);
   // Nothing moved: every layer kept, the same maps and visibility, the same caster counts.
   const Frame still = render(*player_, scene);
   EXPECT_EQ(still.stats.shadow_layers_rendered, 0u);
@@ -117,6 +125,27 @@ TEST_F(ShadowCacheTest, LayersAreRedrawnOnlyWhenTheirInputsChange) {
   const Frame walked_fresh = fresh(scene);
   EXPECT_EQ(walked.map, walked_fresh.map);
   EXPECT_EQ(walked.visibility, walked_fresh.visibility);
+}
+
+// The layered pass draws all of a light's layers in one pass: it redraws all of them or none.
+TEST_F(ShadowCacheTest, TheLayeredPassRedrawsAllLayersOrNone) {
+  auto loaded = load_scene(content_dir() / "scenes" / "default.json", {"shadow.layered=true"});
+  ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+  Scene& scene = *loaded;
+  const Frame first = render(*player_, scene);
+  EXPECT_EQ(first.stats.shadow_layers_rendered, 0xfu);
+  const Frame still = render(*player_, scene);
+  EXPECT_EQ(still.stats.shadow_layers_rendered, 0u);
+  EXPECT_EQ(still.map, first.map);
+  Transform& box = scene.world.get<Transform>(named(scene, "box_floating"));
+  box.translation += glm::vec3(0.3f, 0.2f, 0.1f);
+  const Frame moved = render(*player_, scene);
+  EXPECT_EQ(moved.stats.shadow_layers_rendered, 0xfu);
+  // Against one pass per layer drawn from scratch: the same maps (LocalLightTest's
+  // LayeredPassWritesTheSameMapsAsOnePassPerLayer), through the other code path.
+  const Frame moved_fresh = fresh(scene);
+  EXPECT_EQ(moved.map, moved_fresh.map);
+  EXPECT_EQ(moved.visibility, moved_fresh.visibility);
 }
 
 }  // namespace
