@@ -122,8 +122,9 @@ render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx) {
   return plan_frame(scene, ctx, shadow);
 }
 
-Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx) {
-  return renderer.prewarm(plan_frame(scene, ctx));
+Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
+                     bool shadow_points) {
+  return renderer.prewarm(plan_frame(scene, ctx), shadow_points);
 }
 
 Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,

@@ -58,7 +58,8 @@ render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx);
 render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx, ShadowData& shadow);
 
 /// Phases 1-5, then compiles every program the frame will use (scene load: no compiles later).
-Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx);
+Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
+                     bool shadow_points = false);
 
 /// Phase 5 on its own (pure: no GL), exposed for tests. Draws of entities with a Reflector whose
 /// map is ready get the reflection_cube or reflection_sphere material feature. `extra` are the

@@ -91,21 +91,33 @@ void main() {
   int cascade = -1;
   float view_depth = -(u_view * vec4(v_world_pos, 1.0)).z;
 #if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
-  if (ENABLED(BIT_RECEIVE_SHADOWS))
+  if (ENABLED(BIT_RECEIVE_SHADOWS)) {
+#if VARIANT_HAS_AOVS
     visibility = shadow_visibility(v_world_pos, geometric_n, view_depth, cascade);
+#else
+    // No AOV shows it: where the geometric surface faces away from the light it shadows itself,
+    // so the lookup is skipped (visibility 0; only a normal-mapped normal can still face the
+    // light there). With AOVs the lookup runs everywhere: the AOV contract and its tests keep
+    // today's values on such pixels. llvmpipe runs the masked lookup anyway (no gain there).
+    visibility = 0.0;
+    if (faces_light(u_counts.y, v_world_pos, geometric_n))
+      visibility = shadow_visibility(v_world_pos, geometric_n, view_depth, cascade);
+#endif
+  }
 #endif
 
   vec3 color = u_ambient.rgb * diffuse_color;
 #if MATERIAL_HAS_EMISSIVE
   if (ENABLED(BIT_EMISSIVE)) color += u_emissive;
 #endif
-  // Further shadowed directional lights; the AOV shows the one u_counts.w names.
+  // Further shadowed directional lights (as many as the variant has: none is no code); the AOV
+  // shows the one u_counts.w names.
   float aov_visibility = visibility;
   int aov_cascade = cascade;
-#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
+#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS && EXTRA_SHADOWS > 0
   float extra_visibility[MAX_EXTRA_SHADOWS] = float[MAX_EXTRA_SHADOWS](1.0, 1.0, 1.0);
   if (ENABLED(BIT_RECEIVE_SHADOWS))
-    for (int k = 0; k < u_extra_count.x; ++k) {
+    for (int k = 0; k < EXTRA_SHADOWS; ++k) {
       int c;
       extra_visibility[k] = extra_shadow_visibility(k, v_world_pos, geometric_n, view_depth, c);
       if (k + 1 == u_counts.w) {
@@ -140,8 +152,8 @@ void main() {
     vec3 h = normalize(l + v);
     vec3 spec = f0 * spec_norm * pow(max(dot(n, h), 0.0), shininess);
     float shadow = (i == u_counts.y) ? visibility : 1.0;
-#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
-    for (int k = 0; k < u_extra_count.x; ++k)
+#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS && EXTRA_SHADOWS > 0
+    for (int k = 0; k < EXTRA_SHADOWS; ++k)
       if (u_extra_light[k].x == i) shadow = extra_visibility[k];
 #endif
     color += (diffuse_color + spec) * u_light_color[i].rgb * ndl * attenuation * shadow;

@@ -15,22 +15,29 @@ layout(binding = 2) uniform sampler2DArrayShadow u_shadow_map;  // one layer per
 // light) and the paraboloid margin; cascade_texel(i) is metres per texel at 1 m from the light.
 #if VARIANT_HAS_SHADOW
 #define CASCADES VARIANT_CASCADE_COUNT
+// Further shadowed directional lights of this variant (u_extra_count.x holds the same number).
+// A compile-time count: on llvmpipe a loop whose uniform bound is 0 still runs its body once
+// with every lane masked off, which cost a quarter of the default scene's frame.
+#define EXTRA_SHADOWS (VARIANT_SHADOW_LIGHTS - 1)
 
 // The filtered depth compare of layer `layer` at c: xy texture coordinates, z depth in [0, 1].
 float shadow_taps(int layer, vec3 c) {
   vec4 tc = vec4(c.xy, float(layer), c.z);
 #if VARIANT_SHADOW_FILTER == VARIANT_SHADOW_FILTER_PCF3X3
-  // textureOffset needs constant offsets: the 3x3 kernel is written out.
-  float sum = 0.0;
-  sum += textureOffset(u_shadow_map, tc, ivec2(-1, -1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(0, -1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(1, -1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(-1, 0));
-  sum += texture(u_shadow_map, tc);
-  sum += textureOffset(u_shadow_map, tc, ivec2(1, 0));
-  sum += textureOffset(u_shadow_map, tc, ivec2(-1, 1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(0, 1));
-  sum += textureOffset(u_shadow_map, tc, ivec2(1, 1));
+  // S4's 3x3 PCF: the nine nearest-filtered compares of the texels t-1 .. t+1 around the point's
+  // texel t, as four compare-gathers over the 4x4 block t-1 .. t+2 (the t+2 row and column are
+  // left out). A gather at texel coordinate t returns texels t-1 and t (its footprint starts at
+  // floor(t - 0.5)), half a texel from either edge, so rounding cannot shift it. Components:
+  // x (i0, j1), y (i1, j1), z (i1, j0), w (i0, j0). Equal to nine textureOffset taps
+  // (tests/render/shadow_lookup_test.cpp).
+  vec2 size = vec2(textureSize(u_shadow_map, 0).xy);
+  vec2 t = floor(c.xy * size);
+  vec2 lo = t / size, hi = (t + 2.0) / size;
+  vec4 g00 = textureGather(u_shadow_map, vec3(lo, tc.z), c.z);        // t-1, t  x  t-1, t
+  vec4 g10 = textureGather(u_shadow_map, vec3(hi.x, lo.y, tc.z), c.z);  // t+1     x  t-1, t
+  vec4 g01 = textureGather(u_shadow_map, vec3(lo.x, hi.y, tc.z), c.z);  // t-1, t  x  t+1
+  vec4 g11 = textureGather(u_shadow_map, vec3(hi, tc.z), c.z);        // t+1     x  t+1
+  float sum = g00.x + g00.y + g00.z + g00.w + g10.x + g10.w + g01.z + g01.w + g11.w;
   return sum / 9.0;
 #else
   return texture(u_shadow_map, tc);  // filtering (nearest / linear) is set on the texture
@@ -145,6 +152,32 @@ float blend_weight(int cascade, vec3 p, float depth) {
 #endif
 }
 
+// The lookup of `cascade` mixed with the next cascade's by w, the next one's weight in the blend
+// band: (1 - w) v_c + w v_c+1, one lookup where w = 0. Written as a loop that ends on a value
+// (not `if (w > 0.0)` and not a counted loop, which the compiler unrolls into ifs): llvmpipe
+// runs the body of a divergent if for every pixel with the others masked off, so the second
+// lookup cost as much as the first; a loop it leaves once no pixel of the SIMD vector wants
+// another trip, so only vectors that touch the band pay (on llvmpipe, issue 13: about a tenth of
+// the default scene's frame). A GPU branches either way.
+float blended_visibility(int cascade, float w, vec3 p, vec3 n) {
+  float v = 0.0, weight = 1.0 - w;
+  int c = cascade;
+  do {
+    v += weight * cascade_visibility(c, p, n);
+    weight = c == cascade ? w : 0.0;
+    ++c;
+  } while (weight > 0.0);
+  return v;
+}
+
+// Whether the surface at p with geometric normal n faces light `light` (an index into u_light_*).
+// One facing away shadows itself: forward.frag skips its lookup where no AOV shows it.
+bool faces_light(int light, vec3 p, vec3 n) {
+  vec3 to_light = int(u_light_color[light].w) == LIGHT_DIRECTIONAL ? -u_light_dir[light].xyz
+                                                                    : u_light_pos[light].xyz - p;
+  return dot(n, to_light) > 0.0;
+}
+
 float shadow_visibility(vec3 p, vec3 n, float depth, out int cascade) {
 #if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_PERSPECTIVE
   cascade = 0;
@@ -157,12 +190,10 @@ float shadow_visibility(vec3 p, vec3 n, float depth, out int cascade) {
 #endif
   cascade = select_cascade(p, depth);
   if (cascade < 0) return 1.0;
-  float v = cascade_visibility(cascade, p, n);
-  float w = blend_weight(cascade, p, depth);
-  if (w > 0.0) v = mix(v, cascade_visibility(cascade + 1, p, n), w);
-  return v;
+  return blended_visibility(cascade, blend_weight(cascade, p, depth), p, n);
 }
 
+#if EXTRA_SHADOWS > 0
 // Further shadowed directional lights (S0: each has its own N maps): light k's cascades, with the
 // first light's filter and selection (frame features), its own matrices, splits, blend band and
 // normal offset (data). The same steps as cascade_visibility / select_cascade / blend_weight.
@@ -201,10 +232,19 @@ float extra_shadow_visibility(int k, vec3 p, vec3 n, float depth, out int cascad
     w = clamp((depth - (d1 - band * (d1 - d0))) / (band * (d1 - d0)), 0.0, 1.0);
   }
 #endif
-  float v = extra_cascade_visibility(k, cascade, p, n);
-  if (cascade < count - 1 && w > 0.0) v = mix(v, extra_cascade_visibility(k, cascade + 1, p, n), w);
+  if (cascade >= count - 1) w = 0.0;
+  // As blended_visibility(): a loop that ends on a value, so only SIMD vectors in the band pay
+  // for the second lookup on llvmpipe.
+  float v = 0.0, weight = 1.0 - w;
+  int c = cascade;
+  do {
+    v += weight * extra_cascade_visibility(k, c, p, n);
+    weight = c == cascade ? w : 0.0;
+    ++c;
+  } while (weight > 0.0);
   return v;
 }
+#endif
 
 #if VARIANT_DEBUG_CASCADES
 // Tints per cascade: red, green, blue, yellow, magenta, cyan, orange, violet.

@@ -19,12 +19,14 @@ void main() {
   float view_depth = -(u_view * vec4(v_point, 1.0)).z;
   vec3 n = normalize(v_point_normal);
   visibility = shadow_visibility(v_point, n, view_depth, cascade);
-  for (int k = 0; k < u_extra_count.x; ++k)  // as forward.frag picks the AOV's light
+#if EXTRA_SHADOWS > 0
+  for (int k = 0; k < EXTRA_SHADOWS; ++k)  // as forward.frag picks the AOV's light
     if (k + 1 == u_counts.w) {
       int c;
       visibility = extra_shadow_visibility(k, v_point, n, view_depth, c);
       cascade = c;
     }
+#endif
 #endif
   o_visibility = vec2(visibility, float(cascade));
 }

@@ -1,6 +1,7 @@
 // The `kaskad` command line: render scenes headless (or in a window), write images and AOVs,
 // and save canonical scene files. Run `kaskad --help`.
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -343,6 +344,19 @@ int run_render(Args a) {
               "material switches\n",
               st.draw_calls, st.frustum_culled, st.triangles, st.shadow_draw_calls, st.shadow_triangles,
               st.shadow_gpu_ms, st.forward_gpu_ms, st.program_switches, st.material_switches);
+  if (st.shadow_layers > 0) {
+    const int drawn = std::popcount(st.shadow_layers_rendered);
+    std::printf("          shadow layers re-rendered in the last frame: %d of %d", drawn,
+                st.shadow_layers);
+    if (drawn > 0 && drawn < st.shadow_layers) {
+      std::printf(" (");
+      for (int l = 0, n = 0; l < st.shadow_layers; ++l)
+        if (st.shadow_layers_rendered & (1u << l)) std::printf(n++ ? " %d" : "%d", l);
+      std::printf(")");
+    }
+    std::printf("%s\n", drawn < st.shadow_layers ? "; the others kept their depth (same matrix "
+                                                    "and casters)" : "");
+  }
   if (const ShadowData& sh = timings->last.shadow;
       sh.light.valid() && st.cascades > 0 && sh.projection != ShadowProjection::ortho) {
     const char* kinds[] = {"", "spot: 1 perspective map", "point: 6 cube faces",

@@ -236,6 +236,7 @@ void read_expect(ObjectReader& r, Playback& pb, const fs::path& base) {
     FlatExpect q;
     ObjectReader qr(r.raw("flat_resources"), r.at("flat_resources"));
     qr.integer("after", q.after, 0, pb.frames - 1);
+    qr.integer("period", q.period, 0, kMaxFrames);
     float mib = float(q.max_rss_growth_mib);
     qr.number("max_rss_growth_mib", mib, 0.0f, 1.0e6f);
     q.max_rss_growth_mib = mib;
@@ -507,7 +508,8 @@ Result<Scene> load_checked(const Playback& pb, render::Renderer* prewarm = nullp
   if (!scene) return scene.error();
   auto trial = load_scene(pb.scene, sets);
   if (!trial) return trial.error();
-  if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx));
+  const bool points = bool(pb.flicker);  // the flicker gate reads the points pass
+  if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx, points));
   for (const SetEvent& ev : pb.events) {
     if (auto st = apply_live_override(*trial, ev.assignment); !st) {
       Error e = st.error();
@@ -515,7 +517,7 @@ Result<Scene> load_checked(const Playback& pb, render::Renderer* prewarm = nullp
                    pb.file.string() + ")";
       return e;
     }
-    if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx));
+    if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx, points));
   }
   for (const Track& tr : pb.tracks)
     if (!find_named(scene->world, tr.entity).valid())
@@ -729,8 +731,13 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
       }
     }
     const double rss = resident_mib();
-    rss_end = rss;
     const long gl_objects = gpu::live_gl_objects();
+    if (pb.flat_resources) {
+      const FlatExpect& q = *pb.flat_resources;
+      const bool sample = q.period > 0 ? f >= q.after && (f - q.after) % q.period == 0
+                                       : f + 1 == pb.frames;
+      if (sample) rss_end = rss;
+    }
     if (pb.flat_resources && f == pb.flat_resources->after) {
       rss_warm = rss_max_after = rss;
       gl_warm = gl_max_after = gl_objects;
@@ -738,7 +745,12 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
       rss_max_after = std::max(rss_max_after, rss);
       gl_max_after = std::max(gl_max_after, gl_objects);
     }
-    if (pb.flat_resources && (f == 0 || f == pb.flat_resources->after || f + 1 == pb.frames))
+    if (pb.flat_resources &&
+        (f == 0 || f + 1 == pb.frames ||
+         (f >= pb.flat_resources->after &&
+          (pb.flat_resources->period > 0
+               ? (f - pb.flat_resources->after) % pb.flat_resources->period == 0
+               : f == pb.flat_resources->after))))
       std::printf("resources %s frame %d: %.1f MiB resident (peak since warm-up %.1f), %ld GL "
                   "objects\n",
                   pb.file.filename().string().c_str(), f, rss, rss_max_after, gl_objects);
@@ -799,13 +811,14 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
   }
   if (pb.flat_resources) {
     const auto& q = *pb.flat_resources;
-    // Memory at the end against the warm-up frame: settings toggled on the way reallocate
-    // maps and the driver keeps freed pages a while, so peaks between say nothing of leaks.
+    // Memory at the last sample against the warm-up frame, both at the same point of the
+    // playback's cycle: settings toggled on the way reallocate maps and the driver keeps freed
+    // pages a while, so peaks between say nothing of leaks.
     if (rss_end - rss_warm > q.max_rss_growth_mib) {
       char msg[256];
       std::snprintf(msg, sizeof msg,
-                    "resident memory grew by %.1f MiB from frame %d to the end (max %.1f MiB): "
-                    "%.1f -> %.1f MiB (peak %.1f)",
+                    "resident memory grew by %.1f MiB from frame %d to the last sample (max %.1f "
+                    "MiB): %.1f -> %.1f MiB (peak %.1f)",
                     rss_end - rss_warm, q.after, q.max_rss_growth_mib, rss_warm, rss_end,
                     rss_max_after);
       fail_at(-1, msg);

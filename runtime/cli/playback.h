@@ -88,9 +88,13 @@ struct ProbeExpect {
 
 /// Resident memory and live GL objects stay flat after warm-up (soak runs).
 struct FlatExpect {
-  int after = 100;               ///< the warm-up frame the rest is measured against
-  double max_rss_growth_mib = 16.0;  ///< end of the run against frame `after`
-  long max_gl_object_growth = 0;
+  int after = 100;      ///< the warm-up frame the rest is measured against
+  /// Frames after which the whole playback state repeats (camera, tracks, toggles): memory is
+  /// compared at after, after + period, ... so that every sample has the same maps allocated.
+  /// 0: compare the warm-up frame with the last.
+  int period = 0;
+  double max_rss_growth_mib = 16.0;  ///< last sample against the first
+  long max_gl_object_growth = 0;     ///< any frame after warm-up against the first sample
 };
 
 struct Playback {

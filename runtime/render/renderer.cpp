@@ -10,6 +10,7 @@
 #include <numeric>
 #include <optional>
 #include <tuple>
+#include <type_traits>
 
 #include "runtime/core/log.h"
 #include "runtime/gpu/shader.h"
@@ -19,6 +20,8 @@ namespace kaskad::render {
 namespace {
 
 constexpr int kMaxExtra = kMaxShadowedLights - 1;
+// FrameStats::shadow_layers_rendered has one bit per layer of the shadow map.
+static_assert(kMaxShadowedLights * kMaxCascades <= 32);
 
 // std140 mirror of FrameBlock in content/shaders/common.glsl (change together).
 struct alignas(16) FrameBlock {
@@ -79,6 +82,20 @@ struct GpuTexture {
   gpu::Texture texture;
 };
 
+// FNV-1a over the bytes of plain values: the inputs of a shadow layer (shadow caching).
+struct InputHash {
+  std::uint64_t h = 14695981039346656037ull;
+  template <typename T>
+  InputHash& add(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    unsigned char bytes[sizeof(T)];
+    std::memcpy(bytes, &v, sizeof(T));
+    for (unsigned char b : bytes) h = (h ^ b) * 1099511628211ull;
+    return *this;
+  }
+  std::uint64_t value() const { return h | 1u; }  // never 0, which means "nothing drawn"
+};
+
 // A 1x1 texture standing in for a missing material texture.
 gpu::Texture make_solid_texture(const std::array<float, 4>& rgba, GLenum internal_format) {
   gpu::Texture t = gpu::make_texture(GL_TEXTURE_2D);
@@ -111,6 +128,9 @@ struct Renderer::Impl {
   gpu::Framebuffer shadow_fbo;
   gpu::Texture shadow_map;
   bool shadow_valid = false;
+  /// Per layer of shadow_map: a hash of what its depth was last drawn from (layer_inputs()); 0
+  /// = nothing valid. A layer whose inputs hash the same is kept, not re-rendered.
+  std::vector<std::uint64_t> layer_drawn_from;
 
   // Shadow-points pass target (one pixel per point) and its point buffer.
   int points_width = 0, points_height = 0;
@@ -239,6 +259,7 @@ struct Renderer::Impl {
       glTextureParameterfv(shadow_map.id(), GL_TEXTURE_BORDER_COLOR, border);
       glTextureParameteri(shadow_map.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
       glTextureParameteri(shadow_map.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+      layer_drawn_from.assign(std::size_t(layers), 0);  // new storage: nothing to keep
       shadow_fbo = gpu::make_framebuffer();
       glNamedFramebufferTextureLayer(shadow_fbo.id(), GL_DEPTH_ATTACHMENT, shadow_map.id(), 0, 0);
       glNamedFramebufferDrawBuffer(shadow_fbo.id(), GL_NONE);
@@ -290,15 +311,39 @@ ShaderLibrary& Renderer::shaders() { return *impl_->shaders; }
 
 namespace {
 int cascade_layers(const ShadowPass& p) { return std::clamp(p.cascade_count, 1, kMaxCascades); }
+
+int shaded_lights(const FrameInput& frame) {
+  return std::min<int>(int(frame.lights.size()), kMaxLights);
+}
+
+bool has_shadow(const FrameInput& frame) {
+  return frame.shadow.light_index >= 0 && frame.shadow.light_index < shaded_lights(frame);
+}
+
+// The further shadowed directional lights the frame draws and shades: of
+// FrameInput::extra_shadows those with a shaded light and orthographic cascades, at most
+// kMaxExtra; none without the first shadowed light. Their number is a variant field
+// (shadow_lights), so render() and frame_variant() must agree: both call this.
+std::vector<const ShadowPass*> drawn_extra_shadows(const FrameInput& frame) {
+  std::vector<const ShadowPass*> out;
+  if (!has_shadow(frame)) return out;
+  for (const ShadowPass& e : frame.extra_shadows) {
+    if (int(out.size()) == kMaxExtra) break;
+    if (e.light_index < 0 || e.light_index >= shaded_lights(frame) ||
+        e.projection != ShadowProjection::ortho)
+      continue;
+    out.push_back(&e);
+  }
+  return out;
+}
 }  // namespace
 
 VariantKey frame_variant(const FrameInput& frame) {
   VariantKey k;
-  const bool shadowed = frame.shadow.light_index >= 0 &&
-                        frame.shadow.light_index < std::min<int>(int(frame.lights.size()), kMaxLights);
-  if (shadowed) {
+  if (has_shadow(frame)) {
     const ShadowSettings& s = frame.shadow.settings;
     k.set(VariantKey::kShadow, 1);
+    k.set(VariantKey::kShadowLightsMinus1, std::uint32_t(drawn_extra_shadows(frame).size()));
     k.set(VariantKey::kShadowFilter, std::uint32_t(s.filter));
     k.set(VariantKey::kShadowProjection, std::uint32_t(frame.shadow.projection));
     // Paraboloid hemispheres are projected in code, one pass each: no layered pass for them.
@@ -368,8 +413,11 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   return out;
 }
 
-Status Renderer::prewarm(const FrameInput& frame) {
+Status Renderer::prewarm(const FrameInput& frame, bool shadow_points) {
   auto requests = required_programs(frame);
+  // The points pass (shadow_at_points(), the stability metrics) reads the frame's key.
+  if (shadow_points)
+    requests.push_back({Pass::shadow_points, frame_variant(frame).filtered_for(Pass::shadow_points)});
   for (ProgramRequest& r : requests) r.key = impl_->supported(r.key);
   Status st = impl_->shaders->prewarm(requests);
   stats_.shaders = impl_->shaders->stats();
@@ -405,22 +453,16 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   const int light_count = std::min<int>(int(frame.lights.size()), kMaxLights);
   if (int(frame.lights.size()) > kMaxLights)
     log::warn("%zu lights; only the first %d are shaded", frame.lights.size(), kMaxLights);
-  const bool shadowed = frame.shadow.light_index >= 0 && frame.shadow.light_index < light_count;
+  const bool shadowed = has_shadow(frame);
   const int cascades = shadowed ? cascade_layers(frame.shadow) : 0;
   // Further shadowed directional lights: their cascades follow the first light's layers.
-  std::vector<const ShadowPass*> extras;
+  const std::vector<const ShadowPass*> extras = drawn_extra_shadows(frame);
   std::array<int, kMaxShadowedLights> first_layer{};
   int total_layers = cascades;
-  if (shadowed)
-    for (const ShadowPass& e : frame.extra_shadows) {
-      if (int(extras.size()) == kMaxExtra) break;
-      if (e.light_index < 0 || e.light_index >= light_count ||
-          e.projection != ShadowProjection::ortho)
-        continue;
-      first_layer[extras.size()] = total_layers;
-      total_layers += cascade_layers(e);
-      extras.push_back(&e);
-    }
+  for (std::size_t k = 0; k < extras.size(); ++k) {
+    first_layer[k] = total_layers;
+    total_layers += cascade_layers(*extras[k]);
+  }
   const int aov_light = frame.aov_shadow_light >= 0 && frame.aov_shadow_light <= int(extras.size())
                             ? frame.aov_shadow_light
                             : 0;
@@ -546,6 +588,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.cascade_triangles.fill(0);
   stats_.cascade_texel_size.fill(0.0f);
   stats_.cascade_receiver_pixels.fill(0);
+  stats_.shadow_layers_rendered = 0;
+  stats_.shadow_layers = 0;
   for (int c = 0; c < cascades; ++c)
     stats_.cascade_texel_size[std::size_t(c)] = frame.shadow.texel_size[std::size_t(c)];
   if (shadowed) {
@@ -568,16 +612,74 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     // shader routes instance i to the i-th of them (shadow_depth.vert). The same maps as one pass
     // per layer (render test), with fewer draw calls.
     const bool layered = frame_key.has(VariantKey::kShadowLayered);
-    if (layered) {
+    // Light 0 is the first shadowed light, 1.. the extra directional ones; each with its own
+    // culling, bias and casters per cascade, into consecutive layers.
+    auto pass_of = [&](std::size_t light) -> const ShadowPass& {
+      return light == 0 ? frame.shadow : *extras[light - 1];
+    };
+    auto base_of = [&](std::size_t light) { return light == 0 ? 0 : first_layer[light - 1]; };
+    auto layers_of = [&](std::size_t light) {
+      return light == 0 ? cascades : cascade_layers(pass_of(light));
+    };
+    auto caster_mask = [&](std::size_t light, const DrawItem& d) -> std::uint32_t {
+      if (!d.cast_shadows) return 0;
+      return light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu;
+    };
+    // Extra lights are cascades: the plain depth program even after paraboloid maps.
+    auto depth_key = [&](std::size_t light, std::uint32_t i) {
+      VariantKey k = keys[i];
+      if (light > 0) k.set(VariantKey::kShadowProjection, 0);
+      return k;
+    };
+    // Shadow caching (issue 13): a layer keeps last frame's depth when it would be drawn from the
+    // same inputs: its matrix (and paraboloid data), bias and culling, pass mode, and the same
+    // casters (mesh, model matrix, depth program, alpha-mask parameters) in the same order. A
+    // moved caster changes its matrix, a moved camera the layer's matrix or casters; other
+    // assets (another scene) change assets.uid. New map storage invalidates every layer.
+    auto layer_inputs = [&](std::size_t light, int c) {
+      const ShadowPass& pass = pass_of(light);
+      InputHash h;
+      h.add(assets.uid).add(layered).add(pass.projection).add(pass.settings.cull);
+      h.add(pass.settings.slope_bias).add(pass.settings.constant_bias);
+      h.add(pass.view_proj[std::size_t(c)]).add(pass.skipped[std::size_t(c)]);
+      // Only the paraboloid depth pass reads splits (near, far, margin: shadow_depth.vert).
+      if (pass.projection == ShadowProjection::dual_paraboloid) h.add(pass.splits);
+      if (pass.skipped[std::size_t(c)]) return h.value();
+      for (std::uint32_t i : order) {
+        const DrawItem& d = frame.draws[i];
+        if (!(caster_mask(light, d) & (1u << c))) continue;
+        h.add(d.mesh).add(d.model).add(depth_key(light, i).filtered_for(Pass::depth).bits());
+        if (d.material.alpha_mask || im.oracle)
+          h.add(d.material.base_color.a).add(d.material.alpha_cutoff)
+              .add(d.material.base_color_texture);
+      }
+      return h.value();
+    };
+    std::vector<std::uint64_t> inputs(std::size_t(total_layers), 0);
+    bool any_dirty = false;
+    for (std::size_t light = 0; light <= extras.size(); ++light)
+      for (int c = 0; c < layers_of(light); ++c) {
+        const std::size_t layer = std::size_t(base_of(light) + c);
+        inputs[layer] = layer_inputs(light, c);
+        if (inputs[layer] != im.layer_drawn_from[layer]) {
+          stats_.shadow_layers_rendered |= 1u << layer;
+          any_dirty = true;
+        }
+      }
+    // The layered pass draws every layer at once: it redraws all of them or none.
+    if (layered && any_dirty)  // up to 32 layers (4 lights x 8 cascades): no 1u << 32
+      stats_.shadow_layers_rendered = ~0u >> (32 - total_layers);
+    stats_.shadow_layers = total_layers;
+    auto redraw = [&](int layer) { return (stats_.shadow_layers_rendered >> layer) & 1u; };
+    if (layered && any_dirty) {
       glNamedFramebufferTexture(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0);
       glClear(GL_DEPTH_BUFFER_BIT);
     }
-    // Light 0 is the first shadowed light, 1.. the extra directional ones; each with its own
-    // culling, bias and casters per cascade, into consecutive layers.
+    // Stats count the casters each layer holds, whether drawn now or kept from an earlier frame.
     for (std::size_t light = 0; light <= extras.size(); ++light) {
-      const ShadowPass& pass = light == 0 ? frame.shadow : *extras[light - 1];
-      const int base = light == 0 ? 0 : first_layer[light - 1];
-      const int layers = light == 0 ? cascades : cascade_layers(pass);
+      const ShadowPass& pass = pass_of(light);
+      const int base = base_of(light);
+      const int layers = layers_of(light);
       if (pass.settings.cull == CullMode::none) {
         glDisable(GL_CULL_FACE);
       } else {
@@ -592,26 +694,28 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
           if (!pass.skipped[std::size_t(c)]) live |= 1u << c;
         for (std::uint32_t i : order) {
           const DrawItem& d = frame.draws[i];
-          const std::uint32_t mask =
-              live &
-              (light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu);
-          if (!d.cast_shadows || mask == 0) continue;
+          const std::uint32_t mask = live & caster_mask(light, d);
+          if (mask == 0) continue;
           const GpuMesh& m = im.mesh(d.mesh, assets);
           if (m.index_count == 0) continue;
-          if (Status st = use_program(Pass::depth, keys[i], current); !st) {
-            glDisable(GL_POLYGON_OFFSET_FILL);
-            glEndQuery(GL_TIME_ELAPSED);
-            return st;
-          }
-          if (keys[i].has(VariantKey::kAlphaMask) || im.oracle) bind_material(current, d, keys[i]);
-          glProgramUniform1ui(current, kUniLayerMask, mask);
-          glProgramUniform1i(current, kUniLayerBase, base);
-          glProgramUniformMatrix4fv(current, kUniLayerViewProj, layers, GL_FALSE,
-                                    &pass.view_proj[0][0][0]);
-          glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-          glBindVertexArray(m.vao.id());
           const int instances = std::popcount(mask);
-          glDrawElementsInstanced(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr, instances);
+          if (any_dirty) {
+            if (Status st = use_program(Pass::depth, keys[i], current); !st) {
+              glDisable(GL_POLYGON_OFFSET_FILL);
+              glEndQuery(GL_TIME_ELAPSED);
+              return st;
+            }
+            if (keys[i].has(VariantKey::kAlphaMask) || im.oracle)
+              bind_material(current, d, keys[i]);
+            glProgramUniform1ui(current, kUniLayerMask, mask);
+            glProgramUniform1i(current, kUniLayerBase, base);
+            glProgramUniformMatrix4fv(current, kUniLayerViewProj, layers, GL_FALSE,
+                                      &pass.view_proj[0][0][0]);
+            glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+            glBindVertexArray(m.vao.id());
+            glDrawElementsInstanced(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
+                                    instances);
+          }
           ++stats_.shadow_draw_calls;
           stats_.shadow_triangles += std::size_t(instances) * std::size_t(m.index_count / 3);
           for (int c = 0; light == 0 && c < layers; ++c)
@@ -623,34 +727,35 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
         continue;
       }
       for (int c = 0; c < layers; ++c) {
-        glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(),
-                                       0, base + c);
-        glClear(GL_DEPTH_BUFFER_BIT);
+        const bool draw = redraw(base + c);
+        if (draw) {
+          glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT,
+                                         im.shadow_map.id(), 0, base + c);
+          glClear(GL_DEPTH_BUFFER_BIT);
+        }
         if (pass.skipped[std::size_t(c)]) continue;
         const glm::mat4& light_vp = pass.view_proj[std::size_t(c)];
         for (std::uint32_t i : order) {
           const DrawItem& d = frame.draws[i];
-          const std::uint32_t mask =
-              light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu;
-          if (!d.cast_shadows || !(mask & (1u << c))) continue;
+          if (!(caster_mask(light, d) & (1u << c))) continue;
           const GpuMesh& m = im.mesh(d.mesh, assets);
           if (m.index_count == 0) continue;
-          // Extra lights are cascades: the plain depth program even after paraboloid maps.
-          VariantKey depth_key = keys[i];
-          if (light > 0) depth_key.set(VariantKey::kShadowProjection, 0);
-          if (Status st = use_program(Pass::depth, depth_key, current); !st) {
-            glDisable(GL_POLYGON_OFFSET_FILL);
-            glDisable(GL_CLIP_DISTANCE0);
-            glEndQuery(GL_TIME_ELAPSED);
-            return st;
+          if (draw) {
+            if (Status st = use_program(Pass::depth, depth_key(light, i), current); !st) {
+              glDisable(GL_POLYGON_OFFSET_FILL);
+              glDisable(GL_CLIP_DISTANCE0);
+              glEndQuery(GL_TIME_ELAPSED);
+              return st;
+            }
+            // The oracle's one depth program reads the material bits from a uniform: set it for
+            // every draw, or an alpha-masked draw's bits leak into the next layer's opaque draws.
+            if (keys[i].has(VariantKey::kAlphaMask) || im.oracle)
+              bind_material(current, d, keys[i]);
+            glProgramUniformMatrix4fv(current, kUniLightViewProj, 1, GL_FALSE, &light_vp[0][0]);
+            glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+            glBindVertexArray(m.vao.id());
+            glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
           }
-          // The oracle's one depth program reads the material bits from a uniform: set it for
-          // every draw, or an alpha-masked draw's bits leak into the next layer's opaque draws.
-          if (keys[i].has(VariantKey::kAlphaMask) || im.oracle) bind_material(current, d, keys[i]);
-          glProgramUniformMatrix4fv(current, kUniLightViewProj, 1, GL_FALSE, &light_vp[0][0]);
-          glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-          glBindVertexArray(m.vao.id());
-          glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
           ++stats_.shadow_draw_calls;
           stats_.shadow_triangles += std::size_t(m.index_count / 3);
           if (light == 0) {
@@ -662,6 +767,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
     glDisable(GL_CLIP_DISTANCE0);
+    for (std::size_t layer = 0; layer < inputs.size(); ++layer)
+      if (redraw(int(layer))) im.layer_drawn_from[layer] = inputs[layer];
     im.shadow_valid = true;
   }
   glEndQuery(GL_TIME_ELAPSED);

@@ -132,8 +132,14 @@ struct FrameStats {
   int draw_calls = 0;
   int frustum_culled = 0;             ///< draws outside the main view's frustum, not drawn
   std::size_t triangles = 0;          ///< submitted in the forward pass
+  /// Casters in the shadow map's layers (all cascades) and their triangles, whether drawn this
+  /// frame or kept from an earlier one (shadow_layers_rendered says which layers were drawn).
   int shadow_draw_calls = 0;
-  std::size_t shadow_triangles = 0;   ///< submitted to the shadow map (all cascades)
+  std::size_t shadow_triangles = 0;
+  int shadow_layers = 0;  ///< layers of the shadow map this frame (all shadowed lights)
+  /// Bit l: texture-array layer l was cleared and re-rendered this frame. The others kept their
+  /// depth: same matrix, casters, caster matrices, bias and pass mode as when last drawn.
+  std::uint32_t shadow_layers_rendered = 0;
   int cascades = 0;                   ///< cascade layers of the shadow map this frame
   std::array<int, kMaxCascades> cascade_draw_calls{};         ///< casters drawn per cascade
   std::array<std::size_t, kMaxCascades> cascade_triangles{};  ///< their triangles
@@ -183,8 +189,9 @@ class Renderer {
                                                   const RendererOptions& options = {});
 
   /// Compiles (or loads from the binary cache) every program `frame` needs, before the first
-  /// frame. Programs built later count as runtime compiles in stats().shaders.
-  Status prewarm(const FrameInput& frame);
+  /// frame, and with `shadow_points` the points pass's (shadow_at_points()). Programs built later
+  /// count as runtime compiles in stats().shaders.
+  Status prewarm(const FrameInput& frame, bool shadow_points = false);
   ShaderLibrary& shaders();
   ~Renderer();
 

@@ -18,6 +18,7 @@
 //   debug_cascades, cascade_selection and shadow_projection need shadow
 //   shadow_projection != ortho has cascade_count 1 (cascades are directional only)
 //   shadow_layered needs shadow; the depth pass keeps it (its vertex shader picks the layer)
+//   shadow_lights != 1 needs shadow (the lookups of lights that do not exist are not compiled)
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask, and the projection
 // when it is dual_paraboloid: its vertex shader differs), so every material shares one or two
 // shadow programs.
@@ -124,6 +125,10 @@ inline constexpr FeatureSpec kFeatureTable[] = {
      .stages = kVertexStage, .offset = 27, .requires_ = {"shadow"}},
     {.name = "debug_cascades", .kind = FeatureKind::frame, .define = "VARIANT_DEBUG_CASCADES",
      .stages = kFragmentStage, .offset = 23, .requires_ = {"shadow"}},
+    // The count of shadowed lights the frame shades (the first plus further directional ones):
+    // loops over them get a compile-time bound, so lights that do not exist cost nothing.
+    {.name = "shadow_lights", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_LIGHTS",
+     .stages = kFragmentStage, .offset = 28, .min = 1, .max = 4, .requires_ = {"shadow"}},
 };
 inline constexpr int kFeatureCount = int(std::size(kFeatureTable));
 
@@ -226,6 +231,10 @@ class VariantKey {
   static constexpr Field kShadowProjection = feature_field("shadow_projection");
   static constexpr std::uint32_t kProjectionDualParaboloid = 3;
   static constexpr Field kShadowLayered = feature_field("shadow_layered");  ///< depth pass: all layers in one pass
+  /// Shadowed lights - 1 (1..4): the first plus the further directional ones the frame has.
+  /// A count, not a switch, so loops over shadowed lights have a compile-time bound and a light
+  /// that does not exist costs nothing (llvmpipe runs a zero-trip loop's body once, masked).
+  static constexpr Field kShadowLightsMinus1 = feature_field("shadow_lights");
   static constexpr std::uint32_t kFrameMask = 0xffff0000u;
 
   constexpr VariantKey() = default;
@@ -296,6 +305,11 @@ static_assert(!VariantKey().set(VariantKey::kReflectionBox, 1).valid());
 static_assert(VariantKey().set(VariantKey::kReflectionBox, 1).set(VariantKey::kReflectionCube, 1).valid());
 static_assert(VariantKey().set(VariantKey::kNormalMap, 1).filtered_for(Pass::depth) == VariantKey());
 static_assert(!VariantKey().set(VariantKey::kShadowProjection, 1).valid());
+static_assert(!VariantKey().set(VariantKey::kShadowLightsMinus1, 1).valid());
+static_assert(VariantKey()
+                  .set(VariantKey::kShadow, 1)
+                  .set(VariantKey::kShadowLightsMinus1, 3)
+                  .filtered_for(Pass::depth) == VariantKey());
 static_assert(
     VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 2).valid());
 static_assert(!VariantKey()

@@ -1,6 +1,7 @@
 // Variant keys, the feature manifest and material files: no GL needed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <cstdlib>
 #include <fstream>
@@ -40,14 +41,15 @@ bool documented_rules_hold(VariantKey k) {
       V::kReceiveShadows.mask() | V::kReflectionBox.mask() | V::kShadow.mask() |
       V::kShadowFilter.mask() | V::kCascadeCountMinus1.mask() | V::kAovs.mask() |
       V::kDebugCascades.mask() | V::kCascadeSelection.mask() | V::kShadowProjection.mask() |
-      V::kShadowLayered.mask();
+      V::kShadowLayered.mask() | V::kShadowLightsMinus1.mask();
   if (k.bits() & ~used) return false;
   if (k.get(V::kShadowFilter) > 2) return false;  // none, bilinear, pcf3x3
   if (k.has(V::kReflectionCube) && k.has(V::kReflectionSphere)) return false;
   if (k.has(V::kReflectionBox) && !k.has(V::kReflectionCube)) return false;
   const bool needs_shadow = k.has(V::kShadowFilter) || k.has(V::kCascadeCountMinus1) ||
                             k.has(V::kDebugCascades) || k.has(V::kCascadeSelection) ||
-                            k.has(V::kShadowProjection) || k.has(V::kShadowLayered);
+                            k.has(V::kShadowProjection) || k.has(V::kShadowLayered) ||
+                            k.has(V::kShadowLightsMinus1);
   if (needs_shadow && !k.has(V::kShadow)) return false;
   if (k.has(V::kShadowProjection) && k.has(V::kCascadeCountMinus1)) return false;
   return true;
@@ -81,8 +83,9 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   EXPECT_EQ(disagree, 0);
   // Material keys: 2^5 free bits x 4 of the 8 reflection cube/sphere/box combinations = 128.
   // Frame keys: 2 without shadow (aovs), and with shadow 3 filters x 2 aovs x 2 debug x
-  // 2 selection x 2 layered x (8 ortho cascade counts + 3 other projections) = 528.
-  EXPECT_EQ(valid, 128 * 530);
+  // 2 selection x 2 layered x 4 shadowed-light counts x (8 ortho cascade counts + 3 other
+  // projections) = 2112.
+  EXPECT_EQ(valid, 128 * 2114);
 }
 
 // The table is the one source: the manifest's features, their fields and the GLSL bit numbers
@@ -179,6 +182,58 @@ TEST(ShaderConstants, CommonGlslMatchesTheRendererLimits) {
   };
   EXPECT_EQ(define("MAX_CASCADES"), kMaxCascades);
   EXPECT_EQ(define("MAX_EXTRA_SHADOWS"), kMaxShadowedLights - 1);
+}
+
+// The number of shadowed lights is a frame feature: a frame compiles the lookups of the lights
+// it shades and no others (issue 13: dormant extra-light code cost a quarter of the frame).
+TEST(FrameVariant, ShadowLightsCountsTheShadowedLightsTheFrameShades) {
+  const FeatureManifest m = manifest();
+  const Feature& lights = *m.find("shadow_lights");
+  FrameInput frame;
+  frame.lights.resize(4);
+  EXPECT_EQ(m.value(lights, frame_variant(frame)), 1);  // no shadow: the field is off
+  EXPECT_FALSE(frame_variant(frame).has(VariantKey::kShadowLightsMinus1));
+  // Extra lights without a first shadowed light are not drawn.
+  frame.extra_shadows.resize(1);
+  frame.extra_shadows[0].light_index = 1;
+  EXPECT_FALSE(frame_variant(frame).has(VariantKey::kShadow));
+  EXPECT_FALSE(frame_variant(frame).has(VariantKey::kShadowLightsMinus1));
+
+  frame.shadow.light_index = 0;
+  frame.extra_shadows.clear();
+  EXPECT_EQ(m.value(lights, frame_variant(frame)), 1);
+  // Drawn: a directional light in range. Not drawn: a light index past the shaded lights, a
+  // spot projection (extras are directional cascades).
+  ShadowPass extra;
+  extra.light_index = 1;
+  frame.extra_shadows.push_back(extra);
+  extra.light_index = 9;
+  frame.extra_shadows.push_back(extra);
+  extra.light_index = 2;
+  extra.projection = ShadowProjection::perspective;
+  frame.extra_shadows.push_back(extra);
+  VariantKey k = frame_variant(frame);
+  EXPECT_EQ(m.value(lights, k), 2);
+  EXPECT_TRUE(k.valid());
+  EXPECT_EQ(m.check(k), "");
+  EXPECT_NE(m.describe(k).find("shadow_lights=2"), std::string::npos) << m.describe(k);
+  // At most kMaxShadowedLights in all.
+  extra.projection = ShadowProjection::ortho;
+  for (int i = 0; i < 5; ++i) frame.extra_shadows.push_back(extra);
+  k = frame_variant(frame);
+  EXPECT_EQ(m.value(lights, k), kMaxShadowedLights);
+  // The forward and points passes read it; the depth pass does not.
+  EXPECT_EQ(k.filtered_for(Pass::shadow_points).get(VariantKey::kShadowLightsMinus1), 3u);
+  EXPECT_EQ(k.filtered_for(Pass::depth).get(VariantKey::kShadowLightsMinus1), 0u);
+  const auto defs = m.defines(k, ShaderStage::fragment);
+  EXPECT_NE(std::find(defs.begin(), defs.end(), std::pair<std::string, std::string>(
+                                                    "VARIANT_SHADOW_LIGHTS", "4")),
+            defs.end());
+  // Without a shadow the count is an invalid key, named by the manifest.
+  const VariantKey orphan = VariantKey().set(VariantKey::kShadowLightsMinus1, 1);
+  EXPECT_FALSE(orphan.valid());
+  EXPECT_NE(m.check(orphan).find("shadow_lights requires shadow"), std::string::npos)
+      << m.check(orphan);
 }
 
 struct BadMaterial {

@@ -1,0 +1,152 @@
+// Shadow caching (issue 13): a shadow-map layer is re-rendered only when what it is drawn from
+// changed (its matrix, its casters, a caster's matrix, bias, pass mode); otherwise it keeps its
+// depth. Checked on the default scene: a repeated frame re-renders nothing and keeps the same
+// maps; after a caster, the sun or the camera moves, the maps (kept and re-rendered layers
+// together) and the visibility AOV are exactly those drawn with nothing cached for the same scene
+// state. Fails when the layer's inputs leave out the caster matrices or the light matrix.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "components/camera.h"
+#include "components/name.h"
+#include "components/transform.h"
+#include "runtime/cli/player.h"
+#include "tests/render/player_fixture.h"
+
+namespace kaskad {
+namespace {
+
+class ShadowCacheTest : public PlayerTest {
+ protected:
+  static ecs::Entity named(const Scene& s, const std::string& name) {
+    ecs::Entity found;
+    s.world.view<Name>().each([&](ecs::Entity e, const Name& n) {
+      if (n.value == name) found = e;
+    });
+    return found;
+  }
+
+  struct Frame {
+    render::FrameStats stats;
+    std::vector<float> map;         // every layer's depth
+    std::vector<float> visibility;  // the AOV's visibility channel
+  };
+
+  static Frame render(Player& player, Scene& scene) {
+    Frame f;
+    RenderRun run;
+    run.width = 320;
+    run.height = 180;
+    auto t = render_frames(player, scene, run);
+    EXPECT_TRUE(t.ok()) << t.error().to_string();
+    if (!t.ok()) return f;
+    f.stats = t->last.stats;
+    f.map = player.renderer->read_shadow_map().pixels;
+    const Image aov = player.renderer->read_aovs();
+    for (int y = 0; y < aov.height; ++y)
+      for (int x = 0; x < aov.width; ++x) f.visibility.push_back(aov.at(x, y, 7));
+    return f;
+  }
+
+  // The same scene state drawn with nothing cached: the scene loaded again (new assets, so no
+  // layer's inputs match) with `scene`'s transforms, into new map storage (a frame with another
+  // map size first), so that nothing of an earlier frame's maps can survive in it.
+  static Frame fresh(const Scene& scene) {
+    auto other = load_scene(content_dir() / "scenes" / "default.json", {"shadow.map_size=1024"});
+    EXPECT_TRUE(other.ok()) << other.error().to_string();
+    if (other.ok()) render(*player_, *other);
+    auto copy = load_scene(content_dir() / "scenes" / "default.json", {});
+    EXPECT_TRUE(copy.ok()) << copy.error().to_string();
+    if (!copy.ok()) return {};
+    for (const char* name : {"box_floating", "camera", "sun"})
+      copy->world.get<Transform>(named(*copy, name)) =
+          scene.world.get<Transform>(named(scene, name));
+    Frame f = render(*player_, *copy);
+    EXPECT_EQ(f.stats.shadow_layers_rendered, (1u << f.stats.shadow_layers) - 1u);
+    return f;
+  }
+};
+
+TEST_F(ShadowCacheTest, LayersAreRedrawnOnlyWhenTheirInputsChange) {
+  auto loaded = load_scene(content_dir() / "scenes" / "default.json", {});
+  ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+  Scene& scene = *loaded;
+
+  const Frame first = render(*player_, scene);
+  ASSERT_EQ(first.stats.shadow_layers, 4);
+  EXPECT_EQ(first.stats.shadow_layers_rendered, 0xfu);
+  // A real map: lit and shadowed receivers.
+  EXPECT_NE(std::count(first.visibility.begin(), first.visibility.end(), 1.0f), 0);
+  EXPECT_NE(std::count(first.visibility.begin(), first.visibility.end(), 0.0f), 0);
+  // Nothing moved: every layer kept, the same maps and visibility, the same caster counts.
+  const Frame still = render(*player_, scene);
+  EXPECT_EQ(still.stats.shadow_layers_rendered, 0u);
+  EXPECT_EQ(still.map, first.map);
+  EXPECT_EQ(still.visibility, first.visibility);
+  EXPECT_EQ(still.stats.shadow_draw_calls, first.stats.shadow_draw_calls);
+  EXPECT_EQ(still.stats.cascade_draw_calls, first.stats.cascade_draw_calls);
+
+  // A caster moves: the layers that hold it are redrawn, and the maps are those drawn with
+  // nothing cached.
+  Transform& box = scene.world.get<Transform>(named(scene, "box_floating"));
+  box.translation += glm::vec3(0.3f, 0.2f, 0.1f);
+  const Frame moved = render(*player_, scene);
+  EXPECT_NE(moved.stats.shadow_layers_rendered, 0u);
+  EXPECT_NE(moved.map, first.map);
+  const Frame moved_fresh = fresh(scene);
+  EXPECT_EQ(moved.map, moved_fresh.map);
+  EXPECT_EQ(moved.visibility, moved_fresh.visibility);
+
+  // Back to the cached scene, unchanged since its last frame: its assets differ from the fresh
+  // copy's, so every layer is redrawn once, then kept again.
+  EXPECT_EQ(render(*player_, scene).map, moved.map);
+  EXPECT_EQ(render(*player_, scene).stats.shadow_layers_rendered, 0u);
+
+  // The sun turns a little: same splits and casters, new light matrices.
+  Transform& sun = scene.world.get<Transform>(named(scene, "sun"));
+  sun.rotation = glm::angleAxis(0.03f, glm::vec3(0.0f, 1.0f, 0.0f)) * sun.rotation;
+  const Frame turned = render(*player_, scene);
+  EXPECT_EQ(turned.stats.shadow_layers_rendered, 0xfu);
+  const Frame turned_fresh = fresh(scene);
+  EXPECT_EQ(turned.map, turned_fresh.map);
+  EXPECT_EQ(turned.visibility, turned_fresh.visibility);
+  render(*player_, scene);
+
+  // The camera moves: the cascades move with it and are redrawn; again as drawn from scratch.
+  scene.world.get<Transform>(named(scene, "camera")).translation += glm::vec3(0.7f, 0.0f, -0.4f);
+  const Frame walked = render(*player_, scene);
+  EXPECT_NE(walked.stats.shadow_layers_rendered, 0u);
+  const Frame walked_fresh = fresh(scene);
+  EXPECT_EQ(walked.map, walked_fresh.map);
+  EXPECT_EQ(walked.visibility, walked_fresh.visibility);
+}
+
+// The layered pass draws all of a light's layers in one pass: it redraws all of them or none.
+TEST_F(ShadowCacheTest, TheLayeredPassRedrawsAllLayersOrNone) {
+  auto loaded = load_scene(content_dir() / "scenes" / "default.json", {"shadow.layered=true"});
+  ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+  Scene& scene = *loaded;
+  const Frame first = render(*player_, scene);
+  EXPECT_EQ(first.stats.shadow_layers_rendered, 0xfu);
+  const Frame still = render(*player_, scene);
+  EXPECT_EQ(still.stats.shadow_layers_rendered, 0u);
+  EXPECT_EQ(still.map, first.map);
+  Transform& box = scene.world.get<Transform>(named(scene, "box_floating"));
+  box.translation += glm::vec3(0.3f, 0.2f, 0.1f);
+  const Frame moved = render(*player_, scene);
+  EXPECT_EQ(moved.stats.shadow_layers_rendered, 0xfu);
+  // Against one pass per layer drawn from scratch: the same maps (LocalLightTest's
+  // LayeredPassWritesTheSameMapsAsOnePassPerLayer), through the other code path.
+  const Frame moved_fresh = fresh(scene);
+  EXPECT_EQ(moved.map, moved_fresh.map);
+  EXPECT_EQ(moved.visibility, moved_fresh.visibility);
+}
+
+}  // namespace
+}  // namespace kaskad
