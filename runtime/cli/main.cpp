@@ -54,7 +54,7 @@ usage:
                                     or a folder of faces; L: auto, faces, horizontal_cross,
                                     vertical_cross, equirect, sphere), print what was found, write
                                     its faces (OUT: a pattern with * or a folder) or S3 sphere map
-  kaskad play FILE|DIR... [--out DIR] [--update-goldens] [--shard i/n]
+  kaskad play FILE|DIR... [--out DIR] [--update-goldens] [--shard i/n | --jobs N]
                                     replay playback files (camera keys, timeline, captures) and
                                     check their expectations (README "Scene playback"); writes
                                     DIR/<file>/frame_NNNN.png, frames.csv, diffs, DIR/summary.json

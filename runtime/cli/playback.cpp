@@ -9,7 +9,11 @@
 #include <set>
 #include <sstream>
 
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+extern char** environ;
 
 #include <nlohmann/json.hpp>
 
@@ -939,10 +943,19 @@ int run_play_command(int argc, char** argv) {
   options.headless = !gpu::display_available();
   std::vector<fs::path> files;
   bool merge = false;
+  int jobs = 1;
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--merge") {
       merge = true;
+      continue;
+    }
+    if (arg == "--jobs") {
+      if (i + 1 >= argc) return usage("--jobs needs a value");
+      const std::string v = argv[++i];
+      char tail = 0;
+      if (std::sscanf(v.c_str(), "%d%c", &jobs, &tail) != 1 || jobs < 1 || jobs > 256)
+        return usage("--jobs expects a number of processes in [1, 256], got '" + v + "'");
       continue;
     }
     if (arg == "--out" || arg == "--shard") {
@@ -986,6 +999,42 @@ int run_play_command(int argc, char** argv) {
     return *failed == 0 ? 0 : 1;
   }
   if (files.empty()) return usage("name playback files or folders of them");
+  if (jobs > 1) {
+    if (options.shard_count > 1) return usage("give --jobs or --shard, not both");
+    // One process per shard (one GL context each), then one merged summary.
+    std::vector<pid_t> children;
+    std::vector<fs::path> dirs;
+    for (int j = 0; j < jobs; ++j) {
+      dirs.push_back(options.out_dir / ("shard-" + std::to_string(j)));
+      std::vector<std::string> args = {"kaskad", "play", "--shard",
+                                       std::to_string(j) + "/" + std::to_string(jobs), "--out",
+                                       dirs.back().string(), options.headless ? "--headless" : "--window"};
+      if (options.update_goldens) args.push_back("--update-goldens");
+      for (const fs::path& f : files) args.push_back(f.string());
+      std::vector<char*> cargs;
+      for (std::string& a : args) cargs.push_back(a.data());
+      cargs.push_back(nullptr);
+      pid_t pid = 0;
+      if (posix_spawn(&pid, "/proc/self/exe", nullptr, nullptr, cargs.data(), environ) != 0) {
+        std::fprintf(stderr, "kaskad: error: cannot start a play process for shard %d\n", j);
+        return 1;
+      }
+      children.push_back(pid);
+    }
+    bool crashed = false;
+    for (pid_t pid : children) {
+      int status = 0;
+      waitpid(pid, &status, 0);
+      // 0 and 1 are results; anything else (a signal, a usage error) is a broken run.
+      crashed = crashed || !WIFEXITED(status) || WEXITSTATUS(status) > 1;
+    }
+    auto failed = merge_summaries(dirs, options.out_dir);
+    if (!failed) {
+      std::fprintf(stderr, "kaskad: error: %s\n", failed.error().to_string().c_str());
+      return 1;
+    }
+    return crashed || *failed != 0 ? 1 : 0;
+  }
   auto failures = run_playbacks(files, options);
   if (!failures) {
     std::fprintf(stderr, "kaskad: error: %s\n", failures.error().to_string().c_str());

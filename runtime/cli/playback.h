@@ -161,8 +161,9 @@ std::vector<std::size_t> shard_files(std::size_t count, int index, int n);
 Result<std::size_t> merge_summaries(const std::vector<std::filesystem::path>& dirs,
                                     const std::filesystem::path& out_dir);
 
-/// `kaskad play FILE|DIR... [--out DIR] [--update-goldens] [--shard i/n] [--headless|--window]`
-/// (a DIR stands for its *.json files). argv[1] is "play". Exit status: 0 all expectations
+/// `kaskad play FILE|DIR... [--out DIR] [--update-goldens] [--shard i/n | --jobs N]
+/// [--headless|--window]` (a DIR stands for its *.json files; --jobs runs N shard processes
+/// into OUT/shard-i and merges their summaries). argv[1] is "play". Exit status: 0 all expectations
 /// held, 1 an expectation failed or a file could not be read or run, 2 usage error.
 int run_play_command(int argc, char** argv);
 
