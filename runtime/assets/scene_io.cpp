@@ -892,6 +892,79 @@ ecs::Entity add_ground(Scene& scene, const Aabb& extent) {
   return e;
 }
 
+Result<ecs::Entity> add_entity(Scene& scene, const json& block, const std::string& where) {
+  ecs::World& w = scene.world;
+  std::map<std::string, ecs::Entity> by_name;
+  w.view<Name>().each([&](ecs::Entity e, const Name& n) { by_name.emplace(n.value, e); });
+  try {
+    // Checked on a scratch scene first, so a bad block leaves the live one untouched.
+    Scene scratch;
+    scratch.file = scene.file;
+    scratch.shadow_defaults = scene.shadow_defaults;
+    std::map<std::string, ecs::Entity> scratch_names = by_name;
+    std::vector<Pending> parents;
+    FirstSun sun;
+    parse_entity(block, where, scratch, scratch_names, parents, sun);
+    for (const Pending& p : parents)
+      if (!by_name.count(p.parent)) fail(p.where, "no entity named '" + p.parent + "'");
+    if (!block.is_object() || !block.contains("name") || !block["name"].is_string())
+      fail(where + "/name", "an added entity needs a name");
+    bool material_file = false;
+    scratch.world.view<MaterialRef>().each([&](ecs::Entity, const MaterialRef&) { material_file = true; });
+    if (material_file)
+      fail(where + "/material", "an added entity takes an inline material, not a material file");
+    bool tiled = false;
+    scratch.world.view<PrimitiveMesh>().each(
+        [&](ecs::Entity, const PrimitiveMesh& pm) { tiled = tiled || pm.tiles > 1; });
+    if (tiled) fail(where + "/primitive/tiles", "an added terrain cannot be tiled");
+  } catch (const ContentError& e) {
+    return Error{scene.file.string(), e.where, e.message};
+  }
+  std::vector<Pending> parents;
+  FirstSun sun;
+  parse_entity(block, where, scene, by_name, parents, sun);  // checked above: cannot fail
+  const ecs::Entity e = by_name.at(block.at("name").get<std::string>());
+  for (const Pending& p : parents) w.get<Transform>(p.entity).parent = by_name.at(p.parent);
+  if (const auto* pm = w.try_get<PrimitiveMesh>(e))
+    w.get<MeshRenderer>(e).mesh = scene.assets.add_mesh(make_primitive(pm->shape, pm->segments));
+  if (const auto* m = w.try_get<ModelRef>(e)) {
+    const fs::path path = scene.file.parent_path() / m->path;
+    auto report = import_gltf(path, w, scene.assets, e, e, /*activate_first_camera=*/false);
+    if (!report) return report.error();
+    const MeshRenderer flags = w.get<MeshRenderer>(e);
+    w.view<MeshRenderer, Imported>().each([&](ecs::Entity, MeshRenderer& mr, Imported& imp) {
+      if (imp.source == e) {
+        mr.cast_shadows = flags.cast_shadows;
+        mr.receive_shadows = flags.receive_shadows;
+        mr.layer = flags.layer;
+      }
+    });
+  }
+  return e;
+}
+
+Status remove_entity(Scene& scene, const std::string& name) {
+  ecs::World& w = scene.world;
+  ecs::Entity target = ecs::kNullEntity;
+  w.view<Name>().each([&](ecs::Entity e, const Name& n) {
+    if (n.value == name && !target.valid()) target = e;
+  });
+  if (!target.valid()) return Error{scene.file.string(), "", "no entity named '" + name + "' to remove"};
+  // The entity, everything parented below it and everything imported for it.
+  std::vector<ecs::Entity> doomed{target};
+  for (std::size_t i = 0; i < doomed.size(); ++i) {
+    const ecs::Entity root = doomed[i];
+    w.view<Transform>().each([&](ecs::Entity e, const Transform& t) {
+      const auto* imp = w.try_get<Imported>(e);
+      if ((t.parent == root || (imp && imp->source == root)) &&
+          std::find(doomed.begin(), doomed.end(), e) == doomed.end())
+        doomed.push_back(e);
+    });
+  }
+  for (ecs::Entity e : doomed) w.destroy(e);
+  return {};
+}
+
 json scene_to_json(const Scene& scene, const fs::path& base_dir) {
   json doc;
   doc["kaskad_scene"] = kFormatVersion;

@@ -61,6 +61,15 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest =
 /// render.width/height change the setting only (the player's targets keep their size).
 Status apply_live_override(Scene& scene, const std::string& assignment);
 
+/// Adds an entity from a scene file's entity block (`where` is its JSON path for messages) to a
+/// loaded scene between frames: validated as in scene files (a bad block leaves the scene
+/// unchanged), its primitive meshed, its model imported. It needs a unique name; material files
+/// and tiled terrains are not taken (inline materials are).
+Result<ecs::Entity> add_entity(Scene& scene, const nlohmann::json& block, const std::string& where);
+
+/// Removes the entity named `name`, everything parented below it and everything imported for it.
+Status remove_entity(Scene& scene, const std::string& name);
+
 /// Where a ground for `models` (their world bounds) goes: a flat box at min.y (a hair below)
 /// covering their footprint and the shadow their bounds cast along `light_direction` (lights
 /// below about 14 degrees of elevation count as 14), with a margin of a quarter of their size.

@@ -336,15 +336,27 @@ Result<Playback> parse_playback(const std::string& text, const fs::path& file) {
         }
         ObjectReader er(tl[i], at);
         SetEvent ev;
+        ev.where = at;
         ev.frame = read_when(er, pb, at);
         er.string("set", ev.assignment);
-        if (ev.assignment.find('=') == std::string::npos)
-          fail(er.at("set"), "an event sets a \"key=value\" (or give keys to move an entity)");
+        er.string("remove", ev.remove);
+        if (er.has("add")) {
+          if (!er.raw("add").is_object()) fail(er.at("add"), "expected an entity block of a scene file");
+          ev.add = er.raw("add");
+        }
+        const int kinds = !ev.assignment.empty() + !ev.remove.empty() + bool(ev.add);
+        if (kinds != 1)
+          fail(at, "an event has one of set (\"key=value\"), add (an entity block) or remove (a "
+                   "name); or give keys to move an entity");
+        if (!ev.assignment.empty() && ev.assignment.find('=') == std::string::npos)
+          fail(er.at("set"), "expected \"key=value\"");
         int every = 0;
         er.integer("every", every, 0, kMaxFrames);
         er.finish();
         for (int f = ev.frame; f < pb.frames; f += every) {
-          pb.events.push_back({f, ev.assignment});
+          SetEvent copy = ev;
+          copy.frame = f;
+          pb.events.push_back(std::move(copy));
           if (every == 0) break;
         }
       }
@@ -481,6 +493,7 @@ ecs::Entity find_named(const ecs::World& w, const std::string& name) {
 // `start` is the entity's transform at load: relative tracks move from it along its axes.
 void apply_pose(ecs::World& w, ecs::Entity e, const Track& track, const PoseKey& pose,
                 const Transform& start) {
+  if (!w.alive(e) || !w.has<Transform>(e)) return;  // removed by the timeline
   Transform& t = w.get<Transform>(e);
   if (pose.position && track.relative) {
     const glm::vec3 m = *pose.position;
@@ -499,6 +512,18 @@ std::string frame_name(const char* prefix, int f, const char* ext) {
   return buf;
 }
 
+// One timeline event on a loaded scene.
+Status apply_event(Scene& scene, const SetEvent& ev) {
+  if (ev.add) {
+    auto e = add_entity(scene, *ev.add, ev.where + "/add");
+    if (!e) return e.error();
+    update_transforms(scene.world, scene.assets);
+    return {};
+  }
+  if (!ev.remove.empty()) return remove_entity(scene, ev.remove);
+  return apply_live_override(scene, ev.assignment);
+}
+
 // Loads the scene of `pb` with its sets and size, and checks every timeline event and track
 // against a second copy first, so that a bad key fails before the first frame. With a
 // renderer, every state the timeline reaches is pre-warmed on that copy: toggles mid-run
@@ -515,7 +540,7 @@ Result<Scene> load_checked(const Playback& pb, render::Renderer* prewarm = nullp
   const bool points = bool(pb.flicker);  // the flicker gate reads the points pass
   if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx, points));
   for (const SetEvent& ev : pb.events) {
-    if (auto st = apply_live_override(*trial, ev.assignment); !st) {
+    if (auto st = apply_event(*trial, ev); !st) {
       Error e = st.error();
       e.message += " (timeline event at frame " + std::to_string(ev.frame) + " of " +
                    pb.file.string() + ")";
@@ -608,7 +633,7 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
     const double t = f * pb.dt;
     // 1. Timeline: events due now, then the tracks' poses.
     for (; next_event < pb.events.size() && pb.events[next_event].frame <= f; ++next_event)
-      KASKAD_TRY(apply_live_override(*scene, pb.events[next_event].assignment));
+      KASKAD_TRY(apply_event(*scene, pb.events[next_event]));
     if (pb.camera)
       apply_pose(scene->world, camera, *pb.camera, sample_track(*pb.camera, t), camera_start);
     for (const Moved& m : moved)

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 #include <glm/gtc/quaternion.hpp>
 
 #include "runtime/core/result.h"
@@ -52,7 +53,10 @@ struct Track {
 /// "every" are expanded into one per repeat when the file is read).
 struct SetEvent {
   int frame = 0;
-  std::string assignment;
+  std::string assignment;  ///< "key=value"; empty for add and remove events
+  std::string remove;      ///< the entity to remove (with its children)
+  std::optional<nlohmann::json> add;  ///< an entity block of a scene file to add
+  std::string where;       ///< the event's JSON path, for messages
 };
 
 struct GoldenExpect {

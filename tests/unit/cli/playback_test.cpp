@@ -66,6 +66,23 @@ TEST(Playback, ErrorsNameTheFileThePathAndTheValidKeys) {
   expect_error(R"({"scene": "a.json", "frames": 1e999})", {"dir/test.json"});
 }
 
+TEST(Playback, EventsSetAddOrRemoveAndRepeat) {
+  auto pb = parse(R"({"scene": "a.json", "frames": 10, "timeline": [
+    {"frame": 1, "add": {"name": "crate", "primitive": {"shape": "box"}}},
+    {"frame": 2, "remove": "crate"},
+    {"frame": 3, "every": 3, "set": "shadow.filter=none"}]})");
+  ASSERT_TRUE(pb.ok()) << pb.error().to_string();
+  ASSERT_EQ(pb->events.size(), 5u);  // 1, 2, then 3, 6, 9
+  EXPECT_TRUE(pb->events[0].add);
+  EXPECT_EQ(pb->events[1].remove, "crate");
+  EXPECT_EQ(pb->events[4].frame, 9);
+  EXPECT_EQ(pb->events[4].assignment, "shadow.filter=none");
+  expect_error(R"({"scene": "a.json", "timeline": [{"frame": 0, "set": "a=1", "remove": "b"}]})",
+               {"/timeline/0", "one of set"});
+  expect_error(R"({"scene": "a.json", "timeline": [{"frame": 0, "add": 3}]})",
+               {"/timeline/0/add", "entity block"});
+}
+
 TEST(Playback, TracksInterpolateLinearlyOrThroughTheKeys) {
   Track t;
   t.keys.push_back({.t = 0.0, .position = glm::vec3(0, 0, 0), .scale = glm::vec3(1)});
