@@ -748,6 +748,42 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
   return scene;
 }
 
+namespace {
+
+// Imports entity e's glTF model (ModelRef): the meshes take e's renderer flags and layer, the
+// lights the scene's shadow settings.
+Status import_model(Scene& scene, ecs::Entity e, bool activate_first_camera) {
+  ecs::World& w = scene.world;
+  const fs::path path = scene.file.parent_path() / w.get<ModelRef>(e).path;
+  auto report = import_gltf(path, w, scene.assets, e, e, activate_first_camera);
+  if (!report) return report.error();
+  for (const auto& warning : report->warnings) log::warn("%s: %s", path.string().c_str(), warning.c_str());
+  // The model entity's renderer flags apply to everything imported under it.
+  const MeshRenderer flags = w.get<MeshRenderer>(e);
+  w.view<MeshRenderer, Imported>().each([&](ecs::Entity, MeshRenderer& mr, Imported& imp) {
+    if (imp.source == e) {
+      mr.cast_shadows = flags.cast_shadows;
+      mr.receive_shadows = flags.receive_shadows;
+      mr.layer = flags.layer;
+    }
+  });
+  // The scene's shadow settings apply to the model's own lights as to any other (a glTF has
+  // none of its own); --set ENTITY.shadow.* on the imported light refines them afterwards.
+  std::vector<ecs::Entity> lights;
+  w.view<Light, Imported>().each([&](ecs::Entity l, Light&, Imported& imp) {
+    if (imp.source == e) lights.push_back(l);
+  });
+  for (ecs::Entity l : lights) {
+    if (w.has<ShadowSettings>(l))
+      w.get<ShadowSettings>(l) = scene.shadow_defaults;
+    else
+      w.emplace<ShadowSettings>(l, scene.shadow_defaults);
+  }
+  return {};
+}
+
+}  // namespace
+
 Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) {
   ecs::World& w = scene.world;
   std::vector<std::pair<ecs::Entity, MaterialRef>> material_refs;
@@ -809,33 +845,7 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
       it = shared.emplace(key, scene.assets.add_mesh(make_primitive(p.shape, p.segments))).first;
     w.get<MeshRenderer>(e).mesh = it->second;
   }
-  for (auto& [e, m] : models) {
-    const fs::path path = scene.file.parent_path() / m.path;
-    auto report = import_gltf(path, w, scene.assets, e, e, /*activate_first_camera=*/true);
-    if (!report) return report.error();
-    for (const auto& warning : report->warnings) log::warn("%s: %s", path.string().c_str(), warning.c_str());
-    // The model entity's renderer flags apply to everything imported under it.
-    const MeshRenderer flags = w.get<MeshRenderer>(e);
-    w.view<MeshRenderer, Imported>().each([&](ecs::Entity, MeshRenderer& mr, Imported& imp) {
-      if (imp.source == e) {
-        mr.cast_shadows = flags.cast_shadows;
-        mr.receive_shadows = flags.receive_shadows;
-        mr.layer = flags.layer;
-      }
-    });
-    // The scene's shadow settings apply to the model's own lights as to any other (a glTF has
-    // none of its own); --set ENTITY.shadow.* on the imported light refines them afterwards.
-    std::vector<ecs::Entity> lights;
-    w.view<Light, Imported>().each([&](ecs::Entity l, Light&, Imported& imp) {
-      if (imp.source == e) lights.push_back(l);
-    });
-    for (ecs::Entity l : lights) {
-      if (w.has<ShadowSettings>(l))
-        w.get<ShadowSettings>(l) = scene.shadow_defaults;
-      else
-        w.emplace<ShadowSettings>(l, scene.shadow_defaults);
-    }
-  }
+  for (auto& model : models) KASKAD_TRY(import_model(scene, model.first, /*activate_first_camera=*/true));
   return {};
 }
 
@@ -927,19 +937,7 @@ Result<ecs::Entity> add_entity(Scene& scene, const json& block, const std::strin
   for (const Pending& p : parents) w.get<Transform>(p.entity).parent = by_name.at(p.parent);
   if (const auto* pm = w.try_get<PrimitiveMesh>(e))
     w.get<MeshRenderer>(e).mesh = scene.assets.add_mesh(make_primitive(pm->shape, pm->segments));
-  if (const auto* m = w.try_get<ModelRef>(e)) {
-    const fs::path path = scene.file.parent_path() / m->path;
-    auto report = import_gltf(path, w, scene.assets, e, e, /*activate_first_camera=*/false);
-    if (!report) return report.error();
-    const MeshRenderer flags = w.get<MeshRenderer>(e);
-    w.view<MeshRenderer, Imported>().each([&](ecs::Entity, MeshRenderer& mr, Imported& imp) {
-      if (imp.source == e) {
-        mr.cast_shadows = flags.cast_shadows;
-        mr.receive_shadows = flags.receive_shadows;
-        mr.layer = flags.layer;
-      }
-    });
-  }
+  if (w.has<ModelRef>(e)) KASKAD_TRY(import_model(scene, e, /*activate_first_camera=*/false));
   return e;
 }
 
