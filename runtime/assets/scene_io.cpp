@@ -608,7 +608,8 @@ Status apply_live_override(Scene& scene, const std::string& assignment) {
     std::vector<std::pair<ecs::Entity, ShadowSettings>> lights;
     scene.world.view<ShadowSettings>().each([&](ecs::Entity e, const ShadowSettings& own) {
       ShadowSettings s = defaults;
-      ObjectReader lr(write_shadow(own, &scene.shadow_defaults), "/shadow");
+      const json own_fields = write_shadow(own, &scene.shadow_defaults);  // outlives the reader
+      ObjectReader lr(own_fields, "/shadow");
       read_shadow(lr, s);
       lights.emplace_back(e, s);
     });

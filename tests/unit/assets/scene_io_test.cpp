@@ -501,3 +501,60 @@ TEST(SceneIo, GroundCoversTheFootprintAndTheShadowOfTheBounds) {
 
 }  // namespace
 }  // namespace kaskad
+
+namespace kaskad {
+namespace {
+
+TEST(SceneIo, LiveOverridesChangeALoadedSceneAsAFileWould) {
+  // Two suns: "a" takes the scene-wide filter, "b" overrides it in its own block.
+  auto s = read_scene(write_file("live.json", R"({"shadow": {"filter": "pcf3x3"}, "entities": [
+    {"name": "a", "light": {"type": "directional", "cast_shadows": true}},
+    {"name": "b", "light": {"type": "directional", "cast_shadows": true}, "shadow": {"filter": "none"}},
+    {"name": "box", "primitive": {"shape": "box"}}]})"));
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  { auto st = apply_live_override(*s, "shadow.filter=bilinear"); ASSERT_TRUE(st.ok()) << st.error().to_string(); }
+  ASSERT_TRUE(apply_live_override(*s, "shadow.cascade_count=2").ok());
+  EXPECT_EQ(s->shadow_defaults.filter, ShadowFilter::bilinear);
+  EXPECT_EQ(s->world.get<ShadowSettings>(find(*s, "a")).filter, ShadowFilter::bilinear);
+  EXPECT_EQ(s->world.get<ShadowSettings>(find(*s, "b")).filter, ShadowFilter::none);  // its own
+  EXPECT_EQ(s->world.get<ShadowSettings>(find(*s, "b")).cascade_count, 2);
+  ASSERT_TRUE(apply_live_override(*s, "render.exposure=0.5").ok());
+  EXPECT_FLOAT_EQ(s->render.exposure, 0.5f);
+  ASSERT_TRUE(apply_live_override(*s, "box.transform.translation.1=3").ok());
+  EXPECT_FLOAT_EQ(s->world.get<Transform>(find(*s, "box")).translation.y, 3.0f);
+  // A bad value is an error and changes nothing.
+  auto bad = apply_live_override(*s, "shadow.cascade_count=12");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().to_string().find("cascade_count"), std::string::npos);
+  EXPECT_EQ(s->shadow_defaults.cascade_count, 2);
+  EXPECT_EQ(s->world.get<ShadowSettings>(find(*s, "a")).cascade_count, 2);
+}
+
+TEST(SceneIo, EntitiesAreAddedAndRemovedBetweenFrames) {
+  auto s = read_scene(kContent / "scenes" / "default.json");
+  ASSERT_TRUE(s.ok());
+  ASSERT_TRUE(instantiate_scene(*s).ok());
+  const std::size_t meshes = s->assets.meshes.size();
+  auto added = add_entity(*s, nlohmann::json::parse(R"({"name": "crate", "primitive": {"shape": "box"},
+      "transform": {"parent": "box_floating"}})"), "/timeline/0/add");
+  ASSERT_TRUE(added.ok()) << added.error().to_string();
+  EXPECT_EQ(s->assets.meshes.size(), meshes + 1);
+  EXPECT_EQ(s->world.get<Transform>(*added).parent, find(*s, "box_floating"));
+  // A duplicate name or a bad field changes nothing.
+  const std::size_t alive = s->world.size();
+  auto dup = add_entity(*s, nlohmann::json::parse(R"({"name": "crate"})"), "/x");
+  ASSERT_FALSE(dup.ok());
+  EXPECT_NE(dup.error().to_string().find("duplicate"), std::string::npos) << dup.error().to_string();
+  auto bad = add_entity(*s, nlohmann::json::parse(R"({"name": "c2", "primitive": {"shape": "blob"}})"), "/x");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().to_string().find("/x/primitive/shape"), std::string::npos) << bad.error().to_string();
+  EXPECT_EQ(s->world.size(), alive);
+  // Removing the parent takes the child along.
+  ASSERT_TRUE(remove_entity(*s, "box_floating").ok());
+  EXPECT_FALSE(find(*s, "box_floating").valid());
+  EXPECT_FALSE(s->world.alive(*added));
+  EXPECT_FALSE(remove_entity(*s, "box_floating").ok());
+}
+
+}  // namespace
+}  // namespace kaskad
