@@ -568,7 +568,9 @@ struct FileResult {
   int captured = 0;
 };
 
-Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOptions& options) {
+// `out` is the file's own output folder.
+Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOptions& options,
+                            const fs::path& out) {
   FileResult result;
   const auto t_start = std::chrono::steady_clock::now();
   auto fail_at = [&](int frame, const std::string& message) {
@@ -582,7 +584,6 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
   const int gl_errors_before = gpu::debug_error_count();
   auto scene = load_checked(pb, player.renderer.get(), &ctx);
   if (!scene) return scene.error();
-  const fs::path out = options.out_dir / pb.file.stem();
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) return Error{out.string(), "", "cannot create the output folder: " + ec.message()};
@@ -892,7 +893,15 @@ Result<std::vector<PlayFailure>> run_playbacks(const std::vector<fs::path>& file
                   {"shard", std::to_string(options.shard_index) + "/" + std::to_string(options.shard_count)},
                   {"files", json::array()}};
   for (const Playback& pb : playbacks) {
-    auto r = play_one(*player, pb, options);
+    // Output folders by file name; files of the same name from different folders get their
+    // folder's name in front.
+    std::string name = pb.file.stem().string();
+    for (const Playback& other : playbacks)
+      if (&other != &pb && other.file.stem() == pb.file.stem()) {
+        name = pb.file.parent_path().filename().string() + "_" + name;
+        break;
+      }
+    auto r = play_one(*player, pb, options, options.out_dir / name);
     if (!r) return r.error();
     json failed = json::array();
     for (const PlayFailure& f : r->failures) {
