@@ -19,9 +19,11 @@
 #include <limits>
 #include <map>
 #include <new>
+#include <optional>
 #include <string_view>
 #include <system_error>
 
+#include "runtime/core/atomic_file.h"
 #include "runtime/core/file_io.h"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -294,6 +296,14 @@ Result<Image> load_image_from_memory(const void* data, std::size_t size, const s
   }
 }
 
+Status check_image_output(const std::filesystem::path& path) {
+  auto out = OIIO::ImageOutput::create(path.string());
+  if (!out) {
+    return Error{path.string(), "", "cannot write this image format: " + one_line(OIIO::geterror())};
+  }
+  return check_output_path(path);
+}
+
 Status save_image(const std::filesystem::path& path, const Image& image) {
   KASKAD_CHECK(image.width > 0 && image.height > 0 && image.channels > 0,
                "image must be non-empty, was " + std::to_string(image.width) + " x " +
@@ -308,6 +318,9 @@ Status save_image(const std::filesystem::path& path, const Image& image) {
 
   const std::string name = path.string();
   const std::string ext = lowercase_extension(path);
+  // Declared before the writer, which may still use it while it is destroyed.
+  std::vector<unsigned char> encoded;
+  OIIO::Filesystem::IOVecOutput memory(encoded);
   auto out = OIIO::ImageOutput::create(name);
   if (!out) {
     return Error{name, "", "cannot write this image format: " + one_line(OIIO::geterror())};
@@ -330,7 +343,18 @@ Status save_image(const std::filesystem::path& path, const Image& image) {
     spec.alpha_channel =
         alpha == spec.channelnames.end() ? -1 : int(alpha - spec.channelnames.begin());
   }
-  if (!out->open(name, spec)) {
+  // Atomic output (runtime/core/atomic_file.h): encode into memory when the format's writer
+  // can (PNG, EXR, ...), then write_file_atomic checks every byte and renames; otherwise the
+  // writer writes a temporary file beside the target that is renamed only when complete.
+  KASKAD_TRY(check_output_path(path));
+  const bool in_memory = out->supports("ioproxy") && out->set_ioproxy(&memory);
+  std::optional<TempFile> temp;
+  if (!in_memory) {
+    auto t = TempFile::create(path);
+    if (!t) return t.error();
+    temp.emplace(std::move(t.value()));
+  }
+  if (!out->open(in_memory ? name : temp->path().string(), spec)) {
     return Error{name, "", "cannot open for writing: " + one_line(out->geterror())};
   }
 
@@ -353,7 +377,9 @@ Status save_image(const std::filesystem::path& path, const Image& image) {
   }
   if (!written) return Error{name, "", "write failed: " + one_line(out->geterror())};
   if (!out->close()) return Error{name, "", "write failed: " + one_line(out->geterror())};
-  return {};
+  out.reset();
+  if (in_memory) return write_file_atomic(path, encoded.data(), encoded.size());
+  return temp->commit();
 }
 
 std::vector<std::uint8_t> to_rgba8(const Image& image) {

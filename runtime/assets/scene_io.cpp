@@ -25,6 +25,7 @@
 #include "runtime/assets/material_file.h"
 #include "runtime/assets/primitives.h"
 #include "runtime/assets/reflector_io.h"
+#include "runtime/core/atomic_file.h"
 #include "runtime/core/json_reader.h"
 #include "runtime/core/log.h"
 
@@ -521,6 +522,20 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
       if (it->second == p.entity) fail(p.where, "an entity cannot be its own parent");
       scene.world.get<Transform>(p.entity).parent = it->second;
     }
+    // Parent cycles (a -> b -> a) are content errors here, with the names, rather than a
+    // warning from the transform system every frame.
+    std::map<ecs::Entity, std::string, bool (*)(ecs::Entity, ecs::Entity)> names(entity_less);
+    for (const auto& [n, e] : by_name) names[e] = n;
+    for (const Pending& p : parents) {
+      std::string chain = names[p.entity];
+      ecs::Entity at = scene.world.get<Transform>(p.entity).parent;
+      for (std::size_t steps = 0; at.valid() && steps <= parents.size(); ++steps) {
+        chain += " -> " + names[at];
+        if (at == p.entity) fail(p.where, "parent cycle: " + chain);
+        const Transform* t = scene.world.try_get<Transform>(at);
+        at = t ? t->parent : ecs::kNullEntity;
+      }
+    }
   } catch (const ContentError& e) {
     return Error{file.string(), e.where, e.message};
   } catch (const json::exception& e) {
@@ -631,24 +646,9 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
 }
 
 Status save_scene(const fs::path& file, const Scene& scene) {
+  KASKAD_TRY(check_output_path(file));  // before the work, and with a clear word for a folder
   const fs::path dir = file.parent_path().empty() ? fs::path(".") : file.parent_path();
-  const std::string text = scene_to_json(scene, dir).dump(2) + "\n";
-  fs::path tmp = file;
-  tmp += ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return Error{file.string(), "", "cannot write (directory missing or not writable)"};
-    out << text;
-    out.flush();
-    if (!out) return Error{file.string(), "", "write failed (disk full?)"};
-  }
-  std::error_code ec;
-  fs::rename(tmp, file, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    return Error{file.string(), "", "cannot replace the file: " + ec.message()};
-  }
-  return {};
+  return write_file_atomic(file, scene_to_json(scene, dir).dump(2) + "\n");
 }
 
 Result<Scene> read_scene(const fs::path& file, const std::vector<std::string>& overrides) {
