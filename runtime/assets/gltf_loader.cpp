@@ -51,6 +51,7 @@
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/tinygltf_config.h"
 #include "runtime/core/file_io.h"
+#include "runtime/core/json_reader.h"
 
 namespace kaskad {
 namespace {
@@ -350,6 +351,25 @@ Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadS
   tinygltf::Model model;
   std::string err, warn;
   const std::string base_dir = path.parent_path().string();
+  // For JSON errors, our own parse of the same text gives the line, column and reason (in the
+  // JSON chunk for a .glb) instead of nlohmann's raw message.
+  auto locate_json_error = [&](std::string raw) -> Error {
+    const std::size_t start = binary ? std::min<std::size_t>(20, data.size()) : 0;
+    std::size_t length = data.size() - start;
+    if (binary && data.size() >= 16) length = std::min<std::size_t>(length, read_u32(data, 12));
+    auto located = json_reader::parse_json_text(
+        std::string(data.begin() + std::ptrdiff_t(start), data.begin() + std::ptrdiff_t(start + length)),
+        file);
+    if (located) {
+      if (auto p = raw.find("] "); raw.rfind("[json.exception", 0) == 0 && p != std::string::npos)
+        raw.erase(0, p + 2);
+      return Error{file, "", "invalid glTF JSON: " + raw};
+    }
+    Error e = located.error();
+    if (binary)
+      e.where = e.where.empty() ? std::string("JSON chunk") : std::string("JSON chunk, ") + e.where;
+    return e;
+  };
   bool ok = false;
   try {
     ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data.data(),
@@ -361,8 +381,12 @@ Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadS
     return Error{file, "", "out of memory while parsing"};
   } catch (const std::exception& e) {
     // tinygltf 2.7 lets some std::vector::at() exceptions escape on malformed buffers.
-    return Error{file, "", std::string("invalid glTF: ") + e.what()};
+    const std::string what = e.what();
+    if (what.find("[json.exception") != std::string::npos) return locate_json_error(what);
+    return Error{file, "", "invalid glTF: " + what};
   }
+  // tinygltf catches nlohmann's exceptions (a number like 1e999) itself and passes their raw text on.
+  if (!ok && err.find("[json.exception") != std::string::npos) return locate_json_error(join_lines(err));
   if (!ok) return Error{file, "", "invalid glTF: " + join_lines(err)};
   for (const auto& line : split_lines(warn)) warnings.push_back(line);
   // tinygltf reports some spec violations in `err` yet succeeds; keep them as warnings.

@@ -8,16 +8,20 @@
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <new>
 #include <optional>
 #include <string_view>
@@ -34,6 +38,7 @@
 #endif
 #endif
 #ifdef KASKAD_LSAN
+#include <sanitizer/common_interface_defs.h>
 #include <sanitizer/lsan_interface.h>
 #endif
 
@@ -58,6 +63,50 @@ class IgnoreLeaksInOiio {
 #endif
   IgnoreLeaksInOiio(const IgnoreLeaksInOiio&) = delete;
   IgnoreLeaksInOiio& operator=(const IgnoreLeaksInOiio&) = delete;
+};
+
+/// libpng (inside OIIO's PNG reader) prints "libpng error: ..." lines to stderr itself; the same
+/// text reaches us through OIIO's geterror() and ends up in our error message. While a decoder
+/// runs, the process's stderr therefore goes to /dev/null, so raw library lines never reach the
+/// user (README "Bad input"). Sanitizer reports keep the real stderr (a duplicate of it).
+/// Serialised: the file descriptor is process-wide.
+class QuietStderr {
+ public:
+  QuietStderr() : lock_(mutex()) {
+    static const int real = ::dup(2);
+#ifdef KASKAD_LSAN
+    static const bool reports_kept = [] {
+      __sanitizer_set_report_fd(reinterpret_cast<void*>(static_cast<std::intptr_t>(real)));
+      return true;
+    }();
+    (void)reports_kept;
+#endif
+    (void)real;
+    std::fflush(stderr);
+    saved_ = ::dup(2);
+    const int null = ::open("/dev/null", O_WRONLY);
+    if (null >= 0) {
+      ::dup2(null, 2);
+      ::close(null);
+    }
+  }
+  ~QuietStderr() {
+    std::fflush(stderr);
+    if (saved_ >= 0) {
+      ::dup2(saved_, 2);
+      ::close(saved_);
+    }
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::unique_lock<std::mutex> lock_;
+  int saved_ = -1;
 };
 
 /// Largest image we decode, in float values (width * height * channels): 2^28 floats = 1 GiB,
@@ -274,6 +323,7 @@ Result<Image> load_image(const std::filesystem::path& path) {
     auto bytes = read_file_bytes(path, kMaxFileBytes);
     if (!bytes) return bytes.error();
     const auto& b = bytes.value();
+    [[maybe_unused]] QuietStderr quiet;
     return decode(b.data(), b.size(), path.string(),
                   choose_format(b.data(), b.size(), path.string(), {}));
   } catch (const std::bad_alloc&) {
@@ -288,6 +338,7 @@ Result<Image> load_image_from_memory(const void* data, std::size_t size, const s
   if (data == nullptr || size == 0) return Error{name, "", "empty image data (0 bytes)"};
   const auto* bytes = static_cast<const std::uint8_t*>(data);
   try {
+    [[maybe_unused]] QuietStderr quiet;
     return decode(bytes, size, name, choose_format(bytes, size, name, mime_type));
   } catch (const std::bad_alloc&) {
     return Error{name, "", "out of memory while decoding the image"};
@@ -297,11 +348,12 @@ Result<Image> load_image_from_memory(const void* data, std::size_t size, const s
 }
 
 Status check_image_output(const std::filesystem::path& path) {
+  KASKAD_TRY(check_output_path(path));
   auto out = OIIO::ImageOutput::create(path.string());
   if (!out) {
     return Error{path.string(), "", "cannot write this image format: " + one_line(OIIO::geterror())};
   }
-  return check_output_path(path);
+  return {};
 }
 
 Status save_image(const std::filesystem::path& path, const Image& image) {

@@ -1,6 +1,7 @@
 #include "runtime/assets/scene_io.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -480,7 +481,18 @@ Status apply_override(json& doc, const std::string& assignment) {
     }
   }
   json value = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (value.is_discarded()) value = text;  // a bare word is a string
+  if (value.is_discarded()) {
+    // A bare word is a string; something that starts like a number must be one (1e999, 1.2.3).
+    const bool numeric = !text.empty() && (std::isdigit(static_cast<unsigned char>(text[0])) ||
+                                           ((text[0] == '-' || text[0] == '.') && text.size() > 1 &&
+                                            std::isdigit(static_cast<unsigned char>(text[1]))));
+    if (numeric) {
+      auto parsed = json_reader::parse_json_text(text, "--set");
+      return Error{"--set", key, std::string("value '") + text + "' is not a valid number" +
+                                     (parsed ? std::string() : ": " + parsed.error().message)};
+    }
+    value = text;
+  }
   *node = value;
   return {};
 }
@@ -612,8 +624,9 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
     for (const auto& warning : report->warnings) log::warn("%s: %s", path.string().c_str(), warning.c_str());
     // The model entity's renderer flags apply to everything imported under it.
     const MeshRenderer flags = w.get<MeshRenderer>(e);
+    const ecs::Entity model = e;  // clang 14 cannot capture structured bindings
     w.view<MeshRenderer, Imported>().each([&](ecs::Entity, MeshRenderer& mr, Imported& imp) {
-      if (imp.source == e) {
+      if (imp.source == model) {
         mr.cast_shadows = flags.cast_shadows;
         mr.receive_shadows = flags.receive_shadows;
         mr.layer = flags.layer;

@@ -294,6 +294,11 @@ int run_render(Args a) {
   const fs::path out = a.output.empty() ? fs::path("out") / (scene_path.stem().string() + ".png")
                                         : fs::path(a.output);
   if (auto st = check_render_outputs(a, out); !st) return fail(st.error());
+  if (!a.env.empty()) {
+    // An input read only after the frames: checked before them, so a bad map fails before any
+    // output is written.
+    if (auto env = load_cube_map(a.env); !env) return fail(env.error());
+  }
   if (a.width > 0) {
     a.sets.push_back("render.width=" + std::to_string(a.width));
     a.sets.push_back("render.height=" + std::to_string(a.height));

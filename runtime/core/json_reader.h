@@ -183,12 +183,28 @@ inline std::string line_column(const std::string& text, std::size_t byte) {
   return "line " + std::to_string(line) + ", column " + std::to_string(col);
 }
 
-/// nlohmann's message without its "[json.exception.xxx.N] " prefix.
+/// nlohmann's message without its "[json.exception.xxx.N] " prefix and the "parse error at line
+/// L, column C: " that our Error::where already gives; bytes that are not printable ASCII (the
+/// message quotes the input) are shown as \xNN.
 inline std::string json_message(const std::exception& e) {
   std::string msg = e.what();
   if (msg.rfind("[json.exception", 0) == 0)
     if (auto p = msg.find("] "); p != std::string::npos) msg = msg.substr(p + 2);
-  return msg;
+  if (msg.rfind("parse error at line ", 0) == 0)
+    if (auto p = msg.find(": "); p != std::string::npos) msg = "parse error: " + msg.substr(p + 2);
+  std::string out;
+  for (const char c : msg) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u < 0x7f) {
+      out += c;
+    } else {
+      static const char* hex = "0123456789ABCDEF";
+      out += "\\x";
+      out += hex[u >> 4];
+      out += hex[u & 15];
+    }
+  }
+  return out;
 }
 
 /// A SAX consumer that only remembers where the parser gave up: nlohmann reports number
