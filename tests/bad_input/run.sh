@@ -19,7 +19,7 @@ tmp="$(mktemp -d "${TMPDIR:-/tmp}/bad_input.XXXXXX")"
 trap 'rm -rf "$tmp"' EXIT
 export KASKAD_SHADER_CACHE=off
 passed=0 failed=0 n=0
-rows=""
+rows="" atomic_summary=""
 
 # Previous outputs every case starts from (a real PNG and EXR, so byte changes are meaningful).
 "$KASKAD" render --headless --size 24x16 --frames 1 -o "$tmp/prev.png" --aov "$tmp/prev.exr" >/dev/null 2>&1 ||
@@ -70,6 +70,7 @@ atomic_case() {  # atomic_case NAME COMMAND...   (the previous output is $dir/ou
   if { [ "$rc" -eq 1 ] || [ "$rc" -eq 2 ]; } && cmp -s "$tmp/prev.png" "$dir/out.png" &&
      [ "$(ls -A "$dir")" = "out.png" ]; then
     echo "ok   $name: exit $rc, previous output byte-identical, no temporary file left"
+    atomic_summary+="${atomic_summary:+; }$name: exit $rc, previous output byte-identical"
     passed=$((passed + 1))
   else
     echo "FAIL $name: exit $rc; $(ls -A "$dir" | tr '\n' ' ')"; tail -3 "$tmp/atomic.log"
@@ -97,6 +98,16 @@ fi
 
 if [ -n "$table" ]; then
   {
+    echo "# Bad input: what kaskad says"
+    echo
+    echo "Written by \`bash tests/bad_input/run.sh --table docs/bad_input.md\` (with \`KASKAD\` and"
+    echo "\`KASKAD_CONTENT\` set). One row per case of \`tests/bad_input/cases.txt\`: the arguments"
+    echo "(\`{DIR}\` = \`tests/bad_input\`, \`{OUT}\` = a folder of previous outputs that must stay"
+    echo "unchanged, \`{R}\` = \`--headless --size 32x32 --frames 1 -o {OUT}/out.png\`), the exit code and"
+    echo "the first line of the message. Every case must exit 1 or 2, name the file or value, print no"
+    echo "raw library lines and create or change nothing. Then a failed write under \`ulimit -f\` and"
+    echo "into a read-only folder must leave the previous output byte-identical: $atomic_summary."
+    echo
     echo "| # | arguments | exit | first line of the message |"
     echo "|---|---|---|---|"
     printf '%s' "$rows"
