@@ -374,6 +374,29 @@ Status Renderer::prewarm(const FrameInput& frame) {
 
 namespace {
 
+/// Whether the driver can make the shadow map array (GL limits, then a proxy texture).
+Status check_shadow_map_size(int size, int layers, DepthFormat format) {
+  const std::string where = "shadow.map_size " + std::to_string(size);
+  GLint max_size = 0, max_layers = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  const double bytes = double(size) * size * layers * (format == DepthFormat::d16 ? 2.0 : 4.0);
+  std::string what = std::to_string(size) + "^2 x " + std::to_string(layers) + " layers";
+  if (size > max_size || layers > max_layers)
+    return Error{"", where, "shadow maps of " + what + " exceed this driver's limits (GL_MAX_TEXTURE_SIZE " +
+                                std::to_string(max_size) + ", GL_MAX_ARRAY_TEXTURE_LAYERS " +
+                                std::to_string(max_layers) + ")"};
+  glTexImage3D(GL_PROXY_TEXTURE_2D_ARRAY, 0, GLint(depth_internal_format(format)), size, size, layers,
+               0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+  GLint got = 0;
+  glGetTexLevelParameteriv(GL_PROXY_TEXTURE_2D_ARRAY, 0, GL_TEXTURE_WIDTH, &got);
+  if (got == 0)
+    return Error{"", where, "the OpenGL driver refuses shadow maps of " + what + " (" +
+                                std::to_string(int(bytes / double(1 << 20))) +
+                                " MiB); use a smaller map_size or fewer cascades"};
+  return {};
+}
+
 /// MemAvailable from /proc/meminfo in bytes; 0 when unknown.
 std::uint64_t available_memory() {
   std::ifstream in("/proc/meminfo");
@@ -600,6 +623,15 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     }
     return {};
   };
+
+  // A shadow map array the driver refuses (llvmpipe: over 1 GiB, e.g. 16384^2 x 4 cascades) is
+  // an error before any pass starts, not a string of GL errors.
+  if (shadowed) {
+    const ShadowSettings& s = frame.shadow.settings;
+    if (!im.shadow_fbo || s.map_size != im.shadow_size || total_layers != im.shadow_layers ||
+        s.depth_format != im.shadow_format)
+      KASKAD_TRY(check_shadow_map_size(s.map_size, total_layers, s.depth_format));
+  }
 
   // Pass 1: shadow maps (S4, S0 step 6): depth only, one layer per cascade, light viewport, bias
   // by polygon offset, chosen culling. Each layer gets only the casters overlapping its cascade.
