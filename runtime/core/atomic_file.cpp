@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <climits>
 #include <cstring>
 #include <utility>
 
@@ -21,9 +22,11 @@ fs::path folder_of(const fs::path& path) {
 /// mkstemps() in the target's folder: ".NAME.XXXXXX.EXT" (hidden, same extension). Returns the fd
 /// (or -1 with errno set) and fills `temp`.
 int make_temp(const fs::path& target, fs::path& temp) {
-  const std::string ext = target.extension().string();
-  std::string pattern =
-      (folder_of(target) / (std::string(".") + target.stem().string() + ".kaskad-XXXXXX" + ext)).string();
+  const std::string ext = target.extension().string().substr(0, 32);
+  // The stem is shortened so that a long (but valid) target name still has a valid temp name.
+  std::string pattern = (folder_of(target) / (std::string(".") + target.stem().string().substr(0, 64) +
+                                              ".kaskad-XXXXXX" + ext))
+                            .string();
   const int fd = ::mkstemps(pattern.data(), int(ext.size()));
   if (fd >= 0) temp = pattern;
   return fd;
@@ -94,6 +97,8 @@ Status check_output_path(const fs::path& path) {
   if (fs::is_directory(st) || path.filename().empty() || path.filename() == "." ||
       path.filename() == "..")
     return Error{name, "", "is a folder, not a file: name the file to write"};
+  if (path.filename().string().size() > NAME_MAX)
+    return Error{name, "", "file name longer than " + std::to_string(NAME_MAX) + " bytes"};
   if (fs::exists(st) && !fs::is_regular_file(st))
     return Error{name, "", "exists and is not a regular file (a device, pipe or socket); "
                            "kaskad replaces only regular files"};
