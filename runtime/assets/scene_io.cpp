@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -482,11 +483,10 @@ Status apply_override(json& doc, const std::string& assignment) {
   }
   json value = json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (value.is_discarded()) {
-    // A bare word is a string; something that starts like a number must be one (1e999, 1.2.3).
-    const bool numeric = !text.empty() && (std::isdigit(static_cast<unsigned char>(text[0])) ||
-                                           ((text[0] == '-' || text[0] == '.') && text.size() > 1 &&
-                                            std::isdigit(static_cast<unsigned char>(text[1]))));
-    if (numeric) {
+    // A bare word is a string (4k_sky.hdr); a well-formed number JSON cannot hold (1e999) is an
+    // error, not the string "1e999".
+    static const std::regex kNumber(R"(-?[0-9]+(\.[0-9]+)?([eE][+-]?[0-9]+)?)");
+    if (std::regex_match(text, kNumber)) {
       auto parsed = json_reader::parse_json_text(text, "--set");
       return Error{"--set", key, std::string("value '") + text + "' is not a valid number" +
                                      (parsed ? std::string() : ": " + parsed.error().message)};
