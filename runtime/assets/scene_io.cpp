@@ -456,7 +456,8 @@ Status apply_override(json& doc, const std::string& assignment) {
     std::vector<std::string> names;
     for (auto& ent : doc["entities"]) {
       if (ent.contains("name") && ent["name"] == parts[0]) node = &ent;
-      if (ent.contains("name")) names.push_back(ent["name"].get<std::string>());
+      // An earlier override may have made a name anything (--set sun.name=5).
+      if (ent.contains("name") && ent["name"].is_string()) names.push_back(ent["name"].get<std::string>());
     }
     if (!node)
       return Error{"--set", key, "no setting section or entity named '" + parts[0] +
