@@ -4,8 +4,10 @@
 #include <epoxy/gl.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -100,7 +102,7 @@ bool shadow_panel(ShadowSettings& s) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run_editor(int argc, char** argv) {
   std::string scene_path = (content_dir() / "scenes" / "default.json").string();
   std::vector<std::string> sets;
   for (int i = 1; i < argc; ++i) {
@@ -243,4 +245,18 @@ int main(int argc, char** argv) {
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
   return 0;
+}
+
+int main(int argc, char** argv) {
+  // As in the CLI (runtime/cli/main.cpp): a file-size limit fails a write instead of killing the
+  // editor, and anything that escapes the readers is an error exit with a message, not an abort.
+  std::signal(SIGXFSZ, SIG_IGN);
+  try {
+    return run_editor(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "kaskad_editor: error: unexpected failure: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "kaskad_editor: error: unexpected failure (unknown exception)\n");
+  }
+  return 1;
 }

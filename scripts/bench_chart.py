@@ -77,7 +77,18 @@ def chart(rows, column, out_dir, suffix):
         ax.grid(True, alpha=0.3)
         ax.legend()
         out = os.path.join(out_dir, f"{scene}{suffix}.png")
-        fig.savefig(out)
+        # Atomic, as every output of Kaskad (README "Outputs"): a temporary file in the same
+        # folder, synced, then renamed over the previous chart.
+        tmp = os.path.join(out_dir, f".{scene}{suffix}.tmp.png")
+        try:
+            fig.savefig(tmp)
+            with open(tmp, "rb+") as f:
+                os.fsync(f.fileno())
+            os.replace(tmp, out)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+            raise
         plt.close(fig)
         written.append(out)
     return written

@@ -569,26 +569,53 @@ Result<SphereMap> load_sphere_map(const std::filesystem::path& path) {
   return sphere_from_image(*image, path.string());
 }
 
-Status save_cube_faces(const CubeMap& cube, const std::filesystem::path& pattern_or_dir) {
-  KASKAD_CHECK(cube.size >= 1, "cube must be non-empty, size was " + std::to_string(cube.size));
+namespace {
+
+/// The six files save_cube_faces writes for `pattern_or_dir`.
+std::array<std::string, 6> cube_face_files(const std::filesystem::path& pattern_or_dir) {
   const std::string s = pattern_or_dir.string();
   const auto star = s.find('*');
-  std::error_code ec;
-  if (star == std::string::npos) {
-    std::filesystem::create_directories(pattern_or_dir, ec);
-    if (ec) return Error{s, "", "cannot create the directory: " + ec.message()};
-  }
-  for (int f = 0; f < 6; ++f) {
-    std::string file;
+  std::array<std::string, 6> files;
+  for (std::size_t f = 0; f < 6; ++f) {
     if (star != std::string::npos) {
-      file = s.substr(0, star);
-      file += kFaceSuffix[std::size_t(f)];
-      file += s.substr(star + 1);
+      // Appended piece by piece: GCC 12 warns (-Wrestrict, falsely) on a + b + c here.
+      files[f] = s.substr(0, star);
+      files[f] += kFaceSuffix[f];
+      files[f] += s.substr(star + 1);
     } else {
-      file = (pattern_or_dir / (std::string(kFaceSuffix[std::size_t(f)]) + ".exr")).string();
+      files[f] = (pattern_or_dir / (std::string(kFaceSuffix[f]) + ".exr")).string();
     }
-    KASKAD_TRY(save_image(file, image_of(cube.faces[std::size_t(f)], cube.size, cube.size)));
   }
+  return files;
+}
+
+}  // namespace
+
+Status check_cube_faces_output(const std::filesystem::path& pattern_or_dir) {
+  const std::string s = pattern_or_dir.string();
+  if (s.find('*') == std::string::npos) {
+    // A folder the user named: made when missing (one level; its parent must exist).
+    std::error_code ec;
+    const auto parent = pattern_or_dir.parent_path().empty() ? std::filesystem::path(".")
+                                                             : pattern_or_dir.parent_path();
+    if (!std::filesystem::exists(pattern_or_dir, ec)) {
+      if (!std::filesystem::is_directory(parent, ec))
+        return Error{s, "", "cannot make this folder: '" + parent.string() +
+                                "' does not exist (kaskad makes only the folder named)"};
+      std::filesystem::create_directory(pattern_or_dir, ec);
+      if (ec) return Error{s, "", "cannot make this folder: " + ec.message()};
+    }
+  }
+  for (const std::string& file : cube_face_files(pattern_or_dir)) KASKAD_TRY(check_image_output(file));
+  return {};
+}
+
+Status save_cube_faces(const CubeMap& cube, const std::filesystem::path& pattern_or_dir) {
+  KASKAD_CHECK(cube.size >= 1, "cube must be non-empty, size was " + std::to_string(cube.size));
+  KASKAD_TRY(check_cube_faces_output(pattern_or_dir));  // all six before the first is written
+  const auto files = cube_face_files(pattern_or_dir);
+  for (std::size_t f = 0; f < 6; ++f)
+    KASKAD_TRY(save_image(files[f], image_of(cube.faces[f], cube.size, cube.size)));
   return {};
 }
 

@@ -172,8 +172,13 @@ Result<SphereMap> load_sphere_map(const std::filesystem::path& path);
 
 /// Debug dump of the six faces as images (format from the extension; EXR keeps floats).
 /// `pattern_or_dir`: a path with one `*`, replaced by px nx py ny pz nz (e.g. "out/probe_*.png"),
-/// or a directory (created if missing) that receives px.exr ... nz.exr.
+/// or a folder (made when missing, one level) that receives px.exr ... nz.exr. All six files
+/// are checked before the first is written; each is written atomically.
 Status save_cube_faces(const CubeMap& cube, const std::filesystem::path& pattern_or_dir);
+
+/// The checks of save_cube_faces without writing: the folder (made when missing), then every
+/// face file's format and path.
+Status check_cube_faces_output(const std::filesystem::path& pattern_or_dir);
 
 /// Debug dump of a sphere map as an image (format from the extension).
 Status save_sphere_map(const SphereMap& map, const std::filesystem::path& path);

@@ -18,7 +18,9 @@
 #include <draco/mesh/mesh.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <glm/gtc/quaternion.hpp>
@@ -50,6 +52,7 @@
 #include "runtime/assets/material_file.h"
 #include "runtime/assets/tinygltf_config.h"
 #include "runtime/core/file_io.h"
+#include "runtime/core/json_reader.h"
 
 namespace kaskad {
 namespace {
@@ -241,6 +244,62 @@ std::vector<std::uint8_t> replace_glb_json(const std::vector<std::uint8_t>& glb,
   return out;
 }
 
+std::uint32_t read_u32(const std::vector<std::uint8_t>& d, std::size_t at) {
+  std::uint32_t v = 0;
+  std::memcpy(&v, d.data() + at, 4);
+  return v;
+}
+
+/// The binary glTF container (glTF 2.0 spec, section 4.4 "GLB File Format Specification"),
+/// checked before tinygltf so that a damaged file is reported with the byte offset and what is
+/// wrong there (tinygltf says only "Invalid glTF binary.").
+Status check_glb_container(const std::vector<std::uint8_t>& d, const std::string& file) {
+  const std::size_t n = d.size();
+  const std::string size = std::to_string(n) + " bytes";
+  if (n < 12)
+    return Error{file, "byte " + std::to_string(n),
+                 "truncated: the file ends inside the 12-byte GLB header (" + size + ")"};
+  if (const std::uint32_t version = read_u32(d, 4); version != 2)
+    return Error{file, "byte 4", "GLB container version " + std::to_string(version) +
+                                     "; only version 2 (glTF 2.0) is supported"};
+  const std::uint64_t length = read_u32(d, 8);
+  if (length > n)
+    return Error{file, "byte " + std::to_string(n),
+                 "truncated: the GLB header (byte 8) says the file is " + std::to_string(length) +
+                     " bytes, but it ends after " + size};
+  if (length < n)
+    return Error{file, "byte " + std::to_string(length),
+                 std::to_string(n - length) + " bytes after the end the GLB header gives (" +
+                     std::to_string(length) + " bytes)"};
+  // Chunks: 4-byte length, 4-byte type, data. The first is JSON, an optional second BIN.
+  std::size_t at = 12;
+  for (int chunk = 0; at < n; ++chunk) {
+    const std::string where = "byte " + std::to_string(at);
+    const char* what = chunk == 0 ? "JSON chunk" : chunk == 1 ? "BIN chunk" : "chunk";
+    if (n - at < 8)
+      return Error{file, where, std::string("truncated: the file ends inside the ") + what +
+                                    " header (" + std::to_string(n - at) + " of 8 bytes)"};
+    const std::uint64_t chunk_length = read_u32(d, at);
+    const std::uint32_t type = read_u32(d, at + 4);
+    if (chunk == 0 && type != 0x4E4F534Au) {
+      char hex[16];
+      std::snprintf(hex, sizeof hex, "0x%08X", type);
+      return Error{file, "byte " + std::to_string(at + 4),
+                   std::string("the first chunk must be JSON (type 0x4E4F534A), found type ") + hex};
+    }
+    if (chunk == 0 && chunk_length == 0)
+      return Error{file, where, "the JSON chunk is empty"};
+    if (at + 8 + chunk_length > n)
+      return Error{file, where,
+                   std::string("truncated: the ") + what + " says it holds " +
+                       std::to_string(chunk_length) + " bytes from byte " + std::to_string(at + 8) +
+                       ", but the file ends after " + size};
+    at += 8 + std::size_t(chunk_length);
+  }
+  if (at == 12) return Error{file, "byte 12", "truncated: the GLB has no JSON chunk"};
+  return {};
+}
+
 /// Parses .gltf or .glb (told apart by the "glTF" magic, not the extension).
 Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadState& images,
                                    std::vector<std::string>& warnings) {
@@ -250,7 +309,21 @@ Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadS
   std::vector<std::uint8_t>& data = bytes.value();
 
   const bool binary = data.size() >= 4 && std::memcmp(data.data(), "glTF", 4) == 0;
+  if (!binary) {
+    // Text glTF is JSON: an object, after optional whitespace (and a UTF-8 byte order mark).
+    std::size_t first = data.size() >= 3 && data[0] == 0xEF && data[1] == 0xBB && data[2] == 0xBF ? 3 : 0;
+    while (first < data.size() && std::isspace(data[first])) ++first;
+    if (first == data.size() || data[first] != '{') {
+      std::string ext = path.extension().string();
+      for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+      return Error{file, "byte 0",
+                   ext == ".glb" ? "not a binary glTF: it does not start with the magic 'glTF'"
+                                 : "neither a binary glTF (magic 'glTF') nor glTF JSON (an object "
+                                   "'{ ... }')"};
+    }
+  }
   if (binary) {
+    KASKAD_TRY(check_glb_container(data, file));
     // Header: magic, version, total length, then the JSON chunk's length and type at byte 12
     // and its content from byte 20. tinygltf validates all of it; we only look when it fits.
     std::uint32_t total_length = 0, json_length = 0;
@@ -279,6 +352,25 @@ Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadS
   tinygltf::Model model;
   std::string err, warn;
   const std::string base_dir = path.parent_path().string();
+  // For JSON errors, our own parse of the same text gives the line, column and reason (in the
+  // JSON chunk for a .glb) instead of nlohmann's raw message.
+  auto locate_json_error = [&](std::string raw) -> Error {
+    const std::size_t start = binary ? std::min<std::size_t>(20, data.size()) : 0;
+    std::size_t length = data.size() - start;
+    if (binary && data.size() >= 16) length = std::min<std::size_t>(length, read_u32(data, 12));
+    auto located = json_reader::parse_json_text(
+        std::string(data.begin() + std::ptrdiff_t(start), data.begin() + std::ptrdiff_t(start + length)),
+        file);
+    if (located) {
+      if (auto p = raw.find("] "); raw.rfind("[json.exception", 0) == 0 && p != std::string::npos)
+        raw.erase(0, p + 2);
+      return Error{file, "", "invalid glTF JSON: " + raw};
+    }
+    Error e = located.error();
+    if (binary)
+      e.where = e.where.empty() ? std::string("JSON chunk") : std::string("JSON chunk, ") + e.where;
+    return e;
+  };
   bool ok = false;
   try {
     ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data.data(),
@@ -290,8 +382,12 @@ Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadS
     return Error{file, "", "out of memory while parsing"};
   } catch (const std::exception& e) {
     // tinygltf 2.7 lets some std::vector::at() exceptions escape on malformed buffers.
-    return Error{file, "", std::string("invalid glTF: ") + e.what()};
+    const std::string what = e.what();
+    if (what.find("[json.exception") != std::string::npos) return locate_json_error(what);
+    return Error{file, "", "invalid glTF: " + what};
   }
+  // tinygltf catches nlohmann's exceptions (a number like 1e999) itself and passes their raw text on.
+  if (!ok && err.find("[json.exception") != std::string::npos) return locate_json_error(join_lines(err));
   if (!ok) return Error{file, "", "invalid glTF: " + join_lines(err)};
   for (const auto& line : split_lines(warn)) warnings.push_back(line);
   // tinygltf reports some spec violations in `err` yet succeeds; keep them as warnings.

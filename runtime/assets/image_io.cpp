@@ -10,20 +10,26 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <new>
+#include <optional>
 #include <string_view>
 #include <system_error>
 
+#include "runtime/core/atomic_file.h"
 #include "runtime/core/file_io.h"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -34,6 +40,7 @@
 #endif
 #endif
 #ifdef KASKAD_LSAN
+#include <sanitizer/common_interface_defs.h>
 #include <sanitizer/lsan_interface.h>
 #endif
 
@@ -60,9 +67,55 @@ class IgnoreLeaksInOiio {
   IgnoreLeaksInOiio& operator=(const IgnoreLeaksInOiio&) = delete;
 };
 
+/// libpng (inside OIIO's PNG reader) prints "libpng error: ..." lines to stderr itself; the same
+/// text reaches us through OIIO's geterror() and ends up in our error message. While a decoder
+/// runs, the process's stderr therefore goes to /dev/null, so raw library lines never reach the
+/// user (README "Bad input"). Sanitizer reports keep the real stderr (a duplicate of it).
+/// Serialised: the file descriptor is process-wide.
+class QuietStderr {
+ public:
+  QuietStderr() : lock_(mutex()) {
+    static const int real = ::dup(2);
+#ifdef KASKAD_LSAN
+    static const bool reports_kept = [] {
+      __sanitizer_set_report_fd(reinterpret_cast<void*>(static_cast<std::intptr_t>(real)));
+      return true;
+    }();
+    (void)reports_kept;
+#endif
+    (void)real;
+    std::fflush(stderr);
+    saved_ = ::dup(2);
+    const int null = ::open("/dev/null", O_WRONLY);
+    if (null >= 0) {
+      ::dup2(null, 2);
+      ::close(null);
+    }
+  }
+  ~QuietStderr() {
+    std::fflush(stderr);
+    if (saved_ >= 0) {
+      ::dup2(saved_, 2);
+      ::close(saved_);
+    }
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::unique_lock<std::mutex> lock_;
+  int saved_ = -1;
+};
+
 /// Largest image we decode, in float values (width * height * channels): 2^28 floats = 1 GiB,
 /// e.g. 16384 x 16384 x 1 or 8192 x 8192 x 4. Guards against headers that claim absurd sizes.
 constexpr std::uint64_t kMaxImageValues = std::uint64_t(1) << 28;
+/// Most values (width * height * channels) one byte of image data may decode to; see decode().
+constexpr std::uint64_t kMaxValuesPerByte = 65536;
 /// Limits per side and on channels, checked before decoding too: OIIO reads in chunks of up to
 /// 64 scanlines (or a whole tile) and allocates that chunk by the header's sizes, so a 175-byte
 /// BMP claiming 16M x 5 pixels made it ask for 12.8 GB (found by tests/fuzz/fuzz_image.cpp).
@@ -173,6 +226,49 @@ std::string one_line(std::string s) {
 }
 
 /// Decodes `size` bytes with the reader for `format`. `name` is only used in messages.
+/// OpenEXR allocates while reading the header, before OIIO hands us anything: a 626-byte file
+/// whose string attribute claimed 2 GB made it take 2 GB (found by scripts/fuzz.sh image), and a
+/// huge data window sizes its line-offset table. So the (first) header is walked here first
+/// (OpenEXR file layout: magic, version, then attributes `name\0 type\0 int32 size, value` up
+/// to an empty name): every attribute must fit in the file, and the data and display windows
+/// must be at most kMaxImageSide a side.
+Status check_exr_windows(const std::uint8_t* d, std::size_t n, const std::string& name) {
+  std::size_t at = 8;
+  auto text = [&](std::string& out) {
+    out.clear();
+    while (at < n && d[at] != 0 && out.size() < 256) out += char(d[at++]);
+    if (at >= n || d[at] != 0) return false;
+    ++at;
+    return true;
+  };
+  std::string attr, type;
+  while (at < n) {
+    if (!text(attr)) break;  // truncated headers are the decoder's to report
+    if (attr.empty()) break;
+    if (!text(type) || n - at < 4) break;
+    std::int32_t length = 0;
+    std::memcpy(&length, d + at, 4);
+    at += 4;
+    if (length < 0 || std::size_t(length) > n - at)
+      return Error{name, "byte " + std::to_string(at - 4),
+                   "corrupt or truncated: the EXR header attribute '" + attr + "' claims " +
+                       std::to_string(length) + " bytes, but only " + std::to_string(n - at) +
+                       " follow"};
+    if ((attr == "dataWindow" || attr == "displayWindow") && type == "box2i" && length == 16) {
+      std::int32_t box[4];
+      std::memcpy(box, d + at, 16);
+      const std::int64_t w = std::int64_t(box[2]) - box[0] + 1, h = std::int64_t(box[3]) - box[1] + 1;
+      if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide)
+        return Error{name, "byte " + std::to_string(at),
+                     "corrupt or too large: the EXR " + attr + " is " + std::to_string(w) + " x " +
+                         std::to_string(h) + " pixels (at most " + std::to_string(kMaxImageSide) +
+                         " a side)"};
+    }
+    at += std::size_t(length);
+  }
+  return {};
+}
+
 Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::string& name,
                      const std::string& format) {
   if (size == 0) return Error{name, "", "empty image data (0 bytes)"};
@@ -182,6 +278,7 @@ Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::stri
                  "file extension)"};
   }
 
+  if (format == "openexr") KASKAD_TRY(check_exr_windows(data, size, name));
   OIIO::Filesystem::IOMemReader proxy(data, size);
   // The proxy must travel in the open() configuration: handing it to create() alone is not
   // enough for every reader (the PNG reader then opens `name` as a file). UnassociatedAlpha keeps
@@ -236,6 +333,16 @@ Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::stri
                      std::to_string(spec.height) + " x " + std::to_string(spec.nchannels) +
                      " values, at most 2^28)"};
   }
+  // No codec we allow packs more than a few thousand values into one byte (deflate's limit is
+  // about 1000:1), so a header that claims far more than the data could hold is refused before
+  // the buffers are allocated: a 626-byte EXR claiming a huge data window made the decoder take
+  // 2 GB and 3 s before it failed (found by scripts/fuzz.sh image).
+  if (values > std::uint64_t(size) * kMaxValuesPerByte) {
+    return Error{name, "",
+                 "corrupt or truncated: the header claims " + std::to_string(spec.width) + " x " +
+                     std::to_string(spec.height) + " x " + std::to_string(spec.nchannels) +
+                     " values, more than " + std::to_string(size) + " bytes of data can hold"};
+  }
 
   Image image;
   image.width = spec.width;
@@ -274,6 +381,7 @@ Result<Image> load_image(const std::filesystem::path& path) {
     auto bytes = read_file_bytes(path, kMaxFileBytes);
     if (!bytes) return bytes.error();
     const auto& b = bytes.value();
+    [[maybe_unused]] QuietStderr quiet;
     return decode(b.data(), b.size(), path.string(),
                   choose_format(b.data(), b.size(), path.string(), {}));
   } catch (const std::bad_alloc&) {
@@ -288,12 +396,22 @@ Result<Image> load_image_from_memory(const void* data, std::size_t size, const s
   if (data == nullptr || size == 0) return Error{name, "", "empty image data (0 bytes)"};
   const auto* bytes = static_cast<const std::uint8_t*>(data);
   try {
+    [[maybe_unused]] QuietStderr quiet;
     return decode(bytes, size, name, choose_format(bytes, size, name, mime_type));
   } catch (const std::bad_alloc&) {
     return Error{name, "", "out of memory while decoding the image"};
   } catch (const std::exception& e) {
     return Error{name, "", std::string("image decode failed: ") + e.what()};
   }
+}
+
+Status check_image_output(const std::filesystem::path& path) {
+  KASKAD_TRY(check_output_path(path));
+  auto out = OIIO::ImageOutput::create(path.string());
+  if (!out) {
+    return Error{path.string(), "", "cannot write this image format: " + one_line(OIIO::geterror())};
+  }
+  return {};
 }
 
 Status save_image(const std::filesystem::path& path, const Image& image) {
@@ -310,6 +428,9 @@ Status save_image(const std::filesystem::path& path, const Image& image) {
 
   const std::string name = path.string();
   const std::string ext = lowercase_extension(path);
+  // Declared before the writer, which may still use it while it is destroyed.
+  std::vector<unsigned char> encoded;
+  OIIO::Filesystem::IOVecOutput memory(encoded);
   auto out = OIIO::ImageOutput::create(name);
   if (!out) {
     return Error{name, "", "cannot write this image format: " + one_line(OIIO::geterror())};
@@ -332,7 +453,18 @@ Status save_image(const std::filesystem::path& path, const Image& image) {
     spec.alpha_channel =
         alpha == spec.channelnames.end() ? -1 : int(alpha - spec.channelnames.begin());
   }
-  if (!out->open(name, spec)) {
+  // Atomic output (runtime/core/atomic_file.h): encode into memory when the format's writer
+  // can (PNG, EXR, ...), then write_file_atomic checks every byte and renames; otherwise the
+  // writer writes a temporary file beside the target that is renamed only when complete.
+  KASKAD_TRY(check_output_path(path));
+  const bool in_memory = out->supports("ioproxy") && out->set_ioproxy(&memory);
+  std::optional<TempFile> temp;
+  if (!in_memory) {
+    auto t = TempFile::create(path);
+    if (!t) return t.error();
+    temp.emplace(std::move(t.value()));
+  }
+  if (!out->open(in_memory ? name : temp->path().string(), spec)) {
     return Error{name, "", "cannot open for writing: " + one_line(out->geterror())};
   }
 
@@ -355,7 +487,9 @@ Status save_image(const std::filesystem::path& path, const Image& image) {
   }
   if (!written) return Error{name, "", "write failed: " + one_line(out->geterror())};
   if (!out->close()) return Error{name, "", "write failed: " + one_line(out->geterror())};
-  return {};
+  out.reset();
+  if (in_memory) return write_file_atomic(path, encoded.data(), encoded.size());
+  return temp->commit();
 }
 
 std::vector<std::uint8_t> to_rgba8(const Image& image) {

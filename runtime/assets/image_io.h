@@ -38,7 +38,12 @@ Result<Image> load_image_from_memory(const void* data, std::size_t size, const s
 /// to [0,1] and rounded.
 std::vector<std::uint8_t> to_rgba8(const Image& image);
 
-/// Writes an image; the format follows the extension. 8-bit formats (PNG, JPEG) get values clamped
+/// Checks before any work that save_image(path, ...) can succeed: an image format OpenImageIO
+/// writes (by the extension) and a writable path (check_output_path in atomic_file.h).
+Status check_image_output(const std::filesystem::path& path);
+
+/// Writes an image atomically (runtime/core/atomic_file.h: a failure leaves the previous file
+/// as it was); the format follows the extension. 8-bit formats (PNG, JPEG) get values clamped
 /// to [0,1] and quantised; EXR keeps 32-bit float and channel_names. Reading an EXR back may
 /// reorder its channels (OIIO puts R, G, B, A first): look channels up by name.
 Status save_image(const std::filesystem::path& path, const Image& image);

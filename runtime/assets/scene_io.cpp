@@ -1,11 +1,13 @@
 #include "runtime/assets/scene_io.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <optional>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -25,6 +27,7 @@
 #include "runtime/assets/material_file.h"
 #include "runtime/assets/primitives.h"
 #include "runtime/assets/reflector_io.h"
+#include "runtime/core/atomic_file.h"
 #include "runtime/core/json_reader.h"
 #include "runtime/core/log.h"
 
@@ -534,7 +537,17 @@ Status set_field(json* node, const std::vector<std::string>& parts, const std::s
     }
   }
   json value = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (value.is_discarded()) value = text;  // a bare word is a string
+  if (value.is_discarded()) {
+    // A bare word is a string (4k_sky.hdr); a well-formed number JSON cannot hold (1e999) is an
+    // error, not the string "1e999".
+    static const std::regex kNumber(R"(-?[0-9]+(\.[0-9]+)?([eE][+-]?[0-9]+)?)");
+    if (std::regex_match(text, kNumber)) {
+      auto parsed = json_reader::parse_json_text(text, "--set");
+      return Error{"--set", key, std::string("value '") + text + "' is not a valid number" +
+                                     (parsed ? std::string() : ": " + parsed.error().message)};
+    }
+    value = text;
+  }
   *node = value;
   return {};
 }
@@ -574,7 +587,8 @@ Status apply_override(json& doc, const std::string& assignment) {
     std::vector<std::string> names;
     for (auto& ent : doc["entities"]) {
       if (ent.contains("name") && ent["name"] == parts[0]) node = &ent;
-      if (ent.contains("name")) names.push_back(ent["name"].get<std::string>());
+      // An earlier override may have made a name anything (--set sun.name=5).
+      if (ent.contains("name") && ent["name"].is_string()) names.push_back(ent["name"].get<std::string>());
     }
     if (!node)
       return Error{"--set", key, "no setting section or entity named '" + parts[0] +
@@ -730,15 +744,18 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
       if (it->second == p.entity) fail(p.where, "an entity cannot be its own parent");
       scene.world.get<Transform>(p.entity).parent = it->second;
     }
-    // A parent chain that comes back to where it started is a content error, not a per-frame
-    // warning.
+    // Parent cycles (a -> b -> a) are content errors here, with the names, rather than a
+    // warning from the transform system every frame.
+    std::map<ecs::Entity, std::string, bool (*)(ecs::Entity, ecs::Entity)> names(entity_less);
+    for (const auto& [n, e] : by_name) names[e] = n;
     for (const Pending& p : parents) {
-      std::string chain = scene.world.get<Name>(p.entity).value;
+      std::string chain = names[p.entity];
       ecs::Entity at = scene.world.get<Transform>(p.entity).parent;
       for (std::size_t steps = 0; at.valid() && steps <= parents.size(); ++steps) {
-        chain += " -> " + scene.world.get<Name>(at).value;
+        chain += " -> " + names[at];
         if (at == p.entity) fail(p.where, "parent cycle: " + chain);
-        at = scene.world.get<Transform>(at).parent;
+        const Transform* t = scene.world.try_get<Transform>(at);
+        at = t ? t->parent : ecs::kNullEntity;
       }
     }
   } catch (const ContentError& e) {
@@ -988,24 +1005,9 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
 }
 
 Status save_scene(const fs::path& file, const Scene& scene) {
+  KASKAD_TRY(check_output_path(file));  // before the work, and with a clear word for a folder
   const fs::path dir = file.parent_path().empty() ? fs::path(".") : file.parent_path();
-  const std::string text = scene_to_json(scene, dir).dump(2) + "\n";
-  fs::path tmp = file;
-  tmp += ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return Error{file.string(), "", "cannot write (directory missing or not writable)"};
-    out << text;
-    out.flush();
-    if (!out) return Error{file.string(), "", "write failed (disk full?)"};
-  }
-  std::error_code ec;
-  fs::rename(tmp, file, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    return Error{file.string(), "", "cannot replace the file: " + ec.message()};
-  }
-  return {};
+  return write_file_atomic(file, scene_to_json(scene, dir).dump(2) + "\n");
 }
 
 Result<Scene> read_scene(const fs::path& file, const std::vector<std::string>& overrides,

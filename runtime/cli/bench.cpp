@@ -17,7 +17,9 @@
 #include "components/material.h"
 #include "components/mesh_renderer.h"
 #include "runtime/cli/player.h"
+#include "runtime/assets/scene_io.h"
 #include "runtime/cli/stability.h"
+#include "runtime/core/atomic_file.h"
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
 
@@ -183,16 +185,38 @@ Status run_bench(const BenchOptions& options) {
   if (!configs) return configs.error();
   std::vector<fs::path> scenes = options.scenes;
   if (scenes.empty()) scenes.push_back(content_dir() / "scenes" / "default.json");
+  // Every scene x configuration is read and its --set values validated before the first frame
+  // (cheap: no models are imported), so a bad value in the sweep fails at once.
+  for (const fs::path& scene_path : scenes)
+    for (const BenchConfig& config : *configs) {
+      std::vector<std::string> sets = config.sets;
+      sets.push_back("render.width=" + std::to_string(options.width));
+      sets.push_back("render.height=" + std::to_string(options.height));
+      auto checked = read_scene(scene_path, sets);
+      if (!checked) {
+        Error e = checked.error();
+        e.message += " (--sweep configuration " + config.label + ")";
+        return e;
+      }
+    }
+  // The output folder is the one the user named (--out, or out/bench): made when missing, one
+  // level only.
   std::error_code ec;
-  fs::create_directories(options.out_dir, ec);
-  if (ec) return Error{options.out_dir.string(), "", "cannot create the output folder: " + ec.message()};
+  const fs::path out_parent =
+      options.out_dir.parent_path().empty() ? fs::path(".") : options.out_dir.parent_path();
+  if (options.out_dir == BenchOptions{}.out_dir)
+    fs::create_directories(options.out_dir, ec);  // the documented default, out/bench
+  else if (!fs::exists(options.out_dir, ec) && fs::is_directory(out_parent, ec))
+    fs::create_directory(options.out_dir, ec);
+  KASKAD_TRY(check_output_folder(options.out_dir));
   const fs::path csv_path = options.out_dir / "bench.csv";
-  std::ofstream csv(csv_path, std::ios::trunc);
-  if (!csv) return Error{csv_path.string(), "", "cannot write"};
+  // The CSV is rewritten atomically after every row (atomic_file.h): rows survive Ctrl-C and
+  // crashes, and the file is never half-written.
+  std::string csv;
   const auto columns = bench_csv_columns();
-  for (std::size_t i = 0; i < columns.size(); ++i) csv << (i ? "," : "") << columns[i];
-  csv << "\n";
-  csv.flush();
+  for (std::size_t i = 0; i < columns.size(); ++i) csv += (i ? "," : "") + columns[i];
+  csv += "\n";
+  KASKAD_TRY(write_file_atomic(csv_path, csv));
 
   gpu::ContextOptions copt;
   copt.headless = true;
@@ -335,9 +359,12 @@ Status run_bench(const BenchOptions& options) {
           has_stability ? fmt(stab_run.step) : fmt(nan),
           has_stability ? fmt(stability.flicker) : fmt(nan),
           has_stability ? fmt(stability.changed_pct) : fmt(nan)};
-      for (std::size_t i = 0; i < row.size(); ++i) csv << (i ? "," : "") << csv_quote(row[i]);
-      csv << "\n";
-      csv.flush();  // rows survive Ctrl-C and crashes
+      for (std::size_t i = 0; i < row.size(); ++i) csv += (i ? "," : "") + csv_quote(row[i]);
+      csv += "\n";
+      if (auto st = write_file_atomic(csv_path, csv); !st) {
+        result = st.error();
+        break;
+      }
       ++done;
     }
     if (!result.ok() || g_interrupted) break;

@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "runtime/assets/env_map.h"
+#include "runtime/assets/image_io.h"
 #include "runtime/reference/reflection_reference.h"
 
 namespace kaskad {
@@ -36,10 +37,6 @@ int parse_size(const std::string& v, int hi) {
   return int(n);
 }
 
-void make_parent(const fs::path& file) {
-  std::error_code ec;
-  if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);
-}
 
 }  // namespace
 
@@ -92,6 +89,12 @@ int run_envmap_command(int argc, char** argv) {
   }
   if (in.empty()) return usage_error("envmap needs an input map");
 
+  // Outputs are checked before any work (README "Outputs"); no folder is made but one named
+  // by --faces DIR.
+  if (!faces_out.empty())
+    if (auto st = check_cube_faces_output(faces_out); !st) return fail(st.error());
+  if (!sphere_out.empty())
+    if (auto st = check_image_output(sphere_out); !st) return fail(st.error());
   const auto t0 = std::chrono::steady_clock::now();
   EnvLayout layout = options.layout;
   auto cube = load_cube_map(in, options, &layout);
@@ -100,7 +103,6 @@ int run_envmap_command(int argc, char** argv) {
               env_layout_name(layout), cube->size,
               options.z_up_3dsmax ? ", converted from 3ds Max Z-up" : "", ms_since(t0));
   if (!faces_out.empty()) {
-    if (faces_out.find('*') != std::string::npos) make_parent(faces_out);
     if (auto st = save_cube_faces(*cube, faces_out); !st) return fail(st.error());
     std::printf("wrote     %s (px nx py ny pz nz)\n", faces_out.c_str());
   }
@@ -109,7 +111,6 @@ int run_envmap_command(int argc, char** argv) {
     const auto t1 = std::chrono::steady_clock::now();
     const SphereMap map = sphere_map_from_cube(*cube, size);
     const double ms = ms_since(t1);
-    make_parent(sphere_out);
     if (auto st = save_sphere_map(map, sphere_out); !st) return fail(st.error());
     std::printf("wrote     %s (sphere map %d^2, S3 eq. 2, %.1f ms)\n", sphere_out.c_str(), size,
                 ms);
@@ -131,7 +132,6 @@ Status write_reflection_reference(const Scene& scene, const Image& aov, const gl
       reference::reflection_scene(scene, environment.empty() ? nullptr : &env);
   auto ref = reference::reflection_reference(*tracer, aov, rs, eye);
   if (!ref) return ref.error();
-  make_parent(out);
   KASKAD_TRY(save_image(out, ref->image));
   std::printf(
       "wrote     %s (reflection reference: reflection.R/G/B reflection.hit mask; %llu rays, "

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -24,6 +25,7 @@
 #include "runtime/cli/envmap_command.h"
 #include "runtime/cli/playback.h"
 #include "runtime/cli/player.h"
+#include "runtime/core/atomic_file.h"
 #include "runtime/core/log.h"
 #include "runtime/gpu/context.h"
 
@@ -296,9 +298,49 @@ void print_cascade_table(const render::FrameStats& st, const ShadowData& sh) {
   }
 }
 
+/// A folder the user named for outputs (--probe-maps DIR): made when missing, but only that one
+/// level; its parent must exist.
+Status make_named_folder(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) {
+    const fs::path parent = dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
+    if (!fs::is_directory(parent, ec))
+      return Error{dir.string(), "", "cannot make this folder: '" + parent.string() +
+                                         "' does not exist (kaskad makes only the folder named)"};
+    fs::create_directory(dir, ec);
+    if (ec) return Error{dir.string(), "", "cannot make this folder: " + ec.message()};
+  }
+  return check_output_folder(dir);
+}
+
+/// Every output of `kaskad render`, checked before the scene is loaded or a frame rendered:
+/// writable, not a folder, a format we can write. The default colour output out/<scene>.png
+/// (README) is the one folder made for the user.
+Status check_render_outputs(const Args& a, const fs::path& out) {
+  std::error_code ec;
+  if (a.output.empty() && !fs::exists(out.parent_path(), ec)) {
+    // out/ is made just before writing; here only that it can be made.
+    KASKAD_TRY(check_output_path(out.parent_path()));
+  } else {
+    KASKAD_TRY(check_image_output(out));
+  }
+  for (const std::string* extra : {&a.aov, &a.shadow_map, &a.reflection_reference})
+    if (!extra->empty()) KASKAD_TRY(check_image_output(*extra));
+  if (!a.probe_maps.empty()) KASKAD_TRY(make_named_folder(a.probe_maps));
+  return {};
+}
+
 int run_render(Args a) {
   const fs::path scene_path =
       a.scene.empty() ? content_dir() / "scenes" / "default.json" : fs::path(a.scene);
+  const fs::path out = a.output.empty() ? fs::path("out") / (scene_path.stem().string() + ".png")
+                                        : fs::path(a.output);
+  if (auto st = check_render_outputs(a, out); !st) return fail(st.error());
+  if (!a.env.empty()) {
+    // An input read only after the frames: checked before them, so a bad map fails before any
+    // output is written.
+    if (auto env = load_cube_map(a.env); !env) return fail(env.error());
+  }
   if (a.width > 0) {
     a.sets.push_back("render.width=" + std::to_string(a.width));
     a.sets.push_back("render.height=" + std::to_string(a.height));
@@ -406,12 +448,15 @@ int run_render(Args a) {
               st.shaders.programs_compiled, st.shaders.cache_hits, st.shaders.compile_ms,
               timings->prewarm_ms, st.shaders.runtime_compiles);
 
-  fs::path out = a.output.empty() ? fs::path("out") / (scene_path.stem().string() + ".png")
-                                  : fs::path(a.output);
-  if (out.has_parent_path()) {
+  // A frame with GL errors is not written over a previous good image.
+  if (gpu::debug_error_count() > 0) {
+    std::fprintf(stderr, "kaskad: error: %d OpenGL errors were reported (see log above); "
+                 "no output written\n", gpu::debug_error_count());
+    return 1;
+  }
+  if (a.output.empty()) {
     std::error_code ec;
-    fs::create_directories(out.parent_path(), ec);
-    if (ec) return fail(Error{out.string(), "", "cannot create its directory: " + ec.message()});
+    fs::create_directory(out.parent_path(), ec);  // the documented default, out/<scene>.png
   }
   if (auto s = save_image(out, player->renderer->read_color()); !s) return fail(s.error());
   std::printf("wrote     %s\n", fs::absolute(out).string().c_str());
@@ -433,9 +478,6 @@ int run_render(Args a) {
     std::printf("wrote     %s (shadow map depth)\n", fs::absolute(a.shadow_map).string().c_str());
   }
   if (!a.probe_maps.empty()) {
-    std::error_code ec;
-    fs::create_directories(a.probe_maps, ec);
-    if (ec) return fail(Error{a.probe_maps, "", "cannot create the directory: " + ec.message()});
     for (const ProbeData::Entry& p : timings->last.probes.probes) {
       const Name* name = scene->world.try_get<Name>(p.entity);
       const std::string stem =
@@ -463,7 +505,7 @@ int run_render(Args a) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run_command(int argc, char** argv) {
   if (argc >= 2 && std::strcmp(argv[1], "envmap") == 0) return run_envmap_command(argc, argv);
   if (argc >= 2 && std::strcmp(argv[1], "play") == 0) return run_play_command(argc, argv);
   const Args a = parse_args(argc, argv);
@@ -476,4 +518,22 @@ int main(int argc, char** argv) {
     return run_bench_command(a, frames_given);
   }
   return run_render(a);
+}
+
+int main(int argc, char** argv) {
+  // A file-size limit (`ulimit -f`) or a full disk must fail the write with an error, not kill
+  // the process: write() then returns EFBIG and the atomic writer keeps the previous file.
+  std::signal(SIGXFSZ, SIG_IGN);
+  // The last line of defence (README "Bad input"): every reader turns library exceptions into
+  // content errors; anything that still escapes is an error exit with a message, never an abort.
+  try {
+    return run_command(argc, argv);
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "kaskad: error: out of memory\n");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "kaskad: error: unexpected failure: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "kaskad: error: unexpected failure (unknown exception)\n");
+  }
+  return 1;
 }

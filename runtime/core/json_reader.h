@@ -15,6 +15,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "runtime/core/file_io.h"
 #include "runtime/core/result.h"
 
 namespace kaskad::json_reader {
@@ -168,30 +169,103 @@ const char* enum_name(E value, const std::vector<std::pair<const char*, E>>& tab
   return "?";
 }
 
-/// Parses a JSON file; syntax errors give the file, line and column.
-inline Result<json> parse_json_file(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return Error{file.string(), "", "cannot open file"};
-  try {
-    return json::parse(in, nullptr, true, /*ignore_comments=*/false);
-  } catch (const json::parse_error& e) {
-    // e.byte gives the offset; turn it into line:column for people.
-    std::ifstream again(file, std::ios::binary);
-    std::string text((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
-    std::size_t line = 1, col = 1;
-    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
+/// "line L, column C" of the 1-based byte position `byte` (what nlohmann reports) in `text`.
+inline std::string line_column(const std::string& text, std::size_t byte) {
+  std::size_t line = 1, col = 1;
+  for (std::size_t i = 0; i + 1 < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
     }
-    std::string msg = e.what();
-    if (auto p = msg.find("parse error"); p != std::string::npos) msg = msg.substr(p);
-    return Error{file.string(), "line " + std::to_string(line) + ", column " + std::to_string(col),
-                 "malformed JSON: " + msg};
   }
+  return "line " + std::to_string(line) + ", column " + std::to_string(col);
+}
+
+/// nlohmann's message without its "[json.exception.xxx.N] " prefix and the "parse error at line
+/// L, column C: " that our Error::where already gives; bytes that are not printable ASCII (the
+/// message quotes the input) are shown as \xNN.
+inline std::string json_message(const std::exception& e) {
+  std::string msg = e.what();
+  if (msg.rfind("[json.exception", 0) == 0)
+    if (auto p = msg.find("] "); p != std::string::npos) msg = msg.substr(p + 2);
+  if (msg.rfind("parse error at line ", 0) == 0)
+    if (auto p = msg.find(": "); p != std::string::npos) msg = "parse error: " + msg.substr(p + 2);
+  std::string out;
+  for (const char c : msg) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u < 0x7f) {
+      out += c;
+    } else {
+      static const char* hex = "0123456789ABCDEF";
+      out += "\\x";
+      out += hex[u >> 4];
+      out += hex[u & 15];
+    }
+  }
+  return out;
+}
+
+/// A SAX consumer that only remembers where the parser gave up: nlohmann reports number
+/// overflows (1e999) as out_of_range without a position, but tells a SAX consumer the offset.
+struct ErrorLocator {
+  std::size_t byte = 0;
+  bool null() { return true; }
+  bool boolean(bool) { return true; }
+  bool number_integer(json::number_integer_t) { return true; }
+  bool number_unsigned(json::number_unsigned_t) { return true; }
+  bool number_float(json::number_float_t, const json::string_t&) { return true; }
+  bool string(json::string_t&) { return true; }
+  bool binary(json::binary_t&) { return true; }
+  bool start_object(std::size_t) { return true; }
+  bool key(json::string_t&) { return true; }
+  bool end_object() { return true; }
+  bool start_array(std::size_t) { return true; }
+  bool end_array() { return true; }
+  bool parse_error(std::size_t position, const std::string&, const json::exception&) {
+    byte = position;
+    return false;
+  }
+};
+
+/// Parses JSON text read from `file` (used in messages). Every error nlohmann can raise (syntax,
+/// number overflow, invalid UTF-8, ...) becomes a content error with line and column.
+inline Result<json> parse_json_text(const std::string& text, const std::string& file) {
+  try {
+    return json::parse(text, nullptr, true, /*ignore_comments=*/false);
+  } catch (const json::parse_error& e) {
+    return Error{file, line_column(text, e.byte), "malformed JSON: " + json_message(e)};
+  } catch (const json::exception& e) {
+    ErrorLocator locator;
+    std::string where;
+    try {
+      json::sax_parse(text, &locator);
+      if (locator.byte > 0) where = line_column(text, locator.byte);
+    } catch (const std::exception&) {
+      // only used to find the place; the message below stands without it
+    }
+    return Error{file, where, "invalid JSON: " + json_message(e)};
+  } catch (const std::bad_alloc&) {
+    return Error{file, "", "out of memory while parsing JSON"};
+  } catch (const std::exception& e) {
+    return Error{file, "", std::string("cannot parse JSON: ") + e.what()};
+  }
+}
+
+/// Parses a JSON file (at most 256 MiB); a missing, empty or unreadable file, a folder, and every
+/// JSON error give the file and, for errors inside it, the line and column.
+inline Result<json> parse_json_file(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(file, ec) && std::filesystem::file_size(file, ec) == 0 && !ec)
+    return parse_json_text({}, file.string());  // "malformed JSON" at line 1, column 1
+  auto bytes = read_file_bytes(file, std::uintmax_t(256) << 20);
+  if (!bytes) {
+    Error e = bytes.error();
+    e.message = "cannot open: " + e.message;
+    return e;
+  }
+  return parse_json_text(std::string(bytes->begin(), bytes->end()), file.string());
 }
 
 }  // namespace kaskad::json_reader

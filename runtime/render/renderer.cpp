@@ -6,7 +6,10 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <string>
 #include <numeric>
 #include <optional>
 #include <tuple>
@@ -424,6 +427,102 @@ Status Renderer::prewarm(const FrameInput& frame, bool shadow_points) {
   return st;
 }
 
+namespace {
+
+/// Whether the driver can make the shadow map array (GL limits, then a proxy texture).
+Status check_shadow_map_size(int size, int layers, DepthFormat format) {
+  const std::string where = "shadow.map_size " + std::to_string(size);
+  GLint max_size = 0, max_layers = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  const double bytes = double(size) * size * layers * (format == DepthFormat::d16 ? 2.0 : 4.0);
+  std::string what = std::to_string(size) + "^2 x " + std::to_string(layers) + " layers";
+  if (size > max_size || layers > max_layers)
+    return Error{"", where, "shadow maps of " + what + " exceed this driver's limits (GL_MAX_TEXTURE_SIZE " +
+                                std::to_string(max_size) + ", GL_MAX_ARRAY_TEXTURE_LAYERS " +
+                                std::to_string(max_layers) + ")"};
+  glTexImage3D(GL_PROXY_TEXTURE_2D_ARRAY, 0, GLint(depth_internal_format(format)), size, size, layers,
+               0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+  GLint got = 0;
+  glGetTexLevelParameteriv(GL_PROXY_TEXTURE_2D_ARRAY, 0, GL_TEXTURE_WIDTH, &got);
+  if (got == 0)
+    return Error{"", where, "the OpenGL driver refuses shadow maps of " + what + " (" +
+                                std::to_string(int(bytes / double(1 << 20))) +
+                                " MiB); use a smaller map_size or fewer cascades"};
+  return {};
+}
+
+/// MemAvailable from /proc/meminfo in bytes; 0 when unknown.
+std::uint64_t available_memory() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  std::uint64_t kib = 0;
+  std::string unit;
+  while (in >> key >> kib >> unit)
+    if (key == "MemAvailable:") return kib * 1024;
+  return 0;
+}
+
+std::string gib(double bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f GiB", bytes / double(1ull << 30));
+  return buf;
+}
+
+}  // namespace
+
+Status Renderer::check_target_size(int width, int height, bool read_aovs) const {
+  const std::string size = std::to_string(width) + "x" + std::to_string(height);
+  const std::string where = "render size " + size;
+  if (width < 1 || height < 1) return Error{"", where, "width and height must be at least 1"};
+  GLint max_texture = 0, max_renderbuffer = 0, max_viewport[2] = {0, 0};
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
+  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
+  glGetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
+  const int limit = std::min({max_texture, max_renderbuffer, max_viewport[0], max_viewport[1]});
+  if (width > limit || height > limit)
+    return Error{"", where,
+                 "larger than this OpenGL driver allows: " + std::to_string(limit) +
+                     " pixels a side (GL_MAX_TEXTURE_SIZE " + std::to_string(max_texture) +
+                     ", GL_MAX_RENDERBUFFER_SIZE " + std::to_string(max_renderbuffer) +
+                     ", GL_MAX_VIEWPORT_DIMS " + std::to_string(max_viewport[0]) + ")"};
+  // The targets of ensure_targets() (change together), asked of the driver through proxy
+  // textures: nothing is allocated, a refused format reads back width 0.
+  struct Target {
+    const char* name;
+    GLenum internal, format, type;
+    int bytes;
+  };
+  const Target targets[] = {{"colour (GL_SRGB8_ALPHA8)", GL_SRGB8_ALPHA8, GL_RGBA, GL_UNSIGNED_BYTE, 4},
+                            {"position (GL_RGBA32F)", GL_RGBA32F, GL_RGBA, GL_FLOAT, 16},
+                            {"normal (GL_RGBA32F)", GL_RGBA32F, GL_RGBA, GL_FLOAT, 16},
+                            {"visibility (GL_RG32F)", GL_RG32F, GL_RG, GL_FLOAT, 8},
+                            {"reflection (GL_RGBA16F)", GL_RGBA16F, GL_RGBA, GL_HALF_FLOAT, 8},
+                            {"depth (GL_DEPTH_COMPONENT32F)", GL_DEPTH_COMPONENT32F,
+                             GL_DEPTH_COMPONENT, GL_FLOAT, 4}};
+  const double pixels = double(width) * double(height);
+  double gpu_bytes = 0.0;
+  for (const Target& t : targets) {
+    glTexImage2D(GL_PROXY_TEXTURE_2D, 0, GLint(t.internal), width, height, 0, t.format, t.type,
+                 nullptr);
+    GLint got = 0;
+    glGetTexLevelParameteriv(GL_PROXY_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &got);
+    if (got == 0)
+      return Error{"", where,
+                   std::string("the OpenGL driver refuses a ") + t.name + " target of this size (" +
+                       gib(pixels * t.bytes) + ")"};
+    gpu_bytes += pixels * t.bytes;
+  }
+  // Read-backs: colour as float RGBA, and with AOVs 14 float channels plus their staging.
+  const double host_bytes = pixels * (16.0 + (read_aovs ? 2.0 * 14 * 4 + 64 : 0.0));
+  const std::uint64_t available = available_memory();
+  if (available > 0 && gpu_bytes + host_bytes > double(available))
+    return Error{"", where,
+                 "needs about " + gib(gpu_bytes + host_bytes) + " for its targets and read-back, " +
+                     "but only " + gib(double(available)) + " of memory is available"};
+  return {};
+}
+
 Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   Impl& im = *impl_;
   KASKAD_CHECK(frame.width > 0 && frame.height > 0 && frame.width <= 16384 &&
@@ -579,6 +678,15 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     }
     return {};
   };
+
+  // A shadow map array the driver refuses (llvmpipe: over 1 GiB, e.g. 16384^2 x 4 cascades) is
+  // an error before any pass starts, not a string of GL errors.
+  if (shadowed) {
+    const ShadowSettings& s = frame.shadow.settings;
+    if (!im.shadow_fbo || s.map_size != im.shadow_size || total_layers != im.shadow_layers ||
+        s.depth_format != im.shadow_format)
+      KASKAD_TRY(check_shadow_map_size(s.map_size, total_layers, s.depth_format));
+  }
 
   // Pass 1: shadow maps (S4, S0 step 6): depth only, one layer per cascade, light viewport, bias
   // by polygon offset, chosen culling. Each layer gets only the casters overlapping its cascade.

@@ -195,6 +195,13 @@ class Renderer {
   ShaderLibrary& shaders();
   ~Renderer();
 
+  /// Checks before the first frame that render targets of `width` x `height` can be made: the
+  /// GL limits (GL_MAX_TEXTURE_SIZE, GL_MAX_RENDERBUFFER_SIZE, GL_MAX_VIEWPORT_DIMS), the driver's
+  /// answer for each target format (proxy textures: llvmpipe refuses textures over 1 GiB) and an
+  /// estimate of the memory the targets and read-backs take against the memory available.
+  /// The error names the size and what refused it.
+  Status check_target_size(int width, int height, bool read_aovs) const;
+
   /// Records and submits the shadow and forward passes. Meshes and textures are uploaded from
   /// `assets` on first use. Errors: shader compile/link failures (content errors).
   Status render(const FrameInput& frame, const AssetStore& assets);

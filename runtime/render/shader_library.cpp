@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 
+#include "runtime/core/atomic_file.h"
 #include "runtime/core/log.h"
 #include "runtime/gpu/shader.h"
 
@@ -66,25 +67,25 @@ bool read_cache(const fs::path& file, std::uint64_t hash, GLenum& format,
 
 void write_cache(const fs::path& file, std::uint64_t hash, GLenum format,
                  const std::vector<std::uint8_t>& binary) {
+  // The cache folder is Kaskad's own (documented in README.md), so it is created here.
   std::error_code ec;
   fs::create_directories(file.parent_path(), ec);
-  fs::path tmp = file;
-  tmp += ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return;  // a cache that cannot be written is not an error, just slower next time
-    const std::uint32_t fmt = format;
-    const std::uint64_t size = binary.size();
-    out.write(kMagic, 4);
-    out.write(reinterpret_cast<const char*>(&kCacheVersion), 4);
-    out.write(reinterpret_cast<const char*>(&fmt), 4);
-    out.write(reinterpret_cast<const char*>(&hash), 8);
-    out.write(reinterpret_cast<const char*>(&size), 8);
-    out.write(reinterpret_cast<const char*>(binary.data()), std::streamsize(binary.size()));
-    if (!out) return;
-  }
-  fs::rename(tmp, file, ec);
-  if (ec) fs::remove(tmp, ec);
+  const std::uint32_t fmt = format;
+  const std::uint64_t size = binary.size();
+  std::vector<std::uint8_t> bytes;
+  auto put = [&](const void* p, std::size_t n) {
+    bytes.insert(bytes.end(), static_cast<const std::uint8_t*>(p), static_cast<const std::uint8_t*>(p) + n);
+  };
+  put(kMagic, 4);
+  put(&kCacheVersion, 4);
+  put(&fmt, 4);
+  put(&hash, 8);
+  put(&size, 8);
+  put(binary.data(), binary.size());
+  // A cache that cannot be written is not an error, just slower next time; a failed write
+  // leaves no partial entry behind (atomic_file.h).
+  if (auto st = write_file_atomic(file, bytes); !st)
+    log::debug("shader cache not written: %s", st.error().to_string().c_str());
 }
 
 }  // namespace

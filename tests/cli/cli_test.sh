@@ -76,6 +76,7 @@ check no_camera nonzero "no camera" -- "$KASKAD" render "$tmp/nocam.json" --head
 check unwritable_output nonzero "cannot|could not|error" -- "$KASKAD" render --headless --size 32x32 --frames 1 -o /proc/nope/x.png
 
 # kaskad envmap and the reflection reference: every layout of one sky loads; bad input names the file.
+mkdir -p "$tmp/env"
 check envmap_folder 0 "faces, 32\^2 x 6 faces" -- "$KASKAD" envmap "$KASKAD_CONTENT/env/cube/SwedishRoyalCastle" \
   --face-size 32 --faces "$tmp/env/sky_*.png" --sphere "$tmp/env/ball.png" --sphere-size 64
 check envmap_equirect 0 "equirect, 256\^2 x 6 faces" -- "$KASKAD" envmap "$KASKAD_CONTENT/env/equirect/venice_sunset_1k.hdr"

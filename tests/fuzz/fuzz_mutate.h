@@ -149,18 +149,36 @@ inline Bytes make_input(const std::vector<Bytes>& seeds, std::uint64_t iteration
   return data;
 }
 
+/// When argv[1] names a file or a folder (a corpus, tests/fuzz/corpus/<target>/), runs every file
+/// argument and every file in the folders once, in name order (replaying saved inputs, or the
+/// CTest corpus run), and returns true.
+inline bool replay_files(int argc, char** argv, EntryPoint entry) {
+  if (argc < 2 || !std::filesystem::exists(argv[1])) return false;
+  std::size_t runs = 0;
+  for (int a = 1; a < argc; ++a) {
+    std::vector<std::filesystem::path> files;
+    if (std::filesystem::is_directory(argv[a])) {
+      for (const auto& e : std::filesystem::recursive_directory_iterator(argv[a]))
+        if (e.is_regular_file()) files.push_back(e.path());
+      std::sort(files.begin(), files.end());
+    } else {
+      files.emplace_back(argv[a]);
+    }
+    for (const auto& file : files) {
+      const Bytes input = read_file(file);
+      entry(input.data(), input.size());
+      ++runs;
+    }
+  }
+  std::printf("%zu inputs ran clean\n", runs);
+  return true;
+}
+
 /// The standalone main(): argv[1] iterations (default 1000), argv[2] first iteration (default 0).
-/// When argv[1] names a file, each file argument runs once instead (replaying a saved input).
+/// When argv[1] names a file or folder, replay_files() runs those instead.
 inline int run_standalone(int argc, char** argv, const std::vector<Bytes>& seeds, EntryPoint entry,
                           Fixup fixup = nullptr) {
-  if (argc > 1 && std::filesystem::is_regular_file(argv[1])) {
-    for (int a = 1; a < argc; ++a) {
-      const Bytes input = read_file(argv[a]);
-      entry(input.data(), input.size());
-      std::printf("%s ran clean\n", argv[a]);
-    }
-    return 0;
-  }
+  if (replay_files(argc, argv, entry)) return 0;
   if (seeds.empty()) {
     std::fprintf(stderr, "no seed files found\n");
     return 2;

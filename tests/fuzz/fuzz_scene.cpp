@@ -8,12 +8,14 @@
 #include <string>
 
 #include "runtime/assets/scene_io.h"
+#include "runtime/core/json_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
-  if (doc.is_discarded()) return 0;
-  auto scene = kaskad::parse_scene(doc, "fuzz.json");
+  // The readers' own JSON boundary: every nlohmann exception must become a content error.
+  auto doc = kaskad::json_reader::parse_json_text(text, "fuzz.json");
+  if (!doc) return 0;
+  auto scene = kaskad::parse_scene(*doc, "fuzz.json");
   if (!scene.ok()) return 0;
   nlohmann::json canonical = kaskad::scene_to_json(*scene);
   (void)kaskad::apply_override(canonical, "shadow.map_size=512");
@@ -26,7 +28,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 }
 
 #ifdef KASKAD_FUZZ_STANDALONE
+#include "tests/fuzz/fuzz_mutate.h"
+
 int main(int argc, char** argv) {
+  if (kaskad::fuzz::replay_files(argc, argv, &LLVMFuzzerTestOneInput)) return 0;
   const int iterations = argc > 1 ? std::atoi(argv[1]) : 1000;
   std::vector<std::string> seeds;
   for (const auto& f : std::filesystem::directory_iterator(std::filesystem::path(KASKAD_CONTENT_DIR) / "scenes")) {

@@ -1,0 +1,53 @@
+// parse_json_text / parse_json_file (runtime/core/json_reader.h): every error nlohmann can raise
+// is a content error with the file, line and column; nothing throws.
+#include "runtime/core/json_reader.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace kaskad {
+namespace {
+
+namespace fs = std::filesystem;
+using json_reader::parse_json_file;
+using json_reader::parse_json_text;
+
+TEST(JsonReader, NumberOverflowIsAContentErrorWithLineAndColumn) {
+  auto doc = parse_json_text("{\n  \"a\": [1,\n    1e999 ] }", "x.json");
+  ASSERT_FALSE(doc.ok());
+  EXPECT_EQ(doc.error().file, "x.json");
+  EXPECT_EQ(doc.error().where, "line 3, column 9");  // the number's last character, as nlohmann counts
+  EXPECT_NE(doc.error().message.find("number overflow parsing '1e999'"), std::string::npos)
+      << doc.error().message;
+  EXPECT_EQ(doc.error().message.find("[json.exception"), std::string::npos) << doc.error().message;
+}
+
+TEST(JsonReader, SyntaxErrorsAndBadBytesAreShownPrintably) {
+  auto doc = parse_json_text("{ \"k\": \"\xff\xfe\" }", "y.json");
+  ASSERT_FALSE(doc.ok());
+  EXPECT_EQ(doc.error().where, "line 1, column 9");
+  EXPECT_NE(doc.error().message.find("\\xFF"), std::string::npos) << doc.error().message;
+  for (const char c : doc.error().to_string()) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << int(c);
+}
+
+TEST(JsonReader, FoldersMissingAndEmptyFiles) {
+  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "json_reader";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "folder.json");
+  std::ofstream(dir / "empty.json").close();
+  auto folder = parse_json_file(dir / "folder.json");
+  ASSERT_FALSE(folder.ok());
+  EXPECT_NE(folder.error().message.find("directory"), std::string::npos) << folder.error().message;
+  auto missing = parse_json_file(dir / "missing.json");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("cannot open"), std::string::npos);
+  auto empty = parse_json_file(dir / "empty.json");
+  ASSERT_FALSE(empty.ok());
+  EXPECT_EQ(empty.error().where, "line 1, column 1");
+}
+
+}  // namespace
+}  // namespace kaskad
