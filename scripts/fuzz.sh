@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # libFuzzer campaigns over the fuzz targets in tests/fuzz (clang, ASan + UBSan; preset `fuzz`).
 #   usage: bash scripts/fuzz.sh [TARGET|all] [SECONDS]     (default: all, 60 s per target)
-# TARGET: gltf image scene envmap material set. Each run starts from the repository corpus
+# TARGET: gltf image scene envmap material set playback. Each run starts from the repository corpus
 # tests/fuzz/corpus/TARGET/ plus what earlier runs found (build/fuzz/corpus/TARGET/, not in git).
 # Crashes, leaks and timeouts are written to build/fuzz/artifacts/TARGET/; turn each one into a
 # fix and a regression file in tests/fuzz/corpus/TARGET/ (CTest replays that folder).
@@ -10,7 +10,7 @@
 # clang, libclang-rt-14-dev) as root when missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-all=(gltf image scene envmap material set)
+all=(gltf image scene envmap material set playback)
 target="${1:-all}"
 seconds="${2:-60}"
 if [ "$target" = all ]; then targets=("${all[@]}"); else targets=("$target"); fi
