@@ -26,6 +26,7 @@ extern char** environ;
 #include "runtime/cli/bench.h"
 #include "runtime/cli/player.h"
 #include "runtime/cli/stability.h"
+#include "runtime/core/atomic_file.h"
 #include "runtime/core/json_reader.h"
 #include "runtime/gpu/context.h"
 #include "runtime/gpu/gl_handles.h"
@@ -613,7 +614,9 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
     moved.push_back({e, &tr, scene->world.get<Transform>(e)});
   }
 
-  std::ofstream csv(out / "frames.csv", std::ios::trunc);
+  // Rows are kept in memory and written atomically at the end (and when a run fails midway,
+  // nothing half-written is left behind).
+  std::ostringstream csv;
   csv << "frame,t,frame_ms,cpu_transforms_ms,cpu_camera_ms,cpu_shadows_ms,cpu_probes_ms,"
          "cpu_draw_list_ms,cpu_render_ms,gpu_shadow_ms,gpu_forward_ms,gpu_probe_ms,draw_calls,"
          "shadow_draw_calls,shadow_triangles,probe_faces,probe_captures,compiles_after_prewarm,"
@@ -800,8 +803,7 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
                    pb.file.filename().string());
   }
   std::fprintf(stderr, "\n");
-  csv.close();
-  if (!csv) return Error{(out / "frames.csv").string(), "", "write failed"};
+  KASKAD_TRY(write_file_atomic(out / "frames.csv", csv.str()));
 
   // 4. Whole-run expectations.
   const int compiles = programs_made() - compiles_before;
@@ -921,11 +923,7 @@ Result<std::vector<PlayFailure>> run_playbacks(const std::vector<fs::path>& file
       std::printf("  %s%s: %s\n", f.file.c_str(),
                   f.frame >= 0 ? (" frame " + std::to_string(f.frame)).c_str() : "", f.message.c_str());
   }
-  const fs::path summary_path = options.out_dir / "summary.json";
-  std::ofstream out(summary_path, std::ios::trunc);
-  out << summary.dump(2) << "\n";
-  out.close();
-  if (!out) return Error{summary_path.string(), "", "write failed"};
+  KASKAD_TRY(write_file_atomic(options.out_dir / "summary.json", summary.dump(2) + "\n"));
   return failures;
 }
 
@@ -959,10 +957,7 @@ Result<std::size_t> merge_summaries(const std::vector<fs::path>& dirs, const fs:
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   const fs::path path = out_dir / "summary.json";
-  std::ofstream out(path, std::ios::trunc);
-  out << merged.dump(2) << "\n";
-  out.close();
-  if (!out) return Error{path.string(), "", "write failed"};
+  KASKAD_TRY(write_file_atomic(path, merged.dump(2) + "\n"));
   std::printf("merged    %zu summaries, %zu files, %zu failed -> %s\n", dirs.size(), files, failed,
               path.string().c_str());
   return failed;
