@@ -109,6 +109,16 @@ std::uint64_t geometry_signature(const Scene& scene) {
 
 }  // namespace
 
+// scripts/bench_chart.py over a bench CSV: one chart per scene into `out_dir`.
+static Status draw_charts(const fs::path& csv_path, const fs::path& out_dir) {
+  const fs::path script = content_dir().parent_path() / "scripts" / "bench_chart.py";
+  const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + csv_path.string() +
+                          "' '" + out_dir.string() + "'";
+  if (std::system(cmd.c_str()) != 0)
+    return Error{script.string(), "", "chart script failed (is python3-matplotlib installed?)"};
+  return {};
+}
+
 void print_progress(std::size_t done, std::size_t total, double elapsed_s,
                     const std::string& what) {
   progress_line(done, total, elapsed_s, what);
@@ -225,7 +235,14 @@ Status run_bench(const BenchOptions& options) {
 
   g_interrupted = false;
   auto previous = std::signal(SIGINT, on_sigint);
-  const std::size_t total = scenes.size() * configs->size();
+  if (options.shard_count < 1 || options.shard_index < 0 || options.shard_index >= options.shard_count)
+    return Error{"--shard", "", "expected i/n with 0 <= i < n"};
+  // This shard's runs: i, i + n, ... of the scene x configuration list.
+  const std::size_t all_runs = scenes.size() * configs->size();
+  std::size_t total = 0;
+  for (std::size_t k = std::size_t(options.shard_index); k < all_runs; k += std::size_t(options.shard_count))
+    ++total;
+  std::size_t run_index = 0;
   std::size_t done = 0;
   const auto t0 = Clock::now();
   std::fprintf(stderr, "kaskad bench: %zu scene(s) x %zu configuration(s), %d frames each at %dx%d -> %s\n",
@@ -237,6 +254,8 @@ Status run_bench(const BenchOptions& options) {
   for (const fs::path& scene_path : scenes) {
     for (const BenchConfig& config : *configs) {
       if (g_interrupted) break;
+      if (run_index++ % std::size_t(options.shard_count) != std::size_t(options.shard_index))
+        continue;  // another shard's
       progress_line(done, total, std::chrono::duration<double>(Clock::now() - t0).count(),
                scene_path.stem().string() + ": " + config.label);
       std::vector<std::string> sets = config.sets;
@@ -376,13 +395,35 @@ Status run_bench(const BenchOptions& options) {
   if (!result.ok()) return result;
   std::printf("wrote     %s (%zu rows%s)\n", fs::absolute(csv_path).string().c_str(), done,
               g_interrupted ? ", interrupted" : "");
-  if (options.chart && done > 0) {
-    const fs::path script = content_dir().parent_path() / "scripts" / "bench_chart.py";
-    const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + csv_path.string() +
-                            "' '" + options.out_dir.string() + "'";
-    if (std::system(cmd.c_str()) != 0)
-      return Error{script.string(), "", "chart script failed (is python3-matplotlib installed?)"};
+  if (options.chart && done > 0) KASKAD_TRY(draw_charts(csv_path, options.out_dir));
+  return {};
+}
+
+Status merge_bench(const std::vector<fs::path>& dirs, const fs::path& out_dir, bool chart) {
+  std::string header, rows;
+  std::size_t count = 0;
+  for (const fs::path& dir : dirs) {
+    const fs::path file = dir / "bench.csv";
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return Error{file.string(), "", "cannot open (is this a kaskad bench --out folder?)"};
+    std::string line;
+    if (!std::getline(in, line)) return Error{file.string(), "line 1", "empty: no header"};
+    if (header.empty()) header = line;
+    if (line != header)
+      return Error{file.string(), "line 1", "columns differ from " + (dirs.front() / "bench.csv").string()};
+    while (std::getline(in, line))
+      if (!line.empty()) {
+        rows += line + "\n";
+        ++count;
+      }
   }
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  KASKAD_TRY(check_output_folder(out_dir));
+  const fs::path csv_path = out_dir / "bench.csv";
+  KASKAD_TRY(write_file_atomic(csv_path, header + "\n" + rows));
+  std::printf("merged    %zu shard CSVs, %zu rows -> %s\n", dirs.size(), count, csv_path.string().c_str());
+  if (chart && count > 0) KASKAD_TRY(draw_charts(csv_path, out_dir));
   return {};
 }
 

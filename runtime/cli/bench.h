@@ -26,6 +26,9 @@ struct BenchOptions {
   /// Stability: frames of the camera path (runtime/cli/stability.h); 0 or 1 = skip.
   int stability_frames = 16;
   int stability_points = 4096;  ///< at most this many fixed receiver points
+  /// --shard i/n: this process runs runs i, i + n, ... of the scene x configuration list (in
+  /// order), for a CI matrix or a job array; merge_bench() joins the shards' CSVs.
+  int shard_index = 0, shard_count = 1;
 };
 
 /// One configuration: a label and its --set overrides.
@@ -47,6 +50,11 @@ Result<std::vector<BenchConfig>> parse_sweep(const std::string& spec);
 
 /// The CSV header, one name per column (documented in README.md "kaskad bench").
 std::vector<std::string> bench_csv_columns();
+
+/// `kaskad bench --merge DIR...`: concatenates the shards' bench.csv (same columns, else an
+/// error naming the file) into OUT/bench.csv and draws the charts when `chart`.
+Status merge_bench(const std::vector<std::filesystem::path>& dirs,
+                   const std::filesystem::path& out_dir, bool chart);
 
 /// Runs the sweep. Prints a progress bar with ETA on stderr; SIGINT stops after the current
 /// configuration, keeping the rows written so far. Writes OUT/bench.csv and OUT/<scene>.png.

@@ -46,7 +46,8 @@ usage:
   kaskad variants [SCENE] [--set key=value]... [--aov]
                                     list the shader variants (pass, key, defines) the scene needs
   kaskad bench [SCENE]... [--sweep SPEC] [--out DIR] [--frames N] [--size WxH] [--no-chart]
-               [--stability-frames N]
+               [--stability-frames N] [--shard i/n]
+  kaskad bench --merge SHARD_OUT_DIR... [--out DIR] [--no-chart]
                                     sweep settings, write DIR/bench.csv and one speed-vs-accuracy
                                     chart per scene (default sweep: see README); flicker at fixed
                                     points over an N-frame camera path (default 16, 0 = off)
@@ -86,6 +87,8 @@ struct Args {
   std::string command;
   std::string scene;
   std::vector<std::string> more_scenes;  ///< bench: every SCENE after the first
+  int shard_index = 0, shard_count = 1;  ///< bench --shard i/n
+  bool merge = false;                    ///< bench --merge: the SCENEs are shard folders
   std::string sweep;
   std::string out_dir;
   bool chart = true;
@@ -158,6 +161,14 @@ Args parse_args(int argc, char** argv) {
       a.out_dir = value();
     } else if (arg == "--stability-frames" && a.command == "bench") {
       a.stability_frames = parse_int(arg, value(), 0, 10000);
+    } else if (arg == "--shard" && a.command == "bench") {
+      const std::string v = value();
+      const auto slash = v.find('/');
+      if (slash == std::string::npos) usage_error("--shard expects i/n, e.g. 0/4, got '" + v + "'");
+      a.shard_count = parse_int("--shard n", v.substr(slash + 1), 1, 100000);
+      a.shard_index = parse_int("--shard i", v.substr(0, slash), 0, a.shard_count - 1);
+    } else if (arg == "--merge" && a.command == "bench") {
+      a.merge = true;
     } else if (arg == "--no-chart") {
       a.chart = false;
     } else if (arg == "--set") {
@@ -282,6 +293,13 @@ int run_bench_command(const Args& a, bool frames_given) {
   }
   o.chart = a.chart;
   if (a.stability_frames >= 0) o.stability_frames = a.stability_frames;
+  o.shard_index = a.shard_index;
+  o.shard_count = a.shard_count;
+  if (a.merge) {
+    if (o.scenes.empty()) usage_error("bench --merge needs the shards' --out folders");
+    if (auto st = merge_bench(o.scenes, o.out_dir, o.chart); !st) return fail(st.error());
+    return 0;
+  }
   if (auto st = run_bench(o); !st) return fail(st.error());
   return 0;
 }

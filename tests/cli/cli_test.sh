@@ -188,5 +188,15 @@ check gltf_aspect_fitted 0 "output 90x90 \(fitted inside 160x90\)" -- "$KASKAD" 
   "$KASKAD_CONTENT/models/2CylinderEngine/glTF-Draco/2CylinderEngine.gltf" --headless \
   --size 160x90 --frames 1 -o "$tmp/engine.png"
 
+# Large sweeps split across machines: shards of the scene x configuration list, then one CSV.
+for i in 0 1; do
+  check "bench_shard_$i" 0 "wrote .*bench.csv \\($((2 - i)) rows\\)" -- "$KASKAD" bench --sweep "shadow.cascade_count=1,2,4" \
+    --frames 1 --size 160x90 --stability-frames 0 --no-chart --shard $i/2 --out "$tmp/shard$i"
+done
+check bench_merge 0 "merged +2 shard CSVs, 3 rows" -- "$KASKAD" bench --merge "$tmp/shard0" "$tmp/shard1" \
+  --out "$tmp/merged" --no-chart
+check bench_merge_missing nonzero "nope/bench.csv: cannot open" -- "$KASKAD" bench --merge "$tmp/nope" \
+  --out "$tmp/merged2" --no-chart
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
