@@ -254,25 +254,6 @@ void read_expect(ObjectReader& r, Playback& pb, const fs::path& base) {
   r.finish();
 }
 
-// Syntax errors as line and column of the text.
-Result<json> parse_text(const std::string& text, const fs::path& file) {
-  try {
-    return json::parse(text, nullptr, true, /*ignore_comments=*/false);
-  } catch (const json::parse_error& e) {
-    std::size_t line = 1, col = 1;
-    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-      col = text[i] == '\n' ? 1 : col + 1;
-      line += text[i] == '\n';
-    }
-    std::string msg = e.what();
-    if (auto p = msg.find("parse error"); p != std::string::npos) msg = msg.substr(p);
-    return Error{file.string(), "line " + std::to_string(line) + ", column " + std::to_string(col),
-                 "malformed JSON: " + msg};
-  } catch (const json::exception& e) {
-    return Error{file.string(), "", std::string("malformed JSON: ") + e.what()};
-  }
-}
-
 glm::vec3 catmull_rom(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2,
                       const glm::vec3& p3, float u) {
   // Uniform Catmull-Rom: passes through p1 at u = 0 and p2 at u = 1.
@@ -290,14 +271,15 @@ std::optional<glm::quat> key_rotation(const PoseKey& k) {
 
 }  // namespace
 
-Result<Playback> parse_playback(const std::string& text, const fs::path& file) {
-  auto doc = parse_text(text, file);
-  if (!doc) return doc.error();
+namespace {
+
+// A parsed playback document: the checks and defaults.
+Result<Playback> playback_from(const json& doc, const fs::path& file) {
   Playback pb;
   pb.file = file;
   const fs::path base = file.parent_path();
   try {
-    ObjectReader r(*doc, "");
+    ObjectReader r(doc, "");
     int version = kFormatVersion;
     r.integer("kaskad_playback", version, 1, kFormatVersion);
     std::string scene;
@@ -388,15 +370,18 @@ Result<Playback> parse_playback(const std::string& text, const fs::path& file) {
   return pb;
 }
 
+}  // namespace
+
+Result<Playback> parse_playback(const std::string& text, const fs::path& file) {
+  auto doc = parse_json_text(text, file.string());
+  if (!doc) return doc.error();
+  return playback_from(*doc, file);
+}
+
 Result<Playback> read_playback(const fs::path& file) {
-  std::error_code ec;
-  if (fs::is_directory(file, ec)) return Error{file.string(), "", "is a directory, not a playback file"};
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return Error{file.string(), "", "cannot open file"};
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof()) return Error{file.string(), "", "cannot read file"};
-  return parse_playback(text.str(), file);
+  auto doc = parse_json_file(file);  // folders, unreadable and empty files: the shared messages
+  if (!doc) return doc.error();
+  return playback_from(*doc, file);
 }
 
 PoseKey sample_track(const Track& track, double t) {
@@ -932,12 +917,12 @@ Result<std::size_t> merge_summaries(const std::vector<fs::path>& dirs, const fs:
   std::size_t failed = 0, files = 0;
   for (const fs::path& dir : dirs) {
     const fs::path file = dir / "summary.json";
-    std::ifstream in(file, std::ios::binary);
-    if (!in) return Error{file.string(), "", "cannot open (is this a kaskad play --out folder?)"};
-    std::ostringstream text;
-    text << in.rdbuf();
-    auto doc = parse_text(text.str(), file);
-    if (!doc) return doc.error();
+    auto doc = parse_json_file(file);
+    if (!doc) {
+      Error e = doc.error();
+      e.message += " (is this a kaskad play --out folder?)";
+      return e;
+    }
     if (!doc->is_object() || !doc->contains("files") || !(*doc)["files"].is_array())
       return Error{file.string(), "/files", "not a kaskad play summary"};
     merged["merged_from"].push_back(file.string());
