@@ -148,11 +148,7 @@ int main(int argc, char** argv) {
   std::vector<kaskad::fuzz::Bytes> seeds;
   seeds.emplace_back(kSyntheticSeed, kSyntheticSeed + std::strlen(kSyntheticSeed));
   const auto models = std::filesystem::path(KASKAD_CONTENT_DIR) / "models";
-  std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::recursive_directory_iterator(models))
-    if (entry.is_regular_file()) files.push_back(entry.path());
-  std::sort(files.begin(), files.end());  // directory order varies; iterations must not
-  for (const auto& file : files) {
+  for (const auto& file : kaskad::fuzz::seed_files(models, {".glb", ".gltf", ".bin", ".png", ".jpg"})) {
     const auto ext = file.extension();
     if (ext == ".glb" || ext == ".gltf") {
       seeds.push_back(kaskad::fuzz::read_file(file));

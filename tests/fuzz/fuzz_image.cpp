@@ -65,15 +65,8 @@ std::vector<kaskad::fuzz::Bytes> generated_seeds() {
 int main(int argc, char** argv) {
   std::vector<kaskad::fuzz::Bytes> seeds = generated_seeds();
   const auto env = std::filesystem::path(KASKAD_CONTENT_DIR) / "env";
-  std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::recursive_directory_iterator(env))
-    if (entry.is_regular_file()) files.push_back(entry.path());
-  std::sort(files.begin(), files.end());  // directory order varies; iterations must not
-  for (const auto& file : files) {
-    const auto ext = file.extension();
-    if (ext == ".jpg" || ext == ".hdr" || ext == ".png")
-      seeds.push_back(kaskad::fuzz::read_file(file));
-  }
+  for (const auto& file : kaskad::fuzz::seed_files(env, {".jpg", ".hdr", ".png"}))
+    seeds.push_back(kaskad::fuzz::read_file(file));
   return kaskad::fuzz::run_standalone(argc, argv, seeds, &LLVMFuzzerTestOneInput);
 }
 #endif  // KASKAD_FUZZ_STANDALONE

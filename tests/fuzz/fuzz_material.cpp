@@ -77,12 +77,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 #include "tests/fuzz/fuzz_mutate.h"
 
 int main(int argc, char** argv) {
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(fs::path(KASKAD_CONTENT_DIR) / "materials"))
-    if (e.path().extension() == ".json") files.push_back(e.path());
-  std::sort(files.begin(), files.end());  // directory order varies; iterations must not
   std::vector<kaskad::fuzz::Bytes> seeds;
-  for (const auto& f : files) seeds.push_back(kaskad::fuzz::read_file(f));
+  for (const auto& f : kaskad::fuzz::seed_files(fs::path(KASKAD_CONTENT_DIR) / "materials", {".json"}))
+    seeds.push_back(kaskad::fuzz::read_file(f));
   return kaskad::fuzz::run_standalone(argc, argv, seeds, &LLVMFuzzerTestOneInput);
 }
 #endif  // KASKAD_FUZZ_STANDALONE

@@ -18,7 +18,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace kaskad::fuzz {
@@ -42,6 +44,20 @@ class Rng {
  private:
   std::uint64_t state_;
 };
+
+/// The regular files below `dir` (recursively) with one of `extensions` (".json"), sorted:
+/// directory order varies, iterations must not.
+inline std::vector<std::filesystem::path> seed_files(
+    const std::filesystem::path& dir, std::initializer_list<std::string_view> extensions) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir))
+    if (entry.is_regular_file() &&
+        std::find(extensions.begin(), extensions.end(), entry.path().extension().string()) !=
+            extensions.end())
+      files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
 
 inline Bytes read_file(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
