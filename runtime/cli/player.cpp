@@ -66,7 +66,7 @@ Result<Scene> load_scene(const std::filesystem::path& file,
     ground_entity = add_ground(*scene, ground_extent(models, sun_direction(scene->world)));
   // Overrides of imported entities (glTF nodes by name) and of the ground.
   for (const std::string& o : later) KASKAD_TRY(apply_entity_override(*scene, o));
-  update_transforms(scene->world, scene->assets);
+  if (!later.empty() || ground_entity.valid()) update_transforms(scene->world, scene->assets);
   // Cameras frame the models; their near/far also take in the ground.
   Aabb framed;
   scene->world.view<WorldBounds>().each([&](ecs::Entity e, const WorldBounds& b) {
