@@ -158,6 +158,17 @@ ecs::Entity light(ecs::World& w, LightType type, glm::vec3 pos, glm::vec3 dir,
   return e;
 }
 
+// A square camera at (0, 5, 12) looking at the origin, near 0.5, far 60.
+CameraState overview_camera(ecs::World& w) {
+  CameraState cam;
+  cam.entity = w.create();
+  cam.camera.near = 0.5f;
+  cam.camera.far = 60.0f;
+  cam.view = glm::lookAt(glm::vec3(0, 5, 12), glm::vec3(0), glm::vec3(0, 1, 0));
+  cam.proj = glm::perspective(glm::radians(cam.camera.fov_y_deg), 1.0f, 0.5f, 60.0f);
+  return cam;
+}
+
 ecs::Entity box(ecs::World& w, const Aabb& b, bool cast, bool receive) {
   const ecs::Entity e = w.create();
   MeshRenderer mr;
@@ -230,12 +241,7 @@ TEST(ShadowCascadeSystem, SeveralDirectionalLightsEachGetCascadesUpToTheCap) {
     s.cascade_count = 1 + i;
     s.map_size = 512 << i;  // extra lights take the first one's
   }
-  CameraState cam;
-  cam.entity = w.create();
-  cam.camera.near = 0.5f;
-  cam.camera.far = 60.0f;
-  cam.view = glm::lookAt(glm::vec3(0, 5, 12), glm::vec3(0), glm::vec3(0, 1, 0));
-  cam.proj = glm::perspective(glm::radians(cam.camera.fov_y_deg), 1.0f, 0.5f, 60.0f);
+  const CameraState cam = overview_camera(w);
   ShadowCascadeState state;
   const std::vector<ShadowData> all = update_shadows(w, cam, state);
   ASSERT_EQ(all.size(), std::size_t(kMaxShadowedLights));
@@ -287,12 +293,7 @@ TEST(ShadowCascadeSystem, SharedSettingsOfLaterLightsAreNamedInTheNotice) {
   light(w, LightType::directional, {0, 10, 0}, glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f)));
   const ecs::Entity second =
       light(w, LightType::directional, {0, 10, 0}, glm::normalize(glm::vec3(-0.3f, -1.0f, 0.1f)));
-  CameraState cam;
-  cam.entity = w.create();
-  cam.camera.near = 0.5f;
-  cam.camera.far = 60.0f;
-  cam.view = glm::lookAt(glm::vec3(0, 5, 12), glm::vec3(0), glm::vec3(0, 1, 0));
-  cam.proj = glm::perspective(glm::radians(cam.camera.fov_y_deg), 1.0f, 0.5f, 60.0f);
+  const CameraState cam = overview_camera(w);
   ShadowCascadeState state;
   ASSERT_EQ(update_shadows(w, cam, state).size(), 2u);
   EXPECT_EQ(state.last_notice, "");  // same settings: nothing to say
