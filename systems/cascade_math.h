@@ -19,11 +19,10 @@
 
 #include "components/bounds.h"
 #include "components/camera.h"
+#include "components/limits.h"
 #include "components/shadow_settings.h"
 
 namespace kaskad {
-
-inline constexpr int kMaxCascades = 8;
 
 // ---- Splits (S0 eq. (1)-(3)) --------------------------------------------------------------------
 

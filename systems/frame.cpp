@@ -23,25 +23,47 @@ double ms_since(Clock::time_point t0) {
 
 namespace {
 
-render::ShadowPass shadow_pass(const ShadowData& shadow, int light_index) {
-  render::ShadowPass sp;
-  sp.light_index = light_index;
-  sp.settings = shadow.settings;
-  sp.projection = shadow.projection;
-  sp.cascade_count = shadow.cascade_count;
-  sp.view_proj = shadow.view_proj;
-  sp.splits = shadow.splits;
-  sp.texel_size = shadow.texel_size;
-  sp.skipped = shadow.skipped;
-  return sp;
+// A shadow view as the renderer draws it; `light_index` is its light's place in
+// FrameInput::lights.
+render::ShadowView shadow_view(const ShadowData& d, int light_index) {
+  render::ShadowView v;
+  const ShadowSettings& s = d.settings;
+  v.light_index = light_index;
+  v.projection = d.projection;
+  v.first_layer = d.first_layer;
+  v.layer_count = d.cascade_count;
+  v.view_proj = d.view_proj;
+  v.splits = d.splits;
+  v.texel_size = d.texel_size;
+  v.skipped = d.skipped;
+  // The basic map (fit scene) is biased by polygon offset alone, as before the cascades.
+  v.normal_offset = d.projection == ShadowProjection::ortho && s.fit_mode == FitMode::scene
+                        ? 0.0f
+                        : s.normal_offset_bias;
+  v.blend_band = s.blend_band;
+  v.paraboloid_margin = d.paraboloid_margin;
+  v.slope_bias = s.slope_bias;
+  v.constant_bias = s.constant_bias;
+  v.cull = s.cull;
+  return v;
 }
 
 }  // namespace
 
+const ShadowData& FrameReport::shadow(std::size_t k) const {
+  static const ShadowData none;
+  return k < shadows.size() ? shadows[k] : none;
+}
+
+int aov_shadow_index(const Scene& scene, std::size_t views) {
+  const int aov = scene.render.aov_shadow_light;
+  return aov >= 0 && aov < int(views) ? aov : 0;
+}
+
 render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx,
-                                     const CameraState& camera, const ShadowData& shadow,
-                                     const ProbeData& probes,
-                                     std::span<const ShadowData> extra) {
+                                     const CameraState& camera,
+                                     std::span<const ShadowData> shadows,
+                                     const ProbeData& probes) {
   const ecs::World& world = scene.world;
   render::FrameInput in;
   in.width = ctx.width;
@@ -53,7 +75,12 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.clear_color = scene.render.clear_color;
   in.exposure = scene.render.exposure;
   in.write_aovs = ctx.write_aovs;
-  in.aov_shadow_light = scene.render.aov_shadow_light;
+  if (!shadows.empty()) {
+    const ShadowSettings& s = shadows.front().settings;  // shared by every view (ShadowData)
+    in.shadow_map = {s.map_size, s.depth_format, s.filter, s.selection, s.layered,
+                     s.debug_cascades};
+    in.aov_shadow_view = aov_shadow_index(scene, shadows.size());
+  }
 
   const Material default_material;
   world.view<MeshRenderer, WorldTransform>().each(
@@ -66,10 +93,10 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         d.material = mat ? *mat : default_material;
         d.cast_shadows = mr.cast_shadows;
         d.receive_shadows = mr.receive_shadows;
-        d.cascade_mask = shadow.cascade_mask(e);
+        d.shadow_layers = 0;
+        for (const ShadowData& v : shadows)
+          d.shadow_layers |= std::uint32_t(v.cascade_mask(e)) << v.first_layer;
         d.layer = mr.layer;
-        for (std::size_t k = 0; k < extra.size() && k + 1 < render::kMaxShadowedLights; ++k)
-          d.extra_cascade_masks |= std::uint32_t(extra[k].cascade_mask(e)) << (8 * k);
         if (const auto* wb = world.try_get<WorldBounds>(e)) d.bounds = wb->box;
         // A reflector's own draw reflects its probe's map once one is complete (S3 eq. (3)).
         d.material.features &= ~(render::VariantKey::kReflectionCube.mask() |
@@ -92,43 +119,24 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
       });
   for (const ProbeData::Entry& p : probes.probes) in.probes.push_back(p.job);
 
+  // Lights in entity order; each shadow view learns its light's index.
+  in.shadow_views.resize(shadows.size());
   world.view<Light, WorldTransform>().each(
       [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {
-        const render::LightItem item = light_shading(l, wt.matrix);
-        if (e == shadow.light) in.shadow = shadow_pass(shadow, int(in.lights.size()));
-        for (std::size_t k = 0; k < extra.size() && k + 1 < render::kMaxShadowedLights; ++k)
-          if (e == extra[k].light) {
-            if (in.extra_shadows.size() < k + 1) in.extra_shadows.resize(k + 1);
-            in.extra_shadows[k] = shadow_pass(extra[k], int(in.lights.size()));
-          }
-        in.lights.push_back(item);
+        for (std::size_t k = 0; k < shadows.size(); ++k)
+          if (e == shadows[k].light) in.shadow_views[k] = shadow_view(shadows[k], int(in.lights.size()));
+        in.lights.push_back(light_shading(l, wt.matrix));
       });
   return in;
 }
 
-render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx, ShadowData& shadow) {
-  update_transforms(scene.world, scene.assets);
-  const CameraState camera = select_camera(scene.world, float(ctx.width) / float(ctx.height));
-  ShadowCascadeState state;
-  std::vector<ShadowData> shadows = update_shadows(scene.world, camera, state);
-  shadow = shadows.front();
-  const ProbeData probes = update_environment_probes(scene.world, ctx.index, /*commit=*/false);
-  return build_frame_input(scene, ctx, camera, shadow, probes,
-                           std::span<const ShadowData>(shadows).subspan(1));
-}
+namespace {
 
-render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx) {
-  ShadowData shadow;
-  return plan_frame(scene, ctx, shadow);
-}
-
-Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
-                     bool shadow_points) {
-  return renderer.prewarm(plan_frame(scene, ctx), shadow_points);
-}
-
-Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
-                 FrameReport& report) {
+// Phases 1-5, timed into `report`. `commit`: advance the probe states (a frame that is rendered)
+// or only plan them. False when the scene has no camera (nothing after phase 2 ran).
+bool run_systems(Scene& scene, const FrameContext& ctx, SystemState& state, bool commit,
+                 FrameReport& report, render::FrameInput& input) {
+  if (state.scene != scene.assets.uid) state = SystemState{scene.assets.uid, {}};
   auto t = Clock::now();
   update_transforms(scene.world, scene.assets);
   report.transforms_ms = ms_since(t);
@@ -136,26 +144,44 @@ Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& c
   t = Clock::now();
   report.camera = select_camera(scene.world, float(ctx.width) / float(ctx.height));
   report.camera_ms = ms_since(t);
-  if (!report.camera.entity.valid())
-    return Error{scene.file.string(), "", "the scene has no camera"};
+  if (!report.camera.entity.valid()) return false;
 
   t = Clock::now();
-  std::vector<ShadowData> shadows = update_shadows(scene.world, report.camera, report.shadow_state);
-  report.shadow = std::move(shadows.front());
-  report.extra_shadows.assign(std::make_move_iterator(shadows.begin() + 1),
-                              std::make_move_iterator(shadows.end()));
+  report.shadows = update_shadows(scene.world, report.camera, state.shadows);
   report.shadows_ms = ms_since(t);
 
   t = Clock::now();
-  report.probes = update_environment_probes(scene.world, ctx.index);
+  report.probes = update_environment_probes(scene.world, ctx.index, commit);
   report.probes_ms = ms_since(t);
 
   t = Clock::now();
-  const render::FrameInput input = build_frame_input(scene, ctx, report.camera, report.shadow,
-                                                     report.probes, report.extra_shadows);
+  input = build_frame_input(scene, ctx, report.camera, report.shadows, report.probes);
   report.draw_list_ms = ms_since(t);
+  return true;
+}
 
-  t = Clock::now();
+}  // namespace
+
+render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx, const SystemState& state,
+                              FrameReport* report) {
+  SystemState planned = state;  // the caller's state stays as it is
+  FrameReport local;
+  render::FrameInput input;
+  run_systems(scene, ctx, planned, /*commit=*/false, report ? *report : local, input);
+  return input;
+}
+
+Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
+                     const SystemState& state, bool shadow_points) {
+  return renderer.prewarm(plan_frame(scene, ctx, state), shadow_points);
+}
+
+Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
+                 SystemState& state, FrameReport& report) {
+  render::FrameInput input;
+  if (!run_systems(scene, ctx, state, /*commit=*/true, report, input))
+    return Error{scene.file.string(), "", "the scene has no camera"};
+  const auto t = Clock::now();
   Status st = renderer.render(input, scene.assets);
   report.render_ms = ms_since(t);
   report.stats = renderer.stats();

@@ -3,9 +3,9 @@
 //   1. Transforms  after it: every Transform has a current WorldTransform and every MeshRenderer
 //                  a current WorldBounds.
 //   2. Camera      after it: the active camera's view/projection for this frame's aspect.
-//   3. Cascades    after it: every shadowed light (the first of any type, up to 3 more
-//                  directional ones) has current splits or faces, one light matrix per layer
-//                  and the casters drawn into each (ShadowData).
+//   3. Cascades    after it: every shadowed light has its shadow view (ShadowData): current
+//                  splits or faces, one light matrix per layer, its layers of the shared
+//                  shadow map and the casters drawn into each.
 //   4. Probes      after it: every Reflector has a ProbeState and this frame's probe job (faces
 //                  to capture, buffer to show); counters are current (ProbeData).
 //   5. DrawList    after it: the renderer's FrameInput holds every drawable, light, probe and
@@ -34,39 +34,53 @@ struct FrameContext {
   bool write_aovs = true;   ///< render the AOV targets too (see render::FrameInput)
 };
 
+/// What the systems carry from one frame of a scene to the next. Whoever runs the frames of a
+/// scene keeps one (the player, a playback run, a stability run) and passes it to every frame.
+/// A state used with another scene starts afresh (history of one scene says nothing of another).
+struct SystemState {
+  std::uint64_t scene = 0;  ///< AssetStore::uid of the scene it belongs to; 0: none yet
+  ShadowCascadeState shadows;
+};
+
 /// What a frame did, for stats output and tests. CPU times in milliseconds.
 struct FrameReport {
   double transforms_ms = 0, camera_ms = 0, shadows_ms = 0, probes_ms = 0, draw_list_ms = 0,
          render_ms = 0;
   CameraState camera;
-  ShadowData shadow;                      ///< the first shadowed light
-  std::vector<ShadowData> extra_shadows;  ///< further shadowed directional lights
+  std::vector<ShadowData> shadows;  ///< one per shadow view (update_shadows())
   ProbeData probes;
   render::FrameStats stats;
-  /// Carried from frame to frame when the caller reuses its report (the player does).
-  ShadowCascadeState shadow_state;
+
+  /// Shadow view k, or an empty one (light null) when there are not that many.
+  const ShadowData& shadow(std::size_t k = 0) const;
 };
 
-/// Runs phases 1-6. Errors: no camera in the scene, shader build failures.
+/// Runs phases 1-6 and advances `state`. Errors: no camera in the scene, shader build failures,
+/// a frame the renderer refuses.
 Status run_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
-                 FrameReport& report);
+                 SystemState& state, FrameReport& report);
 
-/// Phases 1-5 without GL: the renderer input a frame of this scene would get (probe states are
-/// planned, not advanced).
-render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx);
-/// The same, also returning the frame's ShadowData (tests).
-render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx, ShadowData& shadow);
+/// Phases 1-5 without GL, as run_frame() would run them next with `state` (which is not
+/// advanced; probe states are planned, not advanced): the renderer input and, in `report`, what
+/// the systems published.
+render::FrameInput plan_frame(Scene& scene, const FrameContext& ctx,
+                              const SystemState& state = {}, FrameReport* report = nullptr);
 
-/// Phases 1-5, then compiles every program the frame will use (scene load: no compiles later).
+/// Phases 1-5 as plan_frame(), then compiles every program the frame will use (scene load: no
+/// compiles later), and with `shadow_points` the points pass's.
 Status prewarm_frame(Scene& scene, render::Renderer& renderer, const FrameContext& ctx,
-                     bool shadow_points = false);
+                     const SystemState& state = {}, bool shadow_points = false);
+
+/// The index of the shadow view the AOV shows: render.aov_shadow_light counts the shadowed
+/// lights in order; past the last one it is the first. 0 when there are none.
+int aov_shadow_index(const Scene& scene, std::size_t views);
 
 /// Phase 5 on its own (pure: no GL), exposed for tests. Draws of entities with a Reflector whose
-/// map is ready get the reflection_cube or reflection_sphere material feature. `extra` are the
-/// further shadowed directional lights (update_shadows() after its first element).
+/// map is ready get the reflection_cube or reflection_sphere material feature. `shadows` are
+/// update_shadows()'s views.
 render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx,
-                                     const CameraState& camera, const ShadowData& shadow,
-                                     const ProbeData& probes = {},
-                                     std::span<const ShadowData> extra = {});
+                                     const CameraState& camera,
+                                     std::span<const ShadowData> shadows,
+                                     const ProbeData& probes = {});
 
 }  // namespace kaskad

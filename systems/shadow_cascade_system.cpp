@@ -126,7 +126,7 @@ void fit_local_light(const Light& light, const LightFrame& frame, ShadowData& ou
     out.projection = ShadowProjection::dual_paraboloid;
     out.cascade_count = 2;
     const float margin = paraboloid_margin(s.map_size, border);
-    out.splits[2] = margin;  // read by the shaders beside near and far
+    out.paraboloid_margin = margin;
     const auto views = paraboloid_views(frame.origin, frame.direction);
     for (int h = 0; h < 2; ++h) {
       out.view_proj[std::size_t(h)] = views[std::size_t(h)];
@@ -252,8 +252,9 @@ namespace {
 // The maps of one shadowed light (entity `e`, null for none). Errors are logged when they differ
 // from `last_error`, which is updated. `previous` is this slot's last result (freeze_cascades).
 /// `shared`: for lights after the first, the first light's settings whose map_size,
-/// depth_format, filter and selection apply to every light (one shared texture array). They are
-/// applied before fitting, so texel sizes and the stable fit's snapping use the real map size.
+/// depth_format, filter, selection, layered and debug_cascades apply to every light (one shared
+/// texture array, one set of shader features). They are applied before fitting, so texel sizes
+/// and the stable fit's snapping use the real map size.
 ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera, ecs::Entity e,
                               const Light& light_component, const glm::mat4& light_matrix,
                               const ShadowData& previous, std::string& last_error,
@@ -275,6 +276,8 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
     out.settings.depth_format = shared->depth_format;
     out.settings.filter = shared->filter;
     out.settings.selection = shared->selection;
+    out.settings.layered = shared->layered;
+    out.settings.debug_cascades = shared->debug_cascades;
   }
   const ShadowSettings& s = out.settings;
   if (std::string bad = validate_shadow_settings(s); !bad.empty()) {
@@ -443,73 +446,84 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
 
 }  // namespace
 
-std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraState& camera,
-                                       ShadowCascadeState& state) {
+namespace {
+
+// Every shadowed light's view, in entity order, including the ones that failed (light null,
+// `error` set): update_shadows() publishes the others, update_shadow_cascades() the first.
+std::vector<ShadowData> fit_shadowed_lights(const ecs::World& world, const CameraState& camera,
+                                            ShadowCascadeState& state) {
   struct Shadowed {
     ecs::Entity entity;
     Light light;
     glm::mat4 matrix;
   };
   std::vector<Shadowed> lights;
+  int shaded = 0;  // the renderer shades the first kMaxLights lights (FrameInput::lights)
   world.view<Light, WorldTransform>().each(
       [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {
-        if (l.cast_shadows) lights.push_back({e, l, wt.matrix});
+        if (l.cast_shadows && shaded < kMaxLights) lights.push_back({e, l, wt.matrix});
+        ++shaded;
       });
   std::vector<ShadowData> out;
+  out.reserve(std::size_t(kMaxShadowedLights));  // `shared` points into it
+  const ShadowSettings* shared = nullptr;  // the first view's settings
+  int layers = 0;
   std::string notice;  // every notice of this frame, logged once while it stays the same
   auto add_notice = [&](const std::string& n) { notice += (notice.empty() ? "" : "; ") + n; };
+  if (shaded > kMaxLights)
+    add_notice(std::to_string(shaded) + " lights; only the first " + std::to_string(kMaxLights) +
+               " are shaded, so only they can cast shadows");
+  std::size_t slot = 0;
   for (std::size_t i = 0; i < lights.size(); ++i) {
     const Shadowed& l = lights[i];
     const auto* named = world.try_get<Name>(l.entity);
     const std::string name = "light " + (named ? "'" + named->value + "' (" : std::string("(")) +
                              "entity " + std::to_string(l.entity.index) + ")";
+    // The first view's projection is a shader feature; the views after it are cascades.
     if (i > 0 && l.light.type != LightType::directional) {
       add_notice(name +
                  ": only the first shadowed light may be a spot or point light; it is lit "
                  "without shadows");
       continue;
     }
-    if (out.size() == std::size_t(kMaxShadowedLights)) {
+    if (slot == std::size_t(kMaxShadowedLights)) {
       add_notice(std::to_string(lights.size()) + " shadowed lights; only the first " +
                  std::to_string(kMaxShadowedLights) + " get shadow maps, " + name +
                  " and the ones after it are lit without shadows");
       break;
     }
-    const std::size_t slot = out.size();
     ShadowData d = fit_shadowed_light(world, camera, l.entity, l.light, l.matrix,
-                                      state.previous[slot], state.last_errors[slot],
-                                      i == 0 ? nullptr : &out[0].settings);
+                                      state.previous[slot], state.last_errors[slot], shared);
     state.previous[slot] = d;
-    if (i == 0) {
-      out.push_back(std::move(d));
-      if (!out[0].light.valid()) break;  // no primary: no extra lights either
+    ++slot;
+    if (d.light.valid()) {
+      d.first_layer = layers;
+      layers += d.cascade_count;
+    }
+    out.push_back(std::move(d));
+    if (!out.back().light.valid()) continue;  // its error is logged
+    if (!shared) {
+      shared = &out.back().settings;
       continue;
     }
-    if (!d.light.valid()) continue;  // its error is logged
-    // One depth texture array holds every light's layers: the first light's map size, format
-    // and filter apply to all, and its cascade selection, layered pass and debug tint (frame
-    // features of the shaders). fit_shadowed_light applied the first four; say which of them
-    // the light's own component asks otherwise.
-    const ShadowSettings& first = out[0].settings;
+    // Say which of the shared fields the light's own component asks otherwise.
     if (const auto* own = world.try_get<ShadowSettings>(l.entity)) {
       std::string differ;
       auto check = [&](bool same, const char* field) {
         if (!same) differ += std::string(differ.empty() ? "" : ", ") + field;
       };
-      check(own->map_size == first.map_size, "map_size");
-      check(own->depth_format == first.depth_format, "depth_format");
-      check(own->filter == first.filter, "filter");
-      check(own->selection == first.selection, "selection");
-      check(own->layered == first.layered, "layered");
-      check(own->debug_cascades == first.debug_cascades, "debug_cascades");
+      check(own->map_size == shared->map_size, "map_size");
+      check(own->depth_format == shared->depth_format, "depth_format");
+      check(own->filter == shared->filter, "filter");
+      check(own->selection == shared->selection, "selection");
+      check(own->layered == shared->layered, "layered");
+      check(own->debug_cascades == shared->debug_cascades, "debug_cascades");
       if (!differ.empty())
         add_notice(name + ": its " + differ +
                    " differ from the first shadowed light's, whose values apply (one shared "
                    "texture array, one set of shader features)");
     }
-    out.push_back(std::move(d));
   }
-  if (out.empty()) out.emplace_back();
   if (notice != state.last_notice) {
     if (!notice.empty()) log::warn_once("shadows: %s", notice.c_str());
     state.last_notice = notice;
@@ -517,9 +531,19 @@ std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraStat
   return out;
 }
 
+}  // namespace
+
+std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraState& camera,
+                                       ShadowCascadeState& state) {
+  std::vector<ShadowData> views = fit_shadowed_lights(world, camera, state);
+  std::erase_if(views, [](const ShadowData& d) { return !d.light.valid(); });
+  return views;
+}
+
 ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& camera,
                                   ShadowCascadeState& state) {
-  return std::move(update_shadows(world, camera, state).front());
+  std::vector<ShadowData> views = fit_shadowed_lights(world, camera, state);
+  return views.empty() ? ShadowData{} : std::move(views.front());
 }
 
 }  // namespace kaskad

@@ -1,8 +1,9 @@
-// Shadow maps of the first shadowed light, the frame's Cascades phase: cascades of a directional
-// light (S0 with S2's stabilisation), one perspective map of a spot light, six cube faces or two
-// paraboloid hemispheres of a point light. Maths on the CPU only (cascade_math.h,
-// local_light_math.h); the renderer draws one depth layer per cascade (or face, or hemisphere)
-// from the ShadowData published here.
+// The frame's Cascades phase: one shadow view per shadowed light, all in one depth texture array.
+// A view holds the cascades of a directional light (S0 with S2's stabilisation), the perspective
+// map of a spot light, or the six cube faces or two paraboloid hemispheres of a point light.
+// Maths on the CPU only (cascade_math.h, local_light_math.h); the renderer draws one depth layer
+// per cascade (or face, or hemisphere) from the views published here (systems/frame.cpp turns
+// them into render::ShadowView, the shaders read them as u_shadow_views).
 #pragma once
 
 #include <array>
@@ -16,17 +17,20 @@
 #include "components/bounds.h"
 #include "components/shadow_settings.h"
 #include "runtime/ecs/world.h"
-#include "runtime/render/shadow_limits.h"
+#include "components/limits.h"
 #include "systems/camera_system.h"
 #include "systems/cascade_math.h"
 #include "systems/shadow_map_system.h"
 
 namespace kaskad {
 
-/// What the renderer and the stats need of the shadowed light this frame.
+/// One shadowed light's view this frame: what the renderer and the stats need of it.
 struct ShadowData {
   ecs::Entity light = ecs::kNullEntity;  ///< the shadowed light, null when there is none
-  ShadowSettings settings;               ///< the light's own, else defaults
+  /// The light's own (else defaults), except the fields that belong to the shared texture array
+  /// and the frame's shader features: map_size, depth_format, filter, selection, layered and
+  /// debug_cascades are the first view's in every view (update_shadows() warns when they differ).
+  ShadowSettings settings;
   /// ortho: a directional light's cascades; perspective: a spot light's map; cube or
   /// dual_paraboloid: a point light's maps (settings.point_mode).
   ShadowProjection projection = ShadowProjection::ortho;
@@ -34,6 +38,9 @@ struct ShadowData {
   /// cube: 6 faces (+X, -X, +Y, -Y, +Z, -Z); dual_paraboloid: 2 hemispheres. "Cascade" below
   /// means layer for the local lights.
   int cascade_count = 0;
+  /// Its first layer in the shared depth texture array: views follow each other, layers
+  /// first_layer .. first_layer + cascade_count - 1.
+  int first_layer = 0;
   /// World -> light clip space per cascade (cascade 0 is the basic map with FitMode::scene);
   /// dual_paraboloid: world -> hemisphere view (paraboloid_views(); the projection is not a
   /// matrix).
@@ -42,6 +49,8 @@ struct ShadowData {
   /// FitMode::scene: [0, 3.4e38] (one map covers every depth). Spot and point lights: [near, far]
   /// of the maps, metres from the light (local_light_near_far()).
   std::array<float, kMaxCascades + 1> splits{};
+  /// dual_paraboloid: how far past its rim each hemisphere is drawn (paraboloid_margin()).
+  float paraboloid_margin = 0.0f;
   /// Metres per shadow-map texel of each cascade (the larger of x and y). Spot and point lights:
   /// metres per texel at 1 m from the light (the shader scales by the distance).
   std::array<float, kMaxCascades> texel_size{};
@@ -63,12 +72,8 @@ struct ShadowData {
   std::uint8_t cascade_mask(ecs::Entity e) const;
 };
 
-/// Shadowed lights with maps at most: the first (any type) and up to 3 more directional lights
-/// (the renderer's limit, one definition).
-using render::kMaxShadowedLights;
-
-/// State the system owns between frames: the last error per shadowed light and the last notice,
-/// so each is logged once, not every frame.
+/// State the system owns between frames (the player keeps it): the last error per shadowed light
+/// and the last notice, so each is logged once, not every frame.
 struct ShadowCascadeState {
   std::array<std::string, kMaxShadowedLights> last_errors;
   std::string last_notice;
@@ -76,7 +81,9 @@ struct ShadowCascadeState {
   std::array<ShadowData, kMaxShadowedLights> previous;
 };
 
-/// Phase 3. Picks the first Light with cast_shadows (entity order). A spot light gets one
+/// The view of the first Light with cast_shadows (entity order), as update_shadows() fits it, or
+/// one with a null light and the reason (`error`) when that light has no maps. Tests and tools
+/// that look at one light. A spot light gets one
 /// perspective map around its outer cone, a point light six cube faces or two paraboloid
 /// hemispheres (settings.point_mode), all with near/far fitted to the casters and receivers within
 /// the light's range (layers without receivers skipped, casters culled per layer; the cascade
@@ -90,14 +97,15 @@ struct ShadowCascadeState {
 ShadowData update_shadow_cascades(const ecs::World& world, const CameraState& camera,
                                   ShadowCascadeState& state);
 
-/// Phase 3 for every shadowed light: element 0 is update_shadow_cascades()'s result (light null
-/// when there is none); elements 1.. are further directional lights with cast_shadows (entity
-/// order), each fitted with its own settings and cascades, as S0 asks of several directional
-/// lights. They share the first light's map_size, depth_format, filter, selection, layered and
-/// debug_cascades (one texture array, one set of frame features; a warning logged once names
-/// the fields when theirs differ). Spot and point lights after the first
-/// shadowed light are lit without shadows, and lights beyond kMaxShadowedLights are left out,
-/// with a warning logged once. Extra lights are present only when the first one is valid.
+/// Phase 3: one view per shadowed light (Lights with cast_shadows among the first kMaxLights
+/// lights, entity order), at most kMaxShadowedLights, each fitted with its own settings as S0
+/// asks of several lights; empty when no light casts. Views share the texture array's and the
+/// shaders' settings (see ShadowData::settings; a warning logged once names the fields when a
+/// light's own differ). A spot or point light gets a view only as the first shadowed light
+/// (its projection is a shader feature); later ones are lit without shadows, and lights beyond
+/// kMaxShadowedLights are left out, each with a warning logged once. A light whose settings or
+/// transform are invalid gets no view (its error is logged once); the others keep theirs.
+/// first_layer numbers the layers of the views in order.
 std::vector<ShadowData> update_shadows(const ecs::World& world, const CameraState& camera,
                                        ShadowCascadeState& state);
 

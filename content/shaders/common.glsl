@@ -1,40 +1,36 @@
-// Shared declarations. Change together with FrameBlock in runtime/render/renderer.cpp.
-#define MAX_LIGHTS 8
-#define MAX_CASCADES 8
-#define MAX_EXTRA_SHADOWS 3  // further shadowed directional lights (render::kMaxShadowedLights - 1)
+// Shared declarations. FrameBlock is FrameBlock in runtime/render/frame_uniforms.h (std140; its
+// offsets are tested against this block). MAX_LIGHTS, MAX_CASCADES and MAX_SHADOW_VIEWS are
+// defined in every program from components/limits.h (FeatureManifest::defines).
 #define LIGHT_DIRECTIONAL 0
 #define LIGHT_SPOT 1
 #define LIGHT_POINT 2
 
+// One shadowed light's maps: its layers of the shadow map array (ShadowViewBlock).
+struct ShadowView {
+  mat4 view_proj[MAX_CASCADES];  // world -> shadow clip space per layer
+  vec4 splits[3];                // S0's D[0..8], four per vec4: view_split(k, i)
+  vec4 texel[2];                 // metres per texel per layer: view_texel(k, i)
+  ivec4 info;                    // x light index, y first layer, z layer count
+  vec4 params;                   // x normal offset (texels), y blend band, z paraboloid margin
+};
+
 layout(std140, binding = 0) uniform FrameBlock {
   mat4 u_view_proj;
   mat4 u_view;
-  vec4 u_camera_pos;               // xyz: world position
-  vec4 u_ambient;                  // rgb: linear ambient radiance, w: exposure
-  ivec4 u_counts;                  // x: light count, y: shadowed light index (-1: none),
-                                   // z: cascade count, w: shadowed light the AOV shows (0 the
-                                   // first, k extra light k - 1)
-  vec4 u_shadow_params;            // x: normal offset (texels), y: blend band, z: map size
-  mat4 u_cascade_view_proj[MAX_CASCADES];  // world -> shadow clip space per cascade
-  vec4 u_cascade_splits[3];        // S0's D[0..8], four per vec4: cascade_split(i)
-  vec4 u_cascade_texel[2];         // metres per texel per cascade: cascade_texel(i)
-  vec4 u_light_color[MAX_LIGHTS];  // rgb: colour * intensity, w: type
-  vec4 u_light_dir[MAX_LIGHTS];    // xyz: direction the light travels, w: range (0 = infinite)
-  vec4 u_light_pos[MAX_LIGHTS];    // xyz: world position, w: cos(outer cone)
-  vec4 u_light_cone[MAX_LIGHTS];   // x: cos(inner cone)
-  // Further shadowed directional lights, each with its own cascades in the same texture array.
-  ivec4 u_extra_count;                               // x: how many
-  ivec4 u_extra_light[MAX_EXTRA_SHADOWS];            // x light index, y first layer, z cascades
-  vec4 u_extra_params[MAX_EXTRA_SHADOWS];            // x normal offset, y blend band, z map size
-  mat4 u_extra_view_proj[MAX_EXTRA_SHADOWS * MAX_CASCADES];  // [k * MAX_CASCADES + i]
-  vec4 u_extra_splits[MAX_EXTRA_SHADOWS * 3];        // extra_split(k, i)
-  vec4 u_extra_texel[MAX_EXTRA_SHADOWS * 2];         // extra_texel(k, i)
+  vec4 u_camera_pos;                // xyz: world position
+  vec4 u_ambient;                   // rgb: linear ambient radiance
+  vec4 u_frame;                     // x exposure, y shadow map size (texels a side)
+  ivec4 u_counts;                   // x lights, y shadow views, z the view the AOV shows
+  vec4 u_light_color[MAX_LIGHTS];   // rgb: colour * intensity
+  ivec4 u_light_info[MAX_LIGHTS];   // x type (LIGHT_*), y its shadow view (-1: none)
+  vec4 u_light_dir[MAX_LIGHTS];     // xyz: direction the light travels, w: range (0 = infinite)
+  vec4 u_light_pos[MAX_LIGHTS];     // xyz: world position, w: cos(outer cone)
+  vec4 u_light_cone[MAX_LIGHTS];    // x: cos(inner cone)
+  ShadowView u_shadow_views[MAX_SHADOW_VIEWS];
 };
 
-float cascade_split(int i) { return u_cascade_splits[i >> 2][i & 3]; }
-float cascade_texel(int i) { return u_cascade_texel[i >> 2][i & 3]; }
-float extra_split(int k, int i) { return u_extra_splits[k * 3 + (i >> 2)][i & 3]; }
-float extra_texel(int k, int i) { return u_extra_texel[k * 2 + (i >> 2)][i & 3]; }
+float view_split(int k, int i) { return u_shadow_views[k].splits[i >> 2][i & 3]; }
+float view_texel(int k, int i) { return u_shadow_views[k].texel[i >> 2][i & 3]; }
 
 // Per-draw uniforms (explicit locations: no name look-ups at draw time).
 layout(location = 0) uniform mat4 u_model;

@@ -13,8 +13,8 @@ layout(location = 0) out vec4 o_color;
 #if VARIANT_HAS_AOVS
 layout(location = 1) out vec4 o_position;    // xyz world position, w mask (1 = geometry)
 layout(location = 2) out vec4 o_normal;      // xyz world normal facing the camera, w view depth
-layout(location = 3) out vec2 o_visibility;  // x shadow visibility of the shadowed light
-                                             // u_counts.w names (the first by default),
+layout(location = 3) out vec2 o_visibility;  // x shadow visibility of the shadow view
+                                             // u_counts.z names (the first by default),
                                              // y its cascade (-1 outside every cascade)
 layout(location = 4) out vec4 o_reflection;  // rgb reflected colour C_t, a 1 with a map (else 0)
 #endif
@@ -87,47 +87,43 @@ void main() {
   float shininess = max(2.0 / (alpha * alpha) - 2.0, 1.0);
   float spec_norm = (shininess + 8.0) / 8.0;
 
-  float visibility = 1.0;
-  int cascade = -1;
   float view_depth = -(u_view * vec4(v_world_pos, 1.0)).z;
-#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
-  if (ENABLED(BIT_RECEIVE_SHADOWS)) {
-#if VARIANT_HAS_AOVS
-    visibility = shadow_visibility(v_world_pos, geometric_n, view_depth, cascade);
-#else
-    // No AOV shows it: where the geometric surface faces away from the light it shadows itself,
-    // so the lookup is skipped (visibility 0; only a normal-mapped normal can still face the
-    // light there). With AOVs the lookup runs everywhere: the AOV contract and its tests keep
-    // today's values on such pixels. llvmpipe runs the masked lookup anyway (no gain there).
-    visibility = 0.0;
-    if (faces_light(u_counts.y, v_world_pos, geometric_n))
-      visibility = shadow_visibility(v_world_pos, geometric_n, view_depth, cascade);
-#endif
-  }
-#endif
-
   vec3 color = u_ambient.rgb * diffuse_color;
 #if MATERIAL_HAS_EMISSIVE
   if (ENABLED(BIT_EMISSIVE)) color += u_emissive;
 #endif
-  // Further shadowed directional lights (as many as the variant has: none is no code); the AOV
-  // shows the one u_counts.w names.
-  float aov_visibility = visibility;
-  int aov_cascade = cascade;
-#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS && EXTRA_SHADOWS > 0
-  float extra_visibility[MAX_EXTRA_SHADOWS] = float[MAX_EXTRA_SHADOWS](1.0, 1.0, 1.0);
-  if (ENABLED(BIT_RECEIVE_SHADOWS))
-    for (int k = 0; k < EXTRA_SHADOWS; ++k) {
-      int c;
-      extra_visibility[k] = extra_shadow_visibility(k, v_world_pos, geometric_n, view_depth, c);
-      if (k + 1 == u_counts.w) {
-        aov_visibility = extra_visibility[k];
-        aov_cascade = c;
-      }
+  // Shadow visibility per shadow view (as many views as the variant has: none is no code); the
+  // AOV shows the view u_counts.z names, the debug tint view 0's cascade.
+  float aov_visibility = 1.0;
+  int aov_cascade = -1, tint_cascade = -1;
+#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
+  float view_visibility[SHADOW_VIEWS];
+  for (int k = 0; k < SHADOW_VIEWS; ++k) {
+    float visibility = 1.0;
+    int cascade = -1;
+    if (ENABLED(BIT_RECEIVE_SHADOWS)) {
+#if VARIANT_HAS_AOVS
+      visibility = shadow_visibility(k, v_world_pos, geometric_n, view_depth, cascade);
+#else
+      // No AOV shows it: where the geometric surface faces away from the light it shadows
+      // itself, so the lookup is skipped (visibility 0; only a normal-mapped normal can still
+      // face the light there). With AOVs the lookup runs everywhere: the AOV contract and its
+      // tests keep today's values on such pixels. llvmpipe runs the masked lookup anyway.
+      visibility = 0.0;
+      if (faces_light(u_shadow_views[k].info.x, v_world_pos, geometric_n))
+        visibility = shadow_visibility(k, v_world_pos, geometric_n, view_depth, cascade);
+#endif
     }
+    view_visibility[k] = visibility;
+    if (k == u_counts.z) {
+      aov_visibility = visibility;
+      aov_cascade = cascade;
+    }
+    if (k == 0) tint_cascade = cascade;
+  }
 #endif
   for (int i = 0; i < u_counts.x; ++i) {
-    int type = int(u_light_color[i].w);
+    int type = u_light_info[i].x;
     vec3 l;
     float attenuation = 1.0;
     if (type == LIGHT_DIRECTIONAL) {
@@ -151,10 +147,10 @@ void main() {
     if (ndl <= 0.0) continue;
     vec3 h = normalize(l + v);
     vec3 spec = f0 * spec_norm * pow(max(dot(n, h), 0.0), shininess);
-    float shadow = (i == u_counts.y) ? visibility : 1.0;
-#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS && EXTRA_SHADOWS > 0
-    for (int k = 0; k < EXTRA_SHADOWS; ++k)
-      if (u_extra_light[k].x == i) shadow = extra_visibility[k];
+    float shadow = 1.0;
+#if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
+    for (int k = 0; k < SHADOW_VIEWS; ++k)  // constant indices: no dynamic array access
+      if (u_light_info[i].y == k) shadow = view_visibility[k];
 #endif
     color += (diffuse_color + spec) * u_light_color[i].rgb * ndl * attenuation * shadow;
   }
@@ -191,9 +187,9 @@ void main() {
 #endif
 
 #if VARIANT_HAS_SHADOW && VARIANT_DEBUG_CASCADES
-  color *= cascade_tint(cascade);
+  color *= cascade_tint(tint_cascade);
 #endif
-  o_color = vec4(color * u_ambient.w, 1.0);
+  o_color = vec4(color * u_frame.x, 1.0);
 #if VARIANT_HAS_AOVS
   o_position = vec4(v_world_pos, 1.0);
   o_normal = vec4(geometric_n, view_depth);

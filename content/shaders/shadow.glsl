@@ -5,22 +5,35 @@
 layout(binding = 2) uniform sampler2DArrayShadow u_shadow_map;  // one layer per cascade
 #endif
 
-// Visibility of the shadowed light at world position p with geometric normal n: 1 lit, 0
-// shadowed (S4, with S0's cascades). Clamp-to-border with border depth 1 and the z > 1 test keep
-// everything outside a cascade's light frustum lit. Cascade selection and blending mirror
-// select_cascade_by_depth / select_cascade_by_map / cascade_blend_weight* in
-// systems/cascade_math.h (change together). Spot and point lights
-// (VARIANT_SHADOW_PROJECTION != ORTHO) mirror systems/local_light_math.h: layers are the spot
-// map, cube faces or paraboloid hemispheres; cascade_split(0..2) hold near, far (metres from the
-// light) and the paraboloid margin; cascade_texel(i) is metres per texel at 1 m from the light.
+// Visibility of shadow view k's light at world position p with geometric normal n: 1 lit, 0
+// shadowed (S4, with S0's cascades). Every view goes through the same functions, indexed by k
+// (u_shadow_views[k]); its layers are first_layer .. first_layer + layer count - 1 of the array.
+// Clamp-to-border with border depth 1 and the z > 1 test keep everything outside a layer's light
+// frustum lit. Cascade selection and blending: select_cascade_by_depth / select_cascade_by_map /
+// cascade_blend_weight* in systems/cascade_math.h, tested against this code in
+// tests/render/cascade_selection_test.cpp. View 0 may be a spot or point light
+// (VARIANT_SHADOW_PROJECTION != ORTHO; systems/local_light_math.h): its layers are the spot map,
+// cube faces or paraboloid hemispheres, view_split(0, 0..1) hold near and far (metres from the
+// light), and view_texel(0, i) is metres per texel at 1 m from the light.
 #if VARIANT_HAS_SHADOW
-#define CASCADES VARIANT_CASCADE_COUNT
-// Further shadowed directional lights of this variant (u_extra_count.x holds the same number).
-// A compile-time count: on llvmpipe a loop whose uniform bound is 0 still runs its body once
-// with every lane masked off, which cost a quarter of the default scene's frame.
-#define EXTRA_SHADOWS (VARIANT_SHADOW_LIGHTS - 1)
+// Shadow views of this variant (u_counts.y holds the same number). A compile-time count, so the
+// loops over views unroll and a frame with one shadowed light has no code for more: on llvmpipe
+// a loop whose uniform bound is 0 still runs its body once with every lane masked off, which
+// cost a quarter of the default scene's frame.
+#define SHADOW_VIEWS VARIANT_SHADOW_LIGHTS
 
-// The filtered depth compare of layer `layer` at c: xy texture coordinates, z depth in [0, 1].
+// Layer count and first layer of view k. View 0's are constants of the variant (its cascade
+// count; layers start at 0), so its selection loops end at a constant; the others' are data.
+int view_layers(int k) {
+#if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_ORTHO
+  if (k == 0) return VARIANT_CASCADE_COUNT;
+#endif
+  return u_shadow_views[k].info.z;
+}
+int view_first_layer(int k) { return k == 0 ? 0 : u_shadow_views[k].info.y; }
+
+// The filtered depth compare of array layer `layer` at c: xy texture coordinates, z depth in
+// [0, 1].
 float shadow_taps(int layer, vec3 c) {
   vec4 tc = vec4(c.xy, float(layer), c.z);
 #if VARIANT_SHADOW_FILTER == VARIANT_SHADOW_FILTER_PCF3X3
@@ -44,35 +57,37 @@ float shadow_taps(int layer, vec3 c) {
 #endif
 }
 
-// One cascade's lookup. The point moves along the normal by normal_offset texels of this
-// cascade (MJP's normal offset), so the bias follows each cascade's resolution.
-float cascade_visibility(int cascade, vec3 p, vec3 n) {
-  vec3 q = p + n * (u_shadow_params.x * cascade_texel(cascade));
-  vec4 clip = u_cascade_view_proj[cascade] * vec4(q, 1.0);
-  vec3 c = clip.xyz / clip.w * 0.5 + 0.5;  // S0's M_bias
-  if (c.z > 1.0) return 1.0;
-  return shadow_taps(cascade, c);
+// Cascade c of view k. The point moves along the normal by normal_offset texels of this cascade
+// (MJP's normal offset), so the bias follows each cascade's resolution.
+float cascade_visibility(int k, int c, vec3 p, vec3 n) {
+  vec3 q = p + n * (u_shadow_views[k].params.x * view_texel(k, c));
+  vec4 clip = u_shadow_views[k].view_proj[c] * vec4(q, 1.0);
+  vec3 t = clip.xyz / clip.w * 0.5 + 0.5;  // S0's M_bias
+  if (t.z > 1.0) return 1.0;
+  return shadow_taps(view_first_layer(k) + c, t);
 }
 
 #if VARIANT_SHADOW_PROJECTION != VARIANT_SHADOW_PROJECTION_ORTHO
+vec3 view_light_position(int k) { return u_light_pos[u_shadow_views[k].info.x].xyz; }
+
 // Spot and point lights: the normal offset in texels of `layer` at the point's distance (a
 // perspective texel grows with the distance from the light).
-vec3 local_offset_point(int layer, vec3 p, vec3 n) {
-  float dist = distance(p, u_light_pos[u_counts.y].xyz);
-  return p + n * (u_shadow_params.x * cascade_texel(layer) * dist);
+vec3 local_offset_point(int k, int layer, vec3 p, vec3 n) {
+  float dist = distance(p, view_light_position(k));
+  return p + n * (u_shadow_views[k].params.x * view_texel(k, layer) * dist);
 }
 #endif
 
 #if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_PERSPECTIVE || \
     VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_CUBE
 // A spot map or one cube face: a perspective projection, otherwise as a cascade.
-float perspective_visibility(int layer, vec3 p, vec3 n) {
-  vec3 q = local_offset_point(layer, p, n);
-  vec4 clip = u_cascade_view_proj[layer] * vec4(q, 1.0);
+float perspective_visibility(int k, int layer, vec3 p, vec3 n) {
+  vec3 q = local_offset_point(k, layer, p, n);
+  vec4 clip = u_shadow_views[k].view_proj[layer] * vec4(q, 1.0);
   if (clip.w <= 0.0) return 1.0;  // behind the light
   vec3 c = clip.xyz / clip.w * 0.5 + 0.5;
   if (c.z > 1.0) return 1.0;
-  return shadow_taps(layer, c);
+  return shadow_taps(view_first_layer(k) + layer, c);
 }
 #endif
 
@@ -89,66 +104,63 @@ int cube_face(vec3 d) {
 
 #if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_DUAL_PARABOLOID
 // Dual-paraboloid lookup (S0's earlier work): hemisphere 0 is z <= 0 of the view in
-// u_cascade_view_proj[0], hemisphere 1 the rest, seen from the same view turned 180 degrees about
-// y. Mirrors paraboloid_views() / paraboloid_project() (systems/local_light_math.h) and
+// view_proj[0], hemisphere 1 the rest, seen from the same view turned 180 degrees about y.
+// Mirrors paraboloid_views() / paraboloid_project() (systems/local_light_math.h) and
 // shadow_depth.vert.
-float paraboloid_visibility(vec3 p, vec3 n, out int hemisphere) {
-  vec3 q = local_offset_point(0, p, n);
-  vec3 v = (u_cascade_view_proj[0] * vec4(q, 1.0)).xyz;
+float paraboloid_visibility(int k, vec3 p, vec3 n, out int hemisphere) {
+  vec3 q = local_offset_point(k, 0, p, n);
+  vec3 v = (u_shadow_views[k].view_proj[0] * vec4(q, 1.0)).xyz;
   hemisphere = v.z <= 0.0 ? 0 : 1;
   if (hemisphere == 1) v = vec3(-v.x, v.y, -v.z);
   float d = length(v);
   vec3 u = v / max(d, 1e-20);
-  float near = cascade_split(0), far = cascade_split(1), margin = cascade_split(2);
+  float near = view_split(k, 0), far = view_split(k, 1), margin = u_shadow_views[k].params.z;
   vec2 xy = u.xy / ((1.0 - u.z) * (1.0 + margin));
   float z = (d - near) / (far - near);
   if (z > 1.0) return 1.0;
-  return shadow_taps(hemisphere, vec3(xy * 0.5 + 0.5, z));
+  return shadow_taps(view_first_layer(k) + hemisphere, vec3(xy * 0.5 + 0.5, z));
 }
 #endif
 
 #if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
 // Border kept free in NDC: the PCF kernel's reach plus the normal offset, in texels.
-float map_border() { return 2.0 * (1.5 + u_shadow_params.x) / u_shadow_params.z; }
+float map_border(int k) { return 2.0 * (1.5 + u_shadow_views[k].params.x) / u_frame.y; }
 #endif
 
-// The cascade of a point, -1 outside all. depth: view depth |z_view|.
-int select_cascade(vec3 p, float depth) {
+// The cascade of view k at a point, -1 outside all. depth: view depth |z_view|.
+int select_cascade(int k, vec3 p, float depth) {
+  int count = view_layers(k);
 #if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
-  float limit = 1.0 - map_border();
-  for (int i = 0; i < CASCADES; ++i) {
-    vec4 clip = u_cascade_view_proj[i] * vec4(p, 1.0);
+  float limit = 1.0 - map_border(k);
+  for (int i = 0; i < count; ++i) {
+    vec4 clip = u_shadow_views[k].view_proj[i] * vec4(p, 1.0);
     vec3 ndc = clip.xyz / clip.w;
     if (abs(ndc.x) <= limit && abs(ndc.y) <= limit && abs(ndc.z) <= 1.0) return i;
   }
   return -1;
 #else
   // S0: D[i] <= depth < D[i+1]; nearer than D[0] (the camera near plane) counts as cascade 0.
-  if (depth >= cascade_split(CASCADES)) return -1;
+  if (depth >= view_split(k, count)) return -1;
   int cascade = 0;
-  for (int i = 1; i < CASCADES; ++i)
-    if (depth >= cascade_split(i)) cascade = i;
+  for (int i = 1; i < count; ++i)
+    if (depth >= view_split(k, i)) cascade = i;
   return cascade;
 #endif
 }
 
-// Weight of cascade + 1 in the blend band at the end of `cascade` (0 for the last one).
-float blend_weight(int cascade, vec3 p, float depth) {
-#if CASCADES > 1
-  float band = u_shadow_params.y;
-  if (cascade >= CASCADES - 1 || band <= 0.0) return 0.0;
+// Weight of cascade + 1 of view k in the blend band at the end of `cascade` (0 for the last).
+float blend_weight(int k, int cascade, vec3 p, float depth) {
+  float band = u_shadow_views[k].params.y;
+  if (cascade >= view_layers(k) - 1 || band <= 0.0) return 0.0;
 #if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
-  vec4 clip = u_cascade_view_proj[cascade] * vec4(p, 1.0);
+  vec4 clip = u_shadow_views[k].view_proj[cascade] * vec4(p, 1.0);
   vec2 ndc = abs(clip.xy / clip.w);
-  float edge = 1.0 - map_border();
+  float edge = 1.0 - map_border(k);
   return clamp((max(ndc.x, ndc.y) - (edge - band * edge)) / (band * edge), 0.0, 1.0);
 #else
-  float d0 = cascade_split(cascade), d1 = cascade_split(cascade + 1);
+  float d0 = view_split(k, cascade), d1 = view_split(k, cascade + 1);
   float width = band * (d1 - d0);
   return clamp((depth - (d1 - width)) / width, 0.0, 1.0);
-#endif
-#else
-  return 0.0;
 #endif
 }
 
@@ -159,11 +171,11 @@ float blend_weight(int cascade, vec3 p, float depth) {
 // lookup cost as much as the first; a loop it leaves once no pixel of the SIMD vector wants
 // another trip, so only vectors that touch the band pay (on llvmpipe, issue 13: about a tenth of
 // the default scene's frame). A GPU branches either way.
-float blended_visibility(int cascade, float w, vec3 p, vec3 n) {
+float blended_visibility(int k, int cascade, float w, vec3 p, vec3 n) {
   float v = 0.0, weight = 1.0 - w;
   int c = cascade;
   do {
-    v += weight * cascade_visibility(c, p, n);
+    v += weight * cascade_visibility(k, c, p, n);
     weight = c == cascade ? w : 0.0;
     ++c;
   } while (weight > 0.0);
@@ -173,78 +185,30 @@ float blended_visibility(int cascade, float w, vec3 p, vec3 n) {
 // Whether the surface at p with geometric normal n faces light `light` (an index into u_light_*).
 // One facing away shadows itself: forward.frag skips its lookup where no AOV shows it.
 bool faces_light(int light, vec3 p, vec3 n) {
-  vec3 to_light = int(u_light_color[light].w) == LIGHT_DIRECTIONAL ? -u_light_dir[light].xyz
-                                                                    : u_light_pos[light].xyz - p;
+  vec3 to_light = u_light_info[light].x == LIGHT_DIRECTIONAL ? -u_light_dir[light].xyz
+                                                              : u_light_pos[light].xyz - p;
   return dot(n, to_light) > 0.0;
 }
 
-float shadow_visibility(vec3 p, vec3 n, float depth, out int cascade) {
+// Visibility of shadow view k's light; `cascade` is the layer of the view it read (-1: none).
+float shadow_visibility(int k, vec3 p, vec3 n, float depth, out int cascade) {
 #if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_PERSPECTIVE
-  cascade = 0;
-  return perspective_visibility(0, p, n);
+  if (k == 0) {
+    cascade = 0;
+    return perspective_visibility(0, 0, p, n);
+  }
 #elif VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_CUBE
-  cascade = cube_face(p - u_light_pos[u_counts.y].xyz);
-  return perspective_visibility(cascade, p, n);
+  if (k == 0) {
+    cascade = cube_face(p - view_light_position(0));
+    return perspective_visibility(0, cascade, p, n);
+  }
 #elif VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_DUAL_PARABOLOID
-  return paraboloid_visibility(p, n, cascade);
+  if (k == 0) return paraboloid_visibility(0, p, n, cascade);
 #endif
-  cascade = select_cascade(p, depth);
+  cascade = select_cascade(k, p, depth);
   if (cascade < 0) return 1.0;
-  return blended_visibility(cascade, blend_weight(cascade, p, depth), p, n);
+  return blended_visibility(k, cascade, blend_weight(k, cascade, p, depth), p, n);
 }
-
-#if EXTRA_SHADOWS > 0
-// Further shadowed directional lights (S0: each has its own N maps): light k's cascades, with the
-// first light's filter and selection (frame features), its own matrices, splits, blend band and
-// normal offset (data). The same steps as cascade_visibility / select_cascade / blend_weight.
-float extra_cascade_visibility(int k, int c, vec3 p, vec3 n) {
-  vec3 q = p + n * (u_extra_params[k].x * extra_texel(k, c));
-  vec4 clip = u_extra_view_proj[k * MAX_CASCADES + c] * vec4(q, 1.0);
-  vec3 t = clip.xyz / clip.w * 0.5 + 0.5;
-  if (t.z > 1.0) return 1.0;
-  return shadow_taps(u_extra_light[k].y + c, t);
-}
-
-float extra_shadow_visibility(int k, vec3 p, vec3 n, float depth, out int cascade) {
-  int count = u_extra_light[k].z;
-  float band = u_extra_params[k].y;
-  float w = 0.0;
-  cascade = -1;
-#if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
-  float edge = 1.0 - 2.0 * (1.5 + u_extra_params[k].x) / u_extra_params[k].z;
-  for (int i = 0; i < count && cascade < 0; ++i) {
-    vec4 clip = u_extra_view_proj[k * MAX_CASCADES + i] * vec4(p, 1.0);
-    vec3 ndc = clip.xyz / clip.w;
-    if (abs(ndc.x) <= edge && abs(ndc.y) <= edge && abs(ndc.z) <= 1.0) {
-      cascade = i;
-      if (band > 0.0)
-        w = clamp((max(abs(ndc.x), abs(ndc.y)) - (edge - band * edge)) / (band * edge), 0.0, 1.0);
-    }
-  }
-  if (cascade < 0) return 1.0;
-#else
-  if (depth >= extra_split(k, count)) return 1.0;
-  cascade = 0;
-  for (int i = 1; i < count; ++i)
-    if (depth >= extra_split(k, i)) cascade = i;
-  if (band > 0.0) {
-    float d0 = extra_split(k, cascade), d1 = extra_split(k, cascade + 1);
-    w = clamp((depth - (d1 - band * (d1 - d0))) / (band * (d1 - d0)), 0.0, 1.0);
-  }
-#endif
-  if (cascade >= count - 1) w = 0.0;
-  // As blended_visibility(): a loop that ends on a value, so only SIMD vectors in the band pay
-  // for the second lookup on llvmpipe.
-  float v = 0.0, weight = 1.0 - w;
-  int c = cascade;
-  do {
-    v += weight * extra_cascade_visibility(k, c, p, n);
-    weight = c == cascade ? w : 0.0;
-    ++c;
-  } while (weight > 0.0);
-  return v;
-}
-#endif
 
 #if VARIANT_DEBUG_CASCADES
 // Tints per cascade: red, green, blue, yellow, magenta, cyan, orange, violet.

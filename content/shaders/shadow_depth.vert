@@ -34,7 +34,8 @@ void main() {
   vec3 v = (u_light_view_proj * (u_model * vec4(a_position, 1.0))).xyz;
   float d = length(v);
   vec3 u = v / max(d, 1e-20);
-  float near = cascade_split(0), far = cascade_split(1), margin = cascade_split(2);
+  // Paraboloid maps are view 0's (only the first shadow view may be a point light).
+  float near = view_split(0, 0), far = view_split(0, 1), margin = u_shadow_views[0].params.z;
   float w = 1.0 - u.z;
   gl_Position = vec4(u.xy / (1.0 + margin), (2.0 * (d - near) / (far - near) - 1.0) * w, w);
   gl_ClipDistance[0] = margin - u.z;

@@ -1,5 +1,5 @@
-// The shadow-points pass: the visibility the forward pass writes to the AOV (the shadowed light
-// u_counts.w names: 0 the first, k the k-th extra one) at a fixed world point, through the
+// The shadow-points pass: the visibility the forward pass writes to the AOV (the shadow view
+// u_counts.z names) at a fixed world point, through the
 // forward pass's own lookup (shadow.glsl), with the same view depth the forward pass would use
 // for a surface at that point. Output: x visibility (1 without a shadow pass), y cascade (-1
 // outside every cascade).
@@ -17,16 +17,7 @@ void main() {
   int cascade = -1;
 #if VARIANT_HAS_SHADOW
   float view_depth = -(u_view * vec4(v_point, 1.0)).z;
-  vec3 n = normalize(v_point_normal);
-  visibility = shadow_visibility(v_point, n, view_depth, cascade);
-#if EXTRA_SHADOWS > 0
-  for (int k = 0; k < EXTRA_SHADOWS; ++k)  // as forward.frag picks the AOV's light
-    if (k + 1 == u_counts.w) {
-      int c;
-      visibility = extra_shadow_visibility(k, v_point, n, view_depth, c);
-      cascade = c;
-    }
-#endif
+  visibility = shadow_visibility(u_counts.z, v_point, normalize(v_point_normal), view_depth, cascade);
 #endif
   o_visibility = vec2(visibility, float(cascade));
 }

@@ -291,14 +291,17 @@ Status run_bench(const BenchOptions& options) {
       double map_mib = 0.0;
       reference::ShadowMetrics metrics;
       double mrays = 0.0;
-      const ecs::Entity light = with_aovs->last.shadow.light;
+      // The light whose visibility the AOV shows.
+      const std::vector<ShadowData>& views = with_aovs->last.shadows;
+      const ecs::Entity light =
+          views.empty() ? ecs::kNullEntity : views[std::size_t(aov_shadow_index(*scene, views.size()))].light;
       if (light.valid()) {
         if (const auto* s = scene->world.try_get<ShadowSettings>(light)) {
           const double bytes = s->depth_format == DepthFormat::d16 ? 2.0 : 4.0;
           // Every layer of the array: cascades (or spot map, cube faces, hemispheres) of every
-          // shadowed light.
-          int layers = with_aovs->last.shadow.cascade_count;
-          for (const ShadowData& e : with_aovs->last.extra_shadows) layers += e.cascade_count;
+          // shadow view.
+          int layers = 0;
+          for (const ShadowData& v : views) layers += v.cascade_count;
           map_mib = double(s->map_size) * s->map_size * bytes * layers / (1024.0 * 1024.0);
         }
         const std::uint64_t signature = geometry_signature(*scene);

@@ -304,14 +304,16 @@ int run_bench_command(const Args& a, bool frames_given) {
   return 0;
 }
 
-// Per-cascade (or per-layer) stats: world units per texel, casters drawn, their triangles,
-// receiver pixels (AOV pixels shaded from that cascade; 0 without AOVs).
-void print_cascade_table(const render::FrameStats& st, const ShadowData& sh) {
+// Per-layer stats of one shadow view: world units per texel, casters drawn, their triangles,
+// receiver pixels (AOV pixels shaded from that cascade, for the view the AOV shows; 0 without
+// AOVs or for the other views).
+void print_layer_table(const render::FrameStats& st, const ShadowData& sh, bool shown_in_aov) {
   std::printf("          layer  m/texel   casters  triangles  receiver px\n");
-  for (int i = 0; i < st.cascades; ++i) {
-    const auto c = std::size_t(i);
-    std::printf("          %-5d  %-8.3g  %-7d  %-9zu  %zu%s\n", i, double(st.cascade_texel_size[c]),
-                st.cascade_draw_calls[c], st.cascade_triangles[c], st.cascade_receiver_pixels[c],
+  for (int i = 0; i < sh.cascade_count; ++i) {
+    const auto c = std::size_t(i), l = std::size_t(sh.first_layer + i);
+    std::printf("          %-5zu  %-8.3g  %-7d  %-9zu  %zu%s\n", l, double(st.layer_texel_size[l]),
+                st.layer_draw_calls[l], st.layer_triangles[l],
+                shown_in_aov ? st.cascade_receiver_pixels[c] : std::size_t(0),
                 sh.skipped[c] ? "  (skipped)" : "");
   }
 }
@@ -417,42 +419,39 @@ int run_render(Args a) {
     std::printf("%s\n", drawn < st.shadow_layers ? "; the others kept their depth (same matrix "
                                                     "and casters)" : "");
   }
-  if (const ShadowData& sh = timings->last.shadow;
-      sh.light.valid() && st.cascades > 0 && sh.projection != ShadowProjection::ortho) {
-    const char* kinds[] = {"", "spot: 1 perspective map", "point: 6 cube faces",
-                           "point: 2 paraboloid hemispheres"};
-    std::printf("shadow    %s (%d^2 each), near %.3g m, far %.3g m from the light\n",
-                kinds[int(sh.projection)], sh.settings.map_size, double(sh.splits[0]),
-                double(sh.splits[1]));
-    print_cascade_table(st, sh);
-  } else if (sh.light.valid() && st.cascades > 0) {
-    const char* fits[] = {"crop", "stable", "scene"};
-    std::printf("cascades  %d (%s fit, %d^2 each)", st.cascades, fits[int(sh.settings.fit_mode)],
-                sh.settings.map_size);
-    if (sh.settings.fit_mode != FitMode::scene) {
-      std::printf("; splits");
-      for (int i = 0; i <= sh.cascade_count; ++i) std::printf(" %.3g", double(sh.splits[std::size_t(i)]));
-      std::printf(" m; the visible receivers' depths");
-      if (sh.near_used > sh.near_requested)
-        std::printf(" moved the first split out from %.3g m", double(sh.near_requested));
-      if (sh.far_used < sh.far_requested)
-        std::printf("%s pulled the last split in from %.3g m",
-                    sh.near_used > sh.near_requested ? " and" : "", double(sh.far_requested));
-      if (!(sh.near_used > sh.near_requested) && !(sh.far_used < sh.far_requested))
-        std::printf(" fill [camera near, %.3g m]", double(sh.far_requested));
+  const std::vector<ShadowData>& views = timings->last.shadows;
+  const std::size_t aov_view = std::size_t(aov_shadow_index(*scene, views.size()));
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    const ShadowData& sh = views[k];
+    const auto* name = scene->world.try_get<Name>(sh.light);
+    std::printf("shadow    view %zu: light %s (entity %u), layers %d..%d of the %d^2 map%s\n", k,
+                name ? ("'" + name->value + "'").c_str() : "-", sh.light.index, sh.first_layer,
+                sh.first_layer + sh.cascade_count - 1, sh.settings.map_size,
+                views.size() > 1 && k == aov_view ? " (the AOV shows it)" : "");
+    if (sh.projection != ShadowProjection::ortho) {
+      const char* kinds[] = {"", "spot: 1 perspective map", "point: 6 cube faces",
+                             "point: 2 paraboloid hemispheres"};
+      std::printf("          %s, near %.3g m, far %.3g m from the light\n", kinds[int(sh.projection)],
+                  double(sh.splits[0]), double(sh.splits[1]));
+    } else {
+      const char* fits[] = {"crop", "stable", "scene"};
+      std::printf("          %d cascades (%s fit)", sh.cascade_count, fits[int(sh.settings.fit_mode)]);
+      if (sh.settings.fit_mode != FitMode::scene) {
+        std::printf("; splits");
+        for (int i = 0; i <= sh.cascade_count; ++i)
+          std::printf(" %.3g", double(sh.splits[std::size_t(i)]));
+        std::printf(" m; the visible receivers' depths");
+        if (sh.near_used > sh.near_requested)
+          std::printf(" moved the first split out from %.3g m", double(sh.near_requested));
+        if (sh.far_used < sh.far_requested)
+          std::printf("%s pulled the last split in from %.3g m",
+                      sh.near_used > sh.near_requested ? " and" : "", double(sh.far_requested));
+        if (!(sh.near_used > sh.near_requested) && !(sh.far_used < sh.far_requested))
+          std::printf(" fill [camera near, %.3g m]", double(sh.far_requested));
+      }
+      std::printf("\n");
     }
-    std::printf("\n          per cascade draws/triangles:");
-    for (int i = 0; i < st.cascades; ++i)
-      std::printf(" %d/%zu%s", st.cascade_draw_calls[std::size_t(i)],
-                  st.cascade_triangles[std::size_t(i)], sh.skipped[std::size_t(i)] ? " (skipped)" : "");
-    std::printf("\n");
-    print_cascade_table(st, sh);
-  }
-  for (const ShadowData& ex : timings->last.extra_shadows) {
-    std::printf("shadowed  light %u: %d cascades; splits", ex.light.index, ex.cascade_count);
-    for (int i = 0; i <= ex.cascade_count; ++i)
-      std::printf(" %.3g", double(ex.splits[std::size_t(i)]));
-    std::printf(" m\n");
+    print_layer_table(st, sh, k == aov_view);
   }
   if (const ProbeData& pd = timings->last.probes; !pd.probes.empty()) {
     std::printf("probes    %zu reflectors: %llu captures, %llu faces since load; last frame %d "

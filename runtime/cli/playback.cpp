@@ -524,7 +524,7 @@ Result<Scene> load_checked(const Playback& pb, render::Renderer* prewarm = nullp
   auto trial = load_scene(pb.scene, sets);
   if (!trial) return trial.error();
   const bool points = bool(pb.flicker);  // the flicker gate reads the points pass
-  if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx, points));
+  if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx, {}, points));
   for (const SetEvent& ev : pb.events) {
     if (auto st = apply_event(*trial, ev); !st) {
       Error e = st.error();
@@ -532,7 +532,7 @@ Result<Scene> load_checked(const Playback& pb, render::Renderer* prewarm = nullp
                    pb.file.string() + ")";
       return e;
     }
-    if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx, points));
+    if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx, {}, points));
   }
   for (const Track& tr : pb.tracks)
     if (!find_named(scene->world, tr.entity).valid())
@@ -612,6 +612,7 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
   std::vector<int> capture_frames;
   std::vector<std::vector<float>> flicker_values;
   StabilityPoints points;
+  SystemState systems;  // this run's: a fresh scene, frames from 0
   FrameReport report;
   std::size_t next_event = 0;
   const std::set<int> capture(pb.capture.begin(), pb.capture.end());
@@ -630,7 +631,7 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
     // 2. The frame, timed with the GPU waited on.
     ctx.index = std::uint64_t(f);
     const auto t0 = std::chrono::steady_clock::now();
-    KASKAD_TRY(run_frame(*scene, *player.renderer, ctx, report));
+    KASKAD_TRY(run_frame(*scene, *player.renderer, ctx, systems, report));
     player.renderer->finish();
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     frame_ms.push_back(ms);
@@ -691,14 +692,16 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
     }
     if (checked.count(f)) {
       const Image aov = player.renderer->read_aovs();
-      if (!report.shadow.light.valid()) {
+      if (report.shadows.empty()) {
         fail_at(f, "misclassified_pct: no shadowed light this frame");
       } else {
         auto tracer = reference::RayTracer::build(*scene);
         if (!tracer) return tracer.error();
+        // The light whose visibility the AOV shows.
+        const ecs::Entity shown =
+            report.shadows[std::size_t(aov_shadow_index(*scene, report.shadows.size()))].light;
         const auto light = reference::reference_light(
-            scene->world.get<Light>(report.shadow.light),
-            scene->world.get<WorldTransform>(report.shadow.light).matrix);
+            scene->world.get<Light>(shown), scene->world.get<WorldTransform>(shown).matrix);
         auto ref = tracer->shadow_reference(aov, light, {});
         if (!ref) return ref.error();
         auto m = reference::compare_shadows(aov, ref->image);

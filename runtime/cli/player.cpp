@@ -122,17 +122,14 @@ Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRu
   KASKAD_TRY(player.renderer->check_target_size(ctx.width, ctx.height, run.write_aovs));
   if (run.prewarm) {
     const auto t0 = std::chrono::steady_clock::now();
-    KASKAD_TRY(prewarm_frame(scene, *player.renderer, ctx));
+    KASKAD_TRY(prewarm_frame(scene, *player.renderer, ctx, player.systems));
     t.prewarm_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
-  t.last.shadow_state = std::move(player.shadow_state);
   for (int i = 0; i < std::max(1, run.frames); ++i) {
     ctx.index = scene.frames_rendered++;  // carries on across calls (the editor: one per call)
     const auto t0 = std::chrono::steady_clock::now();
-    const Status st = run_frame(scene, *player.renderer, ctx, t.last);
-    player.shadow_state = t.last.shadow_state;
-    KASKAD_TRY(st);
+    KASKAD_TRY(run_frame(scene, *player.renderer, ctx, player.systems, t.last));
     player.renderer->finish();
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -28,9 +28,9 @@ Result<Scene> load_scene(const std::filesystem::path& file,
 struct Player {
   std::unique_ptr<gpu::Context> context;
   std::unique_ptr<render::Renderer> renderer;
-  /// The shadow system's state, carried across render_frames() calls (frozen cascades, errors
-  /// logged once) as the editor renders one call per frame.
-  ShadowCascadeState shadow_state;
+  /// The systems' state of the scene being rendered, carried across render_frames() calls
+  /// (frozen cascades, hysteresis, errors logged once) as the editor renders one call per frame.
+  SystemState systems;
 
   /// Renderer options default to the shader binary cache in default_shader_cache_dir().
   static Result<Player> create(const gpu::ContextOptions& options,

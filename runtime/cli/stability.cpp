@@ -87,12 +87,13 @@ Result<StabilityRun> measure_stability(Player& player, Scene& scene, const Stabi
   const glm::vec3 up = glm::normalize(glm::vec3(world_from_view[1]));
   const glm::vec3 direction = right + 0.5f * up;
 
+  SystemState systems;  // the path's own: frames from 0
   FrameReport report;
   Status status;
   for (int f = 0; f < std::max(1, path.frames); ++f) {
     transform.translation = original.translation + float(f) * run.step * direction;
     ctx.index = std::uint64_t(f);
-    status = run_frame(scene, *player.renderer, ctx, report);
+    status = run_frame(scene, *player.renderer, ctx, systems, report);
     if (!status) break;
     auto v = visibility_at_seen_points(*player.renderer, report.camera, points);
     if (!v) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "components/limits.h"
 #include "runtime/core/json_reader.h"
 
 namespace kaskad::render {
@@ -170,6 +171,10 @@ std::vector<std::pair<std::string, std::string>> FeatureManifest::defines(Varian
     for (auto& c : upper) c = char(std::toupper(static_cast<unsigned char>(c)));
     out.emplace_back("BIT_" + upper, std::to_string(f.field.offset));
   }
+  // The limits that size the frame block (common.glsl), from their one definition.
+  out.emplace_back("MAX_LIGHTS", std::to_string(kMaxLights));
+  out.emplace_back("MAX_CASCADES", std::to_string(kMaxCascades));
+  out.emplace_back("MAX_SHADOW_VIEWS", std::to_string(kMaxShadowedLights));
   return out;
 }
 

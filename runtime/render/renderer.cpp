@@ -17,41 +17,11 @@
 
 #include "runtime/core/log.h"
 #include "runtime/gpu/shader.h"
+#include "runtime/render/frame_uniforms.h"
 #include "runtime/render/probe_capture.h"
 
 namespace kaskad::render {
 namespace {
-
-constexpr int kMaxExtra = kMaxShadowedLights - 1;
-// FrameStats::shadow_layers_rendered has one bit per layer of the shadow map.
-static_assert(kMaxShadowedLights * kMaxCascades <= 32);
-
-// std140 mirror of FrameBlock in content/shaders/common.glsl (change together).
-struct alignas(16) FrameBlock {
-  glm::mat4 view_proj;
-  glm::mat4 view;
-  glm::vec4 camera_pos;
-  glm::vec4 ambient;
-  glm::ivec4 counts;
-  glm::vec4 shadow_params;
-  glm::mat4 cascade_view_proj[kMaxCascades];
-  glm::vec4 cascade_splits[3];  // D[0..8], four per vec4 (std140 pads float arrays to vec4)
-  glm::vec4 cascade_texel[2];   // metres per texel, four per vec4
-  glm::vec4 light_color[kMaxLights];
-  glm::vec4 light_dir[kMaxLights];
-  glm::vec4 light_pos[kMaxLights];
-  glm::vec4 light_cone[kMaxLights];
-  // Further shadowed directional lights (FrameInput::extra_shadows).
-  glm::ivec4 extra_count;             // x: how many
-  glm::ivec4 extra_light[kMaxExtra];  // x light index, y first layer, z cascades
-  glm::vec4 extra_params[kMaxExtra];  // x normal offset, y blend band, z map size
-  glm::mat4 extra_view_proj[kMaxExtra * kMaxCascades];
-  glm::vec4 extra_splits[kMaxExtra * 3];  // D[0..8] of light k: [3k .. 3k+2]
-  glm::vec4 extra_texel[kMaxExtra * 2];   // metres per texel of light k: [2k, 2k+1]
-};
-static_assert(sizeof(FrameBlock) == 2 * 64 + 4 * 16 + kMaxCascades * 64 + 5 * 16 +
-                                        4 * kMaxLights * 16 + 16 +
-                                        kMaxExtra * (2 * 16 + kMaxCascades * 64 + 5 * 16));
 
 GLenum depth_internal_format(DepthFormat f) {
   switch (f) {
@@ -312,49 +282,23 @@ Renderer::~Renderer() = default;
 
 ShaderLibrary& Renderer::shaders() { return *impl_->shaders; }
 
-namespace {
-int cascade_layers(const ShadowPass& p) { return std::clamp(p.cascade_count, 1, kMaxCascades); }
-
-int shaded_lights(const FrameInput& frame) {
-  return std::min<int>(int(frame.lights.size()), kMaxLights);
-}
-
-bool has_shadow(const FrameInput& frame) {
-  return frame.shadow.light_index >= 0 && frame.shadow.light_index < shaded_lights(frame);
-}
-
-// The further shadowed directional lights the frame draws and shades: of
-// FrameInput::extra_shadows those with a shaded light and orthographic cascades, at most
-// kMaxExtra; none without the first shadowed light. Their number is a variant field
-// (shadow_lights), so render() and frame_variant() must agree: both call this.
-std::vector<const ShadowPass*> drawn_extra_shadows(const FrameInput& frame) {
-  std::vector<const ShadowPass*> out;
-  if (!has_shadow(frame)) return out;
-  for (const ShadowPass& e : frame.extra_shadows) {
-    if (int(out.size()) == kMaxExtra) break;
-    if (e.light_index < 0 || e.light_index >= shaded_lights(frame) ||
-        e.projection != ShadowProjection::ortho)
-      continue;
-    out.push_back(&e);
-  }
-  return out;
-}
-}  // namespace
-
 VariantKey frame_variant(const FrameInput& frame) {
   VariantKey k;
-  if (has_shadow(frame)) {
-    const ShadowSettings& s = frame.shadow.settings;
+  if (!frame.shadow_views.empty()) {
+    const ShadowMapSettings& s = frame.shadow_map;
+    const ShadowView& first = frame.shadow_views.front();
+    const int views = std::min<int>(int(frame.shadow_views.size()), kMaxShadowedLights);
     k.set(VariantKey::kShadow, 1);
-    k.set(VariantKey::kShadowLightsMinus1, std::uint32_t(drawn_extra_shadows(frame).size()));
+    k.set(VariantKey::kShadowLightsMinus1, std::uint32_t(views - 1));
     k.set(VariantKey::kShadowFilter, std::uint32_t(s.filter));
-    k.set(VariantKey::kShadowProjection, std::uint32_t(frame.shadow.projection));
+    k.set(VariantKey::kShadowProjection, std::uint32_t(first.projection));
     // Paraboloid hemispheres are projected in code, one pass each: no layered pass for them.
-    if (s.layered && frame.shadow.projection != ShadowProjection::dual_paraboloid)
+    if (s.layered && first.projection != ShadowProjection::dual_paraboloid)
       k.set(VariantKey::kShadowLayered, 1);
     // Layers of spot and point lights are faces, not cascades: no cascade selection code.
-    if (frame.shadow.projection == ShadowProjection::ortho)
-      k.set(VariantKey::kCascadeCountMinus1, std::uint32_t(cascade_layers(frame.shadow) - 1));
+    if (first.projection == ShadowProjection::ortho)
+      k.set(VariantKey::kCascadeCountMinus1,
+            std::uint32_t(std::clamp(first.layer_count, 1, kMaxCascades) - 1));
     k.set(VariantKey::kCascadeSelection, s.selection == CascadeSelection::map_bounds ? 1u : 0u);
     k.set(VariantKey::kDebugCascades, s.debug_cascades ? 1u : 0u);
   }
@@ -387,8 +331,8 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
     out.push_back({Pass::forward, k.filtered_for(Pass::forward)});
     if (fk.has(VariantKey::kShadow) && d.cast_shadows) {
       out.push_back({Pass::depth, k.filtered_for(Pass::depth)});
-      // Extra (directional) lights draw with the plain depth program, whatever the first's is.
-      if (!frame.extra_shadows.empty())
+      // Views after the first are cascades: the plain depth program, whatever the first's is.
+      if (frame.shadow_views.size() > 1)
         out.push_back({Pass::depth,
                        VariantKey(k).set(VariantKey::kShadowProjection, 0).filtered_for(Pass::depth)});
     }
@@ -543,67 +487,11 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.draw_calls = stats_.shadow_draw_calls = 0;
   stats_.triangles = stats_.shadow_triangles = 0;
 
-  // Frame uniforms.
-  FrameBlock fb{};
-  fb.view_proj = frame.camera.proj * frame.camera.view;
-  fb.view = frame.camera.view;
-  fb.camera_pos = glm::vec4(frame.camera.position, 1.0f);
-  fb.ambient = glm::vec4(frame.ambient, frame.exposure);
-  const int light_count = std::min<int>(int(frame.lights.size()), kMaxLights);
+  if (std::string bad = shadow_views_error(frame); !bad.empty())
+    return Error{"", "frame input", bad};
   if (int(frame.lights.size()) > kMaxLights)
-    log::warn("%zu lights; only the first %d are shaded", frame.lights.size(), kMaxLights);
-  const bool shadowed = has_shadow(frame);
-  const int cascades = shadowed ? cascade_layers(frame.shadow) : 0;
-  // Further shadowed directional lights: their cascades follow the first light's layers.
-  const std::vector<const ShadowPass*> extras = drawn_extra_shadows(frame);
-  std::array<int, kMaxShadowedLights> first_layer{};
-  int total_layers = cascades;
-  for (std::size_t k = 0; k < extras.size(); ++k) {
-    first_layer[k] = total_layers;
-    total_layers += cascade_layers(*extras[k]);
-  }
-  const int aov_light = frame.aov_shadow_light >= 0 && frame.aov_shadow_light <= int(extras.size())
-                            ? frame.aov_shadow_light
-                            : 0;
-  fb.counts =
-      glm::ivec4(light_count, shadowed ? frame.shadow.light_index : -1, cascades, aov_light);
-  // The basic map (fit scene) is biased by polygon offset alone, as before the cascades.
-  auto normal_offset_of = [](const ShadowPass& sp) {
-    return sp.projection == ShadowProjection::ortho && sp.settings.fit_mode == FitMode::scene
-               ? 0.0f
-               : sp.settings.normal_offset_bias;
-  };
-  fb.extra_count = glm::ivec4(int(extras.size()), 0, 0, 0);
-  for (std::size_t k = 0; k < extras.size(); ++k) {
-    const ShadowPass& e = *extras[k];
-    const int n = cascade_layers(e);
-    fb.extra_light[k] = glm::ivec4(e.light_index, first_layer[k], n, 0);
-    fb.extra_params[k] = glm::vec4(normal_offset_of(e), e.settings.blend_band,
-                                   float(frame.shadow.settings.map_size), 0);
-    for (int i = 0; i < n; ++i) {
-      fb.extra_view_proj[k * kMaxCascades + std::size_t(i)] = e.view_proj[std::size_t(i)];
-      fb.extra_texel[k * 2 + std::size_t(i / 4)][i % 4] = e.texel_size[std::size_t(i)];
-    }
-    for (int i = 0; i <= n; ++i)
-      fb.extra_splits[k * 3 + std::size_t(i / 4)][i % 4] = e.splits[std::size_t(i)];
-  }
-  if (shadowed) {
-    const ShadowPass& sp = frame.shadow;
-    const float normal_offset = normal_offset_of(sp);
-    fb.shadow_params = glm::vec4(normal_offset, sp.settings.blend_band, float(sp.settings.map_size), 0);
-    for (int i = 0; i < cascades; ++i) {
-      fb.cascade_view_proj[i] = sp.view_proj[std::size_t(i)];
-      fb.cascade_texel[i / 4][i % 4] = sp.texel_size[std::size_t(i)];
-    }
-    for (int i = 0; i <= cascades; ++i) fb.cascade_splits[i / 4][i % 4] = sp.splits[std::size_t(i)];
-  }
-  for (int i = 0; i < light_count; ++i) {
-    const LightItem& l = frame.lights[std::size_t(i)];
-    fb.light_color[i] = glm::vec4(l.color, float(int(l.type)));
-    fb.light_dir[i] = glm::vec4(l.direction, l.range);
-    fb.light_pos[i] = glm::vec4(l.position, l.cos_outer);
-    fb.light_cone[i] = glm::vec4(l.cos_inner, 0, 0, 0);
-  }
+    log::warn_once("%zu lights; only the first %d are shaded", frame.lights.size(), kMaxLights);
+  const FrameBlock fb = pack_frame_block(frame);
   glNamedBufferSubData(im.frame_ubo.id(), 0, sizeof fb, &fb);
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
 
@@ -681,62 +569,52 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
 
   // A shadow map array the driver refuses (llvmpipe: over 1 GiB, e.g. 16384^2 x 4 cascades) is
   // an error before any pass starts, not a string of GL errors.
-  if (shadowed) {
-    const ShadowSettings& s = frame.shadow.settings;
-    if (!im.shadow_fbo || s.map_size != im.shadow_size || total_layers != im.shadow_layers ||
-        s.depth_format != im.shadow_format)
-      KASKAD_TRY(check_shadow_map_size(s.map_size, total_layers, s.depth_format));
-  }
+  const std::vector<ShadowView>& views = frame.shadow_views;
+  const bool shadowed = !views.empty();
+  const ShadowMapSettings& map = frame.shadow_map;
+  const int total_layers = shadowed ? views.back().first_layer + views.back().layer_count : 0;
+  if (shadowed && (!im.shadow_fbo || map.size != im.shadow_size ||
+                   total_layers != im.shadow_layers || map.format != im.shadow_format))
+    KASKAD_TRY(check_shadow_map_size(map.size, total_layers, map.format));
 
-  // Pass 1: shadow maps (S4, S0 step 6): depth only, one layer per cascade, light viewport, bias
-  // by polygon offset, chosen culling. Each layer gets only the casters overlapping its cascade.
+  // Pass 1: shadow maps (S4, S0 step 6): depth only, one layer per cascade, face or hemisphere
+  // of each shadow view, light viewport, bias by polygon offset, chosen culling. Each layer gets
+  // only the casters overlapping its volume (DrawItem::shadow_layers).
   glBeginQuery(GL_TIME_ELAPSED, im.timers[0].id());
-  stats_.cascades = cascades;
-  stats_.cascade_draw_calls.fill(0);
-  stats_.cascade_triangles.fill(0);
-  stats_.cascade_texel_size.fill(0.0f);
+  stats_.layer_draw_calls.fill(0);
+  stats_.layer_triangles.fill(0);
+  stats_.layer_texel_size.fill(0.0f);
   stats_.cascade_receiver_pixels.fill(0);
   stats_.shadow_layers_rendered = 0;
-  stats_.shadow_layers = 0;
-  for (int c = 0; c < cascades; ++c)
-    stats_.cascade_texel_size[std::size_t(c)] = frame.shadow.texel_size[std::size_t(c)];
+  stats_.shadow_layers = total_layers;
+  for (const ShadowView& v : views)
+    for (int c = 0; c < v.layer_count; ++c)
+      stats_.layer_texel_size[std::size_t(v.first_layer + c)] = v.texel_size[std::size_t(c)];
   if (shadowed) {
-    const ShadowSettings& s = frame.shadow.settings;
-    im.ensure_shadow_map(s.map_size, total_layers, s.depth_format, s.filter);
+    im.ensure_shadow_map(map.size, total_layers, map.format, map.filter);
     glBindFramebuffer(GL_FRAMEBUFFER, im.shadow_fbo.id());
-    glViewport(0, 0, s.map_size, s.map_size);
+    glViewport(0, 0, map.size, map.size);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     glClearDepth(1.0);
     glEnable(GL_POLYGON_OFFSET_FILL);
-    // Paraboloid hemispheres end at a clip distance (shadow_depth.vert).
-    const bool paraboloid = frame.shadow.projection == ShadowProjection::dual_paraboloid;
-    if (paraboloid) glEnable(GL_CLIP_DISTANCE0);
     const std::vector<std::uint32_t> order = sorted_by(Pass::depth, keys);
     GLuint current = 0;  // kept across layers: the light matrix is a per-draw uniform
     // Layered: every layer attached at once and cleared together (skipped layers stay clear);
-    // each caster is drawn once per light, instanced over the layers it overlaps, and the vertex
+    // each caster is drawn once per view, instanced over the layers it overlaps, and the vertex
     // shader routes instance i to the i-th of them (shadow_depth.vert). The same maps as one pass
     // per layer (render test), with fewer draw calls.
     const bool layered = frame_key.has(VariantKey::kShadowLayered);
-    // Light 0 is the first shadowed light, 1.. the extra directional ones; each with its own
-    // culling, bias and casters per cascade, into consecutive layers.
-    auto pass_of = [&](std::size_t light) -> const ShadowPass& {
-      return light == 0 ? frame.shadow : *extras[light - 1];
-    };
-    auto base_of = [&](std::size_t light) { return light == 0 ? 0 : first_layer[light - 1]; };
-    auto layers_of = [&](std::size_t light) {
-      return light == 0 ? cascades : cascade_layers(pass_of(light));
-    };
-    auto caster_mask = [&](std::size_t light, const DrawItem& d) -> std::uint32_t {
+    // The layers of view `v` that draw `d` (bit c: layer first_layer + c).
+    auto caster_mask = [&](const ShadowView& v, const DrawItem& d) -> std::uint32_t {
       if (!d.cast_shadows) return 0;
-      return light == 0 ? d.cascade_mask : (d.extra_cascade_masks >> (8 * (light - 1))) & 0xffu;
+      return (d.shadow_layers >> v.first_layer) & (~0u >> (32 - v.layer_count));
     };
-    // Extra lights are cascades: the plain depth program even after paraboloid maps.
-    auto depth_key = [&](std::size_t light, std::uint32_t i) {
+    // Views after the first are cascades: the plain depth program even after paraboloid maps.
+    auto depth_key = [&](std::size_t view, std::uint32_t i) {
       VariantKey k = keys[i];
-      if (light > 0) k.set(VariantKey::kShadowProjection, 0);
+      if (view > 0) k.set(VariantKey::kShadowProjection, 0);
       return k;
     };
     // Shadow caching (issue 13): a layer keeps last frame's depth when it would be drawn from the
@@ -744,19 +622,20 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     // casters (mesh, model matrix, depth program, alpha-mask parameters) in the same order. A
     // moved caster changes its matrix, a moved camera the layer's matrix or casters; other
     // assets (another scene) change assets.uid. New map storage invalidates every layer.
-    auto layer_inputs = [&](std::size_t light, int c) {
-      const ShadowPass& pass = pass_of(light);
+    auto layer_inputs = [&](std::size_t view, int c) {
+      const ShadowView& v = views[view];
       InputHash h;
-      h.add(assets.uid).add(layered).add(pass.projection).add(pass.settings.cull);
-      h.add(pass.settings.slope_bias).add(pass.settings.constant_bias);
-      h.add(pass.view_proj[std::size_t(c)]).add(pass.skipped[std::size_t(c)]);
-      // Only the paraboloid depth pass reads splits (near, far, margin: shadow_depth.vert).
-      if (pass.projection == ShadowProjection::dual_paraboloid) h.add(pass.splits);
-      if (pass.skipped[std::size_t(c)]) return h.value();
+      h.add(assets.uid).add(layered).add(v.projection).add(v.cull);
+      h.add(v.slope_bias).add(v.constant_bias);
+      h.add(v.view_proj[std::size_t(c)]).add(v.skipped[std::size_t(c)]);
+      // Only the paraboloid depth pass reads splits (near, far) and the margin (shadow_depth.vert).
+      if (v.projection == ShadowProjection::dual_paraboloid)
+        h.add(v.splits).add(v.paraboloid_margin);
+      if (v.skipped[std::size_t(c)]) return h.value();
       for (std::uint32_t i : order) {
         const DrawItem& d = frame.draws[i];
-        if (!(caster_mask(light, d) & (1u << c))) continue;
-        h.add(d.mesh).add(d.model).add(depth_key(light, i).filtered_for(Pass::depth).bits());
+        if (!(caster_mask(v, d) & (1u << c))) continue;
+        h.add(d.mesh).add(d.model).add(depth_key(view, i).filtered_for(Pass::depth).bits());
         if (d.material.alpha_mask || im.oracle)
           h.add(d.material.base_color.a).add(d.material.alpha_cutoff)
               .add(d.material.base_color_texture);
@@ -765,50 +644,55 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     };
     std::vector<std::uint64_t> inputs(std::size_t(total_layers), 0);
     bool any_dirty = false;
-    for (std::size_t light = 0; light <= extras.size(); ++light)
-      for (int c = 0; c < layers_of(light); ++c) {
-        const std::size_t layer = std::size_t(base_of(light) + c);
-        inputs[layer] = layer_inputs(light, c);
+    for (std::size_t view = 0; view < views.size(); ++view)
+      for (int c = 0; c < views[view].layer_count; ++c) {
+        const std::size_t layer = std::size_t(views[view].first_layer + c);
+        inputs[layer] = layer_inputs(view, c);
         if (inputs[layer] != im.layer_drawn_from[layer]) {
           stats_.shadow_layers_rendered |= 1u << layer;
           any_dirty = true;
         }
       }
     // The layered pass draws every layer at once: it redraws all of them or none.
-    if (layered && any_dirty)  // up to 32 layers (4 lights x 8 cascades): no 1u << 32
+    if (layered && any_dirty)  // up to 32 layers (4 views x 8 cascades): no 1u << 32
       stats_.shadow_layers_rendered = ~0u >> (32 - total_layers);
-    stats_.shadow_layers = total_layers;
     auto redraw = [&](int layer) { return (stats_.shadow_layers_rendered >> layer) & 1u; };
     if (layered && any_dirty) {
       glNamedFramebufferTexture(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT, im.shadow_map.id(), 0);
       glClear(GL_DEPTH_BUFFER_BIT);
     }
     // Stats count the casters each layer holds, whether drawn now or kept from an earlier frame.
-    for (std::size_t light = 0; light <= extras.size(); ++light) {
-      const ShadowPass& pass = pass_of(light);
-      const int base = base_of(light);
-      const int layers = layers_of(light);
-      if (pass.settings.cull == CullMode::none) {
+    auto count_in_layer = [&](int layer, const GpuMesh& m) {
+      ++stats_.layer_draw_calls[std::size_t(layer)];
+      stats_.layer_triangles[std::size_t(layer)] += std::size_t(m.index_count / 3);
+    };
+    for (std::size_t view = 0; view < views.size(); ++view) {
+      const ShadowView& v = views[view];
+      if (v.cull == CullMode::none) {
         glDisable(GL_CULL_FACE);
       } else {
         glEnable(GL_CULL_FACE);
-        glCullFace(pass.settings.cull == CullMode::front ? GL_FRONT : GL_BACK);
+        glCullFace(v.cull == CullMode::front ? GL_FRONT : GL_BACK);
       }
-      glPolygonOffset(pass.settings.slope_bias, pass.settings.constant_bias);
-      if (light > 0) glDisable(GL_CLIP_DISTANCE0);  // only paraboloid hemispheres clip
+      glPolygonOffset(v.slope_bias, v.constant_bias);
+      // Paraboloid hemispheres end at a clip distance (shadow_depth.vert).
+      if (v.projection == ShadowProjection::dual_paraboloid) {
+        glEnable(GL_CLIP_DISTANCE0);
+      } else {
+        glDisable(GL_CLIP_DISTANCE0);
+      }
       if (layered) {
         std::uint32_t live = 0;
-        for (int c = 0; c < layers; ++c)
-          if (!pass.skipped[std::size_t(c)]) live |= 1u << c;
+        for (int c = 0; c < v.layer_count; ++c)
+          if (!v.skipped[std::size_t(c)]) live |= 1u << c;
         for (std::uint32_t i : order) {
           const DrawItem& d = frame.draws[i];
-          const std::uint32_t mask = live & caster_mask(light, d);
+          const std::uint32_t mask = live & caster_mask(v, d);
           if (mask == 0) continue;
           const GpuMesh& m = im.mesh(d.mesh, assets);
           if (m.index_count == 0) continue;
-          const int instances = std::popcount(mask);
           if (any_dirty) {
-            if (Status st = use_program(Pass::depth, keys[i], current); !st) {
+            if (Status st = use_program(Pass::depth, depth_key(view, i), current); !st) {
               glDisable(GL_POLYGON_OFFSET_FILL);
               glEndQuery(GL_TIME_ELAPSED);
               return st;
@@ -816,40 +700,38 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
             if (keys[i].has(VariantKey::kAlphaMask) || im.oracle)
               bind_material(current, d, keys[i]);
             glProgramUniform1ui(current, kUniLayerMask, mask);
-            glProgramUniform1i(current, kUniLayerBase, base);
-            glProgramUniformMatrix4fv(current, kUniLayerViewProj, layers, GL_FALSE,
-                                      &pass.view_proj[0][0][0]);
+            glProgramUniform1i(current, kUniLayerBase, v.first_layer);
+            glProgramUniformMatrix4fv(current, kUniLayerViewProj, v.layer_count, GL_FALSE,
+                                      &v.view_proj[0][0][0]);
             glProgramUniformMatrix4fv(current, kUniModel, 1, GL_FALSE, &d.model[0][0]);
             glBindVertexArray(m.vao.id());
             glDrawElementsInstanced(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
-                                    instances);
+                                    std::popcount(mask));
           }
-          ++stats_.shadow_draw_calls;
-          stats_.shadow_triangles += std::size_t(instances) * std::size_t(m.index_count / 3);
-          for (int c = 0; light == 0 && c < layers; ++c)
-            if (mask & (1u << c)) {
-              ++stats_.cascade_draw_calls[std::size_t(c)];
-              stats_.cascade_triangles[std::size_t(c)] += std::size_t(m.index_count / 3);
-            }
+          ++stats_.shadow_draw_calls;  // one instanced draw
+          stats_.shadow_triangles += std::size_t(std::popcount(mask)) * std::size_t(m.index_count / 3);
+          for (int c = 0; c < v.layer_count; ++c)
+            if (mask & (1u << c)) count_in_layer(v.first_layer + c, m);
         }
         continue;
       }
-      for (int c = 0; c < layers; ++c) {
-        const bool draw = redraw(base + c);
+      for (int c = 0; c < v.layer_count; ++c) {
+        const int layer = v.first_layer + c;
+        const bool draw = redraw(layer);
         if (draw) {
           glNamedFramebufferTextureLayer(im.shadow_fbo.id(), GL_DEPTH_ATTACHMENT,
-                                         im.shadow_map.id(), 0, base + c);
+                                         im.shadow_map.id(), 0, layer);
           glClear(GL_DEPTH_BUFFER_BIT);
         }
-        if (pass.skipped[std::size_t(c)]) continue;
-        const glm::mat4& light_vp = pass.view_proj[std::size_t(c)];
+        if (v.skipped[std::size_t(c)]) continue;
+        const glm::mat4& light_vp = v.view_proj[std::size_t(c)];
         for (std::uint32_t i : order) {
           const DrawItem& d = frame.draws[i];
-          if (!(caster_mask(light, d) & (1u << c))) continue;
+          if (!(caster_mask(v, d) & (1u << c))) continue;
           const GpuMesh& m = im.mesh(d.mesh, assets);
           if (m.index_count == 0) continue;
           if (draw) {
-            if (Status st = use_program(Pass::depth, depth_key(light, i), current); !st) {
+            if (Status st = use_program(Pass::depth, depth_key(view, i), current); !st) {
               glDisable(GL_POLYGON_OFFSET_FILL);
               glDisable(GL_CLIP_DISTANCE0);
               glEndQuery(GL_TIME_ELAPSED);
@@ -866,10 +748,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
           }
           ++stats_.shadow_draw_calls;
           stats_.shadow_triangles += std::size_t(m.index_count / 3);
-          if (light == 0) {
-            ++stats_.cascade_draw_calls[std::size_t(c)];
-            stats_.cascade_triangles[std::size_t(c)] += std::size_t(m.index_count / 3);
-          }
+          count_in_layer(layer, m);
         }
       }
     }
@@ -966,10 +845,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
       im.probes->cube(job.handle, job.target, job.resolution);
       for (int f = 0; f < 6; ++f) {
         if (!(job.faces & (1u << f))) continue;
-        FrameBlock face_fb = fb;
-        face_fb.view_proj = job.view_proj[std::size_t(f)];
-        face_fb.camera_pos = glm::vec4(job.center, 1.0f);
-        face_fb.ambient.w = 1.0f;  // linear radiance: exposure applies where the map is shown
+        const FrameBlock face_fb = probe_face_block(fb, job, f);
         glNamedBufferSubData(im.frame_ubo.id(), 0, sizeof face_fb, &face_fb);
         im.probes->begin_face(job.handle, job.target, f, frame.clear_color);
         const int before = stats_.draw_calls;

@@ -1,8 +1,8 @@
-// The forward renderer: a depth-only shadow pass per cascade of one shadowed light (one layer of
-// a depth texture array each), then one forward pass that writes colour and the AOVs (world
-// position + mask, facing normal + view depth, shadow visibility + cascade) into an offscreen
-// framebuffer. Headless and windowed use the same passes; a window
-// only adds present().
+// The forward renderer: a depth-only shadow pass over the shadow views (one layer of a depth
+// texture array per cascade, face or hemisphere), probe captures, then one forward pass that
+// writes colour and the AOVs (world position + mask, facing normal + view depth, shadow
+// visibility + cascade) into an offscreen framebuffer. Headless and windowed use the same passes;
+// a window only adds present().
 #pragma once
 
 #include <array>
@@ -16,117 +16,16 @@
 
 #include <glm/glm.hpp>
 
-#include "components/bounds.h"
-#include "components/light.h"
-#include "components/material.h"
-#include "components/probe_state.h"
-#include "components/shadow_settings.h"
 #include "runtime/assets/asset_store.h"
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/core/result.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/render/shader_library.h"
-#include "runtime/render/shadow_limits.h"
+#include "runtime/render/frame_input.h"
 #include "runtime/render/variant_key.h"
 
 namespace kaskad::render {
-
-struct CameraView {
-  glm::mat4 view{1.0f};
-  glm::mat4 proj{1.0f};
-  glm::vec3 position{0.0f};
-};
-
-struct DrawItem {
-  MeshId mesh = kNoMesh;
-  glm::mat4 model{1.0f};
-  Material material;
-  bool cast_shadows = true;
-  bool receive_shadows = true;
-  std::uint8_t cascade_mask = 0xff;  ///< bit i: drawn into cascade i (when cast_shadows)
-  int layer = 0;                     ///< MeshRenderer::layer (probes may exclude layers)
-  /// World bounds, for culling against the main view and each probe face; empty: always drawn.
-  Aabb bounds;
-  /// The reflection probe this draw reflects (its own Reflector; none by default). The draw is
-  /// never drawn into that probe. With a reflection material feature on, it is shaded with the
-  /// probe's visible map, scaled by `reflection_scale` = k_s * p_r (S3 eq. (3)).
-  ProbeHandle probe;
-  float reflection_scale = 0.0f;
-  /// Bit 8k + i: drawn into cascade i of FrameInput::extra_shadows[k].
-  std::uint32_t extra_cascade_masks = 0;
-};
-
-/// One reflection probe's GPU work this frame (systems/environment_probe_system.h). Each probe
-/// has two cube maps (RGBA16F with mips): `faces` of buffer `target` are captured, then buffer
-/// `visible` is shaded with. Captures draw the frame's draws (shadows included) except the
-/// probe's own and excluded layers; reflective draws in them use their probes' visible maps as
-/// of before this frame's captures (no recursion).
-struct ProbeJob {
-  ProbeHandle handle;
-  glm::vec3 center{0.0f};
-  float near = 0.05f, far = 100.0f;
-  int resolution = 128;
-  std::uint32_t exclude_layers = 0;
-  std::uint8_t faces = 0;  ///< bit f: capture GL face f (+X, -X, +Y, -Y, +Z, -Z) into `target`
-  int target = 1;
-  int visible = 0;
-  bool sphere = false;     ///< shade with a sphere map made from the visible cube (S3 eq. (2))
-  bool box = false;        ///< box projection of cube lookups onto [box_min, box_max] (world)
-  glm::vec3 box_min{0.0f}, box_max{0.0f};
-  /// World -> clip of the six 90° face cameras (systems/environment_probe_system.h).
-  std::array<glm::mat4, 6> view_proj{};
-  /// Static file: index into AssetStore::env_maps to upload into buffer `visible` this frame;
-  /// kNoProbe: nothing to upload.
-  std::uint32_t env_map = kNoProbe;
-};
-
-/// A light as the shaders see it (light_shading() in components/light.h makes one).
-using LightItem = LightShading;
-
-inline constexpr int kMaxCascades = 8;  // change together with systems/cascade_math.h and
-                                        // MAX_CASCADES in common.glsl
-
-/// The shadowed light's cascades (systems/shadow_cascade_system.h, ShadowData).
-struct ShadowPass {
-  int light_index = -1;          ///< index into FrameInput::lights; -1: no shadow pass
-  ShadowSettings settings;
-  /// ortho cascades (directional), perspective (spot), cube (6 faces) or dual_paraboloid (2
-  /// hemispheres) for point lights; the layers below are faces or hemispheres then.
-  ShadowProjection projection = ShadowProjection::ortho;
-  int cascade_count = 0;         ///< layers drawn; 0 with light_index >= 0 is treated as 1
-  /// World -> light clip space per cascade; dual_paraboloid: world -> hemisphere view.
-  std::array<glm::mat4, kMaxCascades> view_proj{};
-  /// S0's D, metres of view depth; spot/point: [near, far] metres from the light.
-  std::array<float, kMaxCascades + 1> splits{};
-  /// Metres per texel per cascade; spot/point: at 1 m from the light.
-  std::array<float, kMaxCascades> texel_size{};
-  std::array<bool, kMaxCascades> skipped{};         ///< no receivers: cleared, nothing drawn
-};
-
-struct FrameInput {
-  int width = 1280;
-  int height = 720;
-  CameraView camera;
-  std::vector<DrawItem> draws;
-  std::vector<LightItem> lights;  ///< at most kMaxLights are used
-  ShadowPass shadow;              ///< the first shadowed light (any type)
-  /// Further shadowed directional lights (ortho cascades), at most kMaxShadowedLights - 1; their
-  /// layers follow the first light's in the same texture array, so map size, format, filter and
-  /// selection are the first light's. Ignored without `shadow`.
-  std::vector<ShadowPass> extra_shadows;
-  /// The AOV's visibility and cascade show this shadowed light: 0 `shadow`, k extra_shadows[k-1].
-  int aov_shadow_light = 0;
-  std::vector<ProbeJob> probes;
-  glm::vec3 ambient{0.05f};
-  glm::vec3 clear_color{0.0f};
-  float exposure = 1.0f;
-  /// Write the AOV targets (position, normal + depth, visibility). Off, the forward pass writes
-  /// colour only: on llvmpipe the three float targets cost more than the shading itself.
-  bool write_aovs = true;
-};
-
-inline constexpr int kMaxLights = 8;  // change together with MAX_LIGHTS in common.glsl
 
 struct FrameStats {
   int draw_calls = 0;
@@ -136,16 +35,16 @@ struct FrameStats {
   /// frame or kept from an earlier one (shadow_layers_rendered says which layers were drawn).
   int shadow_draw_calls = 0;
   std::size_t shadow_triangles = 0;
-  int shadow_layers = 0;  ///< layers of the shadow map this frame (all shadowed lights)
+  int shadow_layers = 0;  ///< layers of the shadow map this frame (all shadow views)
   /// Bit l: texture-array layer l was cleared and re-rendered this frame. The others kept their
   /// depth: same matrix, casters, caster matrices, bias and pass mode as when last drawn.
   std::uint32_t shadow_layers_rendered = 0;
-  int cascades = 0;                   ///< cascade layers of the shadow map this frame
-  std::array<int, kMaxCascades> cascade_draw_calls{};         ///< casters drawn per cascade
-  std::array<std::size_t, kMaxCascades> cascade_triangles{};  ///< their triangles
-  /// World units (metres) per shadow-map texel of each cascade (of the first shadowed light;
-  /// spot/point layers: at 1 m from the light).
-  std::array<float, kMaxCascades> cascade_texel_size{};
+  /// Per layer of the shadow map array (all shadow views; view k's layers start at its
+  /// first_layer): the casters it holds, their triangles, and metres per texel (spot and point
+  /// layers: at 1 m from the light).
+  std::array<int, kMaxShadowLayers> layer_draw_calls{};
+  std::array<std::size_t, kMaxShadowLayers> layer_triangles{};
+  std::array<float, kMaxShadowLayers> layer_texel_size{};
   /// Receiver pixels per cascade: pixels of the frame's AOV whose `cascade` channel is i (visible
   /// shadow-receiving surfaces shaded from cascade i; the first one where blending). Counted by
   /// cascade_pixel_counts(), which render_frames() calls after its last frame when AOVs are
@@ -223,7 +122,8 @@ class Renderer {
   /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;
 
-  /// The AOV's shadowed light's visibility (FrameInput::aov_shadow_light) at fixed world points
+  /// The visibility of the shadow view the AOV shows (FrameInput::aov_shadow_view) at fixed world
+  /// points
   /// with unit normals (one per point),
   /// evaluated by the forward pass's own shadow lookup (content/shaders/shadow.glsl) against the
   /// shadow maps, camera and frame features of the last render(). One (visibility,

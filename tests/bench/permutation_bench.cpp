@@ -109,11 +109,12 @@ int main(int argc, char** argv) {
   auto oracle = make(true, {});
   auto frame_ms = [&](render::Renderer& r) {
     std::vector<double> ms;
+    SystemState systems;
     FrameReport rep;
     for (int i = 0; i < frames; ++i) {
       fc.index = std::uint64_t(i);
       const auto t0 = Clock::now();
-      if (auto st = run_frame(*scene, r, fc, rep); !st) {
+      if (auto st = run_frame(*scene, r, fc, systems, rep); !st) {
         std::fprintf(stderr, "permutation_bench: %s\n", st.error().to_string().c_str());
         std::exit(1);
       }

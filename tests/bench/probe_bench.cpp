@@ -156,12 +156,13 @@ int main(int argc, char** argv) {
       ctx.height = s.render.height;
       ctx.write_aovs = false;
       if (!prewarm_frame(s, *player->renderer, ctx)) return 1;
+      SystemState systems;
       FrameReport report;
       std::vector<double> all, capturing;
       for (int k = 0; k < frames; ++k) {
         ctx.index = std::uint64_t(k);
         const auto t0 = std::chrono::steady_clock::now();
-        if (!run_frame(s, *player->renderer, ctx, report)) return 1;
+        if (!run_frame(s, *player->renderer, ctx, systems, report)) return 1;
         player->renderer->finish();
         const double ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -46,11 +46,11 @@ check save_roundtrip2 0 "wrote" -- "$KASKAD" save "$tmp/a.json" -o "$tmp/b.json"
 if cmp -s "$tmp/a.json" "$tmp/b.json"; then echo "ok   save_identical"; passed=$((passed + 1)); else echo "FAIL save_identical"; failed=$((failed + 1)); fi
 check help 0 "usage" -- "$KASKAD" --help
 # Spot and point lights, several shadowed lights: the shadow lines and the per-layer table.
-check render_spot 0 "shadow +spot: 1 perspective map" -- "$KASKAD" render "$KASKAD_CONTENT/scenes/spot.json" \
+check render_spot 0 "spot: 1 perspective map" -- "$KASKAD" render "$KASKAD_CONTENT/scenes/spot.json" \
   --headless --size 96x64 --frames 1 -o "$tmp/spot.png"
 check render_point_dp 0 "point: 2 paraboloid hemispheres" -- "$KASKAD" render "$KASKAD_CONTENT/scenes/point.json" \
   --headless --size 96x64 --frames 1 -o "$tmp/point.png" --set shadow.point_mode=dual_paraboloid
-check render_two_suns 0 "shadowed +light [0-9]+: 2 cascades" -- "$KASKAD" render "$KASKAD_CONTENT/scenes/two_suns.json" \
+check render_two_suns 0 "view 1: light 'moon' \(entity [0-9]+\), layers 4\.\.5 of" -- "$KASKAD" render "$KASKAD_CONTENT/scenes/two_suns.json" \
   --headless --size 96x64 --frames 1 -o "$tmp/two.png"
 check cascade_table 0 "layer +m/texel +casters +triangles +receiver px" -- "$KASKAD" render --headless \
   --size 96x64 --frames 1 -o "$tmp/t.png" --aov "$tmp/t.exr"

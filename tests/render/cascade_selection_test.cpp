@@ -31,7 +31,7 @@ TEST_F(CascadeSelectionTest, ShaderPicksTheCascadeTheCpuHelpersPick) {
     run.write_aovs = false;
     auto t = render_frames(*player_, *scene, run);
     ASSERT_TRUE(t.ok()) << t.error().to_string();
-    const ShadowData& sh = t->last.shadow;
+    const ShadowData& sh = t->last.shadow();
     const int n = sh.cascade_count;
     ASSERT_EQ(n, 4);
     const std::span<const float> D(sh.splits.data(), std::size_t(n) + 1);

@@ -102,7 +102,7 @@ class DefaultSceneTest : public PlayerTest {
     if (!t.ok()) return {};
     const Image aov = player_->renderer->read_aovs();
     if (aov_out) *aov_out = aov;
-    const ecs::Entity sun = t->last.shadow.light;
+    const ecs::Entity sun = t->last.shadow().light;
     EXPECT_TRUE(sun.valid());
     const glm::vec3 to_light =
         -light_direction(scene->world.get<WorldTransform>(sun).matrix);
@@ -234,7 +234,7 @@ TEST_F(DefaultSceneTest, StableCascadesDoNotShimmerUnderSubTexelCameraMoves) {
     EXPECT_TRUE(scene.ok()) << scene.error().to_string();
     auto t = render_frames(*player_, *scene, {});
     EXPECT_TRUE(t.ok()) << t.error().to_string();
-    if (shadow && t.ok()) *shadow = t->last.shadow;
+    if (shadow && t.ok()) *shadow = t->last.shadow();
     return player_->renderer->read_aovs();
   };
   auto count_changes = [&](const char* fit, int& compared, float& texel) {
@@ -294,18 +294,18 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
   auto t = render_frames(*player_, *scene, {});
   ASSERT_TRUE(t.ok()) << t.error().to_string();
   const render::FrameStats& st = t->last.stats;
-  const ShadowData& sh = t->last.shadow;
-  ASSERT_EQ(st.cascades, 8);
+  const ShadowData& sh = t->last.shadow();
+  ASSERT_EQ(st.shadow_layers, 8);
   int draws = 0, culled = 0;
   std::size_t triangles = 0;
   for (std::size_t i = 0; i < 8; ++i) {
-    EXPECT_EQ(st.cascade_draw_calls[i], int(sh.casters[i].size())) << "cascade " << i;
+    EXPECT_EQ(st.layer_draw_calls[i], int(sh.casters[i].size())) << "cascade " << i;
     if (sh.skipped[i]) {
-      EXPECT_EQ(st.cascade_draw_calls[i], 0) << "cascade " << i;
+      EXPECT_EQ(st.layer_draw_calls[i], 0) << "cascade " << i;
     }
-    draws += st.cascade_draw_calls[i];
-    triangles += st.cascade_triangles[i];
-    culled += 8 - st.cascade_draw_calls[i];  // the default scene has 8 casters
+    draws += st.layer_draw_calls[i];
+    triangles += st.layer_triangles[i];
+    culled += 8 - st.layer_draw_calls[i];  // the default scene has 8 casters
   }
   EXPECT_EQ(draws, st.shadow_draw_calls);
   EXPECT_EQ(triangles, st.shadow_triangles);
@@ -328,9 +328,9 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
   const render::FrameStats& ls = lt->last.stats;
   std::set<std::uint32_t> casters_drawn;
   for (std::size_t i = 0; i < 8; ++i) {
-    EXPECT_EQ(ls.cascade_draw_calls[i], st.cascade_draw_calls[i]) << "cascade " << i;
-    EXPECT_EQ(ls.cascade_triangles[i], st.cascade_triangles[i]) << "cascade " << i;
-    for (ecs::Entity e : lt->last.shadow.casters[i]) casters_drawn.insert(e.index);
+    EXPECT_EQ(ls.layer_draw_calls[i], st.layer_draw_calls[i]) << "cascade " << i;
+    EXPECT_EQ(ls.layer_triangles[i], st.layer_triangles[i]) << "cascade " << i;
+    for (ecs::Entity e : lt->last.shadow().casters[i]) casters_drawn.insert(e.index);
   }
   EXPECT_EQ(ls.shadow_draw_calls, int(casters_drawn.size()));
   EXPECT_LT(ls.shadow_draw_calls, st.shadow_draw_calls);

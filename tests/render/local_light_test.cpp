@@ -52,8 +52,8 @@ class LocalLightTest : public PlayerTest {
     auto t = render_frames(*player_, *scene, run);
     EXPECT_TRUE(t.ok()) << t.error().to_string();
     if (!t.ok()) return out;
-    out.shadow = t->last.shadow;
-    out.extra = t->last.extra_shadows;
+    out.shadow = t->last.shadow();
+    if (t->last.shadows.size() > 1) out.extra.assign(t->last.shadows.begin() + 1, t->last.shadows.end());
     out.stats = t->last.stats;
     out.aov = player_->renderer->read_aovs();
     EXPECT_LE(reference_of, int(out.extra.size()));
@@ -108,14 +108,14 @@ TEST_F(LocalLightTest, PointLightCubeMapAgreesWithRayCastsAwayFromEdges) {
   expect_meaningful(r);
   // Stats: receiver pixels per layer are the AOV's cascade channel counted where the mask is 1
   // (drawn surfaces; the background is not a receiver); texel sizes are the system's.
-  std::array<std::size_t, render::kMaxCascades> counted{};
+  std::array<std::size_t, kMaxCascades> counted{};
   for (int y = 0; y < r.aov.height; ++y)
     for (int x = 0; x < r.aov.width; ++x)
       if (const int c = int(r.aov.at(x, y, 9)); c >= 0 && r.aov.at(x, y, 8) == 1.0f)
         ++counted[std::size_t(c)];
   EXPECT_EQ(r.stats.cascade_receiver_pixels, counted);
   for (int i = 0; i < 6; ++i)
-    EXPECT_EQ(r.stats.cascade_texel_size[std::size_t(i)], r.shadow.texel_size[std::size_t(i)]);
+    EXPECT_EQ(r.stats.layer_texel_size[std::size_t(i)], r.shadow.texel_size[std::size_t(i)]);
   EXPECT_GE(r.layers_seen.size(), 4u) << "the view should see receivers on several cube faces";
   EXPECT_LT(r.metrics.outside_edges.misclassified_pct, 1.0) << describe(r.metrics);
 }
@@ -188,8 +188,8 @@ TEST_F(LocalLightTest, ExtraShadowedLightsAreCappedAndMustBeDirectional) {
   RenderRun run;
   auto t = render_frames(*player_, *scene, run);
   ASSERT_TRUE(t.ok()) << t.error().to_string();
-  EXPECT_TRUE(t->last.shadow.light.valid());
-  EXPECT_TRUE(t->last.extra_shadows.empty());
+  ASSERT_EQ(t->last.shadows.size(), 1u);  // the spot light (second) gets no view
+  EXPECT_TRUE(t->last.shadow().light.valid());
 }
 
 // The layered shadow pass (one instanced draw per caster and light, gl_Layer from the vertex

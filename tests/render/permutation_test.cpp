@@ -51,10 +51,11 @@ class PermutationTest : public HeadlessGlTest {
     if (prewarm) {
       EXPECT_TRUE(prewarm_frame(s, r, ctx).ok());
     }
+    SystemState systems;
     FrameReport report;
     for (int i = 0; i < frames; ++i) {
       ctx.index = std::uint64_t(i);
-      Status st = run_frame(s, r, ctx, report);
+      Status st = run_frame(s, r, ctx, systems, report);
       EXPECT_TRUE(st.ok()) << st.error().to_string();
       if (i == 0) r.shaders().first_frame_done();
     }
@@ -182,9 +183,9 @@ TEST_F(PermutationTest, HotReloadKeepsTheLastGoodProgramAndMapsErrors) {
   {
     std::ifstream in(dir / "forward.frag");
     std::string f((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const std::string from = "o_color = vec4(color * u_ambient.w, 1.0);";
+    const std::string from = "o_color = vec4(color * u_frame.x, 1.0);";
     ASSERT_NE(f.find(from), std::string::npos);
-    f.replace(f.find(from), from.size(), "o_color = vec4(color * u_ambient.w + 0.2, 1.0);");
+    f.replace(f.find(from), from.size(), "o_color = vec4(color * u_frame.x + 0.2, 1.0);");
     std::ofstream(dir / "forward.frag", std::ios::trunc) << f;
   }
   for (const char* name : {"common.glsl", "forward.frag"})

@@ -272,10 +272,11 @@ TEST_F(ProbeTest, EveryNCapturesOnExactlyTheScheduledFrames) {
   ctx.width = 64;
   ctx.height = 48;
   ctx.write_aovs = false;
+  SystemState systems;
   FrameReport report;
   for (int k = 0; k < 8; ++k) {
     ctx.index = std::uint64_t(k);
-    ASSERT_TRUE(run_frame(scene, *player_->renderer, ctx, report).ok());
+    ASSERT_TRUE(run_frame(scene, *player_->renderer, ctx, systems, report).ok());
     EXPECT_EQ(report.stats.probe_faces, k % 3 == 0 ? 6 : 0) << "frame " << k;
   }
   EXPECT_EQ(scene.world.get<ProbeState>(probe).captures, 3u);
@@ -327,7 +328,7 @@ TEST_F(ProbeTest, ProbeSeesAShadowBehindTheMainCamera) {
     auto t = render_frames(*player_, scene, run);
     EXPECT_TRUE(t.ok()) << t.error().to_string();
     if (!t.ok()) return glm::vec4(-1.0f);
-    if (shadow) *shadow = t->last.shadow;
+    if (shadow) *shadow = t->last.shadow();
     const ProbeState& ps = scene.world.get<ProbeState>(named(scene, "probe"));
     return face_centre(player_->renderer->read_probe_cube(ps.handle, ps.front), 3);
   };
@@ -360,6 +361,7 @@ TEST_F(ProbeTest, TimeSlicedCaptureNeverShowsAPartialCube) {
   ctx.width = 64;
   ctx.height = 48;
   ctx.write_aovs = false;
+  SystemState systems;
   FrameReport report;
   auto visible = [&] {
     const ProbeState& ps = scene.world.get<ProbeState>(probe);
@@ -368,7 +370,7 @@ TEST_F(ProbeTest, TimeSlicedCaptureNeverShowsAPartialCube) {
   // The first capture is whole on frame 0 (there is no map to show meanwhile).
   std::uint64_t k = 0;
   ctx.index = k++;
-  ASSERT_TRUE(run_frame(scene, *player_->renderer, ctx, report).ok());
+  ASSERT_TRUE(run_frame(scene, *player_->renderer, ctx, systems, report).ok());
   EXPECT_EQ(report.stats.probe_faces, 6);
   EXPECT_TRUE(scene.world.get<ProbeState>(probe).has_map);
   for (int f = 0; f < 6; ++f)
@@ -376,7 +378,7 @@ TEST_F(ProbeTest, TimeSlicedCaptureNeverShowsAPartialCube) {
   // A static scene does not re-capture.
   for (; k < 9; ++k) {
     ctx.index = k;
-    ASSERT_TRUE(run_frame(scene, *player_->renderer, ctx, report).ok());
+    ASSERT_TRUE(run_frame(scene, *player_->renderer, ctx, systems, report).ok());
     EXPECT_EQ(report.stats.probe_faces, 0) << "frame " << k;
   }
   // Every wall turns white: a change in range.
@@ -385,7 +387,7 @@ TEST_F(ProbeTest, TimeSlicedCaptureNeverShowsAPartialCube) {
   int new_faces = 0;
   for (int i = 0; i < 6; ++i, ++k) {
     ctx.index = k;
-    ASSERT_TRUE(run_frame(scene, *player_->renderer, ctx, report).ok());
+    ASSERT_TRUE(run_frame(scene, *player_->renderer, ctx, systems, report).ok());
     EXPECT_EQ(report.stats.probe_faces, 1);
     const CubeMap cube = visible();
     int white = 0;
@@ -444,8 +446,9 @@ TEST_F(ProbeTest, SphereMapFromTheCubeAndRuntimeSwitch) {
   ctx.width = 240;
   ctx.height = 160;
   ctx.index = 2;
+  SystemState systems;
   FrameReport report;
-  ASSERT_TRUE(run_frame(scene, *player_->renderer, ctx, report).ok());
+  ASSERT_TRUE(run_frame(scene, *player_->renderer, ctx, systems, report).ok());
   ASSERT_EQ(report.probes.probes.size(), 1u);
   EXPECT_FALSE(report.probes.probes[0].sphere);
   const Comparison cube = compare_reflection(player_->renderer->read_aovs(), t->last.camera.position, env);

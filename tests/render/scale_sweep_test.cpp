@@ -51,7 +51,7 @@ TEST_P(ScaleSweepTest, ShadowsAgreeWithTheReferenceAtDefaultSettings) {
   run.frames = 2;
   auto t = render_frames(*player_, *scene, run);
   ASSERT_TRUE(t.ok()) << t.error().to_string();
-  const ShadowData& sh = t->last.shadow;
+  const ShadowData& sh = t->last.shadow();
   ASSERT_TRUE(sh.light.valid()) << "no shadowed light: " << sh.error;
   const Image aov = player_->renderer->read_aovs();
   auto tracer = reference::RayTracer::build(*scene);

@@ -90,7 +90,7 @@ TEST_F(ShadowCacheTest, LayersAreRedrawnOnlyWhenTheirInputsChange) {
   EXPECT_EQ(still.map, first.map);
   EXPECT_EQ(still.visibility, first.visibility);
   EXPECT_EQ(still.stats.shadow_draw_calls, first.stats.shadow_draw_calls);
-  EXPECT_EQ(still.stats.cascade_draw_calls, first.stats.cascade_draw_calls);
+  EXPECT_EQ(still.stats.layer_draw_calls, first.stats.layer_draw_calls);
 
   // A caster moves: the layers that hold it are redrawn, and the maps are those drawn with
   // nothing cached.

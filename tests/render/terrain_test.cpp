@@ -38,7 +38,7 @@ class TerrainTest : public PlayerTest {
     auto t = render_frames(*player_, *scene, {});
     EXPECT_TRUE(t.ok()) << t.error().to_string();
     if (!t.ok()) return out;
-    const ShadowData& sh = t->last.shadow;
+    const ShadowData& sh = t->last.shadow();
     EXPECT_TRUE(sh.light.valid());
     if (!sh.light.valid()) return out;
     ecs::Entity crate = ecs::kNullEntity;

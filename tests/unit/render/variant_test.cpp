@@ -10,6 +10,7 @@
 
 #include "runtime/assets/material_file.h"
 #include "runtime/render/feature_manifest.h"
+#include "runtime/render/frame_uniforms.h"
 #include "runtime/render/renderer.h"
 #include "runtime/render/variant_key.h"
 
@@ -169,57 +170,59 @@ TEST(FeatureManifest, BadManifestsAreRejected) {
   EXPECT_NE(r4.error().to_string().find("glowing"), std::string::npos) << r4.error().to_string();
 }
 
-// common.glsl sizes the frame block's arrays with its own defines; they must match the
-// renderer's FrameBlock limits (written twice: GLSL cannot include a C++ header).
-TEST(ShaderConstants, CommonGlslMatchesTheRendererLimits) {
-  std::ifstream in(kShaders / "common.glsl");
-  ASSERT_TRUE(in) << "cannot open common.glsl";
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  auto define = [&](const std::string& name) {
-    const std::string key = "#define " + name + " ";
-    const auto at = text.find(key);
-    return at == std::string::npos ? -1 : std::atoi(text.c_str() + at + key.size());
-  };
-  EXPECT_EQ(define("MAX_CASCADES"), kMaxCascades);
-  EXPECT_EQ(define("MAX_EXTRA_SHADOWS"), kMaxShadowedLights - 1);
+// The frame block's array sizes reach the shaders as defines made from components/limits.h;
+// no shader defines them itself (one source).
+TEST(ShaderConstants, LimitsAreDefinedFromTheOneCppDefinition) {
+  const FeatureManifest m = manifest();
+  for (const ShaderStage stage : {ShaderStage::vertex, ShaderStage::fragment}) {
+    const auto defs = m.defines(VariantKey(), stage);
+    auto value = [&](const std::string& name) {
+      for (const auto& [key, v] : defs)
+        if (key == name) return std::atoi(v.c_str());
+      return -1;
+    };
+    EXPECT_EQ(value("MAX_LIGHTS"), kMaxLights);
+    EXPECT_EQ(value("MAX_CASCADES"), kMaxCascades);
+    EXPECT_EQ(value("MAX_SHADOW_VIEWS"), kMaxShadowedLights);
+  }
+  for (const auto& entry : std::filesystem::directory_iterator(kShaders)) {
+    std::ifstream in(entry.path());
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(text.find("#define MAX_"), std::string::npos) << entry.path();
+  }
 }
 
-// The number of shadowed lights is a frame feature: a frame compiles the lookups of the lights
-// it shades and no others (issue 13: dormant extra-light code cost a quarter of the frame).
-TEST(FrameVariant, ShadowLightsCountsTheShadowedLightsTheFrameShades) {
+// The number of shadow views is a frame feature: a frame compiles the lookups of the views it
+// shades and no others (issue 13: dormant extra-light code cost a quarter of the frame).
+TEST(FrameVariant, ShadowLightsCountsTheShadowViews) {
   const FeatureManifest m = manifest();
   const Feature& lights = *m.find("shadow_lights");
   FrameInput frame;
   frame.lights.resize(4);
   EXPECT_EQ(m.value(lights, frame_variant(frame)), 1);  // no shadow: the field is off
-  EXPECT_FALSE(frame_variant(frame).has(VariantKey::kShadowLightsMinus1));
-  // Extra lights without a first shadowed light are not drawn.
-  frame.extra_shadows.resize(1);
-  frame.extra_shadows[0].light_index = 1;
   EXPECT_FALSE(frame_variant(frame).has(VariantKey::kShadow));
   EXPECT_FALSE(frame_variant(frame).has(VariantKey::kShadowLightsMinus1));
-
-  frame.shadow.light_index = 0;
-  frame.extra_shadows.clear();
+  auto add_view = [&](int light) {
+    ShadowView v;
+    v.light_index = light;
+    v.layer_count = 2;
+    v.first_layer = frame.shadow_views.empty()
+                        ? 0
+                        : frame.shadow_views.back().first_layer + frame.shadow_views.back().layer_count;
+    frame.shadow_views.push_back(v);
+  };
+  add_view(0);
   EXPECT_EQ(m.value(lights, frame_variant(frame)), 1);
-  // Drawn: a directional light in range. Not drawn: a light index past the shaded lights, a
-  // spot projection (extras are directional cascades).
-  ShadowPass extra;
-  extra.light_index = 1;
-  frame.extra_shadows.push_back(extra);
-  extra.light_index = 9;
-  frame.extra_shadows.push_back(extra);
-  extra.light_index = 2;
-  extra.projection = ShadowProjection::perspective;
-  frame.extra_shadows.push_back(extra);
+  EXPECT_TRUE(frame_variant(frame).has(VariantKey::kShadow));
+  add_view(2);
   VariantKey k = frame_variant(frame);
   EXPECT_EQ(m.value(lights, k), 2);
   EXPECT_TRUE(k.valid());
   EXPECT_EQ(m.check(k), "");
   EXPECT_NE(m.describe(k).find("shadow_lights=2"), std::string::npos) << m.describe(k);
-  // At most kMaxShadowedLights in all.
-  extra.projection = ShadowProjection::ortho;
-  for (int i = 0; i < 5; ++i) frame.extra_shadows.push_back(extra);
+  add_view(1);
+  add_view(3);
+  EXPECT_EQ(shadow_views_error(frame), "");
   k = frame_variant(frame);
   EXPECT_EQ(m.value(lights, k), kMaxShadowedLights);
   // The forward and points passes read it; the depth pass does not.
@@ -234,6 +237,46 @@ TEST(FrameVariant, ShadowLightsCountsTheShadowedLightsTheFrameShades) {
   EXPECT_FALSE(orphan.valid());
   EXPECT_NE(m.check(orphan).find("shadow_lights requires shadow"), std::string::npos)
       << m.check(orphan);
+}
+
+// Shadow views the renderer cannot draw as given are named, not drawn wrongly.
+TEST(FrameInput, ShadowViewsErrorNamesTheBadView) {
+  FrameInput frame;
+  frame.lights.resize(3);
+  ShadowView v;
+  v.light_index = 0;
+  v.layer_count = 4;
+  frame.shadow_views = {v};
+  EXPECT_EQ(shadow_views_error(frame), "");
+  auto error_with = [&](auto&& change) {
+    FrameInput f = frame;
+    f.shadow_views.push_back(v);
+    f.shadow_views[1].light_index = 1;
+    f.shadow_views[1].first_layer = 4;
+    change(f);
+    return shadow_views_error(f);
+  };
+  EXPECT_EQ(error_with([](FrameInput&) {}), "");
+  EXPECT_NE(error_with([](FrameInput& f) { f.shadow_views[1].light_index = 3; })
+                .find("shadow view 1: light index 3 is not one of the 3 shaded lights"),
+            std::string::npos);
+  EXPECT_NE(error_with([](FrameInput& f) { f.shadow_views[1].first_layer = 5; })
+                .find("shadow view 1: first layer 5, expected 4"),
+            std::string::npos);
+  EXPECT_NE(error_with([](FrameInput& f) { f.shadow_views[1].layer_count = 0; })
+                .find("shadow view 1: 0 layers"),
+            std::string::npos);
+  EXPECT_NE(error_with([](FrameInput& f) {
+              f.shadow_views[1].projection = ShadowProjection::perspective;
+            }).find("only the first view may be a spot or point light's"),
+            std::string::npos);
+  EXPECT_NE(error_with([](FrameInput& f) { f.aov_shadow_view = 2; })
+                .find("aov_shadow_view 2 is not one of the 2 shadow views"),
+            std::string::npos);
+  EXPECT_NE(error_with([](FrameInput& f) {
+              for (int i = 0; i < 3; ++i) f.shadow_views.push_back(f.shadow_views[1]);
+            }).find("5 shadow views; at most 4"),
+            std::string::npos);
 }
 
 struct BadMaterial {

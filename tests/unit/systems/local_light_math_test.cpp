@@ -220,7 +220,7 @@ TEST(ShadowCascadeSystem, SpotAndPointLightsGetTheirMaps) {
       } else {
         EXPECT_EQ(d.projection, ShadowProjection::dual_paraboloid);
         EXPECT_EQ(d.cascade_count, 2);
-        EXPECT_GT(d.splits[2], 0.0f);            // the margin
+        EXPECT_GT(d.paraboloid_margin, 0.0f);
         EXPECT_EQ(d.cascade_mask(blocker), 1u);  // the lower hemisphere only
         EXPECT_FALSE(d.skipped[0]);
       }

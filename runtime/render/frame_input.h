@@ -1,0 +1,132 @@
+// What the renderer is given each frame (phase 5's output, systems/frame.h): plain data, no GL.
+// The passes of runtime/render/renderer.h draw exactly this.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "components/bounds.h"
+#include "components/light.h"
+#include "components/limits.h"
+#include "components/material.h"
+#include "components/mesh_renderer.h"
+#include "components/probe_state.h"
+#include "components/shadow_settings.h"
+
+namespace kaskad::render {
+
+struct CameraView {
+  glm::mat4 view{1.0f};
+  glm::mat4 proj{1.0f};
+  glm::vec3 position{0.0f};
+};
+
+struct DrawItem {
+  MeshId mesh = kNoMesh;
+  glm::mat4 model{1.0f};
+  Material material;
+  bool cast_shadows = true;
+  bool receive_shadows = true;
+  /// Bit l: drawn into layer l of the shadow map array (when cast_shadows). Each shadow view
+  /// owns the layers first_layer .. first_layer + layer_count - 1 (ShadowView).
+  std::uint32_t shadow_layers = ~0u;
+  int layer = 0;  ///< MeshRenderer::layer (probes may exclude layers)
+  /// World bounds, for culling against the main view and each probe face; empty: always drawn.
+  Aabb bounds;
+  /// The reflection probe this draw reflects (its own Reflector; none by default). The draw is
+  /// never drawn into that probe. With a reflection material feature on, it is shaded with the
+  /// probe's visible map, scaled by `reflection_scale` = k_s * p_r (S3 eq. (3)).
+  ProbeHandle probe;
+  float reflection_scale = 0.0f;
+};
+
+/// One reflection probe's GPU work this frame (systems/environment_probe_system.h). Each probe
+/// has two cube maps (RGBA16F with mips): `faces` of buffer `target` are captured, then buffer
+/// `visible` is shaded with. Captures draw the frame's draws (shadows included) except the
+/// probe's own and excluded layers; reflective draws in them use their probes' visible maps as
+/// of before this frame's captures (no recursion).
+struct ProbeJob {
+  ProbeHandle handle;
+  glm::vec3 center{0.0f};
+  float near = 0.05f, far = 100.0f;
+  int resolution = 128;
+  std::uint32_t exclude_layers = 0;
+  std::uint8_t faces = 0;  ///< bit f: capture GL face f (+X, -X, +Y, -Y, +Z, -Z) into `target`
+  int target = 1;
+  int visible = 0;
+  bool sphere = false;     ///< shade with a sphere map made from the visible cube (S3 eq. (2))
+  bool box = false;        ///< box projection of cube lookups onto [box_min, box_max] (world)
+  glm::vec3 box_min{0.0f}, box_max{0.0f};
+  /// World -> clip of the six 90° face cameras (systems/environment_probe_system.h).
+  std::array<glm::mat4, 6> view_proj{};
+  /// Static file: index into AssetStore::env_maps to upload into buffer `visible` this frame;
+  /// kNoProbe: nothing to upload.
+  std::uint32_t env_map = kNoProbe;
+};
+
+/// A light as the shaders see it (light_shading() in components/light.h makes one).
+using LightItem = LightShading;
+
+/// One shadowed light's maps (systems/shadow_cascade_system.h makes them): its layers of the
+/// shared depth texture array and what the depth pass and the shaders need to draw and read
+/// them. Every view is handled by the same code; only the first may be a spot or point light
+/// (its projection is a frame shader feature), the others are ortho cascades.
+struct ShadowView {
+  int light_index = -1;  ///< index into FrameInput::lights (one of the shaded ones)
+  /// ortho: a directional light's cascades; perspective: a spot map; cube (6 faces) or
+  /// dual_paraboloid (2 hemispheres): a point light's maps. "Cascade" below means layer.
+  ShadowProjection projection = ShadowProjection::ortho;
+  int first_layer = 0;  ///< its first layer in the shadow map array; views follow each other
+  int layer_count = 1;  ///< in [1, kMaxCascades]
+  /// World -> light clip space per layer; dual_paraboloid: world -> hemisphere view.
+  std::array<glm::mat4, kMaxCascades> view_proj{};
+  /// S0's D, metres of view depth; spot/point: [near, far] metres from the light.
+  std::array<float, kMaxCascades + 1> splits{};
+  /// Metres per texel per layer; spot/point: at 1 m from the light.
+  std::array<float, kMaxCascades> texel_size{};
+  std::array<bool, kMaxCascades> skipped{};  ///< no receivers: cleared, nothing drawn
+  /// Shading: the normal offset in texels of the layer (0 for the basic map, FitMode::scene),
+  /// the blend band (fraction of a cascade), the paraboloid margin (dual_paraboloid).
+  float normal_offset = 0.0f;
+  float blend_band = 0.0f;
+  float paraboloid_margin = 0.0f;
+  /// Depth pass: polygon offset and face culling.
+  float slope_bias = 0.0f, constant_bias = 0.0f;
+  CullMode cull = CullMode::back;
+};
+
+/// The shadow map array and the shadow features shared by every view (the first shadowed
+/// light's settings; see ShadowData::settings).
+struct ShadowMapSettings {
+  int size = ShadowSettings{}.map_size;
+  DepthFormat format = ShadowSettings{}.depth_format;
+  ShadowFilter filter = ShadowSettings{}.filter;
+  CascadeSelection selection = ShadowSettings{}.selection;
+  bool layered = ShadowSettings{}.layered;  ///< all of a view's layers in one instanced pass
+  bool debug_cascades = ShadowSettings{}.debug_cascades;
+};
+
+struct FrameInput {
+  int width = 1280;
+  int height = 720;
+  CameraView camera;
+  std::vector<DrawItem> draws;
+  std::vector<LightItem> lights;  ///< at most kMaxLights are shaded
+  /// One per shadowed light, at most kMaxShadowedLights; empty: no shadow pass.
+  std::vector<ShadowView> shadow_views;
+  ShadowMapSettings shadow_map;
+  /// The view whose visibility and cascade the AOV shows (an index into shadow_views).
+  int aov_shadow_view = 0;
+  std::vector<ProbeJob> probes;
+  glm::vec3 ambient{0.05f};
+  glm::vec3 clear_color{0.0f};
+  float exposure = 1.0f;
+  /// Write the AOV targets (position, normal + depth, visibility). Off, the forward pass writes
+  /// colour only: on llvmpipe the three float targets cost more than the shading itself.
+  bool write_aovs = true;
+};
+
+}  // namespace kaskad::render
