@@ -492,11 +492,12 @@ float cascade_blend_weight(std::span<const float> D, int cascade, float view_dep
   return std::clamp((view_depth - start) / (end - start), 0.0f, 1.0f);
 }
 
-float cascade_blend_weight_map(const glm::vec3& ndc, float blend_band) {
+float cascade_blend_weight_map(const glm::vec3& ndc, float blend_band, float border_ndc) {
   if (!(blend_band > 0.0f)) return 0.0f;
-  const float edge = std::max(std::abs(ndc.x), std::abs(ndc.y));  // 1 at the map's border
-  const float start = 1.0f - std::min(blend_band, 1.0f);
-  return std::clamp((edge - start) / (1.0f - start), 0.0f, 1.0f);
+  const float edge = std::max(std::abs(ndc.x), std::abs(ndc.y));
+  const float limit = 1.0f - border_ndc;  // where the cascade stops being selected
+  const float start = limit - std::min(blend_band, 1.0f) * limit;
+  return std::clamp((edge - start) / (limit - start), 0.0f, 1.0f);
 }
 
 glm::mat4 shadow_bias_matrix() {

@@ -180,7 +180,8 @@ struct CascadeFit {
 CascadeFit fit_cascade(const CameraSlice& slice, const LightFrame& light,
                        const CascadeFitOptions& options, const ShadowGeometry& geometry = {});
 
-// ---- Shading helpers (mirrored by the shader; change together with it) --------------------------
+// ---- Shading helpers (the shader's shadow.glsl computes the same; tests/render/
+// cascade_selection_test.cpp compares the two) -----------------------------------------------------
 
 /// S0: the cascade i with D[i] <= view_depth < D[i+1] (view_depth = |z_view|), -1 outside
 /// [D[0], D[N]) or for fewer than 2 distances.
@@ -198,8 +199,9 @@ float cascade_blend_weight(std::span<const float> D, int cascade, float view_dep
                            float blend_band);
 
 /// The same for map selection: the point's NDC in its cascade; 0 inside, rising linearly to 1
-/// over the outer `blend_band` fraction of the map's half-width.
-float cascade_blend_weight_map(const glm::vec3& ndc, float blend_band);
+/// over the outer `blend_band` fraction of the usable half-width 1 - border_ndc (the border
+/// select_cascade_by_map() keeps free), reaching 1 where that cascade stops being selected.
+float cascade_blend_weight_map(const glm::vec3& ndc, float blend_band, float border_ndc = 0.0f);
 
 /// S0's M_bias: NDC [-1, 1]^3 -> texture space [0, 1]^3 (P_tex = M_bias * P_LNDCS).
 glm::mat4 shadow_bias_matrix();

@@ -913,7 +913,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
 }
 
 Result<std::vector<glm::vec2>> Renderer::shadow_at_points(std::span<const glm::vec3> points,
-                                                          std::span<const glm::vec3> normals) {
+                                                          std::span<const glm::vec3> normals,
+                                                          std::vector<float>* blend_weights) {
   Impl& im = *impl_;
   if (points.size() != normals.size())
     return Error{"", "shadow_at_points", std::to_string(points.size()) + " points but " +
@@ -929,7 +930,7 @@ Result<std::vector<glm::vec2>> Renderer::shadow_at_points(std::span<const glm::v
     im.points_width = w;
     im.points_height = h;
     im.points_target = gpu::make_texture(GL_TEXTURE_2D);
-    glTextureStorage2D(im.points_target.id(), 1, GL_RG32F, w, h);
+    glTextureStorage2D(im.points_target.id(), 1, GL_RGBA32F, w, h);
     im.points_fbo = gpu::make_framebuffer();
     glNamedFramebufferTexture(im.points_fbo.id(), GL_COLOR_ATTACHMENT0, im.points_target.id(), 0);
   }
@@ -963,18 +964,23 @@ Result<std::vector<glm::vec2>> Renderer::shadow_at_points(std::span<const glm::v
   glViewport(0, 0, w, h);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
-  const float clear[4] = {1.0f, -1.0f, 0.0f, 0.0f};
+  const float clear[4] = {1.0f, -1.0f, 0.0f, 0.0f};  // lit, no cascade, no blend
   glClearBufferfv(GL_COLOR, 0, clear);
   glBindVertexArray(vao.id());
   glDrawArrays(GL_POINTS, 0, count);
   glBindVertexArray(0);
-  std::vector<glm::vec2> out(std::size_t(w) * h);
+  std::vector<glm::vec4> texels(std::size_t(w) * h);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(im.points_target.id(), 0, GL_RG, GL_FLOAT,
-                    GLsizei(out.size() * sizeof(glm::vec2)), out.data());
+  glGetTextureImage(im.points_target.id(), 0, GL_RGBA, GL_FLOAT,
+                    GLsizei(texels.size() * sizeof(glm::vec4)), texels.data());
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glEnable(GL_DEPTH_TEST);
-  out.resize(std::size_t(count));
+  std::vector<glm::vec2> out(static_cast<std::size_t>(count));
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = glm::vec2(texels[i]);
+  if (blend_weights) {
+    blend_weights->resize(std::size_t(count));
+    for (std::size_t i = 0; i < out.size(); ++i) (*blend_weights)[i] = texels[i].z;
+  }
   return out;
 }
 

@@ -130,8 +130,11 @@ class Renderer {
   /// cascade) pair per point, as the forward pass would shade a surface there: (1, -1) without a
   /// shadow pass. For stability metrics: the points stay put while the camera moves.
   /// Errors: sizes differ, or the pass's program fails to build.
+  /// With `blend_weights`, also the weight of the next cascade the lookup blended in at each
+  /// point (0 where it did not blend; blend_weight() in shadow.glsl), for tests.
   Result<std::vector<glm::vec2>> shadow_at_points(std::span<const glm::vec3> points,
-                                                  std::span<const glm::vec3> normals);
+                                                  std::span<const glm::vec3> normals,
+                                                  std::vector<float>* blend_weights = nullptr);
 
   /// Pixels of the last frame's AOV per cascade index (FrameStats::cascade_receiver_pixels).
   /// Precondition: the last frame was rendered with write_aovs.

@@ -3,7 +3,8 @@
 // lookup): for points spread through and around the camera's view, the cascade the shader picks
 // is the one select_cascade_by_depth() or select_cascade_by_map() picks. Points within a hair of
 // a split distance or a map border are left out (rounding may go either way there). The blend
-// weights are not compared here: the pass reports only the visibility after blending.
+// weight the lookup used (blend_weight() in shadow.glsl, reported by the pass) is the one
+// cascade_blend_weight() or cascade_blend_weight_map() gives.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -47,6 +48,9 @@ TEST_F(CascadeSelectionTest, ShaderPicksTheCascadeTheCpuHelpersPick) {
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     std::vector<glm::vec3> points, normals;
     std::vector<int> expected;
+    std::vector<float> expected_weight;
+    const float band = sh.settings.blend_band;
+    ASSERT_GT(band, 0.0f);
     std::array<int, 5> per_cascade{};  // -1 .. 3
     while (points.size() < 6000) {
       const float depth = -5.0f + unit(rng) * (1.1f * D[std::size_t(n)] + 5.0f);
@@ -61,6 +65,7 @@ TEST_F(CascadeSelectionTest, ShaderPicksTheCascadeTheCpuHelpersPick) {
         if (near_split) continue;
         // The shader counts anything nearer than D[0] (the camera near plane) as cascade 0.
         want = depth < D[0] ? 0 : select_cascade_by_depth(D, depth);
+        expected_weight.push_back(cascade_blend_weight(D, want, depth, band));
       } else {
         bool near_edge = false;
         for (const glm::mat4& m : maps) {
@@ -72,6 +77,12 @@ TEST_F(CascadeSelectionTest, ShaderPicksTheCascadeTheCpuHelpersPick) {
         }
         if (near_edge) continue;
         want = select_cascade_by_map(maps, p, border);
+        float w = 0.0f;
+        if (want >= 0 && want + 1 < n) {
+          const glm::vec4 clip = maps[std::size_t(want)] * glm::vec4(p, 1.0f);
+          w = cascade_blend_weight_map(glm::vec3(clip) / clip.w, band, border);
+        }
+        expected_weight.push_back(w);
       }
       points.push_back(p);
       normals.emplace_back(0.0f, 1.0f, 0.0f);
@@ -81,17 +92,27 @@ TEST_F(CascadeSelectionTest, ShaderPicksTheCascadeTheCpuHelpersPick) {
     // The points reach every cascade and beyond.
     for (int c = -1; c < n; ++c) EXPECT_GT(per_cascade[std::size_t(c + 1)], 50) << "cascade " << c;
 
-    auto got = player_->renderer->shadow_at_points(points, normals);
+    std::vector<float> weights;
+    auto got = player_->renderer->shadow_at_points(points, normals, &weights);
     ASSERT_TRUE(got.ok()) << got.error().to_string();
     ASSERT_EQ(got->size(), points.size());
-    int wrong = 0;
+    ASSERT_EQ(weights.size(), points.size());
+    int wrong = 0, wrong_weight = 0, in_band = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
       const int shader = int(std::lround((*got)[i].y));
       if (shader != expected[i] && wrong++ < 5)
         ADD_FAILURE() << "point (" << points[i].x << ", " << points[i].y << ", " << points[i].z
                       << "): shader cascade " << shader << ", CPU " << expected[i];
+      if (shader != expected[i]) continue;
+      if (expected_weight[i] > 0.0f && expected_weight[i] < 1.0f) ++in_band;
+      if (std::abs(weights[i] - expected_weight[i]) > 2e-3f && wrong_weight++ < 5)
+        ADD_FAILURE() << "point (" << points[i].x << ", " << points[i].y << ", " << points[i].z
+                      << ") in cascade " << shader << ": shader blend weight " << weights[i]
+                      << ", CPU " << expected_weight[i];
     }
     EXPECT_EQ(wrong, 0) << "of " << points.size() << " points";
+    EXPECT_EQ(wrong_weight, 0) << "of " << points.size() << " points";
+    EXPECT_GT(in_band, 50);  // the blend bands are crossed, not just their outsides
   }
 }
 

@@ -706,6 +706,10 @@ TEST(CascadeSelect, BlendWeights) {
   EXPECT_EQ(cascade_blend_weight_map({0.5f, 0.2f, 0}, 0.1f), 0.0f);
   EXPECT_NEAR(cascade_blend_weight_map({0.95f, 0.2f, 0}, 0.1f), 0.5f, 1e-5f);
   EXPECT_NEAR(cascade_blend_weight_map({0.1f, -1.0f, 0}, 0.1f), 1.0f, 1e-5f);
+  // With a border kept free the band ends where selection ends, at 1 - border.
+  EXPECT_NEAR(cascade_blend_weight_map({0.8f, 0.2f, 0}, 0.1f, 0.2f), 1.0f, 1e-5f);
+  EXPECT_NEAR(cascade_blend_weight_map({0.76f, 0.2f, 0}, 0.1f, 0.2f), 0.5f, 1e-5f);
+  EXPECT_EQ(cascade_blend_weight_map({0.7f, 0.2f, 0}, 0.1f, 0.2f), 0.0f);
 }
 
 TEST(CascadeSelect, BiasMatrixMapsNdcToTextureSpace) {
