@@ -329,3 +329,59 @@ TEST(MaterialFile, ShippedMaterialsLoad) {
 
 }  // namespace
 }  // namespace kaskad::render
+
+namespace kaskad::render {
+namespace {
+
+// pack_frame_block: each view's data in its slot, splits and texel sizes four per vec4, each
+// light pointing at its view, exposure in its own field (a probe face's is 1).
+TEST(FrameUniforms, PackPutsEveryViewAndLightInItsPlace) {
+  FrameInput frame;
+  frame.lights.resize(3);
+  frame.lights[2].type = LightType::spot;
+  frame.exposure = 2.5f;
+  ShadowView a;
+  a.light_index = 2;
+  a.layer_count = 1;
+  a.projection = ShadowProjection::perspective;
+  a.paraboloid_margin = 0.25f;
+  ShadowView b;
+  b.light_index = 0;
+  b.first_layer = 1;
+  b.layer_count = 8;
+  b.normal_offset = 1.5f;
+  b.blend_band = 0.2f;
+  for (int i = 0; i <= 8; ++i) b.splits[std::size_t(i)] = float(i + 1);
+  for (int i = 0; i < 8; ++i) {
+    b.texel_size[std::size_t(i)] = 0.01f * float(i + 1);
+    b.view_proj[std::size_t(i)] = glm::mat4(float(i + 1));
+  }
+  frame.shadow_views = {a, b};
+  frame.aov_shadow_view = 1;
+  ASSERT_EQ(shadow_views_error(frame), "");
+  const FrameBlock fb = pack_frame_block(frame);
+  EXPECT_EQ(fb.counts, glm::ivec4(3, 2, 1, 0));
+  EXPECT_EQ(fb.frame_params.x, 2.5f);
+  EXPECT_EQ(fb.light_info[0], glm::ivec4(int(LightType::directional), 1, 0, 0));
+  EXPECT_EQ(fb.light_info[1].y, -1);
+  EXPECT_EQ(fb.light_info[2], glm::ivec4(int(LightType::spot), 0, 0, 0));
+  EXPECT_EQ(fb.shadow_views[0].info, glm::ivec4(2, 0, 1, 0));
+  EXPECT_EQ(fb.shadow_views[0].params.z, 0.25f);
+  EXPECT_EQ(fb.shadow_views[1].info, glm::ivec4(0, 1, 8, 0));
+  EXPECT_EQ(fb.shadow_views[1].params, glm::vec4(1.5f, 0.2f, 0.0f, 0.0f));
+  EXPECT_EQ(fb.shadow_views[1].splits[0], glm::vec4(1, 2, 3, 4));
+  EXPECT_EQ(fb.shadow_views[1].splits[2].x, 9.0f);
+  EXPECT_EQ(fb.shadow_views[1].texel[1].w, 0.08f);
+  EXPECT_EQ(fb.shadow_views[1].view_proj[7], glm::mat4(8.0f));
+  ProbeJob job;
+  job.center = {1, 2, 3};
+  job.view_proj[4] = glm::mat4(3.0f);
+  const FrameBlock face = probe_face_block(fb, job, 4);
+  EXPECT_EQ(face.view_proj, glm::mat4(3.0f));
+  EXPECT_EQ(face.camera_pos, glm::vec4(1, 2, 3, 1));
+  EXPECT_EQ(face.frame_params.x, 1.0f);
+  EXPECT_EQ(face.view, fb.view);  // sphere maps are made for the main view
+}
+
+}  // namespace
+}  // namespace kaskad::render
