@@ -22,6 +22,7 @@
 #include "runtime/core/result.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/render/shader_library.h"
+#include "runtime/render/draw_list.h"
 #include "runtime/render/frame_input.h"
 #include "runtime/render/variant_key.h"
 
@@ -63,18 +64,6 @@ struct FrameStats {
   ShaderStats shaders;                ///< compiles, cache hits, compile ms (since creation)
 };
 
-/// The frame features of a frame (shadow, filter, AOVs): the VARIANT_* part of every key.
-VariantKey frame_variant(const FrameInput& frame);
-/// The frame features of a probe capture of a frame with features `frame`: no AOVs, and cascades
-/// selected by map bounds. S0's view-depth selection measures the main camera's depth, which
-/// says nothing about a point behind it or beside it that a probe face sees: that point would
-/// fall into cascade 0, whose map does not hold it, and come out lit.
-VariantKey capture_frame_variant(VariantKey frame);
-/// The material features of a draw (MATERIAL_* part): from the material's data.
-VariantKey material_variant(const DrawItem& draw);
-/// Every (pass, key) a frame draws with, sorted and unique: what prewarm compiles and what
-/// `kaskad variants` lists. Pure: no GL.
-std::vector<ProgramRequest> required_programs(const FrameInput& frame);
 
 struct RendererOptions {
   std::filesystem::path shader_cache_dir;  ///< empty: no binary cache
@@ -147,6 +136,7 @@ class Renderer {
 
  private:
   Renderer() = default;
+  void read_timers();  // the previous frame's GPU pass times into stats_
   struct Impl;
   std::unique_ptr<Impl> impl_;
   FrameStats stats_;

@@ -27,11 +27,6 @@ struct ShaderStats {
   int reloads = 0;                ///< programs rebuilt by hot reload
 };
 
-struct ProgramRequest {
-  Pass pass = Pass::forward;
-  VariantKey key;
-};
-
 class ShaderLibrary {
  public:
   /// `shader_dir` holds the GLSL files and features.json. `cache_dir` empty: no binary cache.
@@ -62,6 +57,9 @@ class ShaderLibrary {
   bool binary_cache_supported() const { return binary_formats_ > 0; }
   /// Keys built so far for a pass (for tests and `kaskad variants`).
   std::vector<VariantKey> built_keys(Pass pass) const;
+  /// The test oracle's über-programs select material features by a uniform (features.glsl);
+  /// variants are compiled with them. Draws with such programs set it (DrawState).
+  bool features_by_uniform() const { return oracle_; }
 
  private:
   ShaderLibrary() = default;

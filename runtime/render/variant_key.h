@@ -328,4 +328,10 @@ static_assert(VariantKey()
                   .filtered_for(Pass::depth) ==
               VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 3));
 
+/// A program a frame needs: a pass and its key.
+struct ProgramRequest {
+  Pass pass = Pass::forward;
+  VariantKey key;
+};
+
 }  // namespace kaskad::render

@@ -1,0 +1,156 @@
+#include "runtime/render/draw_list.h"
+
+#include <algorithm>
+#include <tuple>
+
+#include "components/bounds.h"
+
+namespace kaskad::render {
+
+VariantKey frame_variant(const FrameInput& frame) {
+  VariantKey k;
+  if (!frame.shadow_views.empty()) {
+    const ShadowMapSettings& s = frame.shadow_map;
+    const ShadowView& first = frame.shadow_views.front();
+    const int views = std::min<int>(int(frame.shadow_views.size()), kMaxShadowedLights);
+    k.set(VariantKey::kShadow, 1);
+    k.set(VariantKey::kShadowLightsMinus1, std::uint32_t(views - 1));
+    k.set(VariantKey::kShadowFilter, std::uint32_t(s.filter));
+    k.set(VariantKey::kShadowProjection, std::uint32_t(first.projection));
+    // Paraboloid hemispheres are projected in code, one pass each: no layered pass for them.
+    if (s.layered && first.projection != ShadowProjection::dual_paraboloid)
+      k.set(VariantKey::kShadowLayered, 1);
+    // Layers of spot and point lights are faces, not cascades: no cascade selection code.
+    if (first.projection == ShadowProjection::ortho)
+      k.set(VariantKey::kCascadeCountMinus1,
+            std::uint32_t(std::clamp(first.layer_count, 1, kMaxCascades) - 1));
+    k.set(VariantKey::kCascadeSelection, s.selection == CascadeSelection::map_bounds ? 1u : 0u);
+    k.set(VariantKey::kDebugCascades, s.debug_cascades ? 1u : 0u);
+  }
+  if (frame.write_aovs) k.set(VariantKey::kAovs, 1);
+  return k;
+}
+
+VariantKey capture_frame_variant(VariantKey frame) {
+  VariantKey k = VariantKey(frame.bits() & ~VariantKey::kAovs.mask());
+  if (k.has(VariantKey::kShadow) && k.get(VariantKey::kShadowProjection) == 0)  // ortho cascades
+    k.set(VariantKey::kCascadeSelection, 1);
+  return k;
+}
+
+VariantKey material_variant(const DrawItem& d) {
+  // receive_shadows is a per-object flag, but it selects code like a material feature.
+  VariantKey k = VariantKey(d.material.features & VariantKey::kMaterialMask & ~VariantKey::kReceiveShadows.mask());
+  if (d.receive_shadows) k.set(VariantKey::kReceiveShadows, 1);
+  return k;
+}
+
+std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
+  const VariantKey fk = frame_variant(frame);
+  // Probe captures draw without AOVs; a reflector's draw gets its map feature once its first
+  // capture completes (possibly frames later when time-sliced): compile those up front too.
+  const VariantKey capture_fk = capture_frame_variant(fk);
+  std::vector<ProgramRequest> out;
+  for (const DrawItem& d : frame.draws) {
+    const VariantKey k = material_variant(d) | fk;
+    out.push_back({Pass::forward, k.filtered_for(Pass::forward)});
+    if (fk.has(VariantKey::kShadow) && d.cast_shadows) {
+      out.push_back({Pass::depth, k.filtered_for(Pass::depth)});
+      // Views after the first are cascades: the plain depth program, whatever the first's is.
+      if (frame.shadow_views.size() > 1)
+        out.push_back({Pass::depth,
+                       VariantKey(k).set(VariantKey::kShadowProjection, 0).filtered_for(Pass::depth)});
+    }
+    std::vector<VariantKey> materials = {material_variant(d)};
+    for (const ProbeJob& job : frame.probes)
+      if (job.handle == d.probe)
+        materials.push_back(VariantKey(materials[0])
+                                .set(job.sphere ? VariantKey::kReflectionSphere
+                                                : VariantKey::kReflectionCube, 1)
+                                .set(VariantKey::kReflectionBox, job.box ? 1u : 0u));
+    for (const VariantKey m : materials) {
+      out.push_back({Pass::forward, (m | fk).filtered_for(Pass::forward)});
+      if (!frame.probes.empty()) out.push_back({Pass::forward, (m | capture_fk).filtered_for(Pass::forward)});
+    }
+  }
+  auto less = [](const ProgramRequest& a, const ProgramRequest& b) {
+    return std::pair(a.pass, a.key) < std::pair(b.pass, b.key);
+  };
+  std::sort(out.begin(), out.end(), less);
+  out.erase(std::unique(out.begin(), out.end(),
+                        [](const ProgramRequest& a, const ProgramRequest& b) {
+                          return a.pass == b.pass && a.key == b.key;
+                        }),
+            out.end());
+  return out;
+}
+
+VariantKey DrawList::depth_key(std::size_t view, std::uint32_t i) const {
+  VariantKey k = keys[i];
+  if (view > 0) k.set(VariantKey::kShadowProjection, 0);
+  return k;
+}
+
+namespace {
+
+// Draw indices sorted by `by[i]` as pass `pass` sees it, then by material.
+std::vector<std::uint32_t> sorted_by(const FrameInput& frame, Pass pass,
+                                     const std::vector<VariantKey>& by) {
+  auto material_order = [&](std::uint32_t a, std::uint32_t b) {
+    const Material& ma = frame.draws[a].material;
+    const Material& mb = frame.draws[b].material;
+    return std::tie(ma.base_color_texture, ma.normal_texture, ma.double_sided, ma.metallic,
+                    ma.roughness) < std::tie(mb.base_color_texture, mb.normal_texture,
+                                             mb.double_sided, mb.metallic, mb.roughness);
+  };
+  std::vector<std::uint32_t> order(frame.draws.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const VariantKey ka = by[a].filtered_for(pass), kb = by[b].filtered_for(pass);
+    if (ka != kb) return ka < kb;
+    return material_order(a, b);
+  });
+  return order;
+}
+
+}  // namespace
+
+DrawList build_draw_list(const FrameInput& frame, VariantKey frame_key) {
+  DrawList list;
+  list.frame_key = frame_key;
+  list.keys.resize(frame.draws.size());
+  for (std::size_t i = 0; i < frame.draws.size(); ++i)
+    list.keys[i] = material_variant(frame.draws[i]) | frame_key;
+  if (!frame.shadow_views.empty()) list.depth_order = sorted_by(frame, Pass::depth, list.keys);
+  list.forward_order = sorted_by(frame, Pass::forward, list.keys);
+  if (!frame.probes.empty()) {
+    const VariantKey capture = capture_frame_variant(frame_key);
+    list.capture_keys.resize(frame.draws.size());
+    for (std::size_t i = 0; i < frame.draws.size(); ++i)
+      list.capture_keys[i] = material_variant(frame.draws[i]) | capture;
+    list.capture_order = sorted_by(frame, Pass::forward, list.capture_keys);
+  }
+  return list;
+}
+
+std::vector<std::uint32_t> visible_draws(const FrameInput& frame,
+                                         std::span<const std::uint32_t> order,
+                                         const glm::mat4& view_proj, const ProbeJob* capture,
+                                         int& culled) {
+  std::vector<std::uint32_t> out;
+  out.reserve(order.size());
+  for (std::uint32_t i : order) {
+    const DrawItem& d = frame.draws[i];
+    if (capture && (d.probe == capture->handle ||
+                    (capture->exclude_layers & (1u << (d.layer & 31)))))
+      continue;  // the reflector itself and excluded layers are not in its probe
+    if (outside_clip_volume(view_proj, d.bounds)) {
+      ++culled;
+      continue;
+    }
+    out.push_back(i);
+  }
+  return out;
+}
+
+}  // namespace kaskad::render

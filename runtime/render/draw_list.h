@@ -1,0 +1,57 @@
+// The frame's draw list: every draw's program key per pass and the order draws are submitted in,
+// computed once per frame, and culling against a view. Pure: no GL (the passes in
+// runtime/render/passes.h record from it).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "runtime/render/frame_input.h"
+#include "runtime/render/variant_key.h"
+
+namespace kaskad::render {
+
+/// The frame features of a frame (shadow, filter, AOVs): the VARIANT_* part of every key.
+VariantKey frame_variant(const FrameInput& frame);
+/// The frame features of a probe capture of a frame with features `frame`: no AOVs, and cascades
+/// selected by map bounds. S0's view-depth selection measures the main camera's depth, which
+/// says nothing about a point behind it or beside it that a probe face sees: that point would
+/// fall into cascade 0, whose map does not hold it, and come out lit.
+VariantKey capture_frame_variant(VariantKey frame);
+/// The material features of a draw (MATERIAL_* part): from the material's data.
+VariantKey material_variant(const DrawItem& draw);
+
+/// Every (pass, key) a frame draws with, sorted and unique: what prewarm compiles and what
+/// `kaskad variants` lists. Pure: no GL.
+std::vector<ProgramRequest> required_programs(const FrameInput& frame);
+
+struct DrawList {
+  VariantKey frame_key;  ///< frame_variant() as the driver can build it
+  /// Per draw: material_variant() | the frame key, and | the capture frame key (probe faces).
+  std::vector<VariantKey> keys, capture_keys;
+  /// Draw indices in submission order: sorted by the pass's program key, then by material, so
+  /// program and material state change as rarely as possible (stable: ties keep draw order).
+  std::vector<std::uint32_t> depth_order, forward_order, capture_order;
+
+  /// The depth-pass key of draw i in shadow view `view`: views after the first are cascades and
+  /// use the plain depth program whatever the first view's projection is.
+  VariantKey depth_key(std::size_t view, std::uint32_t i) const;
+};
+
+/// Keys and orders of `frame` with frame features `frame_key` (capture keys and order only
+/// when the frame has probes).
+DrawList build_draw_list(const FrameInput& frame, VariantKey frame_key);
+
+/// The draws of `order` that a view with `view_proj` can see, in order: those whose bounds
+/// overlap its clip volume (draws without bounds always). `capture`: a probe face's view, which
+/// also leaves out the probe's own reflector and its excluded layers. `culled` counts the draws
+/// left out for being outside the view.
+std::vector<std::uint32_t> visible_draws(const FrameInput& frame,
+                                         std::span<const std::uint32_t> order,
+                                         const glm::mat4& view_proj, const ProbeJob* capture,
+                                         int& culled);
+
+}  // namespace kaskad::render

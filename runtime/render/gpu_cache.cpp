@@ -1,0 +1,115 @@
+#include "runtime/render/gpu_cache.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+
+#include <glm/glm.hpp>
+
+#include "runtime/core/log.h"
+
+namespace kaskad::render {
+namespace {
+
+// Fixed attribute locations (see the shaders).
+constexpr GLuint kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
+
+// A 1x1 texture standing in for a missing material texture.
+gpu::Texture make_solid_texture(const std::array<float, 4>& rgba, GLenum internal_format) {
+  gpu::Texture t = gpu::make_texture(GL_TEXTURE_2D);
+  glTextureStorage2D(t.id(), 1, internal_format, 1, 1);
+  glTextureSubImage2D(t.id(), 0, 0, 0, 1, 1, GL_RGBA, GL_FLOAT, rgba.data());
+  return t;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<GpuCache>> GpuCache::create(const std::filesystem::path& shader_dir) {
+  std::unique_ptr<GpuCache> c(new GpuCache());
+  auto probes = ProbeMaps::create(shader_dir);
+  if (!probes) return probes.error();
+  c->probes_ = std::move(probes.value());
+  c->white_ = make_solid_texture({1, 1, 1, 1}, GL_SRGB8_ALPHA8);
+  // Exactly (0.5, 0.5, 1): decodes to (0, 0, 1), so the cotangent frame leaves the normal as is.
+  // An 8-bit 128 would tilt every normal by 0.2 degrees, with visible derivative noise.
+  c->flat_normal_ = make_solid_texture({0.5f, 0.5f, 1, 1}, GL_RGBA16F);
+  return c;
+}
+
+void GpuCache::use(const AssetStore& assets) {
+  assets_ = &assets;
+  if (assets.uid == assets_uid_) return;
+  meshes_.clear();
+  textures_.clear();
+  probes_->clear();
+  assets_uid_ = assets.uid;
+}
+
+const GpuMesh& GpuCache::mesh(MeshId id) {
+  KASKAD_CHECK(assets_ && id < assets_->meshes.size(), "mesh id out of range");
+  if (id >= meshes_.size()) meshes_.resize(std::size_t(id) + 1);
+  GpuMesh& m = meshes_[id];
+  if (m.vao) return m;
+  const MeshData& src = assets_->meshes[id];
+  const std::size_t n = src.positions.size();
+  // One buffer, three streams: positions | normals | uvs (uvs zero when the mesh has none).
+  const std::size_t pos_bytes = n * sizeof(glm::vec3), uv_bytes = n * sizeof(glm::vec2);
+  std::vector<std::uint8_t> data(2 * pos_bytes + uv_bytes, 0);
+  std::memcpy(data.data(), src.positions.data(), pos_bytes);
+  if (src.normals.size() == n) std::memcpy(data.data() + pos_bytes, src.normals.data(), pos_bytes);
+  if (src.uvs.size() == n) std::memcpy(data.data() + 2 * pos_bytes, src.uvs.data(), uv_bytes);
+  m.vertices = gpu::make_buffer();
+  glNamedBufferStorage(m.vertices.id(), GLsizeiptr(std::max<std::size_t>(data.size(), 1)),
+                       data.data(), 0);
+  m.indices = gpu::make_buffer();
+  glNamedBufferStorage(m.indices.id(), GLsizeiptr(std::max<std::size_t>(src.indices.size() * 4, 4)),
+                       src.indices.empty() ? nullptr : src.indices.data(), 0);
+  m.index_count = GLsizei(src.indices.size());
+  m.vao = gpu::make_vertex_array();
+  const GLuint vao = m.vao.id();
+  glVertexArrayVertexBuffer(vao, 0, m.vertices.id(), 0, sizeof(glm::vec3));
+  glVertexArrayVertexBuffer(vao, 1, m.vertices.id(), GLintptr(pos_bytes), sizeof(glm::vec3));
+  glVertexArrayVertexBuffer(vao, 2, m.vertices.id(), GLintptr(2 * pos_bytes), sizeof(glm::vec2));
+  const GLuint attrs[3] = {kAttrPosition, kAttrNormal, kAttrUv};
+  const GLint sizes[3] = {3, 3, 2};
+  for (int i = 0; i < 3; ++i) {
+    glEnableVertexArrayAttrib(vao, attrs[i]);
+    glVertexArrayAttribFormat(vao, attrs[i], sizes[i], GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, attrs[i], GLuint(i));
+  }
+  glVertexArrayElementBuffer(vao, m.indices.id());
+  return m;
+}
+
+GLuint GpuCache::texture(TextureId id, bool is_normal_map) {
+  if (!assets_ || id == kNoTexture || id >= assets_->textures.size())
+    return is_normal_map ? flat_normal_.id() : white_.id();
+  if (id >= textures_.size()) textures_.resize(std::size_t(id) + 1);
+  if (!textures_[id]) {
+    const TextureData& src = assets_->textures[id];
+    auto t = std::make_unique<gpu::Texture>(gpu::make_texture(GL_TEXTURE_2D));
+    const GLuint tex = t->id();
+    const int levels = 1 + int(std::floor(std::log2(std::max(1, std::max(src.width, src.height)))));
+    // Colour data is sRGB-encoded; normal maps are linear. Normal maps reuse the same cache slot
+    // as long as a texture is used in one role only (glTF practice).
+    const GLenum fmt = (src.srgb && !is_normal_map) ? GL_SRGB8_ALPHA8 : GL_RGBA8;
+    glTextureStorage2D(tex, levels, fmt, std::max(1, src.width), std::max(1, src.height));
+    if (src.width > 0 && src.height > 0 &&
+        src.rgba8.size() == std::size_t(src.width) * src.height * 4) {
+      glTextureSubImage2D(tex, 0, 0, 0, src.width, src.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                          src.rgba8.data());
+    }
+    glGenerateTextureMipmap(tex);
+    glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    textures_[id] = std::move(t);
+  }
+  return textures_[id]->id();
+}
+
+}  // namespace kaskad::render

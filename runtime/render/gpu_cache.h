@@ -1,0 +1,53 @@
+// The GPU copies of a scene's assets: meshes and material textures uploaded on first use and
+// kept by id, and the reflection probes' maps by probe handle. One AssetStore's ids at a time:
+// a frame of another store (another scene) starts the cache afresh.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "components/mesh_renderer.h"
+#include "runtime/assets/asset_store.h"
+#include "runtime/core/result.h"
+#include "runtime/gpu/gl_handles.h"
+#include "runtime/render/probe_capture.h"
+
+namespace kaskad::render {
+
+/// One mesh on the GPU: positions | normals | uvs in one buffer, 32-bit indices.
+struct GpuMesh {
+  gpu::VertexArray vao;
+  gpu::Buffer vertices;
+  gpu::Buffer indices;
+  GLsizei index_count = 0;
+};
+
+class GpuCache {
+ public:
+  /// Needs a current GL 4.5 context; `shader_dir` holds the probe maps' sphere-map shader.
+  static Result<std::unique_ptr<GpuCache>> create(const std::filesystem::path& shader_dir);
+
+  /// The frame's assets: another store than last frame's clears every mesh, texture and probe map
+  /// (their ids and handles named that store's assets and entities).
+  void use(const AssetStore& assets);
+
+  /// Mesh `id` of the store given to use(), uploaded on first use. Precondition: a valid id.
+  const GpuMesh& mesh(MeshId id);
+  /// Material texture `id` (sRGB colour, or linear for a normal map), uploaded with mips on
+  /// first use; a 1x1 white (or flat normal) texture for kNoTexture or an unknown id.
+  GLuint texture(TextureId id, bool is_normal_map);
+  ProbeMaps& probes() { return *probes_; }
+
+ private:
+  GpuCache() = default;
+  const AssetStore* assets_ = nullptr;
+  std::uint64_t assets_uid_ = 0;
+  std::vector<GpuMesh> meshes_;                        // indexed by MeshId
+  std::vector<std::unique_ptr<gpu::Texture>> textures_;  // indexed by TextureId
+  gpu::Texture white_, flat_normal_;
+  std::unique_ptr<ProbeMaps> probes_;
+};
+
+}  // namespace kaskad::render

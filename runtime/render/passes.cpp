@@ -1,0 +1,516 @@
+#include "runtime/render/passes.h"
+
+#include <epoxy/gl.h>
+
+#include <bit>
+#include <cstring>
+#include <map>
+#include <type_traits>
+
+#include "runtime/render/renderer.h"
+
+namespace kaskad::render {
+namespace {
+
+// Fixed uniform locations (see the shaders).
+constexpr GLint kUniModel = 0, kUniNormalMatrix = 4, kUniBaseColor = 8, kUniMaterial = 9,
+                kUniEmissive = 10, kUniFeatureBits = 11, kUniLightViewProj = 12,
+                // Per-program locations: shadow_depth layering (13, 14, 16+), forward
+                // reflections (16-19); no program has two of them.
+                kUniLayerMask = 13, kUniLayerBase = 14, kUniLayerViewProj = 16,
+                kUniReflection = 16, kUniReflectionBoxMin = 17, kUniReflectionBoxMax = 18,
+                kUniReflectionCentre = 19;
+
+GLenum depth_internal_format(DepthFormat f) {
+  switch (f) {
+    case DepthFormat::d16: return GL_DEPTH_COMPONENT16;
+    case DepthFormat::d32f: return GL_DEPTH_COMPONENT32F;
+    case DepthFormat::d24: break;
+  }
+  return GL_DEPTH_COMPONENT24;
+}
+
+// FNV-1a over the bytes of plain values: the inputs of a shadow layer (shadow caching).
+struct InputHash {
+  std::uint64_t h = 14695981039346656037ull;
+  template <typename T>
+  InputHash& add(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    unsigned char bytes[sizeof(T)];
+    std::memcpy(bytes, &v, sizeof(T));
+    for (unsigned char b : bytes) h = (h ^ b) * 1099511628211ull;
+    return *this;
+  }
+  std::uint64_t value() const { return h | 1u; }  // never 0, which means "nothing drawn"
+};
+
+/// Whether the driver can make the shadow map array (GL limits, then a proxy texture).
+Status check_shadow_map_size(int size, int layers, DepthFormat format) {
+  const std::string where = "shadow.map_size " + std::to_string(size);
+  GLint max_size = 0, max_layers = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  const double bytes = double(size) * size * layers * (format == DepthFormat::d16 ? 2.0 : 4.0);
+  std::string what = std::to_string(size) + "^2 x " + std::to_string(layers) + " layers";
+  if (size > max_size || layers > max_layers)
+    return Error{"", where, "shadow maps of " + what + " exceed this driver's limits (GL_MAX_TEXTURE_SIZE " +
+                                std::to_string(max_size) + ", GL_MAX_ARRAY_TEXTURE_LAYERS " +
+                                std::to_string(max_layers) + ")"};
+  glTexImage3D(GL_PROXY_TEXTURE_2D_ARRAY, 0, GLint(depth_internal_format(format)), size, size, layers,
+               0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+  GLint got = 0;
+  glGetTexLevelParameteriv(GL_PROXY_TEXTURE_2D_ARRAY, 0, GL_TEXTURE_WIDTH, &got);
+  if (got == 0)
+    return Error{"", where, "the OpenGL driver refuses shadow maps of " + what + " (" +
+                                std::to_string(int(bytes / double(1 << 20))) +
+                                " MiB); use a smaller map_size or fewer cascades"};
+  return {};
+}
+
+// The layers of view `v` that draw `d` (bit c: layer first_layer + c).
+std::uint32_t caster_mask(const ShadowView& v, const DrawItem& d) {
+  if (!d.cast_shadows) return 0;
+  return (d.shadow_layers >> v.first_layer) & (~0u >> (32 - v.layer_count));
+}
+
+// Triangles of a mesh as the passes draw it.
+std::size_t triangles(const AssetStore& assets, MeshId id) {
+  return assets.meshes[id].indices.size() / 3;
+}
+
+}  // namespace
+
+// ---- DrawState ----------------------------------------------------------------------------------
+
+DrawState::DrawState(ShaderLibrary& shaders, GpuCache& cache, FrameStats& stats)
+    : shaders_(shaders),
+      cache_(cache),
+      stats_(stats),
+      features_by_uniform_(shaders.features_by_uniform()) {}
+
+Status DrawState::use_program(Pass pass, VariantKey key) {
+  auto prog = shaders_.program(pass, key);
+  if (!prog) return prog.error();
+  if (*prog != program_) {
+    program_ = *prog;
+    glUseProgram(program_);
+    ++stats_.program_switches;
+    material_ = nullptr;  // material uniforms are per program
+  }
+  return {};
+}
+
+void DrawState::bind_material(const DrawItem& d, VariantKey key) {
+  const Material& m = d.material;
+  // Über-programs read the feature bits from a uniform: equal materials differ by their keys.
+  if (material_ && *material_ == m && (!features_by_uniform_ || material_key_ == key.material()))
+    return;
+  material_ = &m;
+  material_key_ = key.material();
+  ++stats_.material_switches;
+  const glm::vec4 params(m.metallic, m.roughness, m.normal_scale, m.alpha_cutoff);
+  glProgramUniform4fv(program_, kUniBaseColor, 1, &m.base_color[0]);
+  glProgramUniform4fv(program_, kUniMaterial, 1, &params[0]);
+  glProgramUniform3fv(program_, kUniEmissive, 1, &m.emissive[0]);
+  if (features_by_uniform_) glProgramUniform1ui(program_, kUniFeatureBits, key.material().bits());
+  glBindTextureUnit(kTexBaseColor, cache_.texture(m.base_color_texture, false));
+  glBindTextureUnit(kTexNormal, cache_.texture(m.normal_texture, true));
+}
+
+bool DrawState::depth_reads_material(VariantKey key) const {
+  return key.has(VariantKey::kAlphaMask) || features_by_uniform_;
+}
+
+// ---- ShadowMapPass ------------------------------------------------------------------------------
+
+void ShadowMapPass::ensure_storage(int size, int layers, DepthFormat format, ShadowFilter filter) {
+  if (fbo_ && size == size_ && layers == layers_ && format == format_ && filter == filter_) return;
+  if (!fbo_ || size != size_ || layers != layers_ || format != format_) {
+    size_ = size;
+    layers_ = layers;
+    format_ = format;
+    map_ = gpu::make_texture(GL_TEXTURE_2D_ARRAY);
+    glTextureStorage3D(map_.id(), 1, depth_internal_format(format), size, size, layers);
+    // S4: clamp to border with border depth 1, so lookups outside the map compare as lit.
+    glTextureParameteri(map_.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glTextureParameteri(map_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+    glTextureParameterfv(map_.id(), GL_TEXTURE_BORDER_COLOR, border);
+    glTextureParameteri(map_.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTextureParameteri(map_.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    drawn_from_.assign(std::size_t(layers), 0);  // new storage: nothing to keep
+    fbo_ = gpu::make_framebuffer();
+    glNamedFramebufferTextureLayer(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0, 0);
+    glNamedFramebufferDrawBuffer(fbo_.id(), GL_NONE);
+    glNamedFramebufferReadBuffer(fbo_.id(), GL_NONE);
+  }
+  filter_ = filter;
+  const GLint f = filter == ShadowFilter::bilinear ? GL_LINEAR : GL_NEAREST;
+  glTextureParameteri(map_.id(), GL_TEXTURE_MIN_FILTER, f);
+  glTextureParameteri(map_.id(), GL_TEXTURE_MAG_FILTER, f);
+}
+
+GLuint ShadowMapPass::texture() {
+  if (!fbo_) ensure_storage(64, 1, DepthFormat::d24, ShadowFilter::none);
+  return map_.id();
+}
+
+Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
+                              const AssetStore& assets, bool layered, bool features_by_uniform,
+                              FrameStats& stats) {
+  const std::vector<ShadowView>& views = frame.shadow_views;
+  const ShadowMapSettings& map = frame.shadow_map;
+  const int total = views.empty() ? 0 : views.back().first_layer + views.back().layer_count;
+  stats.layer_draw_calls.fill(0);
+  stats.layer_triangles.fill(0);
+  stats.layer_texel_size.fill(0.0f);
+  stats.shadow_layers = total;
+  stats.shadow_layers_rendered = 0;
+  stats.shadow_draw_calls = 0;
+  stats.shadow_triangles = 0;
+  redraw_ = 0;
+  layered_ = layered;
+  if (views.empty()) return {};
+  // A shadow map array the driver refuses (llvmpipe: over 1 GiB, e.g. 16384^2 x 4 cascades) is
+  // an error before any pass starts, not a string of GL errors.
+  if (!fbo_ || map.size != size_ || total != layers_ || map.format != format_)
+    KASKAD_TRY(check_shadow_map_size(map.size, total, map.format));
+  ensure_storage(map.size, total, map.format, map.filter);
+
+  // A layer's inputs: its matrix (and paraboloid data), bias and culling, pass mode, and the
+  // casters (mesh, model matrix, depth program, alpha-mask parameters) in order. A moved caster
+  // changes its matrix, a moved camera the layer's matrix or casters; other assets (another
+  // scene) change assets.uid. New storage invalidated every layer.
+  auto layer_inputs = [&](std::size_t view, int c) {
+    const ShadowView& v = views[view];
+    InputHash h;
+    h.add(assets.uid).add(layered).add(v.projection).add(v.cull);
+    h.add(v.slope_bias).add(v.constant_bias);
+    h.add(v.view_proj[std::size_t(c)]).add(v.skipped[std::size_t(c)]);
+    // Only the paraboloid depth pass reads splits (near, far) and the margin (shadow_depth.vert).
+    if (v.projection == ShadowProjection::dual_paraboloid) h.add(v.splits).add(v.paraboloid_margin);
+    if (v.skipped[std::size_t(c)]) return h.value();
+    for (std::uint32_t i : list.depth_order) {
+      const DrawItem& d = frame.draws[i];
+      if (!(caster_mask(v, d) & (1u << c))) continue;
+      const VariantKey key = list.depth_key(view, i);
+      h.add(d.mesh).add(d.model).add(key.filtered_for(Pass::depth).bits());
+      if (key.has(VariantKey::kAlphaMask) || features_by_uniform)
+        h.add(d.material.base_color.a).add(d.material.alpha_cutoff).add(d.material.base_color_texture);
+    }
+    return h.value();
+  };
+  inputs_.assign(std::size_t(total), 0);
+  for (std::size_t view = 0; view < views.size(); ++view)
+    for (int c = 0; c < views[view].layer_count; ++c) {
+      const std::size_t layer = std::size_t(views[view].first_layer + c);
+      inputs_[layer] = layer_inputs(view, c);
+      if (inputs_[layer] != drawn_from_[layer]) redraw_ |= 1u << layer;
+    }
+  // The layered pass draws every layer at once: it redraws all of them or none.
+  if (layered && redraw_ != 0) redraw_ = ~0u >> (32 - total);  // total <= 32: no 1u << 32
+  stats.shadow_layers_rendered = redraw_;
+
+  // Stats: the casters each layer holds, whether drawn now or kept from an earlier frame; a
+  // layered pass draws each caster once per view, instanced over its layers.
+  for (const ShadowView& v : views) {
+    std::uint32_t live = 0;
+    for (int c = 0; c < v.layer_count; ++c)
+      if (!v.skipped[std::size_t(c)]) live |= 1u << c;
+    for (std::uint32_t i : list.depth_order) {
+      const DrawItem& d = frame.draws[i];
+      const std::uint32_t mask = live & caster_mask(v, d);
+      const std::size_t tris = triangles(assets, d.mesh);
+      if (mask == 0 || tris == 0) continue;
+      stats.shadow_draw_calls += layered ? 1 : std::popcount(mask);
+      stats.shadow_triangles += std::size_t(std::popcount(mask)) * tris;
+      for (int c = 0; c < v.layer_count; ++c)
+        if (mask & (1u << c)) {
+          ++stats.layer_draw_calls[std::size_t(v.first_layer + c)];
+          stats.layer_triangles[std::size_t(v.first_layer + c)] += tris;
+        }
+    }
+  }
+  for (const ShadowView& v : views)
+    for (int c = 0; c < v.layer_count; ++c)
+      stats.layer_texel_size[std::size_t(v.first_layer + c)] = v.texel_size[std::size_t(c)];
+  return {};
+}
+
+Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuCache& cache,
+                             DrawState& state) {
+  if (redraw_ == 0) return {};
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
+  glViewport(0, 0, size_, size_);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glClearDepth(1.0);
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  // Layered: every layer attached at once and cleared together (skipped layers stay clear);
+  // each caster is drawn once per view, instanced over the layers it overlaps, and the vertex
+  // shader routes instance i to the i-th of them (shadow_depth.vert). The same maps as one pass
+  // per layer (render test), with fewer draw calls.
+  if (layered_) {
+    glNamedFramebufferTexture(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+  }
+  Status status;
+  // Draws caster i of view `view` (into the layers of `mask`, or the one attached layer).
+  auto draw = [&](std::size_t view, std::uint32_t i, std::uint32_t mask, const glm::mat4* light_vp) {
+    const DrawItem& d = frame.draws[i];
+    const GpuMesh& m = cache.mesh(d.mesh);
+    if (m.index_count == 0) return true;
+    if (Status st = state.use_program(Pass::depth, list.depth_key(view, i)); !st) {
+      status = st;
+      return false;
+    }
+    const GLuint prog = state.program();
+    if (state.depth_reads_material(list.keys[i])) state.bind_material(d, list.keys[i]);
+    const ShadowView& v = frame.shadow_views[view];
+    if (light_vp) {
+      glProgramUniformMatrix4fv(prog, kUniLightViewProj, 1, GL_FALSE, &(*light_vp)[0][0]);
+    } else {
+      glProgramUniform1ui(prog, kUniLayerMask, mask);
+      glProgramUniform1i(prog, kUniLayerBase, v.first_layer);
+      glProgramUniformMatrix4fv(prog, kUniLayerViewProj, v.layer_count, GL_FALSE,
+                                &v.view_proj[0][0][0]);
+    }
+    glProgramUniformMatrix4fv(prog, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+    glBindVertexArray(m.vao.id());
+    if (light_vp) {
+      glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+    } else {
+      glDrawElementsInstanced(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
+                              std::popcount(mask));
+    }
+    return true;
+  };
+  for (std::size_t view = 0; view < frame.shadow_views.size() && status; ++view) {
+    const ShadowView& v = frame.shadow_views[view];
+    if (v.cull == CullMode::none) {
+      glDisable(GL_CULL_FACE);
+    } else {
+      glEnable(GL_CULL_FACE);
+      glCullFace(v.cull == CullMode::front ? GL_FRONT : GL_BACK);
+    }
+    glPolygonOffset(v.slope_bias, v.constant_bias);
+    // Paraboloid hemispheres end at a clip distance (shadow_depth.vert).
+    if (v.projection == ShadowProjection::dual_paraboloid) {
+      glEnable(GL_CLIP_DISTANCE0);
+    } else {
+      glDisable(GL_CLIP_DISTANCE0);
+    }
+    if (layered_) {
+      std::uint32_t live = 0;
+      for (int c = 0; c < v.layer_count; ++c)
+        if (!v.skipped[std::size_t(c)]) live |= 1u << c;
+      for (std::uint32_t i : list.depth_order)
+        if (const std::uint32_t mask = live & caster_mask(v, frame.draws[i]); mask != 0)
+          if (!draw(view, i, mask, nullptr)) break;
+      continue;
+    }
+    for (int c = 0; c < v.layer_count && status; ++c) {
+      const int layer = v.first_layer + c;
+      if (!((redraw_ >> layer) & 1u)) continue;
+      glNamedFramebufferTextureLayer(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0, layer);
+      glClear(GL_DEPTH_BUFFER_BIT);
+      if (v.skipped[std::size_t(c)]) continue;
+      for (std::uint32_t i : list.depth_order)
+        if (caster_mask(v, frame.draws[i]) & (1u << c))
+          if (!draw(view, i, 0, &v.view_proj[std::size_t(c)])) break;
+    }
+  }
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  glDisable(GL_CLIP_DISTANCE0);
+  if (!status) return status;
+  for (std::size_t layer = 0; layer < inputs_.size(); ++layer)
+    if ((redraw_ >> layer) & 1u) drawn_from_[layer] = inputs_[layer];
+  return {};
+}
+
+Image ShadowMapPass::read() const {
+  Image img;
+  img.width = size_;
+  img.height = size_ * layers_;
+  img.channels = 1;
+  img.channel_names = {"Y"};
+  if (!fbo_) return img;
+  // All layers in one read (layer 0 first, rows bottom to top within each); rows are flipped
+  // per layer so the stack reads top to bottom with layer 0 first.
+  const std::size_t row = std::size_t(size_), layer = row * row;
+  std::vector<float> stack(layer * std::size_t(layers_));
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(map_.id(), 0, GL_DEPTH_COMPONENT, GL_FLOAT,
+                    GLsizei(stack.size() * sizeof(float)), stack.data());
+  img.pixels.resize(stack.size());
+  for (int l = 0; l < layers_; ++l)
+    for (int y = 0; y < size_; ++y)
+      std::memcpy(&img.pixels[std::size_t(l) * layer + std::size_t(y) * row],
+                  &stack[std::size_t(l) * layer + std::size_t(size_ - 1 - y) * row],
+                  row * sizeof(float));
+  return img;
+}
+
+// ---- Forward drawing (main view and probe faces) ------------------------------------------------
+
+Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> order,
+                    const std::vector<VariantKey>& keys, const ProbeJob* capture,
+                    const glm::mat4& view_proj, GpuCache& cache, DrawState& state,
+                    FrameStats& stats) {
+  int& culled = capture ? stats.probe_culled : stats.frustum_culled;
+  for (std::uint32_t i : visible_draws(frame, order, view_proj, capture, culled)) {
+    const DrawItem& d = frame.draws[i];
+    const GpuMesh& m = cache.mesh(d.mesh);
+    if (m.index_count == 0) continue;
+    KASKAD_TRY(state.use_program(Pass::forward, keys[i]));
+    const GLuint prog = state.program();
+    if (d.material.double_sided) {
+      glDisable(GL_CULL_FACE);
+    } else {
+      glEnable(GL_CULL_FACE);
+      glCullFace(GL_BACK);
+    }
+    state.bind_material(d, keys[i]);
+    // A draw reflecting a probe gets its map: `visible` as of before this frame's captures (a
+    // probe never sees a cube being captured), and k_s * p_r.
+    const VariantKey key = keys[i];
+    if (key.has(VariantKey::kReflectionCube) || key.has(VariantKey::kReflectionSphere)) {
+      for (const ProbeJob& job : frame.probes) {
+        if (job.handle != d.probe) continue;
+        const bool swapped_now = job.faces != 0 && job.target == job.visible;
+        const int buffer = capture && swapped_now ? 1 - job.visible : job.visible;
+        glBindTextureUnit(kTexReflectionCube, cache.probes().existing_cube(job.handle, buffer));
+        glBindTextureUnit(kTexReflectionSphere, cache.probes().existing_sphere(job.handle));
+        glProgramUniform4f(prog, kUniReflection, d.reflection_scale, 0.0f, 0.0f, 0.0f);
+        if (key.has(VariantKey::kReflectionBox)) {
+          glProgramUniform4f(prog, kUniReflectionBoxMin, job.box_min.x, job.box_min.y, job.box_min.z, 0);
+          glProgramUniform4f(prog, kUniReflectionBoxMax, job.box_max.x, job.box_max.y, job.box_max.z, 0);
+          glProgramUniform4f(prog, kUniReflectionCentre, job.center.x, job.center.y, job.center.z, 0);
+        }
+        break;
+      }
+    }
+    const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(d.model)));
+    glProgramUniformMatrix4fv(prog, kUniModel, 1, GL_FALSE, &d.model[0][0]);
+    glProgramUniformMatrix3fv(prog, kUniNormalMatrix, 1, GL_FALSE, &normal_matrix[0][0]);
+    glBindVertexArray(m.vao.id());
+    glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+    ++stats.draw_calls;
+    stats.triangles += std::size_t(m.index_count / 3);
+  }
+  return {};
+}
+
+// ---- ProbeCapturePass ---------------------------------------------------------------------------
+
+void ProbeCapturePass::prepare(const FrameInput& frame, const AssetStore& assets, GpuCache& cache) {
+  std::vector<ProbeHandle> live;
+  for (const ProbeJob& job : frame.probes) live.push_back(job.handle);
+  std::sort(live.begin(), live.end());
+  cache.probes().retain(live);  // maps of reflectors that no longer exist are dropped
+  for (const ProbeJob& job : frame.probes)
+    if (job.env_map != kNoProbe && job.env_map < assets.env_maps.size())
+      cache.probes().upload(job.handle, job.visible, assets.env_maps[job.env_map]);
+}
+
+Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
+                                const FrameBlock& main, GLuint ubo, GpuCache& cache,
+                                DrawState& state, FrameStats& stats) {
+  if (frame.probes.empty()) return {};
+  glDisable(GL_FRAMEBUFFER_SRGB);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  Status status;
+  for (const ProbeJob& job : frame.probes) {
+    if (job.env_map != kNoProbe || job.faces == 0) continue;  // static maps were uploaded
+    cache.probes().cube(job.handle, job.target, job.resolution);
+    for (int f = 0; f < 6 && status; ++f) {
+      if (!(job.faces & (1u << f))) continue;
+      const FrameBlock face = probe_face_block(main, job, f);
+      glNamedBufferSubData(ubo, 0, sizeof face, &face);
+      cache.probes().begin_face(job.handle, job.target, f, frame.clear_color);
+      const int before = stats.draw_calls;
+      const std::size_t triangles_before = stats.triangles;
+      status = draw_forward(frame, list.capture_order, list.capture_keys, &job, face.view_proj,
+                            cache, state, stats);
+      // Draws into faces are counted apart from the main view's.
+      stats.probe_draw_calls += stats.draw_calls - before;
+      stats.draw_calls = before;
+      stats.triangles = triangles_before;
+      ++stats.probe_faces;
+    }
+    if (!status) break;
+    // Complete (the target is now the visible buffer): rebuild its mip chain.
+    if (job.target == job.visible) cache.probes().finish_cube(job.handle, job.target);
+  }
+  glNamedBufferSubData(ubo, 0, sizeof main, &main);  // the main view's block again
+  if (!status) return status;
+  for (const ProbeJob& job : frame.probes)
+    if (job.sphere && cache.probes().existing_cube(job.handle, job.visible))
+      cache.probes().update_sphere(job.handle, job.visible, glm::mat3(frame.camera.view));
+  return {};
+}
+
+// ---- ForwardPass --------------------------------------------------------------------------------
+
+std::span<const ForwardPass::Target> ForwardPass::targets() {
+  static const Target list[] = {
+      {"colour (GL_SRGB8_ALPHA8)", GL_SRGB8_ALPHA8, GL_RGBA, GL_UNSIGNED_BYTE, 4},
+      {"position (GL_RGBA32F)", GL_RGBA32F, GL_RGBA, GL_FLOAT, 16},  // xyz, w mask
+      {"normal (GL_RGBA32F)", GL_RGBA32F, GL_RGBA, GL_FLOAT, 16},    // xyz, w view depth
+      {"visibility (GL_RG32F)", GL_RG32F, GL_RG, GL_FLOAT, 8},       // visibility, cascade
+      // rgb reflected colour C_t (S3 eq. (3)), a 1 where a map applies
+      {"reflection (GL_RGBA16F)", GL_RGBA16F, GL_RGBA, GL_HALF_FLOAT, 8},
+      {"depth (GL_DEPTH_COMPONENT32F)", GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, GL_FLOAT, 4},
+  };
+  return list;
+}
+
+void ForwardPass::prepare(const FrameInput& frame) {
+  if (fbo_ && frame.width == width_ && frame.height == height_) return;
+  width_ = frame.width;
+  height_ = frame.height;
+  fbo_ = gpu::make_framebuffer();
+  const auto list = targets();
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    gpu::Texture& t = textures_[i];
+    t = gpu::make_texture(GL_TEXTURE_2D);
+    glTextureStorage2D(t.id(), 1, list[i].internal_format, width_, height_);
+    glTextureParameteri(t.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    const bool depth = list[i].format == GL_DEPTH_COMPONENT;
+    glNamedFramebufferTexture(fbo_.id(), depth ? GL_DEPTH_ATTACHMENT : GLenum(GL_COLOR_ATTACHMENT0 + i),
+                              t.id(), 0);
+  }
+}
+
+Status ForwardPass::record(const FrameInput& frame, const DrawList& list, GpuCache& cache,
+                           DrawState& state, FrameStats& stats) {
+  const GLenum bufs[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                          GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
+  glNamedFramebufferDrawBuffers(fbo_.id(), frame.write_aovs ? 5 : 1, bufs);
+  aovs_written_ = frame.write_aovs;
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
+  glViewport(0, 0, frame.width, frame.height);
+  glEnable(GL_FRAMEBUFFER_SRGB);
+  const float clear_color[4] = {frame.clear_color.r * frame.exposure,
+                                frame.clear_color.g * frame.exposure,
+                                frame.clear_color.b * frame.exposure, 1.0f};
+  const float zero[4] = {0, 0, 0, 0};
+  const float one = 1.0f;
+  glClearBufferfv(GL_COLOR, 0, clear_color);
+  if (frame.write_aovs)
+    for (int i = 1; i < 5; ++i) glClearBufferfv(GL_COLOR, i, zero);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glClearBufferfv(GL_DEPTH, 0, &one);
+  const Status st = draw_forward(frame, list.forward_order, list.keys, nullptr,
+                                 frame.camera.proj * frame.camera.view, cache, state, stats);
+  glDisable(GL_FRAMEBUFFER_SRGB);
+  return st;
+}
+
+}  // namespace kaskad::render

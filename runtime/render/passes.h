@@ -1,0 +1,147 @@
+// The renderer's passes, in the order Renderer::render() runs them (renderer.h):
+//   ShadowMapPass      the depth layers of every shadow view (S0, S4)
+//   ProbeCapturePass   reflection probe faces, mips and sphere maps (S3)
+//   ForwardPass        colour and AOVs of the main view
+// Each pass has prepare() (what it checks and decides before any draw: storage, which layers or
+// faces are drawn) and record() (the GL commands), and says what is true after it. Draws go
+// through DrawState, which switches programs and materials only when they change.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "runtime/assets/image_io.h"
+#include "runtime/core/result.h"
+#include "runtime/gpu/gl_handles.h"
+#include "runtime/render/draw_list.h"
+#include "runtime/render/frame_input.h"
+#include "runtime/render/frame_uniforms.h"
+#include "runtime/render/gpu_cache.h"
+#include "runtime/render/shader_library.h"
+
+namespace kaskad::render {
+
+struct FrameStats;
+
+/// Fixed texture units of the shaders (common.glsl, shadow.glsl, forward.frag).
+inline constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
+                        kTexReflectionCube = 3, kTexReflectionSphere = 4;
+
+/// Program and material state while draws are recorded: glUseProgram and the material's
+/// uniforms and textures only when they change (draws are sorted so they rarely do), counted in
+/// the frame's stats.
+class DrawState {
+ public:
+  DrawState(ShaderLibrary& shaders, GpuCache& cache, FrameStats& stats);
+  /// Uses the program of (pass, key); errors are shader build failures.
+  Status use_program(Pass pass, VariantKey key);
+  GLuint program() const { return program_; }
+  /// The material of draw `d` (drawn with `key`) on the current program.
+  void bind_material(const DrawItem& d, VariantKey key);
+  /// Whether a draw with `key` reads its material in the depth pass: alpha-masked draws do, and
+  /// every draw when the library's programs select material features by uniform (the test
+  /// oracle's über-programs).
+  bool depth_reads_material(VariantKey key) const;
+  /// Programs select material features by a uniform, not by compilation (ShaderLibrary).
+  bool features_by_uniform() const { return features_by_uniform_; }
+
+ private:
+  ShaderLibrary& shaders_;
+  GpuCache& cache_;
+  FrameStats& stats_;
+  bool features_by_uniform_;
+  GLuint program_ = 0;
+  const Material* material_ = nullptr;  // bound on program_, with material_key_
+  VariantKey material_key_;
+};
+
+class ShadowMapPass {
+ public:
+  /// Sizes the depth texture array for the frame's views (a size the driver refuses is an error
+  /// before anything is drawn) and decides which layers to draw: a layer whose inputs (matrix,
+  /// bias, culling, pass mode, casters with their meshes, matrices and depth programs) hash as
+  /// when it was last drawn keeps its depth. After it: stats hold the layers, casters per layer
+  /// and the layers to be drawn (shadow_layers_rendered).
+  Status prepare(const FrameInput& frame, const DrawList& list, const AssetStore& assets,
+                 bool layered, bool features_by_uniform, FrameStats& stats);
+  /// Draws those layers. After it: every layer of every view holds the depth of its casters.
+  Status record(const FrameInput& frame, const DrawList& list, GpuCache& cache, DrawState& state);
+
+  /// The depth texture array (a 64^2 single layer before the first shadowed frame, so the
+  /// sampler is always complete).
+  GLuint texture();
+  /// Depth of every layer, stacked top to bottom (layer 0 first), rows top to bottom.
+  Image read() const;
+
+ private:
+  void ensure_storage(int size, int layers, DepthFormat format, ShadowFilter filter);
+  int size_ = 0, layers_ = 0;
+  DepthFormat format_ = DepthFormat::d24;
+  ShadowFilter filter_ = ShadowFilter::none;
+  gpu::Framebuffer fbo_;
+  gpu::Texture map_;
+  bool layered_ = false;
+  /// Per layer: a hash of what its depth was last drawn from; 0 = nothing valid.
+  std::vector<std::uint64_t> drawn_from_;
+  std::vector<std::uint64_t> inputs_;  // this frame's hashes
+  std::uint32_t redraw_ = 0;           // bit l: layer l is drawn this frame
+};
+
+class ProbeCapturePass {
+ public:
+  /// Drops the maps of reflectors that no longer exist and uploads static maps due this frame.
+  void prepare(const FrameInput& frame, const AssetStore& assets, GpuCache& cache);
+  /// Each scheduled face of a probe's back cube is drawn by a 90° camera at the probe centre
+  /// through the forward path (shadows included, no AOVs, no exposure: cubes hold linear
+  /// radiance, with cascades selected by map bounds), then mips and sphere maps. `ubo` holds
+  /// `main`, the main view's block, before and after. After it: every probe's visible buffer
+  /// is the map draws shade with this frame.
+  Status record(const FrameInput& frame, const DrawList& list, const FrameBlock& main,
+                GLuint ubo, GpuCache& cache, DrawState& state, FrameStats& stats);
+};
+
+class ForwardPass {
+ public:
+  /// The colour, AOV and depth targets at the frame's size (made when the size changes).
+  void prepare(const FrameInput& frame);
+  /// Draws the main view's visible draws into colour (and the AOVs when asked for). After it:
+  /// colour holds the frame, the AOVs its surfaces when write_aovs.
+  Status record(const FrameInput& frame, const DrawList& list, GpuCache& cache,
+                DrawState& state, FrameStats& stats);
+
+  struct Target {
+    const char* name;
+    GLenum internal_format, format, type;
+    int bytes_per_pixel;
+  };
+  /// The targets, in attachment order (colour 0..4, then depth): what prepare() makes and what
+  /// Renderer::check_target_size() asks the driver about.
+  static std::span<const Target> targets();
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  bool aovs_written() const { return aovs_written_; }
+  GLuint framebuffer() const { return fbo_.id(); }
+  /// Attachment i of targets().
+  GLuint texture(int i) const { return textures_[std::size_t(i)].id(); }
+
+ private:
+  int width_ = 0, height_ = 0;
+  bool aovs_written_ = false;
+  gpu::Framebuffer fbo_;
+  std::array<gpu::Texture, 6> textures_;
+};
+
+/// The forward path of the main view and of probe faces: draws `order` with `keys` as seen by
+/// `view_proj` (culled per draw), binding reflection maps; `capture` names the probe face being
+/// drawn (its reflector is left out, and reflections read the maps as of before this frame's
+/// captures).
+Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> order,
+                    const std::vector<VariantKey>& keys, const ProbeJob* capture,
+                    const glm::mat4& view_proj, GpuCache& cache, DrawState& state,
+                    FrameStats& stats);
+
+}  // namespace kaskad::render
