@@ -32,13 +32,17 @@ layout(std140, binding = 0) uniform FrameBlock {
 float view_split(int k, int i) { return u_shadow_views[k].splits[i >> 2][i & 3]; }
 float view_texel(int k, int i) { return u_shadow_views[k].texel[i >> 2][i & 3]; }
 
-// Per-draw uniforms (explicit locations: no name look-ups at draw time).
-layout(location = 0) uniform mat4 u_model;
-layout(location = 4) uniform mat3 u_normal_matrix;
-// Per-material uniforms (set when the material changes; draws are sorted by material).
-layout(location = 8) uniform vec4 u_base_color;
-layout(location = 9) uniform vec4 u_material;  // x metallic, y roughness, z normal scale, w alpha cutoff
-layout(location = 10) uniform vec3 u_emissive;
+// Per-material uniforms (set when the material changes; draws are sorted by material). Locations,
+// attributes and texture units are defined from runtime/render/shader_interface.h.
+layout(location = LOC_BASE_COLOR) uniform vec4 u_base_color;
+layout(location = LOC_MATERIAL) uniform vec4 u_material;  // x metallic, y roughness, z normal scale, w alpha cutoff
+layout(location = LOC_EMISSIVE) uniform vec3 u_emissive;
 
-layout(binding = 0) uniform sampler2D u_base_color_tex;
-layout(binding = 1) uniform sampler2D u_normal_tex;
+layout(binding = UNIT_BASE_COLOR) uniform sampler2D u_base_color_tex;
+layout(binding = UNIT_NORMAL) uniform sampler2D u_normal_tex;
+
+#ifdef VERTEX_STAGE_INSTANCED
+// Per instance (InstanceRecord): the model matrix and its normal matrix.
+layout(location = ATTR_MODEL) in mat4 a_model;
+layout(location = ATTR_NORMAL_MATRIX) in mat3 a_normal_matrix;
+#endif

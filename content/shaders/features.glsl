@@ -3,7 +3,7 @@
 // tests) turns every material feature on and lets ENABLED(bit) read u_oracle_features instead,
 // so the same blocks run with uniform-driven selection for comparison.
 #ifdef KASKAD_UBER_ORACLE
-layout(location = 11) uniform uint u_oracle_features;  // VariantKey material bits
+layout(location = LOC_FEATURE_BITS) uniform uint u_oracle_features;  // VariantKey material bits
 #define ENABLED(bit) ((u_oracle_features & (1u << uint(bit))) != 0u)
 #else
 #define ENABLED(bit) true

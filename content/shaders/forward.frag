@@ -21,15 +21,15 @@ layout(location = 4) out vec4 o_reflection;  // rgb reflected colour C_t, a 1 wi
 
 // Reflection maps (S3). The probe's map and x = k_s * p_r (eq. (3)) are set per draw.
 #if MATERIAL_HAS_REFLECTION_CUBE || MATERIAL_HAS_REFLECTION_SPHERE
-layout(location = 16) uniform vec4 u_reflection;
+layout(location = LOC_REFLECTION) uniform vec4 u_reflection;
 #endif
 #if MATERIAL_HAS_REFLECTION_CUBE
-layout(binding = 3) uniform samplerCube u_reflection_cube;
+layout(binding = UNIT_REFLECTION_CUBE) uniform samplerCube u_reflection_cube;
 #endif
 #if MATERIAL_HAS_REFLECTION_BOX
-layout(location = 17) uniform vec4 u_reflection_box_min;  // xyz: world-space box (Reflector)
-layout(location = 18) uniform vec4 u_reflection_box_max;
-layout(location = 19) uniform vec4 u_reflection_centre;   // xyz: the probe's capture centre
+layout(location = LOC_REFLECTION_BOX_MIN) uniform vec4 u_reflection_box_min;  // xyz: world-space box (Reflector)
+layout(location = LOC_REFLECTION_BOX_MAX) uniform vec4 u_reflection_box_max;
+layout(location = LOC_REFLECTION_CENTRE) uniform vec4 u_reflection_centre;   // xyz: the probe's capture centre
 
 // Box projection (parallax correction, beyond S3): the environment is taken to lie on the box,
 // so look up the direction from the capture centre to where the ray (p, r) leaves the box.
@@ -40,7 +40,7 @@ vec3 box_project(vec3 p, vec3 r) {
 }
 #endif
 #if MATERIAL_HAS_REFLECTION_SPHERE
-layout(binding = 4) uniform sampler2D u_reflection_sphere;  // made for this camera (probe_sphere.frag)
+layout(binding = UNIT_REFLECTION_SPHERE) uniform sampler2D u_reflection_sphere;  // made for this camera (probe_sphere.frag)
 #endif
 
 // Cotangent frame from screen-space derivatives: normal mapping without stored tangents.

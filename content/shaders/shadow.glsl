@@ -2,7 +2,7 @@
 // stability probe pass (shadow_points.*), so that both evaluate visibility with the same code.
 // Needs common.glsl and features.glsl first.
 #if VARIANT_HAS_SHADOW
-layout(binding = 2) uniform sampler2DArrayShadow u_shadow_map;  // one layer per cascade
+layout(binding = UNIT_SHADOW) uniform sampler2DArrayShadow u_shadow_map;  // one layer per cascade
 #endif
 
 // Visibility of shadow view k's light at world position p with geometric normal n: 1 lit, 0

@@ -2,10 +2,10 @@
 // placed on its own pixel of a row-major R/G float target (point i -> pixel (i % width, i / width)).
 #include "common.glsl"
 
-layout(location = 13) uniform ivec2 u_target_size;
+layout(location = LOC_TARGET_SIZE) uniform ivec2 u_target_size;
 
-layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec3 a_normal;
+layout(location = ATTR_POSITION) in vec3 a_position;
+layout(location = ATTR_NORMAL) in vec3 a_normal;
 
 flat out vec3 v_point;
 flat out vec3 v_point_normal;

@@ -312,7 +312,7 @@ void print_layer_table(const render::FrameStats& st, const ShadowData& sh, bool 
   for (int i = 0; i < sh.cascade_count; ++i) {
     const auto c = std::size_t(i), l = std::size_t(sh.first_layer + i);
     std::printf("          %-5zu  %-8.3g  %-7d  %-9zu  %zu%s\n", l, double(st.layer_texel_size[l]),
-                st.layer_draw_calls[l], st.layer_triangles[l],
+                st.layer_casters[l], st.layer_triangles[l],
                 shown_in_aov ? st.cascade_receiver_pixels[c] : std::size_t(0),
                 sh.skipped[c] ? "  (skipped)" : "");
   }
@@ -401,11 +401,12 @@ int run_render(Args a) {
   std::printf("frames    %d at %dx%d: first %.1f ms, median %.2f ms (frames 2..%d)\n", a.frames,
               scene->render.width, scene->render.height, timings->first_frame_ms,
               timings->median_ms(), a.frames);
-  std::printf("last      %d draws (%d outside the view, culled), %zu triangles; shadow pass %d "
-              "draws, %zu triangles; GPU shadow %.2f ms, forward %.2f ms; %d program and %d "
-              "material switches\n",
-              st.draw_calls, st.frustum_culled, st.triangles, st.shadow_draw_calls, st.shadow_triangles,
-              st.shadow_gpu_ms, st.forward_gpu_ms, st.program_switches, st.material_switches);
+  std::printf("last      %d objects in %d draw calls (%d outside the view, culled), %zu "
+              "triangles; shadow pass %d caster instances in %d draw calls, %zu triangles; GPU "
+              "shadow %.2f ms, forward %.2f ms; %d program and %d material switches\n",
+              st.instances, st.draw_calls, st.frustum_culled, st.triangles, st.shadow_instances,
+              st.shadow_draw_calls, st.shadow_triangles, st.shadow_gpu_ms, st.forward_gpu_ms,
+              st.program_switches, st.material_switches);
   if (st.shadow_layers > 0) {
     const int drawn = std::popcount(st.shadow_layers_rendered);
     std::printf("          shadow layers re-rendered in the last frame: %d of %d", drawn,
@@ -455,10 +456,10 @@ int run_render(Args a) {
   }
   if (const ProbeData& pd = timings->last.probes; !pd.probes.empty()) {
     std::printf("probes    %zu reflectors: %llu captures, %llu faces since load; last frame %d "
-                "faces, %d draws into them (%d culled by the face frusta)\n",
+                "faces, %d objects in %d draw calls into them (%d culled by the face frusta)\n",
                 pd.probes.size(), static_cast<unsigned long long>(pd.captures_total),
                 static_cast<unsigned long long>(pd.faces_total), st.probe_faces,
-                st.probe_draw_calls, st.probe_culled);
+                st.probe_instances, st.probe_draw_calls, st.probe_culled);
   }
   std::printf("shaders   %d compiled, %d from the binary cache, %.1f ms (prewarm %.1f ms); "
               "%d compiled after the first frame\n",

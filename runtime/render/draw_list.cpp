@@ -93,15 +93,28 @@ VariantKey DrawList::depth_key(std::size_t view, std::uint32_t i) const {
 
 namespace {
 
-// Draw indices sorted by `by[i]` as pass `pass` sees it, then by material.
+// The material's fields in the order draws sort by: textures first (the costliest binds).
+auto material_fields(const Material& m) {
+  return std::tie(m.base_color_texture, m.normal_texture, m.double_sided, m.alpha_mask,
+                  m.metallic, m.roughness, m.base_color.r, m.base_color.g, m.base_color.b,
+                  m.base_color.a, m.normal_scale, m.emissive.r, m.emissive.g, m.emissive.b,
+                  m.alpha_cutoff, m.k_s, m.features);
+}
+
+// Draw indices sorted by `by[i]` as pass `pass` sees it, then by material, then by mesh: draws
+// that may share one instanced draw (same program, material and mesh) end up next to each other.
 std::vector<std::uint32_t> sorted_by(const FrameInput& frame, Pass pass,
                                      const std::vector<VariantKey>& by) {
   auto material_order = [&](std::uint32_t a, std::uint32_t b) {
-    const Material& ma = frame.draws[a].material;
-    const Material& mb = frame.draws[b].material;
-    return std::tie(ma.base_color_texture, ma.normal_texture, ma.double_sided, ma.metallic,
-                    ma.roughness) < std::tie(mb.base_color_texture, mb.normal_texture,
-                                             mb.double_sided, mb.metallic, mb.roughness);
+    const DrawItem& da = frame.draws[a];
+    const DrawItem& db = frame.draws[b];
+    // The depth pass reads a material only to discard alpha-masked texels: without that, draws
+    // of one mesh share a draw whatever their materials.
+    if (pass == Pass::depth && !by[a].has(VariantKey::kAlphaMask) && da.mesh != db.mesh)
+      return da.mesh < db.mesh;
+    const auto fa = material_fields(da.material), fb = material_fields(db.material);
+    if (fa != fb) return fa < fb;
+    return da.mesh < db.mesh;
   };
   std::vector<std::uint32_t> order(frame.draws.size());
   for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;

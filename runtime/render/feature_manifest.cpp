@@ -4,6 +4,7 @@
 #include <cctype>
 
 #include "components/limits.h"
+#include "runtime/render/shader_interface.h"
 #include "runtime/core/json_reader.h"
 
 namespace kaskad::render {
@@ -175,6 +176,8 @@ std::vector<std::pair<std::string, std::string>> FeatureManifest::defines(Varian
   out.emplace_back("MAX_LIGHTS", std::to_string(kMaxLights));
   out.emplace_back("MAX_CASCADES", std::to_string(kMaxCascades));
   out.emplace_back("MAX_SHADOW_VIEWS", std::to_string(kMaxShadowedLights));
+  // Attribute and uniform locations and texture units, from runtime/render/shader_interface.h.
+  for (const auto& [name, value] : shader_interface_defines()) out.emplace_back(name, std::to_string(value));
   return out;
 }
 

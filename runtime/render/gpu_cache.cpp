@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 
 #include <glm/glm.hpp>
@@ -14,8 +15,29 @@
 namespace kaskad::render {
 namespace {
 
-// Fixed attribute locations (see the shaders).
-constexpr GLuint kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
+// The vertex array's instanced attributes (InstanceRecord, divisor 1) read from binding 3.
+constexpr GLuint kInstanceBinding = 3;
+
+void add_instance_attributes(GLuint vao, GLuint buffer) {
+  for (GLuint i = 0; i < 4; ++i) {
+    glEnableVertexArrayAttrib(vao, kAttrModel + i);
+    glVertexArrayAttribFormat(vao, kAttrModel + i, 4, GL_FLOAT, GL_FALSE,
+                              GLuint(offsetof(InstanceRecord, model) + 16 * i));
+    glVertexArrayAttribBinding(vao, kAttrModel + i, kInstanceBinding);
+  }
+  for (GLuint i = 0; i < 3; ++i) {
+    glEnableVertexArrayAttrib(vao, kAttrNormalMatrix + i);
+    glVertexArrayAttribFormat(vao, kAttrNormalMatrix + i, 3, GL_FLOAT, GL_FALSE,
+                              GLuint(offsetof(InstanceRecord, normal_matrix) + 16 * i));
+    glVertexArrayAttribBinding(vao, kAttrNormalMatrix + i, kInstanceBinding);
+  }
+  glEnableVertexArrayAttrib(vao, kAttrLayer);
+  glVertexArrayAttribIFormat(vao, kAttrLayer, 1, GL_UNSIGNED_INT,
+                             GLuint(offsetof(InstanceRecord, layer)));
+  glVertexArrayAttribBinding(vao, kAttrLayer, kInstanceBinding);
+  glVertexArrayBindingDivisor(vao, kInstanceBinding, 1);
+  if (buffer) glVertexArrayVertexBuffer(vao, kInstanceBinding, buffer, 0, sizeof(InstanceRecord));
+}
 
 // A 1x1 texture standing in for a missing material texture.
 gpu::Texture make_solid_texture(const std::array<float, 4>& rgba, GLenum internal_format) {
@@ -81,7 +103,29 @@ const GpuMesh& GpuCache::mesh(MeshId id) {
     glVertexArrayAttribBinding(vao, attrs[i], GLuint(i));
   }
   glVertexArrayElementBuffer(vao, m.indices.id());
+  add_instance_attributes(vao, instances_ ? instances_.id() : 0);
   return m;
+}
+
+std::uint32_t GpuCache::upload(std::span<const InstanceRecord> records) {
+  const std::size_t first = instances_used_;
+  if (first + records.size() > instances_capacity_) {
+    // A larger buffer; draws already recorded this frame keep reading the old one (GL holds it
+    // until they are done), so the new one is filled from the same index on.
+    instances_capacity_ = std::max<std::size_t>({1024, 2 * instances_capacity_, first + records.size()});
+    instances_ = gpu::make_buffer();
+    glNamedBufferStorage(instances_.id(), GLsizeiptr(instances_capacity_ * sizeof(InstanceRecord)),
+                         nullptr, GL_DYNAMIC_STORAGE_BIT);
+    for (GpuMesh& m : meshes_)
+      if (m.vao)
+        glVertexArrayVertexBuffer(m.vao.id(), kInstanceBinding, instances_.id(), 0,
+                                  sizeof(InstanceRecord));
+  }
+  if (!records.empty())
+    glNamedBufferSubData(instances_.id(), GLintptr(first * sizeof(InstanceRecord)),
+                         GLsizeiptr(records.size() * sizeof(InstanceRecord)), records.data());
+  instances_used_ = first + records.size();
+  return std::uint32_t(first);
 }
 
 GLuint GpuCache::texture(TextureId id, bool is_normal_map) {

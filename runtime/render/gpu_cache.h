@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "components/mesh_renderer.h"
@@ -13,6 +14,7 @@
 #include "runtime/core/result.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/render/probe_capture.h"
+#include "runtime/render/shader_interface.h"
 
 namespace kaskad::render {
 
@@ -40,6 +42,13 @@ class GpuCache {
   GLuint texture(TextureId id, bool is_normal_map);
   ProbeMaps& probes() { return *probes_; }
 
+  /// Instance records for this frame's draws: begin_frame() starts the frame; upload() stores
+  /// `records` after the ones stored earlier in the frame and returns the index of the first,
+  /// the base instance of the draws that read them (every mesh's vertex array reads instanced
+  /// attributes from this buffer).
+  void begin_frame() { instances_used_ = 0; }
+  std::uint32_t upload(std::span<const InstanceRecord> records);
+
  private:
   GpuCache() = default;
   const AssetStore* assets_ = nullptr;
@@ -47,6 +56,8 @@ class GpuCache {
   std::vector<GpuMesh> meshes_;                        // indexed by MeshId
   std::vector<std::unique_ptr<gpu::Texture>> textures_;  // indexed by TextureId
   gpu::Texture white_, flat_normal_;
+  gpu::Buffer instances_;
+  std::size_t instances_capacity_ = 0, instances_used_ = 0;  // in records
   std::unique_ptr<ProbeMaps> probes_;
 };
 

@@ -12,14 +12,15 @@
 namespace kaskad::render {
 namespace {
 
-// Fixed uniform locations (see the shaders).
-constexpr GLint kUniModel = 0, kUniNormalMatrix = 4, kUniBaseColor = 8, kUniMaterial = 9,
-                kUniEmissive = 10, kUniFeatureBits = 11, kUniLightViewProj = 12,
-                // Per-program locations: shadow_depth layering (13, 14, 16+), forward
-                // reflections (16-19); no program has two of them.
-                kUniLayerMask = 13, kUniLayerBase = 14, kUniLayerViewProj = 16,
-                kUniReflection = 16, kUniReflectionBoxMin = 17, kUniReflectionBoxMax = 18,
-                kUniReflectionCentre = 19;
+// The instance record of a draw with model matrix `model` (layer: the layered shadow pass's).
+InstanceRecord instance_of(const glm::mat4& model, std::uint32_t layer = 0) {
+  InstanceRecord r;
+  r.model = model;
+  const glm::mat3 n = glm::transpose(glm::inverse(glm::mat3(model)));
+  for (int c = 0; c < 3; ++c) r.normal_matrix[c] = glm::vec4(n[c], 0.0f);
+  r.layer = glm::uvec4(layer, 0, 0, 0);
+  return r;
+}
 
 GLenum depth_internal_format(DepthFormat f) {
   switch (f) {
@@ -109,10 +110,10 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
   material_key_ = key.material();
   ++stats_.material_switches;
   const glm::vec4 params(m.metallic, m.roughness, m.normal_scale, m.alpha_cutoff);
-  glProgramUniform4fv(program_, kUniBaseColor, 1, &m.base_color[0]);
-  glProgramUniform4fv(program_, kUniMaterial, 1, &params[0]);
-  glProgramUniform3fv(program_, kUniEmissive, 1, &m.emissive[0]);
-  if (features_by_uniform_) glProgramUniform1ui(program_, kUniFeatureBits, key.material().bits());
+  glProgramUniform4fv(program_, kLocBaseColor, 1, &m.base_color[0]);
+  glProgramUniform4fv(program_, kLocMaterial, 1, &params[0]);
+  glProgramUniform3fv(program_, kLocEmissive, 1, &m.emissive[0]);
+  if (features_by_uniform_) glProgramUniform1ui(program_, kLocFeatureBits, key.material().bits());
   glBindTextureUnit(kTexBaseColor, cache_.texture(m.base_color_texture, false));
   glBindTextureUnit(kTexNormal, cache_.texture(m.normal_texture, true));
 }
@@ -161,12 +162,13 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   const std::vector<ShadowView>& views = frame.shadow_views;
   const ShadowMapSettings& map = frame.shadow_map;
   const int total = views.empty() ? 0 : views.back().first_layer + views.back().layer_count;
-  stats.layer_draw_calls.fill(0);
+  stats.layer_casters.fill(0);
   stats.layer_triangles.fill(0);
   stats.layer_texel_size.fill(0.0f);
   stats.shadow_layers = total;
   stats.shadow_layers_rendered = 0;
   stats.shadow_draw_calls = 0;
+  stats.shadow_instances = 0;
   stats.shadow_triangles = 0;
   redraw_ = 0;
   layered_ = layered;
@@ -211,8 +213,8 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   if (layered && redraw_ != 0) redraw_ = ~0u >> (32 - total);  // total <= 32: no 1u << 32
   stats.shadow_layers_rendered = redraw_;
 
-  // Stats: the casters each layer holds, whether drawn now or kept from an earlier frame; a
-  // layered pass draws each caster once per view, instanced over its layers.
+  // Stats: the casters each layer holds, whether drawn now or kept from an earlier frame (the
+  // draw calls are counted as they are recorded).
   for (const ShadowView& v : views) {
     std::uint32_t live = 0;
     for (int c = 0; c < v.layer_count; ++c)
@@ -222,11 +224,11 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
       const std::uint32_t mask = live & caster_mask(v, d);
       const std::size_t tris = triangles(assets, d.mesh);
       if (mask == 0 || tris == 0) continue;
-      stats.shadow_draw_calls += layered ? 1 : std::popcount(mask);
+      stats.shadow_instances += std::popcount(mask);
       stats.shadow_triangles += std::size_t(std::popcount(mask)) * tris;
       for (int c = 0; c < v.layer_count; ++c)
         if (mask & (1u << c)) {
-          ++stats.layer_draw_calls[std::size_t(v.first_layer + c)];
+          ++stats.layer_casters[std::size_t(v.first_layer + c)];
           stats.layer_triangles[std::size_t(v.first_layer + c)] += tris;
         }
     }
@@ -238,7 +240,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
 }
 
 Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuCache& cache,
-                             DrawState& state) {
+                             DrawState& state, FrameStats& stats) {
   if (redraw_ == 0) return {};
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
   glViewport(0, 0, size_, size_);
@@ -248,43 +250,55 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
   glClearDepth(1.0);
   glEnable(GL_POLYGON_OFFSET_FILL);
   // Layered: every layer attached at once and cleared together (skipped layers stay clear);
-  // each caster is drawn once per view, instanced over the layers it overlaps, and the vertex
-  // shader routes instance i to the i-th of them (shadow_depth.vert). The same maps as one pass
-  // per layer (render test), with fewer draw calls.
+  // every caster goes once per layer it overlaps as an instance carrying that layer, which the
+  // vertex shader sends there (shadow_depth.vert). The same maps as one pass per layer (render
+  // test), with fewer draw calls.
   if (layered_) {
     glNamedFramebufferTexture(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0);
     glClear(GL_DEPTH_BUFFER_BIT);
   }
-  Status status;
-  // Draws caster i of view `view` (into the layers of `mask`, or the one attached layer).
-  auto draw = [&](std::size_t view, std::uint32_t i, std::uint32_t mask, const glm::mat4* light_vp) {
-    const DrawItem& d = frame.draws[i];
-    const GpuMesh& m = cache.mesh(d.mesh);
-    if (m.index_count == 0) return true;
-    if (Status st = state.use_program(Pass::depth, list.depth_key(view, i)); !st) {
-      status = st;
+  // Casters i and j of a view share one instanced draw: same mesh and depth program, and the
+  // same material where the depth program reads it.
+  auto same_batch = [&](std::size_t view, std::uint32_t i, std::uint32_t j) {
+    const DrawItem& a = frame.draws[i];
+    const DrawItem& b = frame.draws[j];
+    if (a.mesh != b.mesh ||
+        list.depth_key(view, i).filtered_for(Pass::depth) != list.depth_key(view, j).filtered_for(Pass::depth))
       return false;
-    }
-    const GLuint prog = state.program();
-    if (state.depth_reads_material(list.keys[i])) state.bind_material(d, list.keys[i]);
+    return !state.depth_reads_material(list.keys[i]) ||
+           (a.material == b.material && list.keys[i].material() == list.keys[j].material());
+  };
+  Status status;
+  std::vector<InstanceRecord> records;
+  // Draws `runs` (first caster, first record, record count) of view `view` from `records`.
+  struct Run {
+    std::uint32_t draw;
+    std::size_t first, count;
+  };
+  auto draw_runs = [&](std::size_t view, const std::vector<Run>& runs, const glm::mat4* light_vp) {
+    const std::uint32_t base = cache.upload(records);
     const ShadowView& v = frame.shadow_views[view];
-    if (light_vp) {
-      glProgramUniformMatrix4fv(prog, kUniLightViewProj, 1, GL_FALSE, &(*light_vp)[0][0]);
-    } else {
-      glProgramUniform1ui(prog, kUniLayerMask, mask);
-      glProgramUniform1i(prog, kUniLayerBase, v.first_layer);
-      glProgramUniformMatrix4fv(prog, kUniLayerViewProj, v.layer_count, GL_FALSE,
-                                &v.view_proj[0][0][0]);
+    for (const Run& run : runs) {
+      const DrawItem& d = frame.draws[run.draw];
+      const GpuMesh& m = cache.mesh(d.mesh);
+      if (Status st = state.use_program(Pass::depth, list.depth_key(view, run.draw)); !st) {
+        status = st;
+        return;
+      }
+      const GLuint prog = state.program();
+      if (state.depth_reads_material(list.keys[run.draw])) state.bind_material(d, list.keys[run.draw]);
+      if (light_vp) {
+        glProgramUniformMatrix4fv(prog, kLocLightViewProj, 1, GL_FALSE, &(*light_vp)[0][0]);
+      } else {
+        glProgramUniform1i(prog, kLocLayerBase, v.first_layer);
+        glProgramUniformMatrix4fv(prog, kLocLayerViewProj, v.layer_count, GL_FALSE,
+                                  &v.view_proj[0][0][0]);
+      }
+      glBindVertexArray(m.vao.id());
+      glDrawElementsInstancedBaseInstance(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
+                                          GLsizei(run.count), GLuint(base + run.first));
+      ++stats.shadow_draw_calls;
     }
-    glProgramUniformMatrix4fv(prog, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-    glBindVertexArray(m.vao.id());
-    if (light_vp) {
-      glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
-    } else {
-      glDrawElementsInstanced(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
-                              std::popcount(mask));
-    }
-    return true;
   };
   for (std::size_t view = 0; view < frame.shadow_views.size() && status; ++view) {
     const ShadowView& v = frame.shadow_views[view];
@@ -301,13 +315,29 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
     } else {
       glDisable(GL_CLIP_DISTANCE0);
     }
+    // The casters of `mask_of` (bit c: layer c of the view) with a non-empty mesh, in draw order,
+    // grouped into runs that share a draw; each caster adds one record per layer of its mask.
+    auto collect = [&](auto&& mask_of, bool per_layer) {
+      records.clear();
+      std::vector<Run> runs;
+      std::uint32_t previous = 0;
+      for (std::uint32_t i : list.depth_order) {
+        const std::uint32_t mask = mask_of(frame.draws[i]);
+        if (mask == 0 || cache.mesh(frame.draws[i].mesh).index_count == 0) continue;
+        if (runs.empty() || !same_batch(view, previous, i)) runs.push_back({i, records.size(), 0});
+        previous = i;
+        for (int c = 0; c < v.layer_count; ++c)
+          if (mask & (1u << c)) records.push_back(instance_of(frame.draws[i].model, per_layer ? std::uint32_t(c) : 0u));
+        runs.back().count = records.size() - runs.back().first;
+      }
+      return runs;
+    };
     if (layered_) {
       std::uint32_t live = 0;
       for (int c = 0; c < v.layer_count; ++c)
         if (!v.skipped[std::size_t(c)]) live |= 1u << c;
-      for (std::uint32_t i : list.depth_order)
-        if (const std::uint32_t mask = live & caster_mask(v, frame.draws[i]); mask != 0)
-          if (!draw(view, i, mask, nullptr)) break;
+      draw_runs(view, collect([&](const DrawItem& d) { return live & caster_mask(v, d); }, true),
+                nullptr);
       continue;
     }
     for (int c = 0; c < v.layer_count && status; ++c) {
@@ -316,9 +346,9 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
       glNamedFramebufferTextureLayer(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0, layer);
       glClear(GL_DEPTH_BUFFER_BIT);
       if (v.skipped[std::size_t(c)]) continue;
-      for (std::uint32_t i : list.depth_order)
-        if (caster_mask(v, frame.draws[i]) & (1u << c))
-          if (!draw(view, i, 0, &v.view_proj[std::size_t(c)])) break;
+      const std::uint32_t bit = 1u << c;
+      draw_runs(view, collect([&](const DrawItem& d) { return caster_mask(v, d) & bit ? bit : 0u; }, false),
+                &v.view_proj[std::size_t(c)]);
     }
   }
   glDisable(GL_POLYGON_OFFSET_FILL);
@@ -359,10 +389,25 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
                     const glm::mat4& view_proj, GpuCache& cache, DrawState& state,
                     FrameStats& stats) {
   int& culled = capture ? stats.probe_culled : stats.frustum_culled;
-  for (std::uint32_t i : visible_draws(frame, order, view_proj, capture, culled)) {
+  std::vector<std::uint32_t> visible = visible_draws(frame, order, view_proj, capture, culled);
+  std::erase_if(visible, [&](std::uint32_t i) { return cache.mesh(frame.draws[i].mesh).index_count == 0; });
+  std::vector<InstanceRecord> records(visible.size());
+  for (std::size_t k = 0; k < visible.size(); ++k) records[k] = instance_of(frame.draws[visible[k]].model);
+  const std::uint32_t base = cache.upload(records);
+  auto reflective = [&](std::uint32_t i) {
+    return keys[i].has(VariantKey::kReflectionCube) || keys[i].has(VariantKey::kReflectionSphere);
+  };
+  // Runs of visible draws with the same mesh, program and material become one instanced draw;
+  // a reflective draw (its own probe map and k_s * p_r) stays alone.
+  for (std::size_t first = 0; first < visible.size();) {
+    const std::uint32_t i = visible[first];
     const DrawItem& d = frame.draws[i];
+    std::size_t end = first + 1;
+    if (!reflective(i))
+      while (end < visible.size() && frame.draws[visible[end]].mesh == d.mesh &&
+             keys[visible[end]] == keys[i] && frame.draws[visible[end]].material == d.material)
+        ++end;
     const GpuMesh& m = cache.mesh(d.mesh);
-    if (m.index_count == 0) continue;
     KASKAD_TRY(state.use_program(Pass::forward, keys[i]));
     const GLuint prog = state.program();
     if (d.material.double_sided) {
@@ -375,29 +420,29 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
     // A draw reflecting a probe gets its map: `visible` as of before this frame's captures (a
     // probe never sees a cube being captured), and k_s * p_r.
     const VariantKey key = keys[i];
-    if (key.has(VariantKey::kReflectionCube) || key.has(VariantKey::kReflectionSphere)) {
+    if (reflective(i)) {
       for (const ProbeJob& job : frame.probes) {
         if (job.handle != d.probe) continue;
         const bool swapped_now = job.faces != 0 && job.target == job.visible;
         const int buffer = capture && swapped_now ? 1 - job.visible : job.visible;
         glBindTextureUnit(kTexReflectionCube, cache.probes().existing_cube(job.handle, buffer));
         glBindTextureUnit(kTexReflectionSphere, cache.probes().existing_sphere(job.handle));
-        glProgramUniform4f(prog, kUniReflection, d.reflection_scale, 0.0f, 0.0f, 0.0f);
+        glProgramUniform4f(prog, kLocReflection, d.reflection_scale, 0.0f, 0.0f, 0.0f);
         if (key.has(VariantKey::kReflectionBox)) {
-          glProgramUniform4f(prog, kUniReflectionBoxMin, job.box_min.x, job.box_min.y, job.box_min.z, 0);
-          glProgramUniform4f(prog, kUniReflectionBoxMax, job.box_max.x, job.box_max.y, job.box_max.z, 0);
-          glProgramUniform4f(prog, kUniReflectionCentre, job.center.x, job.center.y, job.center.z, 0);
+          glProgramUniform4f(prog, kLocReflectionBoxMin, job.box_min.x, job.box_min.y, job.box_min.z, 0);
+          glProgramUniform4f(prog, kLocReflectionBoxMax, job.box_max.x, job.box_max.y, job.box_max.z, 0);
+          glProgramUniform4f(prog, kLocReflectionCentre, job.center.x, job.center.y, job.center.z, 0);
         }
         break;
       }
     }
-    const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(d.model)));
-    glProgramUniformMatrix4fv(prog, kUniModel, 1, GL_FALSE, &d.model[0][0]);
-    glProgramUniformMatrix3fv(prog, kUniNormalMatrix, 1, GL_FALSE, &normal_matrix[0][0]);
     glBindVertexArray(m.vao.id());
-    glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+    glDrawElementsInstancedBaseInstance(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
+                                        GLsizei(end - first), GLuint(base + first));
     ++stats.draw_calls;
-    stats.triangles += std::size_t(m.index_count / 3);
+    stats.instances += int(end - first);
+    stats.triangles += (end - first) * std::size_t(m.index_count / 3);
+    first = end;
   }
   return {};
 }
@@ -431,13 +476,15 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
       const FrameBlock face = probe_face_block(main, job, f);
       glNamedBufferSubData(ubo, 0, sizeof face, &face);
       cache.probes().begin_face(job.handle, job.target, f, frame.clear_color);
-      const int before = stats.draw_calls;
+      const int before = stats.draw_calls, instances_before = stats.instances;
       const std::size_t triangles_before = stats.triangles;
       status = draw_forward(frame, list.capture_order, list.capture_keys, &job, face.view_proj,
                             cache, state, stats);
       // Draws into faces are counted apart from the main view's.
       stats.probe_draw_calls += stats.draw_calls - before;
+      stats.probe_instances += stats.instances - instances_before;
       stats.draw_calls = before;
+      stats.instances = instances_before;
       stats.triangles = triangles_before;
       ++stats.probe_faces;
     }

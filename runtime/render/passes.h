@@ -20,15 +20,12 @@
 #include "runtime/render/frame_input.h"
 #include "runtime/render/frame_uniforms.h"
 #include "runtime/render/gpu_cache.h"
+#include "runtime/render/shader_interface.h"
 #include "runtime/render/shader_library.h"
 
 namespace kaskad::render {
 
 struct FrameStats;
-
-/// Fixed texture units of the shaders (common.glsl, shadow.glsl, forward.frag).
-inline constexpr GLuint kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
-                        kTexReflectionCube = 3, kTexReflectionSphere = 4;
 
 /// Program and material state while draws are recorded: glUseProgram and the material's
 /// uniforms and textures only when they change (draws are sorted so they rarely do), counted in
@@ -68,7 +65,8 @@ class ShadowMapPass {
   Status prepare(const FrameInput& frame, const DrawList& list, const AssetStore& assets,
                  bool layered, bool features_by_uniform, FrameStats& stats);
   /// Draws those layers. After it: every layer of every view holds the depth of its casters.
-  Status record(const FrameInput& frame, const DrawList& list, GpuCache& cache, DrawState& state);
+  Status record(const FrameInput& frame, const DrawList& list, GpuCache& cache, DrawState& state,
+                FrameStats& stats);
 
   /// The depth texture array (a 64^2 single layer before the first shadowed frame, so the
   /// sampler is always complete).

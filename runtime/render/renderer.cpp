@@ -21,16 +21,9 @@
 #include "runtime/render/gpu_cache.h"
 #include "runtime/render/passes.h"
 #include "runtime/render/probe_capture.h"
+#include "runtime/render/shader_interface.h"
 
 namespace kaskad::render {
-namespace {
-
-// Fixed attribute and uniform locations of the shadow-points pass (shadow_points.*).
-constexpr GLuint kAttrPosition = 0, kAttrNormal = 1;
-constexpr GLint kUniTargetSize = 13;
-
-}  // namespace
-
 struct Renderer::Impl {
   std::unique_ptr<ShaderLibrary> shaders;
   std::unique_ptr<GpuCache> cache;
@@ -175,11 +168,11 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   if (int(frame.lights.size()) > kMaxLights)
     log::warn_once("%zu lights; only the first %d are shaded", frame.lights.size(), kMaxLights);
   read_timers();
-  stats_.draw_calls = 0;
+  stats_.draw_calls = stats_.instances = 0;
   stats_.triangles = 0;
   stats_.frustum_culled = 0;
   stats_.program_switches = stats_.material_switches = 0;
-  stats_.probe_faces = stats_.probe_draw_calls = stats_.probe_culled = 0;
+  stats_.probe_faces = stats_.probe_draw_calls = stats_.probe_instances = stats_.probe_culled = 0;
   stats_.cascade_receiver_pixels.fill(0);
 
   // The frame block of the main view is bound at binding 0 (every pass reads it).
@@ -188,6 +181,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
   // The GPU cache holds this frame's assets (another scene's ids start it afresh).
   im.cache->use(assets);
+  im.cache->begin_frame();
   // Keys and submission orders, once per frame.
   const DrawList list = build_draw_list(frame, im.supported(frame_variant(frame)));
   im.frame_key = list.frame_key;
@@ -197,7 +191,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   KASKAD_TRY(im.shadow.prepare(frame, list, assets, list.frame_key.has(VariantKey::kShadowLayered),
                                state.features_by_uniform(), stats_));
   glBeginQuery(GL_TIME_ELAPSED, im.timers[0].id());
-  Status st = im.shadow.record(frame, list, *im.cache, state);
+  Status st = im.shadow.record(frame, list, *im.cache, state, stats_);
   glEndQuery(GL_TIME_ELAPSED);
   KASKAD_TRY(st);
   glBindTextureUnit(kTexShadow, im.shadow.texture());
@@ -280,7 +274,7 @@ Result<std::vector<glm::vec2>> Renderer::shadow_at_points(std::span<const glm::v
       im.shaders->program(Pass::shadow_points, im.frame_key->filtered_for(Pass::shadow_points));
   if (!program) return program.error();
   glUseProgram(*program);
-  glProgramUniform2i(*program, kUniTargetSize, w, h);
+  glProgramUniform2i(*program, kLocTargetSize, w, h);
   // The frame block and shadow map are still those of the last render(); bind them again in
   // case other GL work ran in between.
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());

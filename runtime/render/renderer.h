@@ -28,13 +28,19 @@
 
 namespace kaskad::render {
 
+/// Draw calls are GL draw calls: draws that share mesh, program and material are one instanced
+/// draw. Instances are the objects those calls draw.
 struct FrameStats {
-  int draw_calls = 0;
+  int draw_calls = 0;                 ///< forward pass of the main view
+  int instances = 0;                  ///< objects drawn by them
   int frustum_culled = 0;             ///< draws outside the main view's frustum, not drawn
   std::size_t triangles = 0;          ///< submitted in the forward pass
-  /// Casters in the shadow map's layers (all cascades) and their triangles, whether drawn this
-  /// frame or kept from an earlier one (shadow_layers_rendered says which layers were drawn).
+  /// Shadow pass draw calls recorded this frame (0 when every layer kept its depth).
   int shadow_draw_calls = 0;
+  /// Caster instances in the shadow map's layers (one per caster and layer) and their
+  /// triangles, whether drawn this frame or kept from an earlier one (shadow_layers_rendered
+  /// says which layers were drawn).
+  int shadow_instances = 0;
   std::size_t shadow_triangles = 0;
   int shadow_layers = 0;  ///< layers of the shadow map this frame (all shadow views)
   /// Bit l: texture-array layer l was cleared and re-rendered this frame. The others kept their
@@ -43,7 +49,7 @@ struct FrameStats {
   /// Per layer of the shadow map array (all shadow views; view k's layers start at its
   /// first_layer): the casters it holds, their triangles, and metres per texel (spot and point
   /// layers: at 1 m from the light).
-  std::array<int, kMaxShadowLayers> layer_draw_calls{};
+  std::array<int, kMaxShadowLayers> layer_casters{};
   std::array<std::size_t, kMaxShadowLayers> layer_triangles{};
   std::array<float, kMaxShadowLayers> layer_texel_size{};
   /// Receiver pixels per cascade: pixels of the frame's AOV whose `cascade` channel is i (visible
@@ -57,7 +63,8 @@ struct FrameStats {
   double probe_gpu_ms = 0.0;          ///< GL_TIME_ELAPSED of the probe captures (previous frame)
   int probe_faces_timed = 0;          ///< faces that probe_gpu_ms covers (previous frame's)
   int probe_faces = 0;                ///< reflection probe cube faces rendered this frame
-  int probe_draw_calls = 0;           ///< draws into those faces (not in draw_calls)
+  int probe_draw_calls = 0;           ///< draw calls into those faces (not in draw_calls)
+  int probe_instances = 0;            ///< objects they draw
   int probe_culled = 0;               ///< draws outside a captured face's frustum, not drawn
   int program_switches = 0;           ///< glUseProgram calls in the frame (draws are sorted)
   int material_switches = 0;          ///< material uniform/texture updates in the frame

@@ -285,7 +285,8 @@ TEST_F(DefaultSceneTest, StableCascadesDoNotShimmerUnderSubTexelCameraMoves) {
 // Crop fits: the stable fit's spheres are wide enough here for every cascade to see every caster
 // once the range starts at the nearest receiver.
 TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
-  // One pass per layer: one draw call per caster and cascade (the layered pass is below).
+  // One pass per layer: the casters of each cascade, one instanced draw call per mesh among
+  // them (the depth program does not read materials; the layered pass is below).
   auto scene = load_scene(
       content_dir() / "scenes" / "default.json",
       {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=false",
@@ -296,18 +297,25 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
   const render::FrameStats& st = t->last.stats;
   const ShadowData& sh = t->last.shadow();
   ASSERT_EQ(st.shadow_layers, 8);
-  int draws = 0, culled = 0;
+  int casters = 0, culled = 0, meshes_per_layer = 0;
   std::size_t triangles = 0;
+  std::set<MeshId> all_meshes;
   for (std::size_t i = 0; i < 8; ++i) {
-    EXPECT_EQ(st.layer_draw_calls[i], int(sh.casters[i].size())) << "cascade " << i;
+    EXPECT_EQ(st.layer_casters[i], int(sh.casters[i].size())) << "cascade " << i;
+    std::set<MeshId> meshes;
+    for (ecs::Entity e : sh.casters[i]) meshes.insert(scene->world.get<MeshRenderer>(e).mesh);
+    if (!sh.skipped[i]) meshes_per_layer += int(meshes.size());
+    all_meshes.insert(meshes.begin(), meshes.end());
     if (sh.skipped[i]) {
-      EXPECT_EQ(st.layer_draw_calls[i], 0) << "cascade " << i;
+      EXPECT_EQ(st.layer_casters[i], 0) << "cascade " << i;
     }
-    draws += st.layer_draw_calls[i];
+    casters += st.layer_casters[i];
     triangles += st.layer_triangles[i];
-    culled += 8 - st.layer_draw_calls[i];  // the default scene has 8 casters
+    culled += 8 - st.layer_casters[i];  // the default scene has 8 casters
   }
-  EXPECT_EQ(draws, st.shadow_draw_calls);
+  EXPECT_EQ(casters, st.shadow_instances);
+  EXPECT_EQ(st.shadow_draw_calls, meshes_per_layer);
+  EXPECT_LT(st.shadow_draw_calls, st.shadow_instances);  // the boxes share a draw
   EXPECT_EQ(triangles, st.shadow_triangles);
   EXPECT_GT(culled, 0);  // the nearest and farthest cascades do not see every caster
   EXPECT_FLOAT_EQ(sh.far_requested, 100.0f);
@@ -317,7 +325,7 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
               double(sh.far_requested), double(sh.far_used), culled);
 
   // Layered: the same casters per cascade and the same triangles, but one instanced draw call
-  // per caster that is in any cascade.
+  // per mesh for all cascades at once.
   auto layered_scene = load_scene(
       content_dir() / "scenes" / "default.json",
       {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=true",
@@ -326,13 +334,12 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
   auto lt = render_frames(*player_, *layered_scene, {});
   ASSERT_TRUE(lt.ok()) << lt.error().to_string();
   const render::FrameStats& ls = lt->last.stats;
-  std::set<std::uint32_t> casters_drawn;
   for (std::size_t i = 0; i < 8; ++i) {
-    EXPECT_EQ(ls.layer_draw_calls[i], st.layer_draw_calls[i]) << "cascade " << i;
+    EXPECT_EQ(ls.layer_casters[i], st.layer_casters[i]) << "cascade " << i;
     EXPECT_EQ(ls.layer_triangles[i], st.layer_triangles[i]) << "cascade " << i;
-    for (ecs::Entity e : lt->last.shadow().casters[i]) casters_drawn.insert(e.index);
   }
-  EXPECT_EQ(ls.shadow_draw_calls, int(casters_drawn.size()));
+  EXPECT_EQ(ls.shadow_instances, st.shadow_instances);
+  EXPECT_EQ(ls.shadow_draw_calls, int(all_meshes.size()));
   EXPECT_LT(ls.shadow_draw_calls, st.shadow_draw_calls);
   EXPECT_EQ(ls.shadow_triangles, st.shadow_triangles);
 }

@@ -1,0 +1,72 @@
+// The fixed interface between the renderer and the shaders, defined once: vertex attribute
+// locations, uniform locations and texture units, and the per-instance record. The shader
+// library defines each as a macro in every program (FeatureManifest::defines: ATTR_*, LOC_*,
+// UNIT_*), so content/shaders/ write `layout(location = LOC_BASE_COLOR)` and never a number.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <utility>
+
+#include <glm/glm.hpp>
+
+namespace kaskad::render {
+
+// Vertex attributes: per vertex (a mesh's streams), then per instance (InstanceRecord).
+inline constexpr unsigned kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
+inline constexpr unsigned kAttrModel = 3;         ///< mat4: locations 3..6
+inline constexpr unsigned kAttrNormalMatrix = 7;  ///< mat3: locations 7..9
+inline constexpr unsigned kAttrLayer = 10;        ///< uint: the layered shadow pass's layer
+
+/// One drawn instance, read by the vertex shaders through instanced attributes (divisor 1) from
+/// the frame's instance buffer: the model matrix, its normal matrix (columns, w unused) and,
+/// for the layered shadow pass, the layer of its view it goes to.
+struct InstanceRecord {
+  glm::mat4 model{1.0f};
+  glm::vec4 normal_matrix[3]{};
+  glm::uvec4 layer{0u};
+};
+static_assert(sizeof(InstanceRecord) == 128);
+
+// Uniform locations (no name look-ups at draw time). Per-program ones may share a number when no
+// program has both: the layered depth pass (13, 14, 16..), the points pass (13), reflections
+// (16..19).
+inline constexpr int kLocBaseColor = 8, kLocMaterial = 9, kLocEmissive = 10,
+                     kLocFeatureBits = 11, kLocLightViewProj = 12, kLocTargetSize = 13,
+                     kLocLayerBase = 14, kLocLayerViewProj = 16,
+                     kLocReflection = 16, kLocReflectionBoxMin = 17, kLocReflectionBoxMax = 18,
+                     kLocReflectionCentre = 19;
+
+// Texture units.
+inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
+                          kTexReflectionCube = 3, kTexReflectionSphere = 4;
+
+/// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...).
+inline std::array<std::pair<const char*, int>, 23> shader_interface_defines() {
+  return {{{"ATTR_POSITION", kAttrPosition},
+           {"ATTR_NORMAL", kAttrNormal},
+           {"ATTR_UV", kAttrUv},
+           {"ATTR_MODEL", kAttrModel},
+           {"ATTR_NORMAL_MATRIX", kAttrNormalMatrix},
+           {"ATTR_LAYER", kAttrLayer},
+           {"LOC_BASE_COLOR", kLocBaseColor},
+           {"LOC_MATERIAL", kLocMaterial},
+           {"LOC_EMISSIVE", kLocEmissive},
+           {"LOC_FEATURE_BITS", kLocFeatureBits},
+           {"LOC_LIGHT_VIEW_PROJ", kLocLightViewProj},
+           {"LOC_TARGET_SIZE", kLocTargetSize},
+           {"LOC_LAYER_BASE", kLocLayerBase},
+           {"LOC_LAYER_VIEW_PROJ", kLocLayerViewProj},
+           {"LOC_REFLECTION", kLocReflection},
+           {"LOC_REFLECTION_BOX_MIN", kLocReflectionBoxMin},
+           {"LOC_REFLECTION_BOX_MAX", kLocReflectionBoxMax},
+           {"LOC_REFLECTION_CENTRE", kLocReflectionCentre},
+           {"UNIT_BASE_COLOR", int(kTexBaseColor)},
+           {"UNIT_NORMAL", int(kTexNormal)},
+           {"UNIT_SHADOW", int(kTexShadow)},
+           {"UNIT_REFLECTION_CUBE", int(kTexReflectionCube)},
+           {"UNIT_REFLECTION_SPHERE", int(kTexReflectionSphere)}}};
+}
+
+}  // namespace kaskad::render
