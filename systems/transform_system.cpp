@@ -112,7 +112,8 @@ TransformStats update_transforms(ecs::World& world, const AssetStore& assets) {
       [&](ecs::Entity e, MeshRenderer&, WorldTransform&) { drawn.push_back(e); });
   for (ecs::Entity e : drawn) {
     const MeshRenderer& mr = world.get<MeshRenderer>(e);
-    const Aabb local = mr.mesh < assets.meshes.size() ? assets.meshes[mr.mesh].bounds : Aabb{};
+    const Aabb local =
+        index(mr.mesh) < assets.meshes.size() ? assets.meshes[index(mr.mesh)].bounds : Aabb{};
     const TransformCache* tc = world.try_get<TransformCache>(e);
     const std::uint64_t world_version = tc && world.has<Transform>(e) ? tc->version : 0;
     if (!world.has<BoundsCache>(e)) world.emplace<BoundsCache>(e);

@@ -156,10 +156,10 @@ struct Renderer::Impl {
   }
 
   const GpuMesh& mesh(MeshId id, const AssetStore& assets) {
-    if (id >= meshes.size()) meshes.resize(std::size_t(id) + 1);
-    GpuMesh& m = meshes[id];
+    if (index(id) >= meshes.size()) meshes.resize(index(id) + 1);
+    GpuMesh& m = meshes[index(id)];
     if (m.vao) return m;
-    const MeshData& src = assets.meshes[id];
+    const MeshData& src = assets.meshes[index(id)];
     const std::size_t n = src.positions.size();
     // One buffer, three streams: positions | normals | uvs (uvs zero when the mesh has none).
     const std::size_t pos_bytes = n * sizeof(glm::vec3), uv_bytes = n * sizeof(glm::vec2);
@@ -192,11 +192,11 @@ struct Renderer::Impl {
   }
 
   GLuint texture(TextureId id, const AssetStore& assets, bool is_normal_map) {
-    if (id == kNoTexture || id >= assets.textures.size())
+    if (id == kNoTexture || index(id) >= assets.textures.size())
       return is_normal_map ? flat_normal.id() : white.id();
-    if (id >= textures.size()) textures.resize(std::size_t(id) + 1);
-    if (!textures[id]) {
-      const TextureData& src = assets.textures[id];
+    if (index(id) >= textures.size()) textures.resize(index(id) + 1);
+    if (!textures[index(id)]) {
+      const TextureData& src = assets.textures[index(id)];
       auto t = std::make_unique<GpuTexture>();
       t->texture = gpu::make_texture(GL_TEXTURE_2D);
       const GLuint tex = t->texture.id();
@@ -215,9 +215,9 @@ struct Renderer::Impl {
       glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
       glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_REPEAT);
       glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_REPEAT);
-      textures[id] = std::move(t);
+      textures[index(id)] = std::move(t);
     }
-    return textures[id]->texture.id();
+    return textures[index(id)]->texture.id();
   }
 
   void ensure_targets(int w, int h) {
@@ -621,8 +621,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     im.probes->retain(live);
   }
   for (const DrawItem& d : frame.draws)
-    if (d.mesh >= assets.meshes.size())
-      return Error{"", "draw list", "mesh id " + std::to_string(d.mesh) + " is out of range"};
+    if (index(d.mesh) >= assets.meshes.size())
+      return Error{"", "draw list", "mesh id " + std::to_string(index(d.mesh)) + " is out of range"};
 
   // Draw order: sorted by program (variant key), then by material, so program and material
   // state change as rarely as possible. Keys are computed once per draw.

@@ -193,7 +193,7 @@ TEST(TransformSystem, BoundsFollowMeshChangesAndRemovedOutputsComeBack) {
   AssetStore assets;
   const MeshId box = assets.add_mesh(make_primitive(PrimitiveShape::box, 8));
   const MeshId big = assets.add_mesh(make_primitive(PrimitiveShape::box, 8));
-  assets.meshes[big].bounds = Aabb::from_corners(glm::vec3(-3.0f), glm::vec3(3.0f));
+  assets.meshes[index(big)].bounds = Aabb::from_corners(glm::vec3(-3.0f), glm::vec3(3.0f));
   const ecs::Entity e = w.create();
   w.emplace<Transform>(e, Transform{{0, 5, 0}});
   w.emplace<MeshRenderer>(e, MeshRenderer{box});
@@ -203,7 +203,7 @@ TEST(TransformSystem, BoundsFollowMeshChangesAndRemovedOutputsComeBack) {
   EXPECT_EQ(s.transforms, 0u);
   EXPECT_EQ(s.bounds, 1u);
   EXPECT_NEAR(w.get<WorldBounds>(e).box.min.y, 2.0f, 1e-5f);
-  assets.meshes[big].bounds = Aabb::from_corners(glm::vec3(-1.0f), glm::vec3(1.0f));
+  assets.meshes[index(big)].bounds = Aabb::from_corners(glm::vec3(-1.0f), glm::vec3(1.0f));
   EXPECT_EQ(update_transforms(w, assets).bounds, 1u);
   EXPECT_NEAR(w.get<WorldBounds>(e).box.min.y, 4.0f, 1e-5f);
   w.get<MeshRenderer>(e).mesh = kNoMesh;
