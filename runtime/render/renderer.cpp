@@ -670,8 +670,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   auto use_program = [&](Pass pass, VariantKey key, GLuint& current) -> Status {
     auto prog = im.shaders->program(pass, key);
     if (!prog) return prog.error();
-    if (*prog != current) {
-      current = *prog;
+    if (prog->id() != current) {
+      current = prog->id();
       glUseProgram(current);
       ++stats_.program_switches;
       bound_material = nullptr;  // material uniforms are per program
@@ -893,8 +893,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     const ProbeJob& job = *it->second;
     const bool swapped_now = job.faces != 0 && job.target == job.visible;
     const int buffer = capture && swapped_now ? 1 - job.visible : job.visible;
-    glBindTextureUnit(kTexReflectionCube, im.probes->existing_cube(job.handle, buffer));
-    glBindTextureUnit(kTexReflectionSphere, im.probes->existing_sphere(job.handle));
+    glBindTextureUnit(kTexReflectionCube, im.probes->existing_cube(job.handle, buffer).id());
+    glBindTextureUnit(kTexReflectionSphere, im.probes->existing_sphere(job.handle).id());
     glProgramUniform4f(prog, kUniReflection, d.reflection_scale, 0.0f, 0.0f, 0.0f);
     if (key.has(VariantKey::kReflectionBox)) {
       glProgramUniform4f(prog, kUniReflectionBoxMin, job.box_min.x, job.box_min.y, job.box_min.z, 0);
@@ -1077,8 +1077,8 @@ Result<std::vector<glm::vec2>> Renderer::shadow_at_points(std::span<const glm::v
   auto program =
       im.shaders->program(Pass::shadow_points, im.frame_key->filtered_for(Pass::shadow_points));
   if (!program) return program.error();
-  glUseProgram(*program);
-  glProgramUniform2i(*program, kUniTargetSize, w, h);
+  glUseProgram(program->id());
+  glProgramUniform2i(program->id(), kUniTargetSize, w, h);
   // The frame block and shadow map are still those of the last render(); bind them again in
   // case other GL work ran in between.
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
