@@ -19,8 +19,8 @@ struct TransformCache {
   ecs::Entity parent = ecs::kNullEntity;   ///< the parent applied (null: root, also for a cycle
                                            ///< or a parent that is gone)
   std::uint64_t parent_version = 0;        ///< that parent's `version` when it was applied
-  /// Changes (to a process-wide unique value) whenever WorldTransform is recomputed; 0: never
-  /// computed, recompute.
+  /// The stamp of the update_transforms call that last recomputed WorldTransform (unique per
+  /// call in the process, so it changes whenever WorldTransform does); 0: never computed.
   std::uint64_t version = 0;
 };
 
