@@ -1,16 +1,26 @@
 // Draws one mesh of the scene's AssetStore with the entity's Material.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 namespace kaskad {
 
-/// Index into AssetStore::meshes; kNoMesh when unset.
-using MeshId = std::uint32_t;
+/// Index into AssetStore::meshes; kNoMesh when unset. Distinct types, so a TextureId passed where
+/// a MeshId belongs does not compile; `MeshId{3}` makes one, index() turns one back into an
+/// index. Enums: comparisons, std::hash and map keys come for free.
+enum class MeshId : std::uint32_t {};
 /// Index into AssetStore::textures; kNoTexture when unset.
-using TextureId = std::uint32_t;
-inline constexpr MeshId kNoMesh = 0xffffffffu;
-inline constexpr TextureId kNoTexture = 0xffffffffu;
+enum class TextureId : std::uint32_t {};
+inline constexpr MeshId kNoMesh{0xffffffffu};
+inline constexpr TextureId kNoTexture{0xffffffffu};
+
+/// The position of the entry an id names (kNo*: 0xffffffff, beyond every store).
+constexpr std::size_t index(MeshId id) { return static_cast<std::size_t>(id); }
+constexpr std::size_t index(TextureId id) { return static_cast<std::size_t>(id); }
+static_assert(!std::is_convertible_v<MeshId, TextureId> && !std::is_convertible_v<TextureId, MeshId>);
+static_assert(!std::is_convertible_v<std::uint32_t, MeshId> && !std::is_convertible_v<MeshId, std::size_t>);
 
 struct MeshRenderer {
   MeshId mesh = kNoMesh;

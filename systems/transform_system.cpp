@@ -1,11 +1,14 @@
 #include "systems/transform_system.h"
 
+#include <atomic>
+#include <cstring>
 #include <glm/gtc/matrix_transform.hpp>
 #include <vector>
 
 #include "components/mesh_renderer.h"
 #include "components/name.h"
 #include "components/transform.h"
+#include "components/transform_cache.h"
 #include "runtime/core/log.h"
 
 namespace kaskad {
@@ -18,13 +21,38 @@ std::string entity_label(const ecs::World& world, ecs::Entity e) {
   return "entity " + std::to_string(e.index);
 }
 
-// Resolves one entity's world matrix, walking up the parent chain; `state` marks entities as
-// 0 = unvisited, 1 = on the current chain (cycle detection), 2 = done.
-glm::mat4 resolve(ecs::World& world, ecs::Entity e, std::vector<std::uint8_t>& state) {
-  if (e.index >= state.size()) state.resize(e.index + 1, 0);
-  if (state[e.index] == 2) return world.get<WorldTransform>(e).matrix;
-  const Transform& t = world.get<Transform>(e);
-  glm::mat4 parent_matrix(1.0f);
+// A stamp unique in the process (like CommandBuffer's serials), taken once per update_transforms
+// call: every WorldTransform recomputed in that call gets it as its TransformCache::version. A
+// child compares its parent's handle and version, so a parent recomputed in a later call always
+// shows a version the child has not recorded. Starts at 1: 0 means "never computed". (One atomic
+// per call, not per entity: an atomic add per recompute cost ~15% when everything moves.)
+std::uint64_t next_stamp() {
+  static std::atomic<std::uint64_t> counter{1};
+  return counter.fetch_add(1, std::memory_order_relaxed);
+}
+
+// Bitwise equality: the same bits in give the same matrix out (NaN included), and -0 vs +0 counts
+// as a change, so a skipped entity keeps exactly what a recompute would have written.
+template <class T>
+bool same_bits(const T& a, const T& b) {
+  return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+static_assert(sizeof(Transform) == 3 * sizeof(glm::vec3) + sizeof(float) + sizeof(ecs::Entity),
+              "Transform has padding: same_bits would compare indeterminate bytes");
+static_assert(sizeof(Aabb) == 2 * sizeof(glm::vec3), "Aabb has padding");
+
+// Brings one entity's WorldTransform up to date, parent chain first, and returns its version;
+// `state` marks entities as 0 = unvisited, 1 = on the current chain (cycle detection), 2 = done.
+// The parent applied is decided exactly as when everything was recomputed each call (same order,
+// same cycle breaking); the matrix is recomputed only when that parent, its version or this
+// entity's Transform bits differ from the TransformCache. `t`, `cache` and `out` are e's.
+std::uint64_t resolve(ecs::World& world, ecs::Entity e, const Transform& t, TransformCache& cache,
+                      WorldTransform& out, std::uint64_t stamp, std::vector<std::uint8_t>& state,
+                      TransformStats& stats) {
+  if (e.index >= state.size()) state.resize(std::size_t{e.index} + 1, 0);
+  if (state[e.index] == 2) return cache.version;
+  ecs::Entity parent = ecs::kNullEntity;
+  std::uint64_t parent_version = 0;
   if (t.parent.valid()) {
     if (!world.alive(t.parent) || !world.has<Transform>(t.parent)) {
       log::warn_once("%s: parent (entity %u) is gone; treating it as a root",
@@ -34,13 +62,37 @@ glm::mat4 resolve(ecs::World& world, ecs::Entity e, std::vector<std::uint8_t>& s
                      entity_label(world, e).c_str(), entity_label(world, t.parent).c_str());
     } else {
       state[e.index] = 1;
-      parent_matrix = resolve(world, t.parent, state);
+      parent = t.parent;
+      parent_version = resolve(world, parent, world.get<Transform>(parent),
+                               world.get<TransformCache>(parent),
+                               world.get<WorldTransform>(parent), stamp, state, stats);
     }
   }
   state[e.index] = 2;
-  auto& out = world.get<WorldTransform>(e);
+  if (cache.version != 0 && cache.parent == parent && cache.parent_version == parent_version &&
+      same_bits(cache.local, t))
+    return cache.version;
+  const glm::mat4 parent_matrix =
+      parent.valid() ? world.get<WorldTransform>(parent).matrix : glm::mat4(1.0f);
   out.matrix = parent_matrix * local_matrix(t);
-  return out.matrix;
+  cache = TransformCache{t, parent, parent_version, stamp};
+  ++stats.transforms;
+  return cache.version;
+}
+
+// Recomputes e's WorldBounds when its inputs differ from the BoundsCache; world_version 0: no
+// version to compare (a WorldTransform without a Transform), always.
+void update_bounds(const AssetStore& assets, const MeshRenderer& mr, const WorldTransform& wt,
+                   std::uint64_t world_version, BoundsCache& cache, WorldBounds& out,
+                   TransformStats& stats) {
+  const Aabb local =
+      index(mr.mesh) < assets.meshes.size() ? assets.meshes[index(mr.mesh)].bounds : Aabb{};
+  if (world_version != 0 && cache.world_version == world_version && cache.mesh == mr.mesh &&
+      same_bits(cache.local, local))
+    return;
+  cache = BoundsCache{mr.mesh, local, world_version};
+  out.box = local.transformed(wt.matrix);
+  ++stats.bounds;
 }
 
 }  // namespace
@@ -50,26 +102,72 @@ glm::mat4 local_matrix(const Transform& t) {
          glm::scale(glm::mat4(1.0f), t.scale);
 }
 
-void update_transforms(ecs::World& world, const AssetStore& assets) {
-  // Structural step first (adding WorldTransform where missing), then values: the view over
-  // Transform is not iterated while WorldTransform components are being added.
-  std::vector<ecs::Entity> entities;
-  world.view<Transform>().each([&](ecs::Entity e, Transform&) { entities.push_back(e); });
-  for (ecs::Entity e : entities)
-    if (!world.has<WorldTransform>(e)) world.emplace<WorldTransform>(e);
-  std::vector<std::uint8_t> state;
-  for (ecs::Entity e : entities) resolve(world, e, state);
-
-  std::vector<ecs::Entity> drawn;
-  world.view<MeshRenderer, WorldTransform>().each(
-      [&](ecs::Entity e, MeshRenderer&, WorldTransform&) { drawn.push_back(e); });
-  for (ecs::Entity e : drawn) {
-    const MeshRenderer& mr = world.get<MeshRenderer>(e);
-    Aabb box;
-    if (mr.mesh < assets.meshes.size())
-      box = assets.meshes[mr.mesh].bounds.transformed(world.get<WorldTransform>(e).matrix);
-    world.emplace<WorldBounds>(e, WorldBounds{box});
+TransformStats update_transforms(ecs::World& world, const AssetStore& assets) {
+  TransformStats stats;
+  // 1. Structural step (adding TransformCache and WorldTransform where missing) before values:
+  //    pools are not changed while views over them run. A new WorldTransform (first call, or one
+  //    someone removed) means version 0: recompute. Skipped when every Transform already has
+  //    both: counting the full view is a plain walk while the pools stay aligned.
+  std::size_t complete = 0;
+  world.view<Transform, TransformCache, WorldTransform>().each(
+      [&](ecs::Entity, Transform&, TransformCache&, WorldTransform&) { ++complete; });
+  if (complete != world.count<Transform>()) {
+    std::vector<ecs::Entity> entities;
+    world.view<Transform>().each([&](ecs::Entity e, Transform&) { entities.push_back(e); });
+    for (ecs::Entity e : entities) {
+      if (!world.has<TransformCache>(e)) world.emplace<TransformCache>(e);
+      if (!world.has<WorldTransform>(e)) {
+        world.emplace<WorldTransform>(e);
+        world.get<TransformCache>(e).version = 0;
+      }
+    }
   }
+
+  // 2. World matrices, in Transform storage order (the Transform pool drives the view: it is
+  //    never larger than the other two now, and ties go to the first type), so parent cycles
+  //    break where they always did.
+  std::vector<std::uint8_t> state;
+  const std::uint64_t stamp = next_stamp();
+  world.view<Transform, TransformCache, WorldTransform>().each(
+      [&](ecs::Entity e, Transform& t, TransformCache& cache, WorldTransform& out) {
+        resolve(world, e, t, cache, out, stamp, state, stats);
+      });
+
+  // 3. Bounds, for every MeshRenderer with a WorldTransform: structural step as in 1, then values.
+  //    Entities with a Transform compare its TransformCache version; the rest (a WorldTransform
+  //    written by someone else: no version) are recomputed every call.
+  std::size_t drawn = 0, drawn_complete = 0;
+  world.view<MeshRenderer, WorldTransform>().each(
+      [&](ecs::Entity, MeshRenderer&, WorldTransform&) { ++drawn; });
+  world.view<MeshRenderer, WorldTransform, BoundsCache, WorldBounds>().each(
+      [&](ecs::Entity, MeshRenderer&, WorldTransform&, BoundsCache&, WorldBounds&) {
+        ++drawn_complete;
+      });
+  if (drawn_complete != drawn) {
+    std::vector<ecs::Entity> entities;
+    world.view<MeshRenderer, WorldTransform>().each(
+        [&](ecs::Entity e, MeshRenderer&, WorldTransform&) { entities.push_back(e); });
+    for (ecs::Entity e : entities) {
+      if (!world.has<BoundsCache>(e)) world.emplace<BoundsCache>(e);
+      if (!world.has<WorldBounds>(e)) {
+        world.emplace<WorldBounds>(e);
+        world.get<BoundsCache>(e).world_version = 0;
+      }
+    }
+  }
+  std::size_t versioned = 0;
+  world.view<MeshRenderer, WorldTransform, BoundsCache, WorldBounds, Transform, TransformCache>()
+      .each([&](ecs::Entity, MeshRenderer& mr, WorldTransform& wt, BoundsCache& cache,
+                WorldBounds& out, Transform&, TransformCache& tc) {
+        update_bounds(assets, mr, wt, tc.version, cache, out, stats);
+        ++versioned;
+      });
+  if (versioned != drawn) {
+    world.view<MeshRenderer, WorldTransform, BoundsCache, WorldBounds>(ecs::exclude<Transform>)
+        .each([&](ecs::Entity, MeshRenderer& mr, WorldTransform& wt, BoundsCache& cache,
+                  WorldBounds& out) { update_bounds(assets, mr, wt, 0, cache, out, stats); });
+  }
+  return stats;
 }
 
 Aabb scene_bounds(const ecs::World& world) {

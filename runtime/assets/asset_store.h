@@ -54,11 +54,11 @@ struct AssetStore {
 
   MeshId add_mesh(MeshData mesh) {
     meshes.push_back(std::move(mesh));
-    return MeshId(meshes.size() - 1);
+    return MeshId(static_cast<std::uint32_t>(meshes.size() - 1));
   }
   TextureId add_texture(TextureData texture) {
     textures.push_back(std::move(texture));
-    return TextureId(textures.size() - 1);
+    return TextureId(static_cast<std::uint32_t>(textures.size() - 1));
   }
 
  private:

@@ -59,6 +59,24 @@ struct QueryDeleter { static void destroy(GLuint id) { glDeleteQueries(1, &id); 
 struct SamplerDeleter { static void destroy(GLuint id) { glDeleteSamplers(1, &id); } };
 }  // namespace detail
 
+/// A typed, non-owning name of a GL object that a GlObject of the same kind owns elsewhere: what
+/// public APIs hand out when they keep ownership (a program from the shader library, a probe's
+/// map). Valid while that owner lives and is not reset or replaced; default: none (GL name 0).
+template <class Deleter>
+class GlRef {
+ public:
+  GlRef() = default;
+  /// Refers to what `owner` holds now (none when it holds nothing).
+  GlRef(const GlObject<Deleter>& owner) : id_(owner.id()) {}  // NOLINT: implicit on purpose
+  /// The GL name, for GL calls inside the gpu/render modules only.
+  GLuint id() const { return id_; }
+  explicit operator bool() const { return id_ != 0; }
+  bool operator==(const GlRef&) const = default;
+
+ private:
+  GLuint id_ = 0;
+};
+
 using Buffer = GlObject<detail::BufferDeleter>;
 using Texture = GlObject<detail::TextureDeleter>;
 using Framebuffer = GlObject<detail::FramebufferDeleter>;
@@ -68,6 +86,9 @@ using Program = GlObject<detail::ProgramDeleter>;
 using Shader = GlObject<detail::ShaderDeleter>;
 using Query = GlObject<detail::QueryDeleter>;
 using Sampler = GlObject<detail::SamplerDeleter>;
+using TextureRef = GlRef<detail::TextureDeleter>;
+using ProgramRef = GlRef<detail::ProgramDeleter>;
+using FramebufferRef = GlRef<detail::FramebufferDeleter>;
 
 /// GL objects alive through these owners, all kinds together.
 inline long live_gl_objects() {

@@ -396,12 +396,12 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
   std::vector<std::uint32_t> kept_triangle;  // mesh triangle of each kept triangle
   for (const Item& item : items) {
     const std::string where = "entity " + std::to_string(item.entity.index);
-    if (item.renderer.mesh >= assets.meshes.size()) {
+    if (index(item.renderer.mesh) >= assets.meshes.size()) {
       return Error{"", where,
-                   "MeshRenderer names mesh " + std::to_string(item.renderer.mesh) +
+                   "MeshRenderer names mesh " + std::to_string(index(item.renderer.mesh)) +
                        " but the asset store has " + std::to_string(assets.meshes.size())};
     }
-    const MeshData& mesh = assets.meshes[item.renderer.mesh];
+    const MeshData& mesh = assets.meshes[index(item.renderer.mesh)];
     world_positions.resize(mesh.positions.size());
     for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
       const glm::vec3 p = glm::vec3(item.matrix * glm::vec4(mesh.positions[i], 1.0f));
@@ -459,8 +459,8 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
       cutout->factor = item.material->base_color.a;
       cutout->cutoff = item.material->alpha_cutoff;
       const TextureId tex = item.material->base_color_texture;
-      if (tex != kNoTexture && tex < assets.textures.size()) {
-        const TextureData& t = assets.textures[tex];
+      if (tex != kNoTexture && index(tex) < assets.textures.size()) {
+        const TextureData& t = assets.textures[index(tex)];
         if (t.width > 0 && t.height > 0 &&
             t.rgba8.size() == std::size_t(t.width) * std::size_t(t.height) * 4) {
           cutout->width = t.width;

@@ -89,12 +89,12 @@ glm::vec4 sample_texture(const TextureData& texture, const glm::vec2& uv) {
 glm::vec4 hit_base_color(const ReflectionScene& scene, const Material& material,
                          const SurfaceHit& hit) {
   if (material.base_color_texture == kNoTexture || !scene.assets || !scene.world ||
-      material.base_color_texture >= scene.assets->textures.size())
+      index(material.base_color_texture) >= scene.assets->textures.size())
     return material.base_color;
   const auto* mr =
       scene.world->alive(hit.entity) ? scene.world->try_get<MeshRenderer>(hit.entity) : nullptr;
-  if (!mr || mr->mesh >= scene.assets->meshes.size()) return material.base_color;
-  const MeshData& mesh = scene.assets->meshes[mr->mesh];
+  if (!mr || index(mr->mesh) >= scene.assets->meshes.size()) return material.base_color;
+  const MeshData& mesh = scene.assets->meshes[index(mr->mesh)];
   const std::size_t first = 3 * std::size_t(hit.triangle);
   if (mesh.uvs.size() != mesh.positions.size() || first + 2 >= mesh.indices.size())
     return material.base_color;
@@ -107,7 +107,7 @@ glm::vec4 hit_base_color(const ReflectionScene& scene, const Material& material,
   const glm::vec2 b = hit.barycentric;
   const glm::vec2 at = (1.0f - b.x - b.y) * uv[0] + b.x * uv[1] + b.y * uv[2];
   return material.base_color *
-         sample_texture(scene.assets->textures[material.base_color_texture], at);
+         sample_texture(scene.assets->textures[index(material.base_color_texture)], at);
 }
 
 ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment) {

@@ -71,11 +71,12 @@ void GpuCache::use(const AssetStore& assets) {
 }
 
 const GpuMesh& GpuCache::mesh(MeshId id) {
-  KASKAD_CHECK(assets_ && id < assets_->meshes.size(), "mesh id out of range");
-  if (id >= meshes_.size()) meshes_.resize(std::size_t(id) + 1);
-  GpuMesh& m = meshes_[id];
+  const std::size_t at = index(id);
+  KASKAD_CHECK(assets_ && at < assets_->meshes.size(), "mesh id out of range");
+  if (at >= meshes_.size()) meshes_.resize(at + 1);
+  GpuMesh& m = meshes_[at];
   if (m.vao) return m;
-  const MeshData& src = assets_->meshes[id];
+  const MeshData& src = assets_->meshes[at];
   const std::size_t n = src.positions.size();
   // One buffer, three streams: positions | normals | uvs (uvs zero when the mesh has none).
   const std::size_t pos_bytes = n * sizeof(glm::vec3), uv_bytes = n * sizeof(glm::vec2);
@@ -128,12 +129,13 @@ std::uint32_t GpuCache::upload(std::span<const InstanceRecord> records) {
   return std::uint32_t(first);
 }
 
-GLuint GpuCache::texture(TextureId id, bool is_normal_map) {
-  if (!assets_ || id == kNoTexture || id >= assets_->textures.size())
-    return is_normal_map ? flat_normal_.id() : white_.id();
-  if (id >= textures_.size()) textures_.resize(std::size_t(id) + 1);
-  if (!textures_[id]) {
-    const TextureData& src = assets_->textures[id];
+gpu::TextureRef GpuCache::texture(TextureId id, bool is_normal_map) {
+  const std::size_t at = index(id);
+  if (!assets_ || id == kNoTexture || at >= assets_->textures.size())
+    return is_normal_map ? flat_normal_ : white_;
+  if (at >= textures_.size()) textures_.resize(at + 1);
+  if (!textures_[at]) {
+    const TextureData& src = assets_->textures[at];
     auto t = std::make_unique<gpu::Texture>(gpu::make_texture(GL_TEXTURE_2D));
     const GLuint tex = t->id();
     const int levels = 1 + int(std::floor(std::log2(std::max(1, std::max(src.width, src.height)))));
@@ -151,9 +153,9 @@ GLuint GpuCache::texture(TextureId id, bool is_normal_map) {
     glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_REPEAT);
     glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_REPEAT);
-    textures_[id] = std::move(t);
+    textures_[at] = std::move(t);
   }
-  return textures_[id]->id();
+  return *textures_[at];
 }
 
 }  // namespace kaskad::render

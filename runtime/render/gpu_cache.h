@@ -39,7 +39,7 @@ class GpuCache {
   const GpuMesh& mesh(MeshId id);
   /// Material texture `id` (sRGB colour, or linear for a normal map), uploaded with mips on
   /// first use; a 1x1 white (or flat normal) texture for kNoTexture or an unknown id.
-  GLuint texture(TextureId id, bool is_normal_map);
+  gpu::TextureRef texture(TextureId id, bool is_normal_map);
   ProbeMaps& probes() { return *probes_; }
 
   /// Instance records for this frame's draws: begin_frame() starts the frame; upload() stores

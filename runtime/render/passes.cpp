@@ -76,7 +76,7 @@ std::uint32_t caster_mask(const ShadowView& v, const DrawItem& d) {
 
 // Triangles of a mesh as the passes draw it.
 std::size_t triangles(const AssetStore& assets, MeshId id) {
-  return assets.meshes[id].indices.size() / 3;
+  return assets.meshes[index(id)].indices.size() / 3;
 }
 
 }  // namespace
@@ -94,7 +94,7 @@ Status DrawState::use_program(Pass pass, VariantKey key) {
   if (!prog) return prog.error();
   if (*prog != program_) {
     program_ = *prog;
-    glUseProgram(program_);
+    glUseProgram(program_.id());
     ++stats_.program_switches;
     material_ = nullptr;  // material uniforms are per program
   }
@@ -110,12 +110,12 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
   material_key_ = key.material();
   ++stats_.material_switches;
   const glm::vec4 params(m.metallic, m.roughness, m.normal_scale, m.alpha_cutoff);
-  glProgramUniform4fv(program_, kLocBaseColor, 1, &m.base_color[0]);
-  glProgramUniform4fv(program_, kLocMaterial, 1, &params[0]);
-  glProgramUniform3fv(program_, kLocEmissive, 1, &m.emissive[0]);
-  if (features_by_uniform_) glProgramUniform1ui(program_, kLocFeatureBits, key.material().bits());
-  glBindTextureUnit(kTexBaseColor, cache_.texture(m.base_color_texture, false));
-  glBindTextureUnit(kTexNormal, cache_.texture(m.normal_texture, true));
+  glProgramUniform4fv(program_.id(), kLocBaseColor, 1, &m.base_color[0]);
+  glProgramUniform4fv(program_.id(), kLocMaterial, 1, &params[0]);
+  glProgramUniform3fv(program_.id(), kLocEmissive, 1, &m.emissive[0]);
+  if (features_by_uniform_) glProgramUniform1ui(program_.id(), kLocFeatureBits, key.material().bits());
+  glBindTextureUnit(kTexBaseColor, cache_.texture(m.base_color_texture, false).id());
+  glBindTextureUnit(kTexNormal, cache_.texture(m.normal_texture, true).id());
 }
 
 bool DrawState::depth_reads_material(VariantKey key) const {
@@ -151,9 +151,9 @@ void ShadowMapPass::ensure_storage(int size, int layers, DepthFormat format, Sha
   glTextureParameteri(map_.id(), GL_TEXTURE_MAG_FILTER, f);
 }
 
-GLuint ShadowMapPass::texture() {
+gpu::TextureRef ShadowMapPass::texture() {
   if (!fbo_) ensure_storage(64, 1, DepthFormat::d24, ShadowFilter::none);
-  return map_.id();
+  return map_;
 }
 
 Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
@@ -285,7 +285,7 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
         status = st;
         return;
       }
-      const GLuint prog = state.program();
+      const GLuint prog = state.program().id();
       if (state.depth_reads_material(list.keys[run.draw])) state.bind_material(d, list.keys[run.draw]);
       if (light_vp) {
         glProgramUniformMatrix4fv(prog, kLocLightViewProj, 1, GL_FALSE, &(*light_vp)[0][0]);
@@ -409,7 +409,7 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
         ++end;
     const GpuMesh& m = cache.mesh(d.mesh);
     KASKAD_TRY(state.use_program(Pass::forward, keys[i]));
-    const GLuint prog = state.program();
+    const GLuint prog = state.program().id();
     if (d.material.double_sided) {
       glDisable(GL_CULL_FACE);
     } else {
@@ -425,8 +425,8 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
         if (job.handle != d.probe) continue;
         const bool swapped_now = job.faces != 0 && job.target == job.visible;
         const int buffer = capture && swapped_now ? 1 - job.visible : job.visible;
-        glBindTextureUnit(kTexReflectionCube, cache.probes().existing_cube(job.handle, buffer));
-        glBindTextureUnit(kTexReflectionSphere, cache.probes().existing_sphere(job.handle));
+        glBindTextureUnit(kTexReflectionCube, cache.probes().existing_cube(job.handle, buffer).id());
+        glBindTextureUnit(kTexReflectionSphere, cache.probes().existing_sphere(job.handle).id());
         glProgramUniform4f(prog, kLocReflection, d.reflection_scale, 0.0f, 0.0f, 0.0f);
         if (key.has(VariantKey::kReflectionBox)) {
           glProgramUniform4f(prog, kLocReflectionBoxMin, job.box_min.x, job.box_min.y, job.box_min.z, 0);
@@ -460,7 +460,7 @@ void ProbeCapturePass::prepare(const FrameInput& frame, const AssetStore& assets
 }
 
 Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
-                                const FrameBlock& main, GLuint ubo, GpuCache& cache,
+                                const FrameBlock& main, const gpu::Buffer& ubo, GpuCache& cache,
                                 DrawState& state, FrameStats& stats) {
   if (frame.probes.empty()) return {};
   glDisable(GL_FRAMEBUFFER_SRGB);
@@ -474,7 +474,7 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
     for (int f = 0; f < 6 && status; ++f) {
       if (!(job.faces & (1u << f))) continue;
       const FrameBlock face = probe_face_block(main, job, f);
-      glNamedBufferSubData(ubo, 0, sizeof face, &face);
+      glNamedBufferSubData(ubo.id(), 0, sizeof face, &face);
       cache.probes().begin_face(job.handle, job.target, f, frame.clear_color);
       const int before = stats.draw_calls, instances_before = stats.instances;
       const std::size_t triangles_before = stats.triangles;
@@ -492,7 +492,7 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
     // Complete (the target is now the visible buffer): rebuild its mip chain.
     if (job.target == job.visible) cache.probes().finish_cube(job.handle, job.target);
   }
-  glNamedBufferSubData(ubo, 0, sizeof main, &main);  // the main view's block again
+  glNamedBufferSubData(ubo.id(), 0, sizeof main, &main);  // the main view's block again
   if (!status) return status;
   for (const ProbeJob& job : frame.probes)
     if (job.sphere && cache.probes().existing_cube(job.handle, job.visible))

@@ -35,7 +35,8 @@ class DrawState {
   DrawState(ShaderLibrary& shaders, GpuCache& cache, FrameStats& stats);
   /// Uses the program of (pass, key); errors are shader build failures.
   Status use_program(Pass pass, VariantKey key);
-  GLuint program() const { return program_; }
+  /// The program in use.
+  gpu::ProgramRef program() const { return program_; }
   /// The material of draw `d` (drawn with `key`) on the current program.
   void bind_material(const DrawItem& d, VariantKey key);
   /// Whether a draw with `key` reads its material in the depth pass: alpha-masked draws do, and
@@ -50,7 +51,7 @@ class DrawState {
   GpuCache& cache_;
   FrameStats& stats_;
   bool features_by_uniform_;
-  GLuint program_ = 0;
+  gpu::ProgramRef program_;
   const Material* material_ = nullptr;  // bound on program_, with material_key_
   VariantKey material_key_;
 };
@@ -70,7 +71,7 @@ class ShadowMapPass {
 
   /// The depth texture array (a 64^2 single layer before the first shadowed frame, so the
   /// sampler is always complete).
-  GLuint texture();
+  gpu::TextureRef texture();
   /// Depth of every layer, stacked top to bottom (layer 0 first), rows top to bottom.
   Image read() const;
 
@@ -98,7 +99,7 @@ class ProbeCapturePass {
   /// `main`, the main view's block, before and after. After it: every probe's visible buffer
   /// is the map draws shade with this frame.
   Status record(const FrameInput& frame, const DrawList& list, const FrameBlock& main,
-                GLuint ubo, GpuCache& cache, DrawState& state, FrameStats& stats);
+                const gpu::Buffer& ubo, GpuCache& cache, DrawState& state, FrameStats& stats);
 };
 
 class ForwardPass {
@@ -122,9 +123,9 @@ class ForwardPass {
   int width() const { return width_; }
   int height() const { return height_; }
   bool aovs_written() const { return aovs_written_; }
-  GLuint framebuffer() const { return fbo_.id(); }
+  gpu::FramebufferRef framebuffer() const { return fbo_; }
   /// Attachment i of targets().
-  GLuint texture(int i) const { return textures_[std::size_t(i)].id(); }
+  gpu::TextureRef texture(int i) const { return textures_[std::size_t(i)]; }
 
  private:
   int width_ = 0, height_ = 0;

@@ -44,7 +44,7 @@ Result<std::unique_ptr<ProbeMaps>> ProbeMaps::create(const std::filesystem::path
   return m;
 }
 
-GLuint ProbeMaps::cube(ProbeHandle handle, int buffer, int resolution) {
+gpu::TextureRef ProbeMaps::cube(ProbeHandle handle, int buffer, int resolution) {
   Probe& p = probes_[handle];
   if (p.resolution != resolution || !p.cubes[0]) {
     p.resolution = resolution;
@@ -52,12 +52,12 @@ GLuint ProbeMaps::cube(ProbeHandle handle, int buffer, int resolution) {
     p.cubes[1] = make_cube(resolution);
     p.sphere = gpu::Texture();
   }
-  return p.cubes[buffer & 1].id();
+  return p.cubes[buffer & 1];
 }
 
-GLuint ProbeMaps::existing_cube(ProbeHandle handle, int buffer) const {
+gpu::TextureRef ProbeMaps::existing_cube(ProbeHandle handle, int buffer) const {
   auto it = probes_.find(handle);
-  return it == probes_.end() ? 0 : it->second.cubes[buffer & 1].id();
+  return it == probes_.end() ? gpu::TextureRef() : gpu::TextureRef(it->second.cubes[buffer & 1]);
 }
 
 void ProbeMaps::begin_face(ProbeHandle handle, int buffer, int face, const glm::vec3& clear) {
@@ -93,14 +93,15 @@ void ProbeMaps::finish_cube(ProbeHandle handle, int buffer) {
 }
 
 void ProbeMaps::upload(ProbeHandle handle, int buffer, const CubeMap& cube_map) {
-  const GLuint tex = cube(handle, buffer, cube_map.size);
+  const GLuint tex = cube(handle, buffer, cube_map.size).id();
   for (int f = 0; f < 6; ++f)
     glTextureSubImage3D(tex, 0, 0, 0, f, cube_map.size, cube_map.size, 1, GL_RGBA, GL_FLOAT,
                         cube_map.faces[std::size_t(f)].data());
   glGenerateTextureMipmap(tex);
 }
 
-GLuint ProbeMaps::update_sphere(ProbeHandle handle, int buffer, const glm::mat3& view_rotation) {
+gpu::TextureRef ProbeMaps::update_sphere(ProbeHandle handle, int buffer,
+                                         const glm::mat3& view_rotation) {
   Probe& p = probes_.at(handle);
   if (!p.sphere) {
     p.sphere = gpu::make_texture(GL_TEXTURE_2D);
@@ -124,12 +125,12 @@ GLuint ProbeMaps::update_sphere(ProbeHandle handle, int buffer, const glm::mat3&
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glBindVertexArray(0);
   glEnable(GL_DEPTH_TEST);
-  return p.sphere.id();
+  return p.sphere;
 }
 
-GLuint ProbeMaps::existing_sphere(ProbeHandle handle) const {
+gpu::TextureRef ProbeMaps::existing_sphere(ProbeHandle handle) const {
   auto it = probes_.find(handle);
-  return it == probes_.end() ? 0 : it->second.sphere.id();
+  return it == probes_.end() ? gpu::TextureRef() : gpu::TextureRef(it->second.sphere);
 }
 
 CubeMap ProbeMaps::read_cube(ProbeHandle handle, int buffer) const {

@@ -26,11 +26,12 @@ class ProbeMaps {
   /// Builds the sphere-map program from `shader_dir`. Needs a current GL 4.5 context.
   static Result<std::unique_ptr<ProbeMaps>> create(const std::filesystem::path& shader_dir);
 
-  /// The GL name of cube buffer `buffer` (0 or 1) of probe `handle`, created (black) on first
-  /// use and recreated when `resolution` changes (both buffers: a resize drops the old maps).
-  GLuint cube(ProbeHandle handle, int buffer, int resolution);
-  /// The cube buffer if it exists, else 0 (for lookups: a probe that was never made has none).
-  GLuint existing_cube(ProbeHandle handle, int buffer) const;
+  /// Cube buffer `buffer` (0 or 1) of probe `handle`, created (black) on first use and recreated
+  /// when `resolution` changes (both buffers: a resize drops the old maps). References from this
+  /// class stay valid until that probe's maps are recreated, retained away or cleared.
+  gpu::TextureRef cube(ProbeHandle handle, int buffer, int resolution);
+  /// The cube buffer if it exists, else none (for lookups: a probe never made has none).
+  gpu::TextureRef existing_cube(ProbeHandle handle, int buffer) const;
 
   /// Binds face `face` (GL order) of the cube as the colour target of the capture framebuffer,
   /// with a depth buffer of the cube's size, sets the viewport and clears to `clear` (linear).
@@ -42,8 +43,9 @@ class ProbeMaps {
 
   /// Renders probe `handle`'s sphere map from cube `buffer` for a camera with world -> view
   /// rotation `view_rotation` (S3 eq. (2) in that view space); returns the 2D texture.
-  GLuint update_sphere(ProbeHandle handle, int buffer, const glm::mat3& view_rotation);
-  GLuint existing_sphere(ProbeHandle handle) const;
+  gpu::TextureRef update_sphere(ProbeHandle handle, int buffer, const glm::mat3& view_rotation);
+  /// The sphere map if one was rendered, else none.
+  gpu::TextureRef existing_sphere(ProbeHandle handle) const;
 
   /// Read-back (tests, debug dumps): a cube buffer as a CubeMap (level 0), the sphere map with
   /// row 0 at the top (SphereMap's convention). Empty when the probe has no such map.

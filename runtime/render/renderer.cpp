@@ -163,8 +163,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   if (std::string bad = shadow_views_error(frame); !bad.empty())
     return Error{"", "frame input", bad};
   for (const DrawItem& d : frame.draws)
-    if (d.mesh >= assets.meshes.size())
-      return Error{"", "draw list", "mesh id " + std::to_string(d.mesh) + " is out of range"};
+    if (index(d.mesh) >= assets.meshes.size())
+      return Error{"", "draw list", "mesh id " + std::to_string(index(d.mesh)) + " is out of range"};
   if (int(frame.lights.size()) > kMaxLights)
     log::warn_once("%zu lights; only the first %d are shaded", frame.lights.size(), kMaxLights);
   read_timers();
@@ -194,13 +194,13 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   Status st = im.shadow.record(frame, list, *im.cache, state, stats_);
   glEndQuery(GL_TIME_ELAPSED);
   KASKAD_TRY(st);
-  glBindTextureUnit(kTexShadow, im.shadow.texture());
+  glBindTextureUnit(kTexShadow, im.shadow.texture().id());
 
   // 2. Probe captures. After it: every probe's visible cube (and sphere map) is the one the
   //    frame's reflections read.
   im.probe_capture.prepare(frame, assets, *im.cache);
   glBeginQuery(GL_TIME_ELAPSED, im.timers[2].id());
-  st = im.probe_capture.record(frame, list, block, im.frame_ubo.id(), *im.cache, state, stats_);
+  st = im.probe_capture.record(frame, list, block, im.frame_ubo, *im.cache, state, stats_);
   glEndQuery(GL_TIME_ELAPSED);
   KASKAD_TRY(st);
 
@@ -273,12 +273,12 @@ Result<std::vector<glm::vec2>> Renderer::shadow_at_points(std::span<const glm::v
   auto program =
       im.shaders->program(Pass::shadow_points, im.frame_key->filtered_for(Pass::shadow_points));
   if (!program) return program.error();
-  glUseProgram(*program);
-  glProgramUniform2i(*program, kLocTargetSize, w, h);
+  glUseProgram(program->id());
+  glProgramUniform2i(program->id(), kLocTargetSize, w, h);
   // The frame block and shadow map are still those of the last render(); bind them again in
   // case other GL work ran in between.
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
-  glBindTextureUnit(kTexShadow, im.shadow.texture());
+  glBindTextureUnit(kTexShadow, im.shadow.texture().id());
   glBindFramebuffer(GL_FRAMEBUFFER, im.points_fbo.id());
   glViewport(0, 0, w, h);
   glDisable(GL_DEPTH_TEST);
@@ -333,7 +333,7 @@ Image Renderer::read_color() const {
   // only for non-sRGB formats, so read bytes instead.
   std::vector<std::uint8_t> bytes(std::size_t(img.width) * img.height * 4);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(fw.texture(0), 0, GL_RGBA, GL_UNSIGNED_BYTE, GLsizei(bytes.size()),
+  glGetTextureImage(fw.texture(0).id(), 0, GL_RGBA, GL_UNSIGNED_BYTE, GLsizei(bytes.size()),
                     bytes.data());
   img.pixels.resize(bytes.size());
   const std::size_t row = std::size_t(img.width) * 4;
@@ -347,10 +347,10 @@ Image Renderer::read_aovs() const {
   const ForwardPass& fw = impl_->forward;
   KASKAD_CHECK(fw.aovs_written(), "the last frame was rendered without write_aovs");
   const int w = fw.width(), h = fw.height();
-  const auto pos = read_texture(fw.texture(1), w, h, GL_RGBA, 4);
-  const auto nrm = read_texture(fw.texture(2), w, h, GL_RGBA, 4);
-  const auto vis = read_texture(fw.texture(3), w, h, GL_RG, 2);
-  const auto refl = read_texture(fw.texture(4), w, h, GL_RGBA, 4);
+  const auto pos = read_texture(fw.texture(1).id(), w, h, GL_RGBA, 4);
+  const auto nrm = read_texture(fw.texture(2).id(), w, h, GL_RGBA, 4);
+  const auto vis = read_texture(fw.texture(3).id(), w, h, GL_RG, 2);
+  const auto refl = read_texture(fw.texture(4).id(), w, h, GL_RGBA, 4);
   Image img;
   img.width = w;
   img.height = h;
@@ -384,8 +384,8 @@ std::array<std::size_t, kMaxCascades> Renderer::cascade_pixel_counts() const {
   const ForwardPass& fw = impl_->forward;
   KASKAD_CHECK(fw.aovs_written(), "the last frame was rendered without write_aovs");
   std::array<std::size_t, kMaxCascades> out{};
-  const auto vis = read_texture(fw.texture(3), fw.width(), fw.height(), GL_RG, 2);
-  const auto pos = read_texture(fw.texture(1), fw.width(), fw.height(), GL_RGBA, 4);
+  const auto vis = read_texture(fw.texture(3).id(), fw.width(), fw.height(), GL_RG, 2);
+  const auto pos = read_texture(fw.texture(1).id(), fw.width(), fw.height(), GL_RGBA, 4);
   for (std::size_t i = 0; i < vis.size() / 2; ++i) {
     if (pos[i * 4 + 3] != 1.0f) continue;  // AOV mask: only shadow-receiving surfaces count
     const int c = int(vis[i * 2 + 1]);
@@ -407,8 +407,8 @@ SphereMap Renderer::read_probe_sphere(ProbeHandle handle) const {
 void Renderer::present(int window_width, int window_height) const {
   const ForwardPass& fw = impl_->forward;
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-  glNamedFramebufferReadBuffer(fw.framebuffer(), GL_COLOR_ATTACHMENT0);
-  glBlitNamedFramebuffer(fw.framebuffer(), 0, 0, 0, fw.width(), fw.height(), 0, 0, window_width,
+  glNamedFramebufferReadBuffer(fw.framebuffer().id(), GL_COLOR_ATTACHMENT0);
+  glBlitNamedFramebuffer(fw.framebuffer().id(), 0, 0, 0, fw.width(), fw.height(), 0, 0, window_width,
                          window_height, GL_COLOR_BUFFER_BIT, GL_LINEAR);
 }
 

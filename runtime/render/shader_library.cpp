@@ -190,21 +190,20 @@ Result<ShaderLibrary::Entry> ShaderLibrary::build(Pass pass, VariantKey key, boo
   return entry;
 }
 
-Result<GLuint> ShaderLibrary::program(Pass pass, VariantKey key) {
+Result<gpu::ProgramRef> ShaderLibrary::program(Pass pass, VariantKey key) {
   key = key.filtered_for(pass);
   if (oracle_) key = key.frame();  // one über-program per frame configuration
   // Hot path: one hash probe; a miss builds the program (and is counted).
   const std::uint64_t k = map_key(pass, key);
-  if (auto it = programs_.find(k); it != programs_.end()) return it->second.program.id();
+  if (auto it = programs_.find(k); it != programs_.end()) return gpu::ProgramRef(it->second.program);
   if (!oracle_) {
     const std::string bad = manifest_.check(key);
     KASKAD_CHECK(bad.empty(), "invalid variant key " + manifest_.describe(key) + ": " + bad);
   }
   auto entry = build(pass, key, false);
   if (!entry) return entry.error();
-  const GLuint id = entry->program.id();
-  programs_.emplace(k, std::move(entry.value()));
-  return id;
+  const auto it = programs_.emplace(k, std::move(entry.value())).first;
+  return gpu::ProgramRef(it->second.program);
 }
 
 Status ShaderLibrary::prewarm(std::span<const ProgramRequest> requests) {

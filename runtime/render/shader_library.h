@@ -38,8 +38,9 @@ class ShaderLibrary {
 
   /// The program for a pass and key (key filtered for the pass first). Hot path: one hash probe;
   /// must stay cheap because it runs once per program switch in every pass. A miss builds it
-  /// (content errors come back as Error; the key must be valid: precondition).
-  Result<GLuint> program(Pass pass, VariantKey key);
+  /// (content errors come back as Error; the key must be valid: precondition). The library owns
+  /// the program: the reference stays valid until hot reload replaces it or the library goes.
+  Result<gpu::ProgramRef> program(Pass pass, VariantKey key);
 
   /// Builds every requested program now (scene load), so frames do not compile.
   Status prewarm(std::span<const ProgramRequest> requests);

@@ -31,7 +31,7 @@ std::vector<Caster> gather_casters(const Scene& scene) {
   scene.world.view<MeshRenderer, WorldTransform>().each(
       [&](ecs::Entity, const MeshRenderer& mr, const WorldTransform& wt) {
         if (!mr.cast_shadows || mr.mesh == kNoMesh) return;
-        const MeshData& m = scene.assets.meshes[mr.mesh];
+        const MeshData& m = scene.assets.meshes[index(mr.mesh)];
         Caster c;
         for (std::uint32_t i : m.indices) {
           const glm::vec3 p = glm::vec3(wt.matrix * glm::vec4(m.positions[i], 1.0f));

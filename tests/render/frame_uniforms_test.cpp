@@ -41,7 +41,7 @@ TEST_F(FrameUniformsTest, CppLayoutMatchesTheCompiledBlock) {
   const render::VariantKey key = render::frame_variant(frame).filtered_for(render::Pass::forward);
   auto program = player_->renderer->shaders().program(render::Pass::forward, key);
   ASSERT_TRUE(program.ok()) << program.error().to_string();
-  const GLuint prog = GLuint(*program);
+  const GLuint prog = program->id();
 
   const GLuint block = glGetProgramResourceIndex(prog, GL_UNIFORM_BLOCK, "FrameBlock");
   ASSERT_NE(block, GL_INVALID_INDEX);

@@ -167,7 +167,7 @@ TEST(GltfLoader, BoxImportsOneMeshUnderItsNodes) {
   int renderers = 0;
   s->world.view<MeshRenderer, Transform>().each([&](ecs::Entity e, MeshRenderer& r, Transform& t) {
     ++renderers;
-    EXPECT_EQ(r.mesh, 0u);
+    EXPECT_EQ(r.mesh, MeshId{0});
     ASSERT_TRUE(t.parent.valid());
     EXPECT_TRUE(s->world.has<Name>(t.parent));
     EXPECT_TRUE(s->world.has<Material>(e));
@@ -259,7 +259,7 @@ TEST(GltfLoader, MilkTruckTexturesAreDecodedThroughOiio) {
 
   int textured = 0;
   s->world.view<Material, MeshRenderer>().each([&](ecs::Entity, Material& m, MeshRenderer&) {
-    textured += m.base_color_texture == 0u;
+    textured += m.base_color_texture == TextureId{0};
     EXPECT_EQ(m.normal_texture, kNoTexture);
     EXPECT_EQ(m.metallic, 0.0f);  // the file's metallicFactor
   });

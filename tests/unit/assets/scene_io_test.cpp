@@ -250,7 +250,7 @@ TEST(SceneIo, TiledTerrainBecomesTileEntitiesAndSavesAsOnePrimitive) {
   std::size_t triangles = 0;
   scene->world.view<MeshRenderer>().each([&](ecs::Entity e, const MeshRenderer& mr) {
     ++tiles;
-    triangles += scene->assets.meshes[mr.mesh].triangle_count();
+    triangles += scene->assets.meshes[index(mr.mesh)].triangle_count();
     EXPECT_FALSE(mr.cast_shadows);
     EXPECT_EQ(scene->world.get<Material>(e).base_color, glm::vec4(0.2f, 0.4f, 0.6f, 1.0f));
   });

@@ -387,7 +387,7 @@ TEST(RayTracer, ContentErrorsAreReported) {
   {
     Scene scene;
     const ecs::Entity e = scene.world.create();
-    scene.world.emplace<MeshRenderer>(e, MeshRenderer{7, true, true});
+    scene.world.emplace<MeshRenderer>(e, MeshRenderer{MeshId{7}, true, true});
     scene.world.emplace<WorldTransform>(e, WorldTransform{});
     const auto tracer = RayTracer::build(scene);
     ASSERT_FALSE(tracer.ok());
@@ -702,7 +702,7 @@ TEST(RayTracerAlpha, CutOutsLetRaysThroughWhereTheRasteriserDiscards) {
     m.alpha_mask = alpha_mask;
     m.alpha_cutoff = 0.5f;
     m.base_color = {1, 1, 1, factor_alpha};
-    m.base_color_texture = 0;
+    m.base_color_texture = TextureId{0};
     m.features = derive_material_features(m);
     scene.world.emplace<Material>(card, m);
     return scene;

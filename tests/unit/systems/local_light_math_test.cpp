@@ -172,7 +172,7 @@ CameraState overview_camera(ecs::World& w) {
 ecs::Entity box(ecs::World& w, const Aabb& b, bool cast, bool receive) {
   const ecs::Entity e = w.create();
   MeshRenderer mr;
-  mr.mesh = 0;
+  mr.mesh = MeshId{0};
   mr.cast_shadows = cast;
   mr.receive_shadows = receive;
   w.emplace<MeshRenderer>(e, mr);

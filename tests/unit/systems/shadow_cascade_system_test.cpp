@@ -46,7 +46,7 @@ ecs::Entity sun(ecs::World& w, const ShadowSettings& s, glm::vec3 dir = {0.3f, -
 ecs::Entity mesh(ecs::World& w, const Aabb& b, bool cast = true, bool receive = true) {
   const ecs::Entity e = w.create();
   MeshRenderer mr;
-  mr.mesh = 0;
+  mr.mesh = MeshId{0};
   mr.cast_shadows = cast;
   mr.receive_shadows = receive;
   w.emplace<MeshRenderer>(e, mr);

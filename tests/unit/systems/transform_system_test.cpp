@@ -2,6 +2,10 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <cstring>
+#include <random>
+#include <vector>
+
 #include "components/camera.h"
 #include "components/mesh_renderer.h"
 #include "components/name.h"
@@ -81,6 +85,207 @@ TEST(TransformSystem, WorldBoundsFollowTheMesh) {
   EXPECT_NEAR(b.max.z - b.min.z, 6.0f, 1e-5f);
   const Aabb all = scene_bounds(w);
   EXPECT_EQ(all.min, b.min);
+}
+
+// A still scene recomputes nothing after the first call; moving one leaf recomputes that leaf.
+TEST(TransformSystem, OnlyWhatChangedIsRecomputed) {
+  ecs::World w;
+  AssetStore assets;
+  const MeshId box = assets.add_mesh(make_primitive(PrimitiveShape::box, 8));
+  std::vector<ecs::Entity> leaves;
+  for (int i = 0; i < 10; ++i) {
+    const ecs::Entity e = w.create();
+    w.emplace<Transform>(e, Transform{{float(i), 0, 0}});
+    w.emplace<MeshRenderer>(e, MeshRenderer{box});
+    leaves.push_back(e);
+  }
+  const TransformStats first = update_transforms(w, assets);
+  EXPECT_EQ(first.transforms, 10u);
+  EXPECT_EQ(first.bounds, 10u);
+  for (int frame = 0; frame < 3; ++frame) {
+    const TransformStats still = update_transforms(w, assets);
+    EXPECT_EQ(still.transforms, 0u) << frame;
+    EXPECT_EQ(still.bounds, 0u) << frame;
+  }
+  // A write through get<>() with no setter and no flag is seen.
+  w.get<Transform>(leaves[3]).translation.y = 2.0f;
+  const TransformStats moved = update_transforms(w, assets);
+  EXPECT_EQ(moved.transforms, 1u);
+  EXPECT_EQ(moved.bounds, 1u);
+  EXPECT_FLOAT_EQ(w.get<WorldTransform>(leaves[3]).matrix[3].y, 2.0f);
+  EXPECT_NEAR(w.get<WorldBounds>(leaves[3]).box.min.y, 1.5f, 1e-5f);
+  // Writing the same values again is no change.
+  w.emplace<Transform>(leaves[3], w.get<Transform>(leaves[3]));
+  EXPECT_EQ(update_transforms(w, assets).transforms, 0u);
+}
+
+// Moving a parent recomputes it and its descendants, nothing else; reparenting is seen.
+TEST(TransformSystem, AMovedParentRecomputesItsDescendantsOnly) {
+  ecs::World w;
+  AssetStore assets;
+  const ecs::Entity root = w.create(), child = w.create(), grandchild = w.create();
+  const ecs::Entity other_root = w.create(), other_child = w.create();
+  w.emplace<Transform>(grandchild, Transform{{0, 0, 1}, {1, 0, 0, 0}, glm::vec3(1.0f), child});
+  w.emplace<Transform>(child, Transform{{0, 1, 0}, {1, 0, 0, 0}, glm::vec3(1.0f), root});
+  w.emplace<Transform>(root, Transform{{1, 0, 0}});
+  w.emplace<Transform>(other_root, Transform{{0, 0, 7}});
+  w.emplace<Transform>(other_child, Transform{{0, 3, 0}, {1, 0, 0, 0}, glm::vec3(1.0f), other_root});
+  EXPECT_EQ(update_transforms(w, assets).transforms, 5u);
+  EXPECT_EQ(update_transforms(w, assets).transforms, 0u);
+
+  w.get<Transform>(root).translation.x = 4.0f;
+  EXPECT_EQ(update_transforms(w, assets).transforms, 3u);
+  EXPECT_FLOAT_EQ(w.get<WorldTransform>(grandchild).matrix[3].x, 4.0f);
+
+  w.get<Transform>(child).scale = glm::vec3(2.0f);
+  EXPECT_EQ(update_transforms(w, assets).transforms, 2u);
+  EXPECT_FLOAT_EQ(w.get<WorldTransform>(grandchild).matrix[3].z, 2.0f);
+
+  // Reparent the child under the other root: the child and the grandchild follow.
+  w.get<Transform>(child).parent = other_root;
+  EXPECT_EQ(update_transforms(w, assets).transforms, 2u);
+  EXPECT_FLOAT_EQ(w.get<WorldTransform>(grandchild).matrix[3].x, 0.0f);
+  EXPECT_FLOAT_EQ(w.get<WorldTransform>(grandchild).matrix[3].z, 9.0f);
+  EXPECT_EQ(update_transforms(w, assets).transforms, 0u);
+
+  // The parent destroyed: the child becomes a root, once.
+  log::set_context("");
+  ::testing::internal::CaptureStderr();
+  w.destroy(other_root);
+  EXPECT_EQ(update_transforms(w, assets).transforms, 3u);  // child, grandchild, other_child
+  EXPECT_EQ(update_transforms(w, assets).transforms, 0u);
+  ::testing::internal::GetCapturedStderr();
+  EXPECT_FLOAT_EQ(w.get<WorldTransform>(grandchild).matrix[3].z, 2.0f);
+}
+
+// A destroyed entity's slot reused by a new entity is recomputed, even with the same values, and
+// a child still naming the old generation becomes a root.
+TEST(TransformSystem, AReusedSlotIsRecomputed) {
+  ecs::World w;
+  AssetStore assets;
+  const MeshId box = assets.add_mesh(make_primitive(PrimitiveShape::box, 8));
+  const ecs::Entity old = w.create(), child = w.create();
+  w.emplace<Transform>(old, Transform{{0, 5, 0}});
+  w.emplace<MeshRenderer>(old, MeshRenderer{box});
+  w.emplace<Transform>(child, Transform{{1, 0, 0}, {1, 0, 0, 0}, glm::vec3(1.0f), old});
+  update_transforms(w, assets);
+  EXPECT_FLOAT_EQ(w.get<WorldTransform>(child).matrix[3].y, 5.0f);
+  w.destroy(old);
+  const ecs::Entity reused = w.create();
+  ASSERT_EQ(reused.index, old.index);
+  ASSERT_NE(reused.generation, old.generation);
+  w.emplace<Transform>(reused, Transform{{0, 5, 0}});
+  w.emplace<MeshRenderer>(reused, MeshRenderer{box});
+  ::testing::internal::CaptureStderr();
+  const TransformStats s = update_transforms(w, assets);
+  ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(s.transforms, 2u);  // the new entity and the orphaned child
+  EXPECT_EQ(s.bounds, 1u);
+  EXPECT_FLOAT_EQ(w.get<WorldTransform>(reused).matrix[3].y, 5.0f);
+  EXPECT_FLOAT_EQ(w.get<WorldTransform>(child).matrix[3].y, 0.0f);
+  EXPECT_NEAR(w.get<WorldBounds>(reused).box.min.y, 4.5f, 1e-5f);
+}
+
+// WorldBounds follow a changed mesh id and a changed mesh in the store, and removed derived
+// components come back.
+TEST(TransformSystem, BoundsFollowMeshChangesAndRemovedOutputsComeBack) {
+  ecs::World w;
+  AssetStore assets;
+  const MeshId box = assets.add_mesh(make_primitive(PrimitiveShape::box, 8));
+  const MeshId big = assets.add_mesh(make_primitive(PrimitiveShape::box, 8));
+  assets.meshes[index(big)].bounds = Aabb::from_corners(glm::vec3(-3.0f), glm::vec3(3.0f));
+  const ecs::Entity e = w.create();
+  w.emplace<Transform>(e, Transform{{0, 5, 0}});
+  w.emplace<MeshRenderer>(e, MeshRenderer{box});
+  update_transforms(w, assets);
+  w.get<MeshRenderer>(e).mesh = big;
+  TransformStats s = update_transforms(w, assets);
+  EXPECT_EQ(s.transforms, 0u);
+  EXPECT_EQ(s.bounds, 1u);
+  EXPECT_NEAR(w.get<WorldBounds>(e).box.min.y, 2.0f, 1e-5f);
+  assets.meshes[index(big)].bounds = Aabb::from_corners(glm::vec3(-1.0f), glm::vec3(1.0f));
+  EXPECT_EQ(update_transforms(w, assets).bounds, 1u);
+  EXPECT_NEAR(w.get<WorldBounds>(e).box.min.y, 4.0f, 1e-5f);
+  w.get<MeshRenderer>(e).mesh = kNoMesh;
+  EXPECT_EQ(update_transforms(w, assets).bounds, 1u);
+  EXPECT_TRUE(w.get<WorldBounds>(e).box.empty());
+
+  w.get<MeshRenderer>(e).mesh = box;
+  update_transforms(w, assets);
+  w.remove<WorldTransform>(e);
+  w.remove<WorldBounds>(e);
+  s = update_transforms(w, assets);
+  EXPECT_EQ(s.transforms, 1u);
+  EXPECT_EQ(s.bounds, 1u);
+  EXPECT_FLOAT_EQ(w.get<WorldTransform>(e).matrix[3].y, 5.0f);
+  EXPECT_NEAR(w.get<WorldBounds>(e).box.min.y, 4.5f, 1e-5f);
+}
+
+// Incremental updates give bit for bit what recomputing everything gives, over random edits.
+TEST(TransformSystem, IncrementalMatchesAFullRecompute) {
+  ecs::World w;
+  AssetStore assets;
+  const MeshId box = assets.add_mesh(make_primitive(PrimitiveShape::box, 8));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+  std::vector<ecs::Entity> all;
+  for (int i = 0; i < 40; ++i) {
+    const ecs::Entity e = w.create();
+    Transform t{{u(rng), u(rng), u(rng)}};
+    if (i > 0 && rng() % 3 != 0) t.parent = all[rng() % all.size()];
+    w.emplace<Transform>(e, t);
+    if (rng() % 2) w.emplace<MeshRenderer>(e, MeshRenderer{box});
+    all.push_back(e);
+  }
+  ::testing::internal::CaptureStderr();
+  for (int frame = 0; frame < 30; ++frame) {
+    for (int k = 0; k < 3; ++k) {
+      const ecs::Entity e = all[rng() % all.size()];
+      if (!w.alive(e)) continue;
+      switch (rng() % 4) {
+        case 0: w.get<Transform>(e).translation.x += u(rng); break;
+        case 1: w.get<Transform>(e).parent = all[rng() % all.size()]; break;  // may form a cycle
+        case 2: w.get<Transform>(e).rotation = glm::angleAxis(u(rng), glm::vec3(0, 1, 0)); break;
+        default: {
+          w.destroy(e);
+          const ecs::Entity n = w.create();
+          w.emplace<Transform>(n, Transform{{u(rng), 0, 0}});
+          w.emplace<MeshRenderer>(n, MeshRenderer{box});
+          all[rng() % all.size()] = n;
+        }
+      }
+    }
+    update_transforms(w, assets);
+    // The reference: a copy of every Transform and MeshRenderer, in the same pool order, in a
+    // fresh world, where everything is computed.
+    ecs::World fresh;
+    std::vector<std::pair<ecs::Entity, ecs::Entity>> pairs;
+    w.view<Transform>().each([&](ecs::Entity e, Transform&) { pairs.push_back({e, ecs::kNullEntity}); });
+    // Recreate with the same slots: create up to the largest index, keep only the used ones.
+    std::uint32_t max_index = 0;
+    for (auto& p : pairs) max_index = std::max(max_index, p.first.index);
+    std::vector<ecs::Entity> slot(max_index + 1);
+    for (auto& s : slot) s = fresh.create();
+    for (auto& p : pairs) p.second = slot[p.first.index];
+    for (auto& p : pairs) {
+      Transform t = w.get<Transform>(p.first);
+      if (t.parent.valid()) t.parent = w.alive(t.parent) ? slot[t.parent.index] : ecs::Entity{t.parent.index, 999};
+      fresh.emplace<Transform>(p.second, t);
+      if (const auto* mr = w.try_get<MeshRenderer>(p.first)) fresh.emplace<MeshRenderer>(p.second, *mr);
+    }
+    update_transforms(fresh, assets);
+    for (auto& p : pairs) {
+      ASSERT_EQ(std::memcmp(&w.get<WorldTransform>(p.first).matrix,
+                            &fresh.get<WorldTransform>(p.second).matrix, sizeof(glm::mat4)), 0)
+          << "frame " << frame << " entity " << p.first.index;
+      if (w.has<MeshRenderer>(p.first)) {
+        ASSERT_EQ(std::memcmp(&w.get<WorldBounds>(p.first).box, &fresh.get<WorldBounds>(p.second).box,
+                              sizeof(Aabb)), 0)
+            << "frame " << frame << " entity " << p.first.index;
+      }
+    }
+  }
+  ::testing::internal::GetCapturedStderr();
 }
 
 TEST(CameraSystem, ActiveCameraWinsAndAutoFrameFitsTheBounds) {
