@@ -75,6 +75,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.clear_color = scene.render.clear_color;
   in.exposure = scene.render.exposure;
   in.write_aovs = ctx.write_aovs;
+  in.shadow_cache = scene.render.shadow_cache;
   if (!shadows.empty()) {
     const ShadowSettings& s = shadows.front().settings;  // shared by every view (ShadowData)
     in.shadow_map = {s.map_size, s.depth_format, s.filter, s.selection, s.layered,

@@ -32,6 +32,9 @@ struct RenderSettings {
   /// A receive-only plane in a neutral grey under the models, large enough to catch their
   /// shadow, so that a bare model shows one.
   GroundMode ground = GroundMode::automatic;
+  /// Shadow caching: a shadow-map layer whose inputs are those it was last drawn from keeps its
+  /// depth. Off, every layer is drawn every frame (for measurements and comparisons).
+  bool shadow_cache = true;
 };
 
 struct Scene {

@@ -195,6 +195,7 @@ void read_render(ObjectReader& r, RenderSettings& s) {
   r.number("exposure", s.exposure, 0.0f, 1.0e4f);
   r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
   r.enumeration("ground", s.ground, kGroundModes);
+  r.boolean("shadow_cache", s.shadow_cache);
   r.finish();
 }
 
@@ -991,7 +992,8 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
                    {"clear_color", vec(r.clear_color)},
                    {"exposure", num(r.exposure)},
                    {"aov_shadow_light", r.aov_shadow_light},
-                   {"ground", enum_name(r.ground, kGroundModes)}};
+                   {"ground", enum_name(r.ground, kGroundModes)},
+                   {"shadow_cache", r.shadow_cache}};
   doc["shadow"] = write_shadow(scene.shadow_defaults, nullptr);
   std::vector<ecs::Entity> authored;
   scene.world.view<Transform>().each([&](ecs::Entity e, const Transform&) {

@@ -127,6 +127,8 @@ struct FrameInput {
   /// Write the AOV targets (position, normal + depth, visibility). Off, the forward pass writes
   /// colour only: on llvmpipe the three float targets cost more than the shading itself.
   bool write_aovs = true;
+  /// Keep shadow-map layers whose inputs did not change (ShadowMapPass); off: draw all.
+  bool shadow_cache = true;
 };
 
 }  // namespace kaskad::render

@@ -207,7 +207,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
     for (int c = 0; c < views[view].layer_count; ++c) {
       const std::size_t layer = std::size_t(views[view].first_layer + c);
       inputs_[layer] = layer_inputs(view, c);
-      if (inputs_[layer] != drawn_from_[layer]) redraw_ |= 1u << layer;
+      if (inputs_[layer] != drawn_from_[layer] || !frame.shadow_cache) redraw_ |= 1u << layer;
     }
   // The layered pass draws every layer at once: it redraws all of them or none.
   if (layered && redraw_ != 0) redraw_ = ~0u >> (32 - total);  // total <= 32: no 1u << 32

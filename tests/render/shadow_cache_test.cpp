@@ -150,5 +150,21 @@ TEST_F(ShadowCacheTest, TheLayeredPassRedrawsAllLayersOrNone) {
   EXPECT_EQ(moved.visibility, moved_fresh.visibility);
 }
 
+// render.shadow_cache=false draws every layer every frame, with the same maps as the cache keeps.
+TEST_F(ShadowCacheTest, CacheOffDrawsEveryLayerEveryFrame) {
+  auto cached = load_scene(content_dir() / "scenes" / "default.json", {});
+  auto uncached = load_scene(content_dir() / "scenes" / "default.json", {"render.shadow_cache=false"});
+  ASSERT_TRUE(cached.ok() && uncached.ok());
+  render(*player_, *cached);
+  const Frame kept = render(*player_, *cached);
+  EXPECT_EQ(kept.stats.shadow_layers_rendered, 0u);
+  render(*player_, *uncached);
+  const Frame drawn = render(*player_, *uncached);
+  EXPECT_EQ(drawn.stats.shadow_layers_rendered, 0xfu);
+  EXPECT_GT(drawn.stats.shadow_draw_calls, 0);
+  EXPECT_EQ(drawn.map, kept.map);
+  EXPECT_EQ(drawn.visibility, kept.visibility);
+}
+
 }  // namespace
 }  // namespace kaskad
