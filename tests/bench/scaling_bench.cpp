@@ -91,20 +91,15 @@ struct RunResult {
 };
 
 // `frames` frames of `scene`; `moving` turns the camera about the origin a little every frame.
+// Frames go through render_frames() one at a time (the player's frame loop and timing), so this
+// file builds against older trees too, for before/after runs.
 RunResult run(Player& player, Scene& scene, int frames, bool moving) {
-  FrameContext ctx;
-  ctx.width = scene.render.width;
-  ctx.height = scene.render.height;
-  ctx.write_aovs = false;
-  SystemState systems;
-  if (!prewarm_frame(scene, *player.renderer, ctx, systems)) die("prewarm failed");
   ecs::Entity camera = ecs::kNullEntity;
   scene.world.view<Camera, Transform>().each(
       [&](ecs::Entity e, const Camera& c, const Transform&) {
         if (c.active && !camera.valid()) camera = e;
       });
   const Transform start = scene.world.get<Transform>(camera);
-  FrameReport report;
   RunResult r;
   std::vector<double> ms, phases[6], shadow_gpu, forward_gpu;
   // GPU times arrive a frame late and from frame 1 on: render two more frames than asked.
@@ -115,13 +110,14 @@ RunResult run(Player& player, Scene& scene, int frames, bool moving) {
       t.translation = glm::vec3(turn * glm::vec4(start.translation, 1.0f));
       t.rotation = glm::quat_cast(glm::mat3(turn)) * start.rotation;
     }
-    ctx.index = std::uint64_t(f);
-    const auto t0 = std::chrono::steady_clock::now();
-    if (auto st = run_frame(scene, *player.renderer, ctx, systems, report); !st)
-      die(st.error().to_string());
-    player.renderer->finish();
-    const double frame =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    RenderRun one;
+    one.frames = 1;
+    one.write_aovs = false;
+    one.prewarm = f == 0;
+    auto t = render_frames(player, scene, one);
+    if (!t) die(t.error().to_string());
+    const double frame = t->first_frame_ms;
+    const FrameReport& report = t->last;
     const render::FrameStats& s = report.stats;
     if (f == 0) r.first_frame_ms = frame;
     if (f == 2) r.first_shadow_gpu_ms = s.shadow_gpu_ms;  // frame 1's (frame 0 times uploads)
@@ -165,8 +161,8 @@ int main(int argc, char** argv) {
               "frames)\n",
               frames);
   std::printf("%9s %9s %8s %8s %8s %8s %9s %9s %8s %8s %9s\n", "instances", "frame ms",
-              "xform ms", "shadow", "drawlist", "render", "GPU shad", "GPU fwd", "draws", "shadow",
-              "load s");
+              "xform ms", "shadow", "drawlist", "render", "GPU shad", "GPU fwd", "draws",
+              "shd draws", "load s");
   double at_1000 = 0.0;
   for (int n : {100, 1000, 10000, 100000}) {
     if (n > max_instances) break;
