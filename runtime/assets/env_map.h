@@ -29,11 +29,10 @@
 #include <glm/glm.hpp>
 
 #include "runtime/core/result.h"
+#include "systems/sphere_map_math.h"
 
 namespace kaskad {
 
-/// GL cube-map face order: face i is GL_TEXTURE_CUBE_MAP_POSITIVE_X + i.
-enum class CubeFace : int { pos_x, neg_x, pos_y, neg_y, pos_z, neg_z };
 
 /// Short face names used in file names: "px", "nx", "py", "ny", "pz", "nz" (in CubeFace order).
 const char* cube_face_suffix(CubeFace face);
@@ -59,19 +58,7 @@ struct CubeMap {
 template <class F>
 CubeMap make_cube_map(int size, F&& fill);
 
-/// The unit direction through face coordinate (s, t), s,t in [0,1] (table 8.19 inverted; also
-/// S3's face formulas, e.g. +X: s = -z / (2|x|) + 1/2, t = -y / (2|x|) + 1/2).
-glm::vec3 cube_direction(CubeFace face, float s, float t);
 
-/// Where a direction meets the cube: the face of its major axis (ties go to X, then Y, then Z;
-/// S3: "the coordinate with the largest absolute value, by its sign") and s,t in [0,1].
-struct CubeCoord {
-  CubeFace face;
-  float s, t;
-};
-/// Inverse of cube_direction for any non-zero direction (need not be unit). Zero or non-finite
-/// directions give {pos_z, 0.5, 0.5}.
-CubeCoord cube_coord(const glm::vec3& direction);
 
 /// Bilinear lookup inside the face the direction selects (clamped at that face's edges: no
 /// filtering across faces, so seams are off by at most half a texel). Empty cube: vec4(0).
@@ -96,9 +83,6 @@ struct SphereMap {
   }
 };
 
-/// S3 eq. (2) at texel centre (i, j) of a `size` map (row j from the top, see SphereMap): the
-/// view-space reflection direction stored there. Outside the unit circle: (0, 0, -1).
-glm::vec3 sphere_map_direction(int i, int j, int size);
 
 /// Sphere map from a cube map per S3 eq. (2), for a viewer whose view-space directions turn into
 /// world (cube) directions by `view_to_world` (the rotation part of (MV)^-1, S3 eq. 6; the
@@ -108,11 +92,6 @@ glm::vec3 sphere_map_direction(int i, int j, int size);
 SphereMap sphere_map_from_cube(const CubeMap& cube, int size,
                                const glm::mat3& view_to_world = glm::mat3(1.0f));
 
-/// S3 eq. (4)-(5): the texture coordinate (s', t') in [0,1]^2 of a view-space reflection
-/// direction (need not be unit): A_z = sqrt((R_z + 1) / 2), s = R_x / (2 A_z), t = R_y / (2 A_z),
-/// s' = (s + 1) / 2, t' = (t + 1) / 2. t' grows UPWARDS (GL texture convention): t' = 1 is the
-/// top row (row 0) of a SphereMap. R = (0, 0, -1) (the singular rim point) gives (1, 0.5).
-glm::vec2 sphere_map_uv(const glm::vec3& reflected_view);
 
 /// Bilinear lookup of a sphere map at sphere_map_uv(reflected_view), clamped at the map's edges.
 /// Empty map: vec4(0).
@@ -185,10 +164,6 @@ Status save_sphere_map(const SphereMap& map, const std::filesystem::path& path);
 
 // --- 3ds Max (Z-up) conversion, S3 eq. (7) and its face table -----------------------------------
 
-/// S3's M_rot: (x, y, z) -> (x, -z, y), a 90 degree rotation about X. It maps an engine (Y-up)
-/// direction to the same direction in 3ds Max (Z-up) coordinates, and a 3ds Max direction to
-/// S3's cube-map space (CMCS).
-glm::vec3 m_rot(const glm::vec3& v);
 
 /// Converts a cube whose faces hold 3ds Max-authored images, named by 3ds Max axes (face px =
 /// RIGHT (+X), nx = LEFT, py = BACK (+Y), ny = FRONT (-Y), pz = UP (+Z), nz = DOWN (-Z)), into

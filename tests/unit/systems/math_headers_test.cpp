@@ -14,6 +14,7 @@
 #include "components/transform.h"
 #include "systems/cascade_math.h"
 #include "systems/local_light_math.h"
+#include "systems/sphere_map_math.h"
 
 #include <gtest/gtest.h>
 
