@@ -769,14 +769,61 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
 
 namespace {
 
+// Gives entity e a copy of the entities an earlier import made under `first` (Imported{first}):
+// the same meshes, textures and materials, so N instances of one model load and upload it once
+// and draw it instanced. Parents are remapped into the copy; copied cameras are not active.
+void copy_import(ecs::World& w, ecs::Entity first, ecs::Entity e) {
+  std::vector<ecs::Entity> originals;
+  w.view<Imported>().each([&](ecs::Entity x, const Imported& imp) {
+    if (imp.source == first) originals.push_back(x);
+  });
+  std::sort(originals.begin(), originals.end(), entity_less);
+  auto key = [](ecs::Entity x) { return (std::uint64_t(x.generation) << 32) | x.index; };
+  std::map<std::uint64_t, ecs::Entity> copy_of;  // every copy first, so any parent maps
+  for (ecs::Entity original : originals) copy_of[key(original)] = w.create();
+  for (ecs::Entity original : originals) {
+    const ecs::Entity c = copy_of[key(original)];
+    w.emplace<Imported>(c, Imported{e});
+    if (const auto* n = w.try_get<Name>(original)) w.emplace<Name>(c, *n);
+    if (const auto* t = w.try_get<Transform>(original)) {
+      Transform copy = *t;
+      if (copy.parent == first) {
+        copy.parent = e;
+      } else if (auto it = copy_of.find(key(copy.parent)); it != copy_of.end()) {
+        copy.parent = it->second;
+      }
+      w.emplace<Transform>(c, copy);
+    }
+    if (const auto* m = w.try_get<MeshRenderer>(original)) w.emplace<MeshRenderer>(c, *m);
+    if (const auto* m = w.try_get<Material>(original)) w.emplace<Material>(c, *m);
+    if (const auto* l = w.try_get<Light>(original)) w.emplace<Light>(c, *l);
+    if (const auto* sh = w.try_get<ShadowSettings>(original)) w.emplace<ShadowSettings>(c, *sh);
+    if (const auto* cam = w.try_get<Camera>(original)) {
+      Camera copy = *cam;
+      copy.active = false;
+      w.emplace<Camera>(c, copy);
+    }
+  }
+}
+
 // Imports entity e's glTF model (ModelRef): the meshes take e's renderer flags and layer, the
-// lights the scene's shadow settings.
-Status import_model(Scene& scene, ecs::Entity e, bool activate_first_camera) {
+// lights the scene's shadow settings. `imported` (file -> the first entity that imported it):
+// a file imported before is copied from that entity's import instead of read again.
+Status import_model(Scene& scene, ecs::Entity e, bool activate_first_camera,
+                    std::map<std::string, ecs::Entity>* imported = nullptr) {
   ecs::World& w = scene.world;
   const fs::path path = scene.file.parent_path() / w.get<ModelRef>(e).path;
-  auto report = import_gltf(path, w, scene.assets, e, e, activate_first_camera);
-  if (!report) return report.error();
-  for (const auto& warning : report->warnings) log::warn("%s: %s", path.string().c_str(), warning.c_str());
+  std::error_code ec;
+  const std::string file_key = fs::weakly_canonical(path, ec).string();
+  const auto earlier = imported ? imported->find(file_key) : std::map<std::string, ecs::Entity>::iterator{};
+  if (imported && earlier != imported->end()) {
+    copy_import(w, earlier->second, e);
+  } else {
+    auto report = import_gltf(path, w, scene.assets, e, e, activate_first_camera);
+    if (!report) return report.error();
+    for (const auto& warning : report->warnings) log::warn("%s: %s", path.string().c_str(), warning.c_str());
+    if (imported) imported->emplace(file_key, e);
+  }
   // The model entity's renderer flags apply to everything imported under it.
   const MeshRenderer flags = w.get<MeshRenderer>(e);
   w.view<MeshRenderer, Imported>().each([&](ecs::Entity, MeshRenderer& mr, Imported& imp) {
@@ -864,7 +911,9 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
       it = shared.emplace(key, scene.assets.add_mesh(make_primitive(p.shape, p.segments))).first;
     w.get<MeshRenderer>(e).mesh = it->second;
   }
-  for (auto& model : models) KASKAD_TRY(import_model(scene, model.first, /*activate_first_camera=*/true));
+  std::map<std::string, ecs::Entity> imported;  // each file is read once (copy_import)
+  for (auto& model : models)
+    KASKAD_TRY(import_model(scene, model.first, /*activate_first_camera=*/true, &imported));
   return {};
 }
 

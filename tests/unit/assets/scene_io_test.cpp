@@ -3,6 +3,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 
 #include "components/camera.h"
 #include "components/light.h"
@@ -234,6 +236,55 @@ TEST(SceneIo, ModelRendererFlagsAndLayerReachImportedMeshes) {
     EXPECT_FALSE(mr.cast_shadows);
   });
   EXPECT_GT(meshes, 0);
+}
+
+// Several entities naming one glTF file read it once: every instance gets its own entity tree
+// (names, parents inside its own tree, its own renderer flags) over the same meshes and
+// materials, so the renderer uploads them once and draws them instanced.
+TEST(SceneIo, InstancesOfOneModelShareItsMeshes) {
+  const std::string model = (kContent / "models/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf").string();
+  auto scene_with = [&](int n) {
+    std::string entities;
+    for (int i = 0; i < n; ++i)
+      entities += std::string(i ? "," : "") + R"({"name": "truck)" + std::to_string(i) +
+                  R"(", "transform": {"translation": [)" + std::to_string(4 * i) +
+                  R"(, 0, 0]}, "model": {"path": ")" + model + R"("}, "renderer": {"layer": )" +
+                  std::to_string(i) + "}}";
+    auto scene = read_scene(write_file("trucks_" + std::to_string(n) + ".json",
+                                       R"({"entities": [)" + entities + "]}"));
+    EXPECT_TRUE(scene.ok()) << scene.error().to_string();
+    if (scene.ok()) {
+      EXPECT_TRUE(instantiate_scene(*scene).ok());
+    }
+    return scene;
+  };
+  auto one = scene_with(1), three = scene_with(3);
+  ASSERT_TRUE(one.ok() && three.ok());
+  EXPECT_EQ(three->assets.meshes.size(), one->assets.meshes.size());
+  EXPECT_EQ(three->assets.textures.size(), one->assets.textures.size());
+  // Per instance: the same number of imported entities with the same names and meshes, parents
+  // in the instance's own tree, the instance's layer.
+  std::map<std::uint32_t, std::vector<std::string>> names;   // by instance entity index
+  std::map<std::uint32_t, std::multiset<MeshId>> meshes;
+  three->world.view<Imported>().each([&](ecs::Entity e, const Imported& imp) {
+    names[imp.source.index].push_back(three->world.get<Name>(e).value);
+    const ecs::Entity parent = three->world.get<Transform>(e).parent;
+    const bool in_own_tree = parent == imp.source ||
+                             (three->world.has<Imported>(parent) &&
+                              three->world.get<Imported>(parent).source == imp.source);
+    EXPECT_TRUE(in_own_tree) << three->world.get<Name>(e).value;
+    if (const auto* mr = three->world.try_get<MeshRenderer>(e)) {
+      meshes[imp.source.index].insert(mr->mesh);
+      EXPECT_EQ(mr->layer, int(imp.source.index));  // truck i is entity i, layer i
+    }
+  });
+  ASSERT_EQ(names.size(), 3u);
+  for (auto& [source, list] : names) std::sort(list.begin(), list.end());
+  EXPECT_EQ(names[1], names[0]);
+  EXPECT_EQ(names[2], names[0]);
+  EXPECT_EQ(meshes[1], meshes[0]);
+  EXPECT_EQ(meshes[2], meshes[0]);
+  EXPECT_FALSE(meshes[0].empty());
 }
 
 // A tiled terrain instantiates one entity per tile (the authored one plus imported children with
