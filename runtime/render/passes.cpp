@@ -239,6 +239,95 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   return {};
 }
 
+namespace {
+
+// Casters of one shadow view drawn by one instanced draw: draw list entry `draw` gives the mesh,
+// program and material; records first .. first + count - 1 the instances.
+struct CasterRun {
+  std::uint32_t draw;
+  std::size_t first, count;
+};
+
+// The casters of view `view` in `layers` (bit c: layer c of the view; a caster goes to the layers
+// of its mask in `layers`), in depth order, as runs that share a draw (same mesh and depth
+// program, and the same material where the depth program reads it), their instance records in
+// `records`: one per caster and layer, carrying that layer when `per_layer` (the layered pass).
+std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache,
+                                   const DrawState& state, std::size_t view, std::uint32_t layers,
+                                   bool per_layer, std::vector<InstanceRecord>& records) {
+  const ShadowView& v = frame.shadow_views[view];
+  auto same_batch = [&](std::uint32_t i, std::uint32_t j) {
+    const DrawItem& a = frame.draws[i];
+    const DrawItem& b = frame.draws[j];
+    if (a.mesh != b.mesh || list.depth_key(view, i).filtered_for(Pass::depth) !=
+                                list.depth_key(view, j).filtered_for(Pass::depth))
+      return false;
+    return !state.depth_reads_material(list.keys[i]) ||
+           (a.material == b.material && list.keys[i].material() == list.keys[j].material());
+  };
+  records.clear();
+  std::vector<CasterRun> runs;
+  std::uint32_t previous = 0;
+  for (std::uint32_t i : list.depth_order) {
+    const std::uint32_t mask = layers & caster_mask(v, frame.draws[i]);
+    if (mask == 0 || cache.mesh(frame.draws[i].mesh).index_count == 0) continue;
+    if (runs.empty() || !same_batch(previous, i)) runs.push_back({i, records.size(), 0});
+    previous = i;
+    for (int c = 0; c < v.layer_count; ++c)
+      if (mask & (1u << c))
+        records.push_back(instance_of(frame.draws[i].model, per_layer ? std::uint32_t(c) : 0u));
+    runs.back().count = records.size() - runs.back().first;
+  }
+  return runs;
+}
+
+// Culling, polygon offset and clipping of view `v`'s depth pass.
+void set_depth_state(const ShadowView& v) {
+  if (v.cull == CullMode::none) {
+    glDisable(GL_CULL_FACE);
+  } else {
+    glEnable(GL_CULL_FACE);
+    glCullFace(v.cull == CullMode::front ? GL_FRONT : GL_BACK);
+  }
+  glPolygonOffset(v.slope_bias, v.constant_bias);
+  // Paraboloid hemispheres end at a clip distance (shadow_depth.vert).
+  if (v.projection == ShadowProjection::dual_paraboloid) {
+    glEnable(GL_CLIP_DISTANCE0);
+  } else {
+    glDisable(GL_CLIP_DISTANCE0);
+  }
+}
+
+// Records instanced depth draws of `runs` of view `view` (their records uploaded first);
+// light_vp: the one layer's matrix, null for the layered pass.
+Status draw_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache, DrawState& state,
+                 FrameStats& stats, std::size_t view, std::span<const CasterRun> runs,
+                 std::span<const InstanceRecord> records, const glm::mat4* light_vp) {
+  const std::uint32_t base = cache.upload(records);
+  const ShadowView& v = frame.shadow_views[view];
+  for (const CasterRun& run : runs) {
+    const DrawItem& d = frame.draws[run.draw];
+    const GpuMesh& m = cache.mesh(d.mesh);
+    KASKAD_TRY(state.use_program(Pass::depth, list.depth_key(view, run.draw)));
+    const GLuint prog = state.program().id();
+    if (state.depth_reads_material(list.keys[run.draw])) state.bind_material(d, list.keys[run.draw]);
+    if (light_vp) {  // one layer
+      glProgramUniformMatrix4fv(prog, kLocLightViewProj, 1, GL_FALSE, &(*light_vp)[0][0]);
+    } else {  // layered: every layer of the view, the instance says which
+      glProgramUniform1i(prog, kLocLayerBase, v.first_layer);
+      glProgramUniformMatrix4fv(prog, kLocLayerViewProj, v.layer_count, GL_FALSE,
+                                &v.view_proj[0][0][0]);
+    }
+    glBindVertexArray(m.vao.id());
+    glDrawElementsInstancedBaseInstance(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
+                                        GLsizei(run.count), GLuint(base + run.first));
+    ++stats.shadow_draw_calls;
+  }
+  return {};
+}
+
+}  // namespace
+
 Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuCache& cache,
                              DrawState& state, FrameStats& stats) {
   if (redraw_ == 0) return {};
@@ -257,87 +346,17 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
     glNamedFramebufferTexture(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0);
     glClear(GL_DEPTH_BUFFER_BIT);
   }
-  // Casters i and j of a view share one instanced draw: same mesh and depth program, and the
-  // same material where the depth program reads it.
-  auto same_batch = [&](std::size_t view, std::uint32_t i, std::uint32_t j) {
-    const DrawItem& a = frame.draws[i];
-    const DrawItem& b = frame.draws[j];
-    if (a.mesh != b.mesh ||
-        list.depth_key(view, i).filtered_for(Pass::depth) != list.depth_key(view, j).filtered_for(Pass::depth))
-      return false;
-    return !state.depth_reads_material(list.keys[i]) ||
-           (a.material == b.material && list.keys[i].material() == list.keys[j].material());
-  };
   Status status;
   std::vector<InstanceRecord> records;
-  // Draws `runs` (first caster, first record, record count) of view `view` from `records`.
-  struct Run {
-    std::uint32_t draw;
-    std::size_t first, count;
-  };
-  auto draw_runs = [&](std::size_t view, const std::vector<Run>& runs, const glm::mat4* light_vp) {
-    const std::uint32_t base = cache.upload(records);
-    const ShadowView& v = frame.shadow_views[view];
-    for (const Run& run : runs) {
-      const DrawItem& d = frame.draws[run.draw];
-      const GpuMesh& m = cache.mesh(d.mesh);
-      if (Status st = state.use_program(Pass::depth, list.depth_key(view, run.draw)); !st) {
-        status = st;
-        return;
-      }
-      const GLuint prog = state.program().id();
-      if (state.depth_reads_material(list.keys[run.draw])) state.bind_material(d, list.keys[run.draw]);
-      if (light_vp) {
-        glProgramUniformMatrix4fv(prog, kLocLightViewProj, 1, GL_FALSE, &(*light_vp)[0][0]);
-      } else {
-        glProgramUniform1i(prog, kLocLayerBase, v.first_layer);
-        glProgramUniformMatrix4fv(prog, kLocLayerViewProj, v.layer_count, GL_FALSE,
-                                  &v.view_proj[0][0][0]);
-      }
-      glBindVertexArray(m.vao.id());
-      glDrawElementsInstancedBaseInstance(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
-                                          GLsizei(run.count), GLuint(base + run.first));
-      ++stats.shadow_draw_calls;
-    }
-  };
   for (std::size_t view = 0; view < frame.shadow_views.size() && status; ++view) {
     const ShadowView& v = frame.shadow_views[view];
-    if (v.cull == CullMode::none) {
-      glDisable(GL_CULL_FACE);
-    } else {
-      glEnable(GL_CULL_FACE);
-      glCullFace(v.cull == CullMode::front ? GL_FRONT : GL_BACK);
-    }
-    glPolygonOffset(v.slope_bias, v.constant_bias);
-    // Paraboloid hemispheres end at a clip distance (shadow_depth.vert).
-    if (v.projection == ShadowProjection::dual_paraboloid) {
-      glEnable(GL_CLIP_DISTANCE0);
-    } else {
-      glDisable(GL_CLIP_DISTANCE0);
-    }
-    // The casters of `mask_of` (bit c: layer c of the view) with a non-empty mesh, in draw order,
-    // grouped into runs that share a draw; each caster adds one record per layer of its mask.
-    auto collect = [&](auto&& mask_of, bool per_layer) {
-      records.clear();
-      std::vector<Run> runs;
-      std::uint32_t previous = 0;
-      for (std::uint32_t i : list.depth_order) {
-        const std::uint32_t mask = mask_of(frame.draws[i]);
-        if (mask == 0 || cache.mesh(frame.draws[i].mesh).index_count == 0) continue;
-        if (runs.empty() || !same_batch(view, previous, i)) runs.push_back({i, records.size(), 0});
-        previous = i;
-        for (int c = 0; c < v.layer_count; ++c)
-          if (mask & (1u << c)) records.push_back(instance_of(frame.draws[i].model, per_layer ? std::uint32_t(c) : 0u));
-        runs.back().count = records.size() - runs.back().first;
-      }
-      return runs;
-    };
+    set_depth_state(v);
     if (layered_) {
       std::uint32_t live = 0;
       for (int c = 0; c < v.layer_count; ++c)
         if (!v.skipped[std::size_t(c)]) live |= 1u << c;
-      draw_runs(view, collect([&](const DrawItem& d) { return live & caster_mask(v, d); }, true),
-                nullptr);
+      const auto runs = caster_runs(frame, list, cache, state, view, live, true, records);
+      status = draw_runs(frame, list, cache, state, stats, view, runs, records, nullptr);
       continue;
     }
     for (int c = 0; c < v.layer_count && status; ++c) {
@@ -346,9 +365,9 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
       glNamedFramebufferTextureLayer(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0, layer);
       glClear(GL_DEPTH_BUFFER_BIT);
       if (v.skipped[std::size_t(c)]) continue;
-      const std::uint32_t bit = 1u << c;
-      draw_runs(view, collect([&](const DrawItem& d) { return caster_mask(v, d) & bit ? bit : 0u; }, false),
-                &v.view_proj[std::size_t(c)]);
+      const auto runs = caster_runs(frame, list, cache, state, view, 1u << c, false, records);
+      status = draw_runs(frame, list, cache, state, stats, view, runs, records,
+                         &v.view_proj[std::size_t(c)]);
     }
   }
   glDisable(GL_POLYGON_OFFSET_FILL);
