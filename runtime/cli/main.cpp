@@ -270,8 +270,8 @@ int run_variants(const Args& a) {
   std::printf("%s: %zu programs (%s AOVs)\n", scene_path.string().c_str(), requests.size(),
               ctx.write_aovs ? "with" : "without");
   for (const auto& r : requests) {
-    std::printf("\n%-7s key 0x%08x  %s\n", render::pass_name(r.pass),
-                r.key.bits(), manifest->describe(r.key).c_str());
+    std::printf("\n%-7s key 0x%012llx  %s\n", render::pass_name(r.pass),
+                static_cast<unsigned long long>(r.key.bits()), manifest->describe(r.key).c_str());
     std::string defs;
     for (const auto& f : manifest->features())
       defs += " " + f.define + "=" + std::to_string(manifest->value(f, r.key));

@@ -113,7 +113,7 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
   glProgramUniform4fv(program_.id(), kLocBaseColor, 1, &m.base_color[0]);
   glProgramUniform4fv(program_.id(), kLocMaterial, 1, &params[0]);
   glProgramUniform3fv(program_.id(), kLocEmissive, 1, &m.emissive[0]);
-  if (features_by_uniform_) glProgramUniform1ui(program_.id(), kLocFeatureBits, key.material().bits());
+  if (features_by_uniform_) glProgramUniform1ui(program_.id(), kLocFeatureBits, GLuint(key.material().bits()));
   glBindTextureUnit(kTexBaseColor, cache_.texture(m.base_color_texture, false).id());
   glBindTextureUnit(kTexNormal, cache_.texture(m.normal_texture, true).id());
 }
