@@ -151,6 +151,31 @@ void ShadowMapPass::ensure_storage(int size, int layers, DepthFormat format, Sha
   glTextureParameteri(map_.id(), GL_TEXTURE_MAG_FILTER, f);
 }
 
+void ShadowMapPass::bind() {
+  const gpu::TextureRef map = texture();
+  auto make = [](bool compare, GLint filter) {
+    gpu::Sampler s = gpu::make_sampler();
+    const GLuint id = s.id();
+    glSamplerParameteri(id, GL_TEXTURE_COMPARE_MODE, compare ? GL_COMPARE_REF_TO_TEXTURE : GL_NONE);
+    glSamplerParameteri(id, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glSamplerParameteri(id, GL_TEXTURE_MIN_FILTER, filter);
+    glSamplerParameteri(id, GL_TEXTURE_MAG_FILTER, filter);
+    // As the map itself (S4): outside it every compare is lit, every raw depth 1.
+    glSamplerParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glSamplerParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+    glSamplerParameterfv(id, GL_TEXTURE_BORDER_COLOR, border);
+    return s;
+  };
+  if (!raw_depth_) raw_depth_ = make(false, GL_NEAREST);
+  if (!linear_compare_) linear_compare_ = make(true, GL_LINEAR);
+  glBindTextureUnit(kTexShadow, map.id());
+  glBindTextureUnit(kTexShadowDepth, map.id());
+  glBindSampler(kTexShadowDepth, raw_depth_.id());
+  glBindTextureUnit(kTexShadowLinear, map.id());
+  glBindSampler(kTexShadowLinear, linear_compare_.id());
+}
+
 gpu::TextureRef ShadowMapPass::texture() {
   if (!fbo_) ensure_storage(64, 1, DepthFormat::d24, ShadowFilter::none);
   return map_;
