@@ -119,13 +119,23 @@ uvec3 pcg3d(uvec3 v) {
   return v;
 }
 
-// The disc kernels' rotation at a point: a hash of the cell of an eighth of a texel of the
-// map's grid the point falls in (uv: its map coordinates). The grid is fixed in the world for a
-// spot map and for stable cascades (texel-snapped), so a surface point keeps its angle while the
-// camera moves: rotated kernels trade banding for noise without shimmering.
-float stable_angle(vec2 uv, int layer) {
-  ivec2 cell = ivec2(floor(uv * (8.0 * u_frame.y)));
-  uvec3 h = pcg3d(uvec3(uvec2(cell), uint(layer)));
+// The disc kernels' rotation at world point q (map coordinates c in layer i of view k): a hash
+// of the cell, an eighth of a texel wide, of the map's texel grid that q falls in, numbered in
+// world-fixed coordinates, so a surface point keeps its angle while the camera moves and rotated
+// kernels trade banding for noise without shimmering. A cascade's grid moves in whole texels
+// (stable fit), which renumbers map coordinates: its cells are numbered from the projection's
+// linear part alone (no translation), i.e. from q's position along the light's axes in texels.
+// A spot map or cube face does not move: its map coordinates serve.
+float stable_angle(int k, int i, vec3 q, vec3 c) {
+  vec2 grid = c.xy;
+  bool ortho = true;
+#if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_PERSPECTIVE || \
+    VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_CUBE
+  ortho = k != 0;
+#endif
+  if (ortho) grid = 0.5 * (mat3(u_shadow_views[k].view_proj[i]) * q).xy;
+  ivec2 cell = ivec2(floor(grid * (8.0 * u_frame.y)));
+  uvec3 h = pcg3d(uvec3(uvec2(cell), uint(view_first_layer(k) + i)));
   return float(h.x >> 8u) * (6.28318531 / 16777216.0);
 }
 
@@ -268,10 +278,10 @@ float wide_taps(int k, int i, vec3 c, vec3 q, vec3 n, float texel) {
   int layer = view_first_layer(k) + i;
   vec2 g = receiver_slope(k, i, q, n, c, texel);
 #if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS
-  return pcss(k, i, layer, c, g, stable_angle(c.xy, layer));
+  return pcss(k, i, layer, c, g, stable_angle(k, i, q, c));
 #elif VARIANT_SHADOW_KERNEL == VARIANT_SHADOW_KERNEL_POISSON
   return disc_pcf(layer, c, g, u_shadow_views[k].soft.y, int(u_shadow_views[k].soft.z),
-                  stable_angle(c.xy, layer));
+                  stable_angle(k, i, q, c));
 #else
   return box_pcf(layer, c, g);
 #endif
