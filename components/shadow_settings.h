@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <string>
 
+#include "components/limits.h"
+
 namespace kaskad {
 
 enum class CullMode { back, front, none };
@@ -164,6 +166,24 @@ struct ShadowSettings {
   /// maps instead of 6 (S0's earlier work).
   PointShadowMode point_mode = PointShadowMode::cube;
 };
+
+/// Texels a lookup reaches from the point's texel: 1.5 for S4's 3x3 (and the single taps), N / 2
+/// for an N x N box, the disc's radius plus one (its taps filter linearly) for poisson, and PCSS's
+/// largest radius plus one. Local lights keep this (plus the normal offset and one spare) free at
+/// their maps' edges; map_bounds selection likewise (shadow.glsl's filter_reach(); change
+/// together).
+inline float filter_reach_texels(const ShadowSettings& s) {
+  if (s.technique == ShadowTechnique::pcss) return float(kPcssMaxRadiusTexels) + 1.0f;
+  if (s.filter != ShadowFilter::pcf3x3) return 1.5f;
+  switch (s.pcf_kernel) {
+    case PcfKernel::k3x3: return 1.5f;
+    case PcfKernel::k5x5: return 2.5f;
+    case PcfKernel::k7x7: return 3.5f;
+    case PcfKernel::k9x9: return 4.5f;
+    case PcfKernel::poisson: return s.pcf_radius + 1.0f;
+  }
+  return 1.5f;
+}
 
 namespace shadow_settings_detail {
 /// Shortest readable form of a setting ("1.2", not "1.200000").

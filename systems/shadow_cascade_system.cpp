@@ -78,8 +78,9 @@ void fit_local_light(const Light& light, const LightFrame& frame, ShadowData& ou
     out.light = ecs::kNullEntity;  // nothing within range
     return;
   }
-  // Texels kept free at the map edges: the 3x3 PCF reach (1.5), the normal offset, 1 spare.
-  const float border = 2.5f + s.normal_offset_bias;
+  // Texels kept free at the map edges: the lookup's reach (1.5 for the 3x3 PCF), the normal
+  // offset, 1 spare.
+  const float border = filter_reach_texels(s) + 1.0f + s.normal_offset_bias;
   float tan_half = 0.0f;  // paraboloid maps clip by distance
   if (light.type == LightType::spot)
     tan_half = spot_tan_half_fov(light.outer_cone_deg, s.map_size, border);

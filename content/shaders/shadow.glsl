@@ -188,10 +188,6 @@ float box_pcf(int layer, vec3 c, vec2 g) {
 #endif
 
 #if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS
-// Widest PCSS search and filter radius, texels: bounds the cost of sparse taps over huge
-// regions (a receiver far behind the map's near plane); penumbrae wider than twice this are cut.
-#define PCSS_MAX_RADIUS 48.0
-
 // Percentage-closer soft shadows (Fernando, "Percentage-Closer Soft Shadows", SIGGRAPH 2005
 // sketch) in layer i of view k at map coordinates c (receiver q). Light size l = soft.x
 // (ShadowData::light_size). The blocker search and the filter take `taps` disc taps each.
@@ -362,8 +358,21 @@ float paraboloid_visibility(int k, vec3 p, vec3 n, out int hemisphere) {
 #endif
 
 #if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
-// Border kept free in NDC: the PCF kernel's reach plus the normal offset, in texels.
-float map_border(int k) { return 2.0 * (1.5 + u_shadow_views[k].params.x) / u_frame.y; }
+// Texels the lookup reaches from the point's texel; filter_reach_texels() in
+// components/shadow_settings.h (change together).
+float filter_reach(int k) {
+#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS
+  return PCSS_MAX_RADIUS + 1.0;
+#elif VARIANT_SHADOW_KERNEL == VARIANT_SHADOW_KERNEL_POISSON
+  return u_shadow_views[k].soft.y + 1.0;
+#elif defined(PCF_SIDE)
+  return 0.5 * float(PCF_SIDE);
+#else
+  return 1.5;
+#endif
+}
+// Border kept free in NDC: the lookup's reach plus the normal offset, in texels.
+float map_border(int k) { return 2.0 * (filter_reach(k) + u_shadow_views[k].params.x) / u_frame.y; }
 #endif
 
 // The cascade of view k at a point, -1 outside all. depth: view depth |z_view|.
