@@ -49,7 +49,8 @@ usage:
                [--stability-frames N] [--shard i/n]
   kaskad bench --merge SHARD_OUT_DIR... [--out DIR] [--no-chart]
                                     sweep settings, write DIR/bench.csv and one speed-vs-accuracy
-                                    chart per scene (default sweep: see README); flicker at fixed
+                                    chart per scene (default sweep: see README; --sweep soft:
+                                    the soft-shadow techniques and kernels); flicker at fixed
                                     points over an N-frame camera path (default 16, 0 = off)
   kaskad envmap IN [--layout L] [--3dsmax] [--face-size N] [--faces OUT] [--sphere OUT.png]
                 [--sphere-size N]
