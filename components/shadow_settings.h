@@ -41,6 +41,10 @@ enum class ShadowTechnique {
          ///< by the light, average blocker depth, penumbra width w = l (d_r - d_b) / d_b, then
          ///< PCF over w (Poisson-like disc of pcf_taps taps). Needs a light with a size
          ///< (Light::angular_size_deg or Light::radius); a punctual light gives hard shadows
+  backprojection,  ///< Guennebaud, Barthe, Paulin 2006: every depth-map texel in the region
+                   ///< PCSS searches that lies in front of the receiver is back-projected from
+                   ///< the receiver onto the light and the covered parts of the light summed
+                   ///< (overlaps are counted twice: too dark where blockers overlap, S1's point)
 };
 
 /// The PCF footprint when filter is pcf3x3 and technique pcf.
@@ -173,7 +177,7 @@ struct ShadowSettings {
 /// their maps' edges; map_bounds selection likewise (shadow.glsl's filter_reach(); change
 /// together).
 inline float filter_reach_texels(const ShadowSettings& s) {
-  if (s.technique == ShadowTechnique::pcss) return float(kPcssMaxRadiusTexels) + 1.0f;
+  if (s.technique != ShadowTechnique::pcf) return float(kPcssMaxRadiusTexels) + 1.0f;
   if (s.filter != ShadowFilter::pcf3x3) return 1.5f;
   switch (s.pcf_kernel) {
     case PcfKernel::k3x3: return 1.5f;
@@ -211,8 +215,8 @@ inline std::string validate_shadow_settings(const ShadowSettings& s) {
   if (filter < 0 || filter > static_cast<int>(ShadowFilter::pcf3x3))
     return "filter must be none, bilinear or pcf3x3, was " + std::to_string(filter);
   const int technique = static_cast<int>(s.technique);
-  if (technique < 0 || technique > static_cast<int>(ShadowTechnique::pcss))
-    return "technique must be pcf or pcss, was " + std::to_string(technique);
+  if (technique < 0 || technique > static_cast<int>(ShadowTechnique::backprojection))
+    return "technique must be pcf, pcss or backprojection, was " + std::to_string(technique);
   const int kernel = static_cast<int>(s.pcf_kernel);
   if (kernel < 0 || kernel > static_cast<int>(PcfKernel::poisson))
     return "pcf_kernel must be 3, 5, 7, 9 or poisson, was " + std::to_string(kernel);

@@ -13,8 +13,10 @@ layout(binding = UNIT_SHADOW) uniform sampler2DArrayShadow u_shadow_map;  // one
 // still give smooth ramps.
 layout(binding = UNIT_SHADOW_LINEAR) uniform sampler2DArrayShadow u_shadow_linear;
 #endif
-#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS
-// The same map without compare: raw depths for PCSS's blocker search.
+#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS || \
+    VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_BACKPROJECTION
+#define SHADOW_SIZED 1  // lookups that use the light's size (PcssMap below)
+// The same map without compare: raw depths for PCSS's blocker search and backprojection.
 layout(binding = UNIT_SHADOW_DEPTH) uniform sampler2DArray u_shadow_depth;
 #endif
 #endif
@@ -187,7 +189,7 @@ float box_pcf(int layer, vec3 c, vec2 g) {
 }
 #endif
 
-#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS
+#ifdef SHADOW_SIZED
 // Percentage-closer soft shadows (Fernando, "Percentage-Closer Soft Shadows", SIGGRAPH 2005
 // sketch) in layer i of view k at map coordinates c (receiver q). Light size l = soft.x
 // (ShadowData::light_size). The blocker search and the filter take `taps` disc taps each.
@@ -230,9 +232,8 @@ float pcss_radius(PcssMap m, float l, float d_r, float d_b) {
                        : 0.5 * l * (d_r - d_b) / m.texel;
 }
 
-float pcss(int k, int i, int layer, vec3 c, vec2 g, float angle) {
-  float l = u_shadow_views[k].soft.x;
-  int taps = int(u_shadow_views[k].soft.z);
+// Layer i of view k as the sized lookups see it.
+PcssMap pcss_map(int k, int i) {
   PcssMap map;
   map.perspective = false;
 #if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_PERSPECTIVE || \
@@ -244,6 +245,15 @@ float pcss(int k, int i, int layer, vec3 c, vec2 g, float angle) {
   mat4 m = u_shadow_views[k].view_proj[i];
   map.depth_per_metre = 0.5 * length(vec3(m[0][2], m[1][2], m[2][2]));
   map.texel = view_texel(k, i);
+  return map;
+}
+#endif
+
+#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS
+float pcss(int k, int i, int layer, vec3 c, vec2 g, float angle) {
+  float l = u_shadow_views[k].soft.x;
+  int taps = int(u_shadow_views[k].soft.z);
+  PcssMap map = pcss_map(k, i);
   float d_r = pcss_distance(map, c.z);
   // 1. Blocker search over the region of every blocker between the map's near plane and the
   //    receiver (ortho: the near plane is depth 0).
@@ -268,6 +278,73 @@ float pcss(int k, int i, int layer, vec3 c, vec2 g, float angle) {
 }
 #endif
 
+#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_BACKPROJECTION
+// Cells per side of the backprojection kernel: 2 BP_HALF + 1.
+#define BP_HALF 12
+
+// Length of [a0, a1] inside [-h, h].
+float overlap_1d(float a0, float a1, float h) { return max(0.0, min(a1, h) - max(a0, -h)); }
+
+// Backprojection soft shadows (Guennebaud, Barthe, Paulin, "Real-time Soft Shadow Mapping by
+// Backprojection", EGSR 2006) in layer i of view k at map coordinates c. Every depth-map cell in
+// PCSS's search region (pcss()) that lies in front of the receiver is a micro-occluder: a square
+// as wide as the cell at its stored depth. It is back-projected from the receiver onto the light
+// and the part of the light it covers is summed; visibility = 1 - the sum, clamped. Overlapping
+// micro-occluders are all counted, so where blockers overlap as seen from the receiver the
+// shadow comes out too dark (S1's criticism; layered occlusion maps fix it).
+//
+// The region: PCSS's blocker search (disc taps over the widest region) finds the blocker nearest
+// the light, d_min; only blockers up to there can hide part of the light, so the region is
+// pcss_radius(d_min) (S1's kernel from the nearest occluder). It is covered by
+// (2 BP_HALF + 1)^2 cells of `step` texels each (step = 1 up to a radius of BP_HALF texels;
+// wider regions read one depth per coarser cell, the stand-in for the paper's hierarchical
+// map).
+//
+// Light plane coordinates of a cell u tangent units (perspective) off the receiver's map point,
+// at depth d_b, seen from the receiver at d_r: the line from the receiver through it reaches the
+// light's plane (distance 0) at u d_r d_b / (d_r - d_b) metres, and the light is the square
+// [-l/2, l/2]^2 (Light::radius). Ortho: a cell x metres off the receiver's map point at height
+// D = d_r - d_b above it is seen in direction x / D (tangent units); the light is the cone of
+// half-angle theta / 2, taken as the square of the same solid angle, side
+// l sqrt(pi) / 2 (l = 2 tan(theta / 2)).
+float backprojection(int k, int i, int layer, vec3 c, vec2 g, float angle) {
+  float l = u_shadow_views[k].soft.x;
+  if (l <= 0.0) return texture(u_shadow_map, vec4(c.xy, float(layer), c.z));  // punctual
+  PcssMap map = pcss_map(k, i);
+  float size = u_frame.y;
+  float half_light = map.perspective ? 0.5 * l : 0.5 * l * 0.88622693;  // sqrt(pi) / 2
+  float d_r = pcss_distance(map, c.z);
+  float search = clamp(pcss_radius(map, l, d_r, map.perspective ? map.near : 0.0), 1.0,
+                       PCSS_MAX_RADIUS);
+  int taps = int(u_shadow_views[k].soft.z);
+  float z_min = c.z;
+  for (int t = 0; t < taps; ++t) {
+    vec2 o = disc_tap(t, taps, angle) * (search / size);
+    float z = texture(u_shadow_depth, vec3(c.xy + o, float(layer))).r;
+    if (z < c.z + dot(g, o)) z_min = min(z_min, z);
+  }
+  if (z_min >= c.z) return 1.0;  // no blocker found
+  float radius = clamp(pcss_radius(map, l, d_r, pcss_distance(map, z_min)) + 1.0, 1.0, search);
+  float step = max(1.0, ceil(radius / float(BP_HALF)));
+  vec2 centre = (floor(c.xy * size) + 0.5) / size;  // the receiver's texel
+  float blocked = 0.0;
+  for (int y = -BP_HALF; y <= BP_HALF; ++y) {
+    for (int x = -BP_HALF; x <= BP_HALF; ++x) {
+      vec2 uv = centre + vec2(float(x), float(y)) * (step / size);
+      float z = texture(u_shadow_depth, vec3(uv, float(layer))).r;
+      if (z >= c.z + dot(g, uv - c.xy)) continue;  // not in front of the receiver
+      float d_b = pcss_distance(map, z);
+      if (d_b >= d_r) continue;
+      // The cell's extent relative to the receiver's map point, in texels, then on the light.
+      vec2 lo = (uv - c.xy) * size - 0.5 * step, hi = lo + step;
+      float f = map.perspective ? map.texel * d_r * d_b / (d_r - d_b) : map.texel / (d_r - d_b);
+      blocked += overlap_1d(lo.x * f, hi.x * f, half_light) * overlap_1d(lo.y * f, hi.y * f, half_light);
+    }
+  }
+  return clamp(1.0 - blocked / (4.0 * half_light * half_light), 0.0, 1.0);
+}
+#endif
+
 // The wide lookup of layer i of view k at map coordinates c, for the receiver q (offset point)
 // with normal n; texel: metres per texel at q.
 float wide_taps(int k, int i, vec3 c, vec3 q, vec3 n, float texel) {
@@ -275,6 +352,8 @@ float wide_taps(int k, int i, vec3 c, vec3 q, vec3 n, float texel) {
   vec2 g = receiver_slope(k, i, q, n, c, texel);
 #if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS
   return pcss(k, i, layer, c, g, stable_angle(k, i, q, c));
+#elif VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_BACKPROJECTION
+  return backprojection(k, i, layer, c, g, stable_angle(k, i, q, c));
 #elif VARIANT_SHADOW_KERNEL == VARIANT_SHADOW_KERNEL_POISSON
   return disc_pcf(layer, c, g, u_shadow_views[k].soft.y, int(u_shadow_views[k].soft.z),
                   stable_angle(k, i, q, c));
@@ -361,7 +440,8 @@ float paraboloid_visibility(int k, vec3 p, vec3 n, out int hemisphere) {
 // Texels the lookup reaches from the point's texel; filter_reach_texels() in
 // components/shadow_settings.h (change together).
 float filter_reach(int k) {
-#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS
+#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS || \
+    VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_BACKPROJECTION
   return PCSS_MAX_RADIUS + 1.0;
 #elif VARIANT_SHADOW_KERNEL == VARIANT_SHADOW_KERNEL_POISSON
   return u_shadow_views[k].soft.y + 1.0;

@@ -55,7 +55,8 @@ const std::vector<std::pair<const char*, CullMode>> kCullModes = {
 const std::vector<std::pair<const char*, ShadowFilter>> kFilters = {
     {"none", ShadowFilter::none}, {"bilinear", ShadowFilter::bilinear}, {"pcf3x3", ShadowFilter::pcf3x3}};
 const std::vector<std::pair<const char*, ShadowTechnique>> kTechniques = {
-    {"pcf", ShadowTechnique::pcf}, {"pcss", ShadowTechnique::pcss}};
+    {"pcf", ShadowTechnique::pcf}, {"pcss", ShadowTechnique::pcss},
+    {"backprojection", ShadowTechnique::backprojection}};
 // pcf_kernel is written as the box side (3, 5, 7, 9) or "poisson".
 const std::vector<std::pair<const char*, PcfKernel>> kKernelNames = {{"poisson", PcfKernel::poisson}};
 const std::vector<std::pair<const char*, Projection>> kProjections = {

@@ -136,7 +136,7 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // ShadowSettings::technique). Bits 32-35 leave the field room for the techniques to come
     // (backprojection, lom, vsm, evsm).
     {.name = "shadow_technique", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_TECHNIQUE",
-     .stages = kFragmentStage, .offset = 32, .values = {"pcf", "pcss"}, .requires_ = {"shadow"}},
+     .stages = kFragmentStage, .offset = 32, .values = {"pcf", "pcss", "backprojection"}, .requires_ = {"shadow"}},
     // The PCF footprint of shadow_filter pcf3x3 (ShadowSettings::pcf_kernel): N x N boxes of
     // nearest compares, or a rotated Poisson-like disc of ShadowSettings::pcf_taps taps.
     {.name = "shadow_kernel", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_KERNEL",
@@ -248,7 +248,7 @@ class VariantKey {
   /// A count, not a switch, so loops over shadowed lights have a compile-time bound and a light
   /// that does not exist costs nothing (llvmpipe runs a zero-trip loop's body once, masked).
   static constexpr Field kShadowLightsMinus1 = feature_field("shadow_lights");
-  /// ShadowTechnique: 0 pcf, 1 pcss.
+  /// ShadowTechnique: 0 pcf, 1 pcss, 2 backprojection.
   static constexpr Field kShadowTechnique = feature_field("shadow_technique");
   /// PcfKernel: 0 3x3, 1 5x5, 2 7x7, 3 9x9, 4 poisson.
   static constexpr Field kShadowKernel = feature_field("shadow_kernel");

@@ -112,9 +112,9 @@ class SoftShadowTest : public PlayerTest {
   }
 };
 
-// (a) PCSS's penumbra has the width similar triangles give: blocker-receiver distance times the
-// tangent of the cone (S1's l (d - z) / z with the light at infinity), within 10%, for a 5 and a
-// 2-degree sun; hard PCF's is far narrower.
+// (a) PCSS's and backprojection's penumbrae have the width similar triangles give:
+// blocker-receiver distance times the tangent of the cone (S1's l (d - z) / z with the light at
+// infinity), within 10%, for a 5 and a 2-degree sun; hard PCF's is far narrower.
 TEST_F(SoftShadowTest, PcssPenumbraWidthMatchesSimilarTriangles) {
   constexpr float kSpacing = 0.0005f;
   for (float theta : {5.0f, 2.0f}) {
@@ -131,6 +131,11 @@ TEST_F(SoftShadowTest, PcssPenumbraWidthMatchesSimilarTriangles) {
     const float width = measured_width(pcss, kSpacing, &texel);
     Scene pcf = load(file, {"shadow.technique=pcf"});
     const float hard = measured_width(pcf, kSpacing);
+    Scene bp = load(file, {"shadow.technique=backprojection"});
+    const float back = measured_width(bp, kSpacing);
+    std::printf("[ sun %.0f deg ] backprojection 10-90%% width %.4f m (%+.1f %%)\n", theta, back,
+                100.0 * (back / expected - 1.0));
+    EXPECT_NEAR(back / expected, 1.0, 0.10) << theta << " degrees, backprojection";
     std::printf("[ sun %.0f deg ] 10-90%% width: analytic %.4f m (full %.4f m), pcss %.4f m "
                 "(%+.1f %%), pcf 3x3 %.4f m; cascade 0 texel %.4f m\n",
                 theta, expected, full, width, 100.0 * (width / expected - 1.0), hard,

@@ -219,7 +219,7 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   EXPECT_EQ(again->shadow_defaults.pcf_taps, 24);
   EXPECT_EQ(again->world.get<ShadowSettings>(find(*again, "lamp")).pcf_kernel, PcfKernel::k9x9);
 
-  expect_error(read_scene(def, {"shadow.technique=vsm"}), {"/shadow/technique", "vsm", "pcf", "pcss"});
+  expect_error(read_scene(def, {"shadow.technique=vsm"}), {"/shadow/technique", "vsm", "pcf", "pcss", "backprojection"});
   expect_error(read_scene(def, {"shadow.pcf_kernel=4"}), {"/shadow/pcf_kernel", "3, 5, 7, 9", "4"});
   expect_error(read_scene(def, {"shadow.pcf_kernel=11"}), {"/shadow/pcf_kernel", "11"});
   expect_error(read_scene(def, {"shadow.pcf_kernel=1"}), {"/shadow/pcf_kernel", "1"});
@@ -240,7 +240,7 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   EXPECT_EQ(validate_shadow_settings(bad), "pcf_taps must be in [8, 64], was 100");
   bad = {};
   bad.technique = ShadowTechnique(7);
-  EXPECT_EQ(validate_shadow_settings(bad), "technique must be pcf or pcss, was 7");
+  EXPECT_EQ(validate_shadow_settings(bad), "technique must be pcf, pcss or backprojection, was 7");
 }
 
 TEST(SceneIo, OverrideErrorsListValidKeys) {

@@ -46,7 +46,7 @@ bool documented_rules_hold(VariantKey k) {
       V::kShadowKernel.mask();
   if (k.bits() & ~used) return false;
   if (k.get(V::kShadowFilter) > 2) return false;     // none, bilinear, pcf3x3
-  if (k.get(V::kShadowTechnique) > 1) return false;  // pcf, pcss
+  if (k.get(V::kShadowTechnique) > 2) return false;  // pcf, pcss, backprojection
   if (k.get(V::kShadowKernel) > 4) return false;     // 3x3, 5x5, 7x7, 9x9, poisson
   if (k.has(V::kReflectionCube) && k.has(V::kReflectionSphere)) return false;
   if (k.has(V::kReflectionBox) && !k.has(V::kReflectionCube)) return false;
@@ -113,9 +113,9 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   // Material keys: 2^5 free bits x 4 of the 8 reflection cube/sphere/box combinations = 128.
   // Frame keys: 2 without shadow (aovs), and with shadow 3 filters x 2 aovs x 2 debug x
   // 2 selection x 2 layered x 4 shadowed-light counts x (8 ortho cascade counts + 3 other
-  // projections) x 2 techniques x 5 kernels = 21120.
+  // projections) x 3 techniques x 5 kernels = 31680.
   EXPECT_EQ(valid_materials, 128);
-  EXPECT_EQ(valid_frames, 2 + 21120);
+  EXPECT_EQ(valid_frames, 2 + 31680);
 }
 
 // The table is the one source: the manifest's features, their fields and the GLSL bit numbers
