@@ -134,7 +134,7 @@ print("flicker stable %g crop %g" % (s, c))
 ' "$tmp/flicker/bench.csv"
 # Soft shadows (issue 14): `--sweep soft` runs the techniques and kernels on the 5-degree sun;
 # pcss is closer to the area-light reference (rmse) than hard 3x3 pcf.
-check bench_soft 0 "wrote .*bench.csv \(7 rows\)" -- "$KASKAD" bench "$KASKAD_CONTENT/scenes/soft/sun_5deg.json" \
+check bench_soft 0 "wrote .*bench.csv \(8 rows\)" -- "$KASKAD" bench "$KASKAD_CONTENT/scenes/soft/sun_5deg.json" \
   --size 200x112 --frames 1 --no-chart --stability-frames 0 --out "$tmp/soft" --sweep soft 2>/dev/null
 check bench_soft_csv 0 "pcss beats pcf" -- /usr/bin/python3 -c '
 import csv, sys
