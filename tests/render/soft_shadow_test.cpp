@@ -249,6 +249,64 @@ TEST_F(SoftShadowTest, BackprojectionOverDarkensWhereOccludersOverlap) {
   EXPECT_LT(error[1], error[0] - 0.04);
 }
 
+// Light leaks into closed geometry: ground points inside a closed 1 x 0.5 x 1 m box (5 cm and
+// more from its walls) under a 5-degree sun, where the reference is 0. Stated bounds: none
+// (<= 0.01) for pcf 3x3, 9x9, the default poisson disc and pcss. A poisson disc of 8 texels
+// reaches past the 5 cm to the wall from the points next to it and reads the ground outside, on
+// the receiver's plane, as lit (measured 0.0625 at 35 of 8281 points: <= 0.07). Backprojection
+// leaks through gaps between micro-occluders at different depths (the box's top and its
+// sunward wall; the paper's gap filling is not implemented): measured 0.0997 at 500 points,
+// bound 0.12.
+TEST_F(SoftShadowTest, NoTechniqueLeaksLightIntoAClosedBox) {
+  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
+  fs::create_directories(dir);
+  const fs::path file = dir / "closed_box.json";
+  std::ofstream(file) << R"({ "kaskad_scene": 1,
+    "render": { "width": 320, "height": 180 },
+    "entities": [
+      { "name": "ground", "transform": { "scale": [40, 1, 40] }, "primitive": { "shape": "plane" } },
+      { "name": "box", "transform": { "translation": [0, 0.25, 0], "scale": [1, 0.5, 1] },
+        "primitive": { "shape": "box" } },
+      { "name": "sun", "transform": { "direction": [0.3, -1, 0.2] },
+        "light": { "type": "directional", "cast_shadows": true, "angular_size_deg": 5 } },
+      { "name": "camera", "transform": { "translation": [0, 3, 4], "look_at": [0, 0, 0] },
+        "camera": { "fov_y_deg": 45, "near": 0.1, "far": 100, "active": true } } ] })";
+  std::vector<glm::vec3> points, normals;
+  for (float z = -0.45f; z <= 0.45f; z += 0.01f)
+    for (float x = -0.45f; x <= 0.45f; x += 0.01f) {
+      points.emplace_back(x, 0.0f, z);
+      normals.emplace_back(0.0f, 1.0f, 0.0f);
+    }
+  const std::vector<std::pair<std::vector<std::string>, float>> cases = {
+      {{"shadow.technique=pcf"}, 0.01f},
+      {{"shadow.pcf_kernel=9"}, 0.01f},
+      {{"shadow.pcf_kernel=poisson"}, 0.01f},
+      {{"shadow.pcf_kernel=poisson", "shadow.pcf_radius=8"}, 0.07f},
+      {{"shadow.technique=pcss"}, 0.01f},
+      {{"shadow.technique=backprojection"}, 0.12f}};
+  for (const auto& [sets, bound] : cases) {
+    Scene scene = load(file, sets);
+    auto t = render_frames(*player_, scene, {});
+    ASSERT_TRUE(t.ok()) << t.error().to_string();
+    auto values = player_->renderer->shadow_at_points(points, normals);
+    ASSERT_TRUE(values.ok()) << values.error().to_string();
+    float worst = 0.0f;
+    glm::vec3 at{0.0f};
+    int leaking = 0;
+    for (std::size_t i = 0; i < values->size(); ++i) {
+      leaking += (*values)[i].x > 0.01f;
+      if ((*values)[i].x > worst) {
+        worst = (*values)[i].x;
+        at = points[i];
+      }
+    }
+    std::printf("[ %s ] largest visibility inside the box %.4f (at x %.2f z %.2f), %d of %zu "
+                "points above 0.01\n",
+                sets.back().c_str(), worst, at.x, at.z, leaking, points.size());
+    EXPECT_LE(worst, bound) << sets.back();
+  }
+}
+
 // (b) On the default scene with a 5-degree sun (content/scenes/soft/sun_5deg.json), PCSS's
 // visibility is closer to the ray-traced area-light reference (256 stratified samples per pixel)
 // than hard 3x3 PCF's, and its RMSE stays below a bound. The same for the spot light of
