@@ -22,9 +22,14 @@ struct Light {
   /// first directional light unless the file says false (scene_io, gltf_loader).
   bool cast_shadows = false;
   /// Directional only: apex angle of the cone of directions the light arrives from, degrees, in
-  /// [0, 45] (the sun: about 0.53). 0 = punctual. The ray-traced reference's area visibility uses
-  /// it (reference_light()); the shadow maps are hard until soft shadows land.
+  /// [0, 45] (the sun: about 0.53). 0 = punctual. The ray-traced reference's area visibility and
+  /// ShadowTechnique::pcss use it.
   float angular_size_deg = 0.0f;
+  /// Spot and point only: the emitter's radius in metres, in [0, 100]; 0 = punctual. Shadows see
+  /// it as a square of side 2 * radius centred on the light and facing along its direction (the
+  /// ray-traced reference's square emitter, S1's square light; pcss's light width l = 2 radius).
+  /// Shading stays punctual.
+  float radius = 0.0f;
 };
 
 /// World-space direction a light shines along: its world matrix applied to local (0, 0, -1),

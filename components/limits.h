@@ -1,5 +1,6 @@
 // The engine's fixed limits, defined once: the C++ side sizes its arrays with them and the shader
-// library defines them in every program (MAX_LIGHTS, MAX_CASCADES, MAX_SHADOW_VIEWS; see
+// library defines them in every program (MAX_LIGHTS, MAX_CASCADES, MAX_SHADOW_VIEWS,
+// PCSS_MAX_RADIUS; see
 // FeatureManifest::defines), so the FrameBlock layout of both sides follows from one place.
 #pragma once
 
@@ -12,6 +13,12 @@ inline constexpr int kMaxLights = 8;
 inline constexpr int kMaxCascades = 8;
 /// Shadow views per frame: one per shadowed light, all in one depth texture array.
 inline constexpr int kMaxShadowedLights = 4;
+
+/// PCSS's widest blocker search and filter radius, texels (PCSS_MAX_RADIUS in the shaders): bounds
+/// the cost of sparse taps over huge regions (a receiver far behind the map's near plane);
+/// penumbrae wider than twice this are cut. Local lights keep this many texels (plus one) free at
+/// their maps' edges (filter_reach_texels()).
+inline constexpr int kPcssMaxRadiusTexels = 48;
 
 /// Layers of the shadow map array at most (every view at its most layers).
 inline constexpr int kMaxShadowLayers = kMaxShadowedLights * kMaxCascades;

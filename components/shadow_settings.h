@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <string>
 
+#include "components/limits.h"
+
 namespace kaskad {
 
 enum class CullMode { back, front, none };
@@ -29,6 +31,31 @@ enum class SplitScheme {
 
 /// Depth attachment format of the shadow maps.
 enum class DepthFormat { d16, d24, d32f };
+
+/// How visibility is estimated from the depth map (issue 14). A frame shader feature
+/// (VARIANT_SHADOW_TECHNIQUE), never a uniform branch.
+enum class ShadowTechnique {
+  pcf,   ///< percentage-closer filtering with a fixed footprint (filter, pcf_kernel): hard shadows
+         ///< smoothed over the kernel, whatever the light's size
+  pcss,  ///< percentage-closer soft shadows (Fernando 2005): blocker search over a region sized
+         ///< by the light, average blocker depth, penumbra width w = l (d_r - d_b) / d_b, then
+         ///< PCF over w (Poisson-like disc of pcf_taps taps). Needs a light with a size
+         ///< (Light::angular_size_deg or Light::radius); a punctual light gives hard shadows
+  backprojection,  ///< Guennebaud, Barthe, Paulin 2006: every depth-map texel in the region
+                   ///< PCSS searches that lies in front of the receiver is back-projected from
+                   ///< the receiver onto the light and the covered parts of the light summed
+                   ///< (overlaps are counted twice: too dark where blockers overlap, S1's point)
+};
+
+/// The PCF footprint when filter is pcf3x3 and technique pcf.
+enum class PcfKernel {
+  k3x3,     ///< S4's 3x3 box of nearest compares (four compare-gathers)
+  k5x5,     ///< N x N boxes of nearest compares, from compare-gathers (one per 2x2 texels)
+  k7x7,
+  k9x9,
+  poisson,  ///< pcf_taps taps on a disc of radius pcf_radius texels, rotated per point by a hash
+            ///< of its position in the light's texel grid (still when the camera moves)
+};
 
 /// How a cascade's light projection is fitted.
 enum class FitMode {
@@ -62,8 +89,8 @@ enum class CascadeSelection {
   map_bounds,  ///< the first cascade whose map contains the point (uses the stable fit's slack)
 };
 
-/// Per shadowed light, except map_size, depth_format, filter, selection, layered and
-/// debug_cascades: every light's layers share one texture array and the shader features are per
+/// Per shadowed light, except map_size, depth_format, filter, technique, pcf_kernel, selection,
+/// layered and debug_cascades: every light's layers share one texture array and the shader features are per
 /// frame, so the first shadowed light's values of these apply to all (update_shadows() warns
 /// once, naming the fields, when another light's own differ).
 struct ShadowSettings {
@@ -79,6 +106,17 @@ struct ShadowSettings {
   CullMode cull = CullMode::back; ///< back is the default for the shadow pass (S2); front reduces
                                   ///< acne but loses single-sided casters (S4, S2)
   ShadowFilter filter = ShadowFilter::pcf3x3;  ///< S4's 3x3 PCF by default
+  /// pcf: today's hard-edged PCF (the default); pcss: soft shadows from the light's size.
+  ShadowTechnique technique = ShadowTechnique::pcf;
+  /// Footprint of filter pcf3x3 with technique pcf. 3x3 by default (S4). Wider kernels reach
+  /// (N - 1) / 2 texels and use a receiver-plane depth bias (Isidoro 2006) on top of slope_bias.
+  PcfKernel pcf_kernel = PcfKernel::k3x3;
+  /// Taps of the Poisson-like disc, in [8, 64], for pcf_kernel poisson and for pcss's blocker
+  /// search and filter. 16: NVIDIA's PCSS sample (Bavoil, "Integrating Realistic Soft Shadows
+  /// into Your Game Engine", 2008) uses 16 Poisson taps for each of the two steps.
+  int pcf_taps = 16;
+  /// Radius of the poisson kernel in texels, in [1, 16]. 2.5: about the reach of a 5x5 box.
+  float pcf_radius = 2.5f;
 
   /// N, in [1, 8]. 4: S0 recommends 3..5 (fewer is barely better than one map; each more costs
   /// a scene render).
@@ -133,6 +171,24 @@ struct ShadowSettings {
   PointShadowMode point_mode = PointShadowMode::cube;
 };
 
+/// Texels a lookup reaches from the point's texel: 1.5 for S4's 3x3 (and the single taps), N / 2
+/// for an N x N box, the disc's radius plus one (its taps filter linearly) for poisson, and PCSS's
+/// largest radius plus one. Local lights keep this (plus the normal offset and one spare) free at
+/// their maps' edges; map_bounds selection likewise (shadow.glsl's filter_reach(); change
+/// together).
+inline float filter_reach_texels(const ShadowSettings& s) {
+  if (s.technique != ShadowTechnique::pcf) return float(kPcssMaxRadiusTexels) + 1.0f;
+  if (s.filter != ShadowFilter::pcf3x3) return 1.5f;
+  switch (s.pcf_kernel) {
+    case PcfKernel::k3x3: return 1.5f;
+    case PcfKernel::k5x5: return 2.5f;
+    case PcfKernel::k7x7: return 3.5f;
+    case PcfKernel::k9x9: return 4.5f;
+    case PcfKernel::poisson: return s.pcf_radius + 1.0f;
+  }
+  return 1.5f;
+}
+
 namespace shadow_settings_detail {
 /// Shortest readable form of a setting ("1.2", not "1.200000").
 inline std::string str(float v) {
@@ -158,6 +214,16 @@ inline std::string validate_shadow_settings(const ShadowSettings& s) {
   const int filter = static_cast<int>(s.filter);
   if (filter < 0 || filter > static_cast<int>(ShadowFilter::pcf3x3))
     return "filter must be none, bilinear or pcf3x3, was " + std::to_string(filter);
+  const int technique = static_cast<int>(s.technique);
+  if (technique < 0 || technique > static_cast<int>(ShadowTechnique::backprojection))
+    return "technique must be pcf, pcss or backprojection, was " + std::to_string(technique);
+  const int kernel = static_cast<int>(s.pcf_kernel);
+  if (kernel < 0 || kernel > static_cast<int>(PcfKernel::poisson))
+    return "pcf_kernel must be 3, 5, 7, 9 or poisson, was " + std::to_string(kernel);
+  if (s.pcf_taps < 8 || s.pcf_taps > 64)
+    return "pcf_taps must be in [8, 64], was " + std::to_string(s.pcf_taps);
+  if (!(s.pcf_radius >= 1.0f && s.pcf_radius <= 16.0f))
+    return "pcf_radius must be in [1, 16] texels, was " + str(s.pcf_radius);
   if (s.cascade_count < 1 || s.cascade_count > 8)
     return "cascade_count must be in [1, 8], was " + std::to_string(s.cascade_count);
   const int scheme = static_cast<int>(s.split_scheme);

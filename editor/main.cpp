@@ -47,6 +47,21 @@ bool shadow_panel(ShadowSettings& s) {
     s.filter = ShadowFilter(filter);
     changed = true;
   }
+  // Soft shadows (issue 14): frame shader features, so a change compiles a program once.
+  int technique = int(s.technique);
+  const char* techniques[] = {"pcf (hard)", "pcss (Fernando 2005)", "backprojection (2006)"};
+  if (ImGui::Combo("technique", &technique, techniques, 3)) {
+    s.technique = ShadowTechnique(technique);
+    changed = true;
+  }
+  int kernel = int(s.pcf_kernel);
+  const char* kernels[] = {"3x3", "5x5", "7x7", "9x9", "poisson disc"};
+  if (ImGui::Combo("pcf kernel", &kernel, kernels, 5)) {
+    s.pcf_kernel = PcfKernel(kernel);
+    changed = true;
+  }
+  changed |= ImGui::SliderInt("disc taps", &s.pcf_taps, 8, 64);
+  changed |= ImGui::SliderFloat("disc radius (texels)", &s.pcf_radius, 1.0f, 16.0f);
   int cull = int(s.cull);
   const char* culls[] = {"back", "front", "none"};
   if (ImGui::Combo("shadow cull", &cull, culls, 3)) {
@@ -193,6 +208,11 @@ int run_editor(int argc, char** argv) {
             ImGui::Checkbox("cast shadows", &light.cast_shadows);
             ImGui::SliderFloat("intensity", &light.intensity, 0.0f, 10.0f);
             ImGui::ColorEdit3("colour", &light.color[0]);
+            // The light's size (soft shadows and the area-light reference).
+            if (light.type == LightType::directional)
+              ImGui::SliderFloat("angular size (deg)", &light.angular_size_deg, 0.0f, 45.0f);
+            else
+              ImGui::SliderFloat("radius (m)", &light.radius, 0.0f, 2.0f);
             shadow_panel(s);
           }
           ImGui::PopID();

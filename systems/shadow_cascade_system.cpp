@@ -78,8 +78,9 @@ void fit_local_light(const Light& light, const LightFrame& frame, ShadowData& ou
     out.light = ecs::kNullEntity;  // nothing within range
     return;
   }
-  // Texels kept free at the map edges: the 3x3 PCF reach (1.5), the normal offset, 1 spare.
-  const float border = 2.5f + s.normal_offset_bias;
+  // Texels kept free at the map edges: the lookup's reach (1.5 for the 3x3 PCF), the normal
+  // offset, 1 spare.
+  const float border = filter_reach_texels(s) + 1.0f + s.normal_offset_bias;
   float tan_half = 0.0f;  // paraboloid maps clip by distance
   if (light.type == LightType::spot)
     tan_half = spot_tan_half_fov(light.outer_cone_deg, s.map_size, border);
@@ -247,12 +248,19 @@ std::vector<std::uint32_t> cull_casters(const glm::mat4& light_view_proj,
   return out;
 }
 
+float light_size_for_shadows(const Light& light) {
+  if (light.type == LightType::directional)
+    return 2.0f * std::tan(0.5f * glm::radians(light.angular_size_deg));
+  return 2.0f * light.radius;
+}
+
 namespace {
 
 // The maps of one shadowed light (entity `e`, null for none). Errors are logged when they differ
 // from `last_error`, which is updated. `previous` is this slot's last result (freeze_cascades).
 /// `shared`: for lights after the first, the first light's settings whose map_size,
-/// depth_format, filter, selection, layered and debug_cascades apply to every light (one shared
+/// depth_format, filter, technique, pcf_kernel, selection, layered and debug_cascades apply to
+/// every light (one shared
 /// texture array, one set of shader features). They are applied before fitting, so texel sizes
 /// and the stable fit's snapping use the real map size.
 ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera, ecs::Entity e,
@@ -275,6 +283,8 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
     out.settings.map_size = shared->map_size;
     out.settings.depth_format = shared->depth_format;
     out.settings.filter = shared->filter;
+    out.settings.technique = shared->technique;
+    out.settings.pcf_kernel = shared->pcf_kernel;
     out.settings.selection = shared->selection;
     out.settings.layered = shared->layered;
     out.settings.debug_cascades = shared->debug_cascades;
@@ -317,6 +327,7 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
     out.light = ecs::kNullEntity;  // nothing to shadow
     return finish();
   }
+  out.light_size = light_size_for_shadows(light_component);
   if (light_component.type != LightType::directional) {
     fit_local_light(light_component, light, out, caster_boxes, caster_entities, receiver_boxes);
     return finish();
@@ -515,6 +526,8 @@ std::vector<ShadowData> fit_shadowed_lights(const ecs::World& world, const Camer
       check(own->map_size == shared->map_size, "map_size");
       check(own->depth_format == shared->depth_format, "depth_format");
       check(own->filter == shared->filter, "filter");
+      check(own->technique == shared->technique, "technique");
+      check(own->pcf_kernel == shared->pcf_kernel, "pcf_kernel");
       check(own->selection == shared->selection, "selection");
       check(own->layered == shared->layered, "layered");
       check(own->debug_cascades == shared->debug_cascades, "debug_cascades");

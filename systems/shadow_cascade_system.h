@@ -15,6 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "components/bounds.h"
+#include "components/light.h"
 #include "components/shadow_settings.h"
 #include "runtime/ecs/world.h"
 #include "components/limits.h"
@@ -25,11 +26,18 @@
 namespace kaskad {
 
 /// One shadowed light's view this frame: what the renderer and the stats need of it.
+/// The size of `light` in the units soft shadows need (ShadowData::light_size). A directional
+/// light of angular size theta is a cone of directions: a blocker at distance D above a receiver
+/// (along the light) hides it from directions within theta / 2 of the axis up to D tan(theta / 2)
+/// to each side, so the penumbra is 2 D tan(theta / 2) wide (= D tan(theta) to first order):
+/// 2 tan(theta / 2) per metre of D. A spot or point light is a square of side l = 2 radius.
+float light_size_for_shadows(const Light& light);
+
 struct ShadowData {
   ecs::Entity light = ecs::kNullEntity;  ///< the shadowed light, null when there is none
   /// The light's own (else defaults), except the fields that belong to the shared texture array
-  /// and the frame's shader features: map_size, depth_format, filter, selection, layered and
-  /// debug_cascades are the first view's in every view (update_shadows() warns when they differ).
+  /// and the frame's shader features: map_size, depth_format, filter, technique, pcf_kernel,
+  /// selection, layered and debug_cascades are the first view's in every view (update_shadows() warns when they differ).
   ShadowSettings settings;
   /// ortho: a directional light's cascades; perspective: a spot light's map; cube or
   /// dual_paraboloid: a point light's maps (settings.point_mode).
@@ -51,6 +59,10 @@ struct ShadowData {
   std::array<float, kMaxCascades + 1> splits{};
   /// dual_paraboloid: how far past its rim each hemisphere is drawn (paraboloid_margin()).
   float paraboloid_margin = 0.0f;
+  /// The light's size as soft shadows use it (light_size_for_shadows()): directional, the
+  /// penumbra width per metre between blocker and receiver, 2 tan(angular size / 2); spot and
+  /// point, the emitter's width l = 2 radius, metres. 0: punctual.
+  float light_size = 0.0f;
   /// Metres per shadow-map texel of each cascade (the larger of x and y). Spot and point lights:
   /// metres per texel at 1 m from the light (the shader scales by the distance).
   std::array<float, kMaxCascades> texel_size{};

@@ -12,6 +12,7 @@ struct ShadowView {
   vec4 texel[2];                 // metres per texel per layer: view_texel(k, i)
   ivec4 info;                    // x light index, y first layer, z layer count
   vec4 params;                   // x normal offset (texels), y blend band, z paraboloid margin
+  vec4 soft;                     // x light size (ShadowView::light_size), y disc radius (texels), z taps
 };
 
 layout(std140, binding = 0) uniform FrameBlock {

@@ -3,6 +3,22 @@
 // Needs common.glsl and features.glsl first.
 #if VARIANT_HAS_SHADOW
 layout(binding = UNIT_SHADOW) uniform sampler2DArrayShadow u_shadow_map;  // one layer per cascade
+// The wide lookups (issue 14): PCF kernels past 3x3 and PCSS. They compare each tap against the
+// receiver plane (receiver_slope()) and rotate their discs per point (stable_angle()).
+#if VARIANT_SHADOW_TECHNIQUE != VARIANT_SHADOW_TECHNIQUE_PCF || \
+    (VARIANT_SHADOW_FILTER == VARIANT_SHADOW_FILTER_PCF3X3 && \
+     VARIANT_SHADOW_KERNEL != VARIANT_SHADOW_KERNEL_3X3)
+#define SHADOW_WIDE 1
+// The same map compared with linear filtering: each disc tap is a hardware 2x2 PCF, so few taps
+// still give smooth ramps.
+layout(binding = UNIT_SHADOW_LINEAR) uniform sampler2DArrayShadow u_shadow_linear;
+#endif
+#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS || \
+    VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_BACKPROJECTION
+#define SHADOW_SIZED 1  // lookups that use the light's size (PcssMap below)
+// The same map without compare: raw depths for PCSS's blocker search and backprojection.
+layout(binding = UNIT_SHADOW_DEPTH) uniform sampler2DArray u_shadow_depth;
+#endif
 #endif
 
 // Visibility of shadow view k's light at world position p with geometric normal n: 1 lit, 0
@@ -57,6 +73,296 @@ float shadow_taps(int layer, vec3 c) {
 #endif
 }
 
+#ifdef SHADOW_WIDE
+// Map coordinates of world point x in layer i of view k: xy texture coordinates, z depth in
+// [0, 1] (S0's M_bias after the projection).
+vec3 map_coords(int k, int i, vec3 x) {
+  vec4 clip = u_shadow_views[k].view_proj[i] * vec4(x, 1.0);
+  return clip.xyz / clip.w * 0.5 + 0.5;
+}
+
+// The way view k's light travels at q (unit).
+vec3 light_travel(int k, vec3 q) {
+  int light = u_shadow_views[k].info.x;
+  return u_light_info[light].x == LIGHT_DIRECTIONAL ? u_light_dir[light].xyz
+                                                     : normalize(q - u_light_pos[light].xyz);
+}
+
+// Receiver plane depth bias (Isidoro, "Shadow Mapping: GPU-based Tips and Techniques", GDC
+// 2006): d depth / d uv of the plane through q (map coordinates c) with normal n, so a tap at
+// uv offset o compares against c.z + dot(g, o), the plane's own depth there, instead of the
+// centre's; kernels wider than 3x3 then need no more slope_bias than 3x3. From the map
+// coordinates of two points of the plane `step` metres from q, not from screen derivatives (the
+// points pass has none). Clamped to the slope of a plane 83 degrees from facing the light
+// (tan = 8), so a plane seen edge-on cannot push the taps' references far behind the map.
+vec2 receiver_slope(int k, int i, vec3 q, vec3 n, vec3 c, float step) {
+  vec3 t1 = normalize(cross(n, abs(n.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0)));
+  vec3 t2 = cross(n, t1);
+  vec3 a = map_coords(k, i, q + step * t1) - c;
+  vec3 b = map_coords(k, i, q + step * t2) - c;
+  float det = a.x * b.y - a.y * b.x;
+  if (abs(det) < 1e-20) return vec2(0.0);
+  // g . a.xy = a.z and g . b.xy = b.z (Cramer's rule).
+  vec2 g = vec2(a.z * b.y - a.y * b.z, a.x * b.z - a.z * b.x) / det;
+  // Depth per uv of that steepest plane: depth per metre along the light x metres per uv x 8.
+  float along = abs(map_coords(k, i, q + step * light_travel(k, q)).z - c.z);
+  float lateral = length(a.xy) + length(b.xy);  // uv per `step` metres, two directions
+  float limit = 8.0 * along * 2.0 / max(lateral, 1e-20);
+  float len = length(g);
+  return len > limit ? g * (limit / len) : g;
+}
+
+// PCG3D (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020).
+uvec3 pcg3d(uvec3 v) {
+  v = v * 1664525u + 1013904223u;
+  v.x += v.y * v.z; v.y += v.z * v.x; v.z += v.x * v.y;
+  v ^= v >> 16u;
+  v.x += v.y * v.z; v.y += v.z * v.x; v.z += v.x * v.y;
+  return v;
+}
+
+// The disc kernels' rotation at world point q (map coordinates c in layer i of view k): a hash
+// of the cell, an eighth of a texel wide, of the map's texel grid that q falls in, numbered in
+// world-fixed coordinates, so a surface point keeps its angle while the camera moves and rotated
+// kernels trade banding for noise without shimmering. A cascade's grid moves in whole texels
+// (stable fit), which renumbers map coordinates: its cells are numbered from the projection's
+// linear part alone (no translation), i.e. from q's position along the light's axes in texels.
+// A spot map or cube face does not move: its map coordinates serve.
+float stable_angle(int k, int i, vec3 q, vec3 c) {
+  vec2 grid = c.xy;
+  bool ortho = true;
+#if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_PERSPECTIVE || \
+    VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_CUBE
+  ortho = k != 0;
+#endif
+  if (ortho) grid = 0.5 * (mat3(u_shadow_views[k].view_proj[i]) * q).xy;
+  ivec2 cell = ivec2(floor(grid * (8.0 * u_frame.y)));
+  uvec3 h = pcg3d(uvec3(uvec2(cell), uint(view_first_layer(k) + i)));
+  return float(h.x >> 8u) * (6.28318531 / 16777216.0);
+}
+
+// Tap i of n of a disc of radius 1: Vogel's sunflower spiral (r = sqrt((i + 1/2) / n), angle i x
+// the golden angle), a Poisson-disc-like pattern that stays even for every n (the first n of a
+// stored Poisson set do not), turned by `angle`.
+vec2 disc_tap(int i, int n, float angle) {
+  float r = sqrt((float(i) + 0.5) / float(n));
+  float a = float(i) * 2.39996323 + angle;
+  return r * vec2(cos(a), sin(a));
+}
+
+// PCF over a disc of `radius` texels, `taps` linear-filtered compares, each against the receiver
+// plane (slope g).
+float disc_pcf(int layer, vec3 c, vec2 g, float radius, int taps, float angle) {
+  float scale = radius / u_frame.y;
+  float sum = 0.0;
+  for (int i = 0; i < taps; ++i) {
+    vec2 o = disc_tap(i, taps, angle) * scale;
+    sum += texture(u_shadow_linear, vec4(c.xy + o, float(layer), c.z + dot(g, o)));
+  }
+  return sum / float(taps);
+}
+
+#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCF && \
+    VARIANT_SHADOW_KERNEL != VARIANT_SHADOW_KERNEL_POISSON
+// Side of the N x N box: 5, 7 or 9 (VARIANT_SHADOW_KERNEL 1, 2, 3).
+#define PCF_SIDE (2 * VARIANT_SHADOW_KERNEL + 3)
+// The N x N nearest compares of texels t - h .. t + h around the point's texel t (h = (N - 1) / 2)
+// as compare-gathers over the (N + 1)^2 block, as the 3x3 in shadow_taps() (which this equals
+// for N = 3 up to the receiver plane): a gather at texel coordinate t - h + 1 + 2i returns
+// texels t - h + 2i and t - h + 2i + 1, and the last gather of each row and column drops its
+// texel t + h + 1. Components: x (i0, j1), y (i1, j1), z (i1, j0), w (i0, j0). Each gather
+// compares against the receiver plane at its centre.
+float box_pcf(int layer, vec3 c, vec2 g) {
+  const int h = (PCF_SIDE - 1) / 2;
+  vec2 size = vec2(textureSize(u_shadow_map, 0).xy);
+  vec2 t = floor(c.xy * size);
+  float sum = 0.0;
+  for (int j = 0; j <= h; ++j) {
+    for (int i = 0; i <= h; ++i) {
+      vec2 uv = (t + vec2(float(2 * i + 1 - h), float(2 * j + 1 - h))) / size;
+      vec4 s = textureGather(u_shadow_map, vec3(uv, float(layer)), c.z + dot(g, uv - c.xy));
+      float wi = i < h ? 1.0 : 0.0, wj = j < h ? 1.0 : 0.0;
+      sum += s.w + wi * s.z + wj * s.x + wi * wj * s.y;
+    }
+  }
+  return sum / float(PCF_SIDE * PCF_SIDE);
+}
+#endif
+
+#ifdef SHADOW_SIZED
+// Percentage-closer soft shadows (Fernando, "Percentage-Closer Soft Shadows", SIGGRAPH 2005
+// sketch) in layer i of view k at map coordinates c (receiver q). Light size l = soft.x
+// (ShadowData::light_size). The blocker search and the filter take `taps` disc taps each.
+//
+// Perspective maps (spot light, cube face): a square light of width l at the centre of
+// projection, the receiver at distance d_r along the axis and a blocker at d_b. The ray from
+// the receiver to a light point s off the centre (|s| <= l / 2) crosses depth d_b at map
+// coordinate (tangent units) x_r / d_r + s (1 / d_b - 1 / d_r): blockers that can hide part of
+// the light lie within (l / 2) (d_r - d_b) / (d_b d_r) of the receiver's map point. With
+// d_b >= near that is the search radius; with d_b = the average blocker depth it is the filter
+// radius, and it is half of Fernando's penumbra w = l (d_r - d_b) / d_b measured at the receiver
+// (w / d_r tangent units). view_texel(k, i) is the texel in tangent units (metres at 1 m).
+//
+// Ortho maps (a directional light's cascades): the light is a cone of directions of apex angle
+// theta, l = 2 tan(theta / 2). A ray from the receiver at angle phi <= theta / 2 from the axis
+// is D tan(phi) off the receiver's map point at height D above it: the radius is (l / 2) D with
+// D = (d_r - d_b) in metres, i.e. the penumbra w = l (d_r - d_b) = 2 (d_r - d_b) tan(theta / 2)
+// (~ (d_r - d_b) tan(theta) for small angles), Fernando's similar triangles with the light at
+// infinity. Each cascade converts metres to its own texels (view_texel(k, i)) and depth to
+// metres by its projection (depth per metre = |third row of view_proj| / 2), so the penumbra is
+// the same width in every cascade.
+struct PcssMap {
+  bool perspective;
+  float near, far;         // perspective: the projection's near and far, metres
+  float depth_per_metre;   // ortho
+  float texel;             // ortho: metres; perspective: tangent units
+};
+
+// Depth in [0, 1] -> distance: metres from the map's near plane (ortho), metres from the light
+// along the axis (perspective, GL's [-1, 1] clip depth).
+float pcss_distance(PcssMap m, float z) {
+  return m.perspective ? 2.0 * m.near * m.far / (m.far + m.near - (2.0 * z - 1.0) * (m.far - m.near))
+                       : z / m.depth_per_metre;
+}
+
+// Radius in texels of the map region where a blocker at distance d_b can hide part of the light
+// from a receiver at d_r (above).
+float pcss_radius(PcssMap m, float l, float d_r, float d_b) {
+  return m.perspective ? 0.5 * l * (d_r - d_b) / (d_b * d_r * m.texel)
+                       : 0.5 * l * (d_r - d_b) / m.texel;
+}
+
+// Layer i of view k as the sized lookups see it.
+PcssMap pcss_map(int k, int i) {
+  PcssMap map;
+  map.perspective = false;
+#if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_PERSPECTIVE || \
+    VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_CUBE
+  map.perspective = k == 0;
+#endif
+  map.near = view_split(k, 0);
+  map.far = view_split(k, 1);
+  mat4 m = u_shadow_views[k].view_proj[i];
+  map.depth_per_metre = 0.5 * length(vec3(m[0][2], m[1][2], m[2][2]));
+  map.texel = view_texel(k, i);
+  return map;
+}
+#endif
+
+#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS
+float pcss(int k, int i, int layer, vec3 c, vec2 g, float angle) {
+  float l = u_shadow_views[k].soft.x;
+  int taps = int(u_shadow_views[k].soft.z);
+  PcssMap map = pcss_map(k, i);
+  float d_r = pcss_distance(map, c.z);
+  // 1. Blocker search over the region of every blocker between the map's near plane and the
+  //    receiver (ortho: the near plane is depth 0).
+  float search = clamp(pcss_radius(map, l, d_r, map.perspective ? map.near : 0.0), 1.0,
+                       PCSS_MAX_RADIUS);
+  float scale = search / u_frame.y;
+  float blockers = 0.0, sum = 0.0;
+  for (int t = 0; t < taps; ++t) {
+    vec2 o = disc_tap(t, taps, angle) * scale;
+    float z = texture(u_shadow_depth, vec3(c.xy + o, float(layer))).r;
+    if (z < c.z + dot(g, o)) {
+      sum += z;
+      blockers += 1.0;
+    }
+  }
+  if (blockers == 0.0) return 1.0;  // nothing between the light and the receiver
+  // 2. Average blocker depth -> 3. penumbra radius (above) -> 4. PCF over it, at least the
+  //    3x3 kernel's reach so contact shadows stay filtered.
+  float d_b = pcss_distance(map, sum / blockers);
+  float radius = clamp(pcss_radius(map, l, d_r, d_b), 1.5, PCSS_MAX_RADIUS);
+  return disc_pcf(layer, c, g, radius, taps, angle);
+}
+#endif
+
+#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_BACKPROJECTION
+// Cells per side of the backprojection kernel: 2 BP_HALF + 1.
+#define BP_HALF 12
+
+// Length of [a0, a1] inside [-h, h].
+float overlap_1d(float a0, float a1, float h) { return max(0.0, min(a1, h) - max(a0, -h)); }
+
+// Backprojection soft shadows (Guennebaud, Barthe, Paulin, "Real-time Soft Shadow Mapping by
+// Backprojection", EGSR 2006) in layer i of view k at map coordinates c. Every depth-map cell in
+// PCSS's search region (pcss()) that lies in front of the receiver is a micro-occluder: a square
+// as wide as the cell at its stored depth. It is back-projected from the receiver onto the light
+// and the part of the light it covers is summed; visibility = 1 - the sum, clamped. Overlapping
+// micro-occluders are all counted, so where blockers overlap as seen from the receiver the
+// shadow comes out too dark (S1's criticism; layered occlusion maps fix it).
+//
+// The region: PCSS's blocker search (disc taps over the widest region) finds the blocker nearest
+// the light, d_min; only blockers up to there can hide part of the light, so the region is
+// pcss_radius(d_min) (S1's kernel from the nearest occluder). It is covered by
+// (2 BP_HALF + 1)^2 cells of `step` texels each (step = 1 up to a radius of BP_HALF texels;
+// wider regions read one depth per coarser cell, the stand-in for the paper's hierarchical
+// map).
+//
+// Light plane coordinates of a cell u tangent units (perspective) off the receiver's map point,
+// at depth d_b, seen from the receiver at d_r: the line from the receiver through it reaches the
+// light's plane (distance 0) at u d_r d_b / (d_r - d_b) metres, and the light is the square
+// [-l/2, l/2]^2 (Light::radius). Ortho: a cell x metres off the receiver's map point at height
+// D = d_r - d_b above it is seen in direction x / D (tangent units); the light is the cone of
+// half-angle theta / 2, taken as the square of the same solid angle, side
+// l sqrt(pi) / 2 (l = 2 tan(theta / 2)).
+float backprojection(int k, int i, int layer, vec3 c, vec2 g, float angle) {
+  float l = u_shadow_views[k].soft.x;
+  if (l <= 0.0) return texture(u_shadow_map, vec4(c.xy, float(layer), c.z));  // punctual
+  PcssMap map = pcss_map(k, i);
+  float size = u_frame.y;
+  float half_light = map.perspective ? 0.5 * l : 0.5 * l * 0.88622693;  // sqrt(pi) / 2
+  float d_r = pcss_distance(map, c.z);
+  float search = clamp(pcss_radius(map, l, d_r, map.perspective ? map.near : 0.0), 1.0,
+                       PCSS_MAX_RADIUS);
+  int taps = int(u_shadow_views[k].soft.z);
+  float z_min = c.z;
+  for (int t = 0; t < taps; ++t) {
+    vec2 o = disc_tap(t, taps, angle) * (search / size);
+    float z = texture(u_shadow_depth, vec3(c.xy + o, float(layer))).r;
+    if (z < c.z + dot(g, o)) z_min = min(z_min, z);
+  }
+  if (z_min >= c.z) return 1.0;  // no blocker found
+  float radius = clamp(pcss_radius(map, l, d_r, pcss_distance(map, z_min)) + 1.0, 1.0, search);
+  float step = max(1.0, ceil(radius / float(BP_HALF)));
+  vec2 centre = (floor(c.xy * size) + 0.5) / size;  // the receiver's texel
+  float blocked = 0.0;
+  for (int y = -BP_HALF; y <= BP_HALF; ++y) {
+    for (int x = -BP_HALF; x <= BP_HALF; ++x) {
+      vec2 uv = centre + vec2(float(x), float(y)) * (step / size);
+      float z = texture(u_shadow_depth, vec3(uv, float(layer))).r;
+      if (z >= c.z + dot(g, uv - c.xy)) continue;  // not in front of the receiver
+      float d_b = pcss_distance(map, z);
+      if (d_b >= d_r) continue;
+      // The cell's extent relative to the receiver's map point, in texels, then on the light.
+      vec2 lo = (uv - c.xy) * size - 0.5 * step, hi = lo + step;
+      float f = map.perspective ? map.texel * d_r * d_b / (d_r - d_b) : map.texel / (d_r - d_b);
+      blocked += overlap_1d(lo.x * f, hi.x * f, half_light) * overlap_1d(lo.y * f, hi.y * f, half_light);
+    }
+  }
+  return clamp(1.0 - blocked / (4.0 * half_light * half_light), 0.0, 1.0);
+}
+#endif
+
+// The wide lookup of layer i of view k at map coordinates c, for the receiver q (offset point)
+// with normal n; texel: metres per texel at q.
+float wide_taps(int k, int i, vec3 c, vec3 q, vec3 n, float texel) {
+  int layer = view_first_layer(k) + i;
+  vec2 g = receiver_slope(k, i, q, n, c, texel);
+#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS
+  return pcss(k, i, layer, c, g, stable_angle(k, i, q, c));
+#elif VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_BACKPROJECTION
+  return backprojection(k, i, layer, c, g, stable_angle(k, i, q, c));
+#elif VARIANT_SHADOW_KERNEL == VARIANT_SHADOW_KERNEL_POISSON
+  return disc_pcf(layer, c, g, u_shadow_views[k].soft.y, int(u_shadow_views[k].soft.z),
+                  stable_angle(k, i, q, c));
+#else
+  return box_pcf(layer, c, g);
+#endif
+}
+#endif
+
 // Cascade c of view k. The point moves along the normal by normal_offset texels of this cascade
 // (MJP's normal offset), so the bias follows each cascade's resolution.
 float cascade_visibility(int k, int c, vec3 p, vec3 n) {
@@ -64,7 +370,11 @@ float cascade_visibility(int k, int c, vec3 p, vec3 n) {
   vec4 clip = u_shadow_views[k].view_proj[c] * vec4(q, 1.0);
   vec3 t = clip.xyz / clip.w * 0.5 + 0.5;  // S0's M_bias
   if (t.z > 1.0) return 1.0;
+#ifdef SHADOW_WIDE
+  return wide_taps(k, c, t, q, n, view_texel(k, c));
+#else
   return shadow_taps(view_first_layer(k) + c, t);
+#endif
 }
 
 #if VARIANT_SHADOW_PROJECTION != VARIANT_SHADOW_PROJECTION_ORTHO
@@ -87,7 +397,11 @@ float perspective_visibility(int k, int layer, vec3 p, vec3 n) {
   if (clip.w <= 0.0) return 1.0;  // behind the light
   vec3 c = clip.xyz / clip.w * 0.5 + 0.5;
   if (c.z > 1.0) return 1.0;
+#ifdef SHADOW_WIDE
+  return wide_taps(k, layer, c, q, n, view_texel(k, layer) * distance(q, view_light_position(k)));
+#else
   return shadow_taps(view_first_layer(k) + layer, c);
+#endif
 }
 #endif
 
@@ -123,8 +437,22 @@ float paraboloid_visibility(int k, vec3 p, vec3 n, out int hemisphere) {
 #endif
 
 #if VARIANT_CASCADE_SELECTION == VARIANT_CASCADE_SELECTION_MAP_BOUNDS
-// Border kept free in NDC: the PCF kernel's reach plus the normal offset, in texels.
-float map_border(int k) { return 2.0 * (1.5 + u_shadow_views[k].params.x) / u_frame.y; }
+// Texels the lookup reaches from the point's texel; filter_reach_texels() in
+// components/shadow_settings.h (change together).
+float filter_reach(int k) {
+#if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS || \
+    VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_BACKPROJECTION
+  return PCSS_MAX_RADIUS + 1.0;
+#elif VARIANT_SHADOW_KERNEL == VARIANT_SHADOW_KERNEL_POISSON
+  return u_shadow_views[k].soft.y + 1.0;
+#elif defined(PCF_SIDE)
+  return 0.5 * float(PCF_SIDE);
+#else
+  return 1.5;
+#endif
+}
+// Border kept free in NDC: the lookup's reach plus the normal offset, in texels.
+float map_border(int k) { return 2.0 * (filter_reach(k) + u_shadow_views[k].params.x) / u_frame.y; }
 #endif
 
 // The cascade of view k at a point, -1 outside all. depth: view depth |z_view|.

@@ -54,6 +54,11 @@ const std::vector<std::pair<const char*, CullMode>> kCullModes = {
     {"back", CullMode::back}, {"front", CullMode::front}, {"none", CullMode::none}};
 const std::vector<std::pair<const char*, ShadowFilter>> kFilters = {
     {"none", ShadowFilter::none}, {"bilinear", ShadowFilter::bilinear}, {"pcf3x3", ShadowFilter::pcf3x3}};
+const std::vector<std::pair<const char*, ShadowTechnique>> kTechniques = {
+    {"pcf", ShadowTechnique::pcf}, {"pcss", ShadowTechnique::pcss},
+    {"backprojection", ShadowTechnique::backprojection}};
+// pcf_kernel is written as the box side (3, 5, 7, 9) or "poisson".
+const std::vector<std::pair<const char*, PcfKernel>> kKernelNames = {{"poisson", PcfKernel::poisson}};
 const std::vector<std::pair<const char*, Projection>> kProjections = {
     {"perspective", Projection::perspective}, {"orthographic", Projection::orthographic}};
 const std::vector<std::pair<const char*, PrimitiveShape>> kShapes = {
@@ -86,6 +91,20 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
   r.number("slope_bias", s.slope_bias, 0.0f, 100.0f);
   r.enumeration("cull", s.cull, kCullModes);
   r.enumeration("filter", s.filter, kFilters);
+  r.enumeration("technique", s.technique, kTechniques);
+  if (r.has("pcf_kernel") && r.raw("pcf_kernel").is_number()) {
+    int side = 3;
+    r.integer("pcf_kernel", side, 3, 9);
+    if (side % 2 == 0)
+      fail(r.at("pcf_kernel"), "must be 3, 5, 7, 9 or \"poisson\", was " + std::to_string(side));
+    s.pcf_kernel = PcfKernel((side - 3) / 2);
+  } else if (r.has("pcf_kernel")) {
+    if (!r.raw("pcf_kernel").is_string())
+      fail(r.at("pcf_kernel"), "expected 3, 5, 7, 9 or \"poisson\", got " + type_name(r.raw("pcf_kernel")));
+    r.enumeration("pcf_kernel", s.pcf_kernel, kKernelNames);
+  }
+  r.integer("pcf_taps", s.pcf_taps, 8, 64);
+  r.number("pcf_radius", s.pcf_radius, 1.0f, 16.0f);
   r.integer("cascade_count", s.cascade_count, 1, 8);
   r.enumeration("split_scheme", s.split_scheme, kSplitSchemes);
   r.number("lambda", s.lambda, 0.0f, 1.0f);
@@ -119,6 +138,12 @@ json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
   put("slope_bias", num(s.slope_bias), s.slope_bias != d.slope_bias);
   put("cull", enum_name(s.cull, kCullModes), s.cull != d.cull);
   put("filter", enum_name(s.filter, kFilters), s.filter != d.filter);
+  put("technique", enum_name(s.technique, kTechniques), s.technique != d.technique);
+  put("pcf_kernel",
+      s.pcf_kernel == PcfKernel::poisson ? json("poisson") : json(3 + 2 * int(s.pcf_kernel)),
+      s.pcf_kernel != d.pcf_kernel);
+  put("pcf_taps", s.pcf_taps, s.pcf_taps != d.pcf_taps);
+  put("pcf_radius", num(s.pcf_radius), s.pcf_radius != d.pcf_radius);
   put("cascade_count", s.cascade_count, s.cascade_count != d.cascade_count);
   put("split_scheme", enum_name(s.split_scheme, kSplitSchemes), s.split_scheme != d.split_scheme);
   put("lambda", num(s.lambda), s.lambda != d.lambda);
@@ -224,7 +249,14 @@ bool read_light(ObjectReader& lr, Light& l) {
   const bool cast_given = lr.has("cast_shadows");
   lr.boolean("cast_shadows", l.cast_shadows);
   lr.number("angular_size_deg", l.angular_size_deg, 0.0f, 45.0f);
+  lr.number("radius", l.radius, 0.0f, 100.0f);
   lr.finish();
+  if (l.type == LightType::directional && l.radius > 0.0f)
+    fail(lr.at("radius"), "is for spot and point lights; a directional light's size is "
+                          "angular_size_deg");
+  if (l.type != LightType::directional && l.angular_size_deg > 0.0f)
+    fail(lr.at("angular_size_deg"), "is for directional lights; a spot or point light's size is "
+                                    "radius (metres)");
   if (l.inner_cone_deg > l.outer_cone_deg)
     fail(lr.at("inner_cone_deg"), "must not exceed outer_cone_deg");
   return cast_given;
@@ -415,7 +447,8 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
                   {"inner_cone_deg", num(l->inner_cone_deg)},
                   {"outer_cone_deg", num(l->outer_cone_deg)},
                   {"cast_shadows", l->cast_shadows},
-                  {"angular_size_deg", num(l->angular_size_deg)}};
+                  {"angular_size_deg", num(l->angular_size_deg)},
+                  {"radius", num(l->radius)}};
     if (const auto* s = w.try_get<ShadowSettings>(e)) {
       json sj = write_shadow(*s, &scene.shadow_defaults);
       if (!sj.empty()) j["shadow"] = sj;

@@ -130,6 +130,12 @@ std::string default_sweep() {
          "shadow.filter=none,pcf3x3";
 }
 
+std::string soft_sweep() {
+  return "shadow.technique=pcf;shadow.pcf_kernel=3,5,9|"
+         "shadow.technique=pcf;shadow.pcf_kernel=poisson;shadow.pcf_taps=16,32|"
+         "shadow.technique=pcss;shadow.pcf_taps=16,32|shadow.technique=backprojection";
+}
+
 namespace {
 
 // One cartesian product: "key=v1,v2;key2=w1,w2".
@@ -191,7 +197,9 @@ std::vector<std::string> bench_csv_columns() {
 }
 
 Status run_bench(const BenchOptions& options) {
-  auto configs = parse_sweep(options.sweep.empty() ? default_sweep() : options.sweep);
+  auto configs = parse_sweep(options.sweep.empty()    ? default_sweep()
+                             : options.sweep == "soft" ? soft_sweep()
+                                                       : options.sweep);
   if (!configs) return configs.error();
   std::vector<fs::path> scenes = options.scenes;
   if (scenes.empty()) scenes.push_back(content_dir() / "scenes" / "default.json");

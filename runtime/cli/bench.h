@@ -43,6 +43,11 @@ void print_progress(std::size_t done, std::size_t total, double elapsed_s, const
 /// The sweep used when none is given: the settings whose speed/accuracy trade-off matters.
 std::string default_sweep();
 
+/// `--sweep soft` (issue 14): the soft-shadow techniques and PCF kernels, for scenes whose lights
+/// have a size (content/scenes/soft/): pcf with kernels 3x3, 5x5, 9x9 and a 16- and 32-tap
+/// disc, pcss with 16 and 32 taps, and backprojection. 8 configurations; chart them by rmse.
+std::string soft_sweep();
+
 /// Parses "key=v1,v2;key2=w1,w2" into the cartesian product, in order; products separated by
 /// '|' are concatenated ("a=1;b=2|a=0;b=0" is two configurations). Errors: empty keys, missing
 /// '=', empty value lists, a key given twice within one product.

@@ -49,7 +49,8 @@ usage:
                [--stability-frames N] [--shard i/n]
   kaskad bench --merge SHARD_OUT_DIR... [--out DIR] [--no-chart]
                                     sweep settings, write DIR/bench.csv and one speed-vs-accuracy
-                                    chart per scene (default sweep: see README); flicker at fixed
+                                    chart per scene (default sweep: see README; --sweep soft:
+                                    the soft-shadow techniques and kernels); flicker at fixed
                                     points over an N-frame camera path (default 16, 0 = off)
   kaskad envmap IN [--layout L] [--3dsmax] [--face-size N] [--faces OUT] [--sphere OUT.png]
                 [--sphere-size N]
@@ -270,8 +271,8 @@ int run_variants(const Args& a) {
   std::printf("%s: %zu programs (%s AOVs)\n", scene_path.string().c_str(), requests.size(),
               ctx.write_aovs ? "with" : "without");
   for (const auto& r : requests) {
-    std::printf("\n%-7s key 0x%08x  %s\n", render::pass_name(r.pass),
-                r.key.bits(), manifest->describe(r.key).c_str());
+    std::printf("\n%-7s key 0x%012llx  %s\n", render::pass_name(r.pass),
+                static_cast<unsigned long long>(r.key.bits()), manifest->describe(r.key).c_str());
     std::string defs;
     for (const auto& f : manifest->features())
       defs += " " + f.define + "=" + std::to_string(manifest->value(f, r.key));

@@ -102,5 +102,6 @@ inline Texture make_texture(GLenum target) { GLuint id = 0; glCreateTextures(tar
 inline Framebuffer make_framebuffer() { GLuint id = 0; glCreateFramebuffers(1, &id); return Framebuffer(id); }
 inline VertexArray make_vertex_array() { GLuint id = 0; glCreateVertexArrays(1, &id); return VertexArray(id); }
 inline Query make_query(GLenum target) { GLuint id = 0; glCreateQueries(target, 1, &id); return Query(id); }
+inline Sampler make_sampler() { GLuint id = 0; glCreateSamplers(1, &id); return Sampler(id); }
 
 }  // namespace kaskad::gpu

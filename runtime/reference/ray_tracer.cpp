@@ -342,6 +342,8 @@ ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix
   r.outer_cone_deg = light.type == LightType::spot ? light.outer_cone_deg : 180.0f;
   r.range = light.type == LightType::directional ? 0.0f : light.range;
   r.angular_size_deg = light.type == LightType::directional ? light.angular_size_deg : 0.0f;
+  // Light::radius: a square of side 2 radius (the square the shadow techniques assume).
+  r.size = light.type == LightType::directional ? 0.0f : 2.0f * light.radius;
   return r;
 }
 

@@ -52,8 +52,8 @@ struct ReferenceLight {
 /// The reference light of a Light component on an entity with this world matrix: direction from
 /// the matrix's -Z (as systems/shadow_map_system.cpp light_direction(); change together), right
 /// from its +X, position from its translation; a directional light's angular_size_deg from the
-/// component (an area light when > 0). Spot and point lights are punctual: set size afterwards
-/// for square emitters (the Light component has no emitter size yet).
+/// component (an area light when > 0); a spot or point light's size = 2 Light::radius (a square
+/// emitter of side 2 radius; punctual when the radius is 0).
 ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix);
 
 /// The first surface a ray hits.

@@ -16,6 +16,10 @@ VariantKey frame_variant(const FrameInput& frame) {
     k.set(VariantKey::kShadow, 1);
     k.set(VariantKey::kShadowLightsMinus1, std::uint32_t(views - 1));
     k.set(VariantKey::kShadowFilter, std::uint32_t(s.filter));
+    k.set(VariantKey::kShadowTechnique, std::uint32_t(s.technique));
+    // The kernel is pcf3x3's footprint; pcss filters with its own disc: one key for each.
+    if (s.filter == ShadowFilter::pcf3x3 && s.technique == ShadowTechnique::pcf)
+      k.set(VariantKey::kShadowKernel, std::uint32_t(s.pcf_kernel));
     k.set(VariantKey::kShadowProjection, std::uint32_t(first.projection));
     // Paraboloid hemispheres are projected in code, one pass each: no layered pass for them.
     if (s.layered && first.projection != ShadowProjection::dual_paraboloid)

@@ -176,6 +176,7 @@ std::vector<std::pair<std::string, std::string>> FeatureManifest::defines(Varian
   out.emplace_back("MAX_LIGHTS", std::to_string(kMaxLights));
   out.emplace_back("MAX_CASCADES", std::to_string(kMaxCascades));
   out.emplace_back("MAX_SHADOW_VIEWS", std::to_string(kMaxShadowedLights));
+  out.emplace_back("PCSS_MAX_RADIUS", std::to_string(kPcssMaxRadiusTexels) + ".0");
   // Attribute and uniform locations and texture units, from runtime/render/shader_interface.h.
   for (const auto& [name, value] : shader_interface_defines()) out.emplace_back(name, std::to_string(value));
   return out;

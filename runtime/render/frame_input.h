@@ -93,6 +93,13 @@ struct ShadowView {
   float normal_offset = 0.0f;
   float blend_band = 0.0f;
   float paraboloid_margin = 0.0f;
+  /// Soft shadows (ShadowSettings::technique): the light's size (ShadowData::light_size:
+  /// directional, 2 tan(angular size / 2), penumbra metres per metre of blocker-receiver
+  /// distance; spot/point, the emitter width 2 radius in metres), and the Poisson disc's taps
+  /// and radius in texels (ShadowSettings::pcf_taps, pcf_radius).
+  float light_size = 0.0f;
+  int pcf_taps = 16;
+  float pcf_radius = 2.5f;
   /// Depth pass: polygon offset and face culling.
   float slope_bias = 0.0f, constant_bias = 0.0f;
   CullMode cull = CullMode::back;
@@ -104,6 +111,8 @@ struct ShadowMapSettings {
   int size = ShadowSettings{}.map_size;
   DepthFormat format = ShadowSettings{}.depth_format;
   ShadowFilter filter = ShadowSettings{}.filter;
+  ShadowTechnique technique = ShadowSettings{}.technique;
+  PcfKernel pcf_kernel = ShadowSettings{}.pcf_kernel;
   CascadeSelection selection = ShadowSettings{}.selection;
   bool layered = ShadowSettings{}.layered;  ///< all of a view's layers in one instanced pass
   bool debug_cascades = ShadowSettings{}.debug_cascades;

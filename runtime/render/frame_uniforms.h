@@ -18,6 +18,8 @@ struct alignas(16) ShadowViewBlock {
   glm::vec4 texel[2];                 ///< metres per texel per layer (view_texel(k, i))
   glm::ivec4 info;                    ///< x light index, y first layer, z layer count
   glm::vec4 params;                   ///< x normal offset (texels), y blend band, z paraboloid margin
+  /// Soft shadows: x light size (ShadowView::light_size), y Poisson disc radius (texels), z taps.
+  glm::vec4 soft;
 };
 
 struct alignas(16) FrameBlock {

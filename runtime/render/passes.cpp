@@ -113,7 +113,7 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
   glProgramUniform4fv(program_.id(), kLocBaseColor, 1, &m.base_color[0]);
   glProgramUniform4fv(program_.id(), kLocMaterial, 1, &params[0]);
   glProgramUniform3fv(program_.id(), kLocEmissive, 1, &m.emissive[0]);
-  if (features_by_uniform_) glProgramUniform1ui(program_.id(), kLocFeatureBits, key.material().bits());
+  if (features_by_uniform_) glProgramUniform1ui(program_.id(), kLocFeatureBits, GLuint(key.material().bits()));
   glBindTextureUnit(kTexBaseColor, cache_.texture(m.base_color_texture, false).id());
   glBindTextureUnit(kTexNormal, cache_.texture(m.normal_texture, true).id());
 }
@@ -149,6 +149,31 @@ void ShadowMapPass::ensure_storage(int size, int layers, DepthFormat format, Sha
   const GLint f = filter == ShadowFilter::bilinear ? GL_LINEAR : GL_NEAREST;
   glTextureParameteri(map_.id(), GL_TEXTURE_MIN_FILTER, f);
   glTextureParameteri(map_.id(), GL_TEXTURE_MAG_FILTER, f);
+}
+
+void ShadowMapPass::bind() {
+  const gpu::TextureRef map = texture();
+  auto make = [](bool compare, GLint filter) {
+    gpu::Sampler s = gpu::make_sampler();
+    const GLuint id = s.id();
+    glSamplerParameteri(id, GL_TEXTURE_COMPARE_MODE, compare ? GL_COMPARE_REF_TO_TEXTURE : GL_NONE);
+    glSamplerParameteri(id, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glSamplerParameteri(id, GL_TEXTURE_MIN_FILTER, filter);
+    glSamplerParameteri(id, GL_TEXTURE_MAG_FILTER, filter);
+    // As the map itself (S4): outside it every compare is lit, every raw depth 1.
+    glSamplerParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glSamplerParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+    glSamplerParameterfv(id, GL_TEXTURE_BORDER_COLOR, border);
+    return s;
+  };
+  if (!raw_depth_) raw_depth_ = make(false, GL_NEAREST);
+  if (!linear_compare_) linear_compare_ = make(true, GL_LINEAR);
+  glBindTextureUnit(kTexShadow, map.id());
+  glBindTextureUnit(kTexShadowDepth, map.id());
+  glBindSampler(kTexShadowDepth, raw_depth_.id());
+  glBindTextureUnit(kTexShadowLinear, map.id());
+  glBindSampler(kTexShadowLinear, linear_compare_.id());
 }
 
 gpu::TextureRef ShadowMapPass::texture() {

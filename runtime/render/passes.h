@@ -72,6 +72,11 @@ class ShadowMapPass {
   /// The depth texture array (a 64^2 single layer before the first shadowed frame, so the
   /// sampler is always complete).
   gpu::TextureRef texture();
+  /// Binds the map for the lookups: to UNIT_SHADOW with its depth compare, and to
+  /// UNIT_SHADOW_DEPTH through a sampler without compare (nearest, border depth 1), which
+  /// reads raw depths (PCSS's blocker search), and to UNIT_SHADOW_LINEAR compared with linear
+  /// filtering (the disc kernels' taps).
+  void bind();
   /// Depth of every layer, stacked top to bottom (layer 0 first), rows top to bottom.
   Image read() const;
 
@@ -82,6 +87,8 @@ class ShadowMapPass {
   ShadowFilter filter_ = ShadowFilter::none;
   gpu::Framebuffer fbo_;
   gpu::Texture map_;
+  gpu::Sampler raw_depth_;       ///< compare off: UNIT_SHADOW_DEPTH
+  gpu::Sampler linear_compare_;  ///< compare, linear: UNIT_SHADOW_LINEAR
   bool layered_ = false;
   /// Per layer: a hash of what its depth was last drawn from; 0 = nothing valid.
   std::vector<std::uint64_t> drawn_from_;

@@ -194,7 +194,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   Status st = im.shadow.record(frame, list, *im.cache, state, stats_);
   glEndQuery(GL_TIME_ELAPSED);
   KASKAD_TRY(st);
-  glBindTextureUnit(kTexShadow, im.shadow.texture().id());
+  im.shadow.bind();
 
   // 2. Probe captures. After it: every probe's visible cube (and sphere map) is the one the
   //    frame's reflections read.
@@ -278,7 +278,7 @@ Result<std::vector<glm::vec2>> Renderer::shadow_at_points(std::span<const glm::v
   // The frame block and shadow map are still those of the last render(); bind them again in
   // case other GL work ran in between.
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
-  glBindTextureUnit(kTexShadow, im.shadow.texture().id());
+  im.shadow.bind();
   glBindFramebuffer(GL_FRAMEBUFFER, im.points_fbo.id());
   glViewport(0, 0, w, h);
   glDisable(GL_DEPTH_TEST);

@@ -39,11 +39,15 @@ inline constexpr int kLocBaseColor = 8, kLocMaterial = 9, kLocEmissive = 10,
                      kLocReflectionCentre = 19;
 
 // Texture units.
+/// kTexShadowDepth: the shadow map again, through a sampler without depth compare (raw depths for
+/// PCSS's blocker search); kTexShadowLinear: again, compared with linear filtering (each tap of
+/// the disc kernels a hardware 2x2 PCF). ShadowMapPass::bind() binds all three.
 inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
-                          kTexReflectionCube = 3, kTexReflectionSphere = 4;
+                          kTexReflectionCube = 3, kTexReflectionSphere = 4, kTexShadowDepth = 5,
+                          kTexShadowLinear = 6;
 
 /// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...).
-inline std::array<std::pair<const char*, int>, 23> shader_interface_defines() {
+inline std::array<std::pair<const char*, int>, 25> shader_interface_defines() {
   return {{{"ATTR_POSITION", kAttrPosition},
            {"ATTR_NORMAL", kAttrNormal},
            {"ATTR_UV", kAttrUv},
@@ -65,6 +69,8 @@ inline std::array<std::pair<const char*, int>, 23> shader_interface_defines() {
            {"UNIT_BASE_COLOR", int(kTexBaseColor)},
            {"UNIT_NORMAL", int(kTexNormal)},
            {"UNIT_SHADOW", int(kTexShadow)},
+           {"UNIT_SHADOW_DEPTH", int(kTexShadowDepth)},
+           {"UNIT_SHADOW_LINEAR", int(kTexShadowLinear)},
            {"UNIT_REFLECTION_CUBE", int(kTexReflectionCube)},
            {"UNIT_REFLECTION_SPHERE", int(kTexReflectionSphere)}}};
 }

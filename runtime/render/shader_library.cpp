@@ -34,8 +34,11 @@ PassFiles files_for(Pass pass) {
   return {"forward.vert", "forward.frag"};
 }
 
+// The program map's key: the pass above the variant key's bits (keys use bits 0-47).
+constexpr int kPassShift = 56;
+constexpr std::uint64_t kKeyBits = (std::uint64_t(1) << kPassShift) - 1u;
 std::uint64_t map_key(Pass pass, VariantKey key) {
-  return (std::uint64_t(pass) << 32) | key.bits();
+  return (std::uint64_t(pass) << kPassShift) | key.bits();
 }
 
 std::string hex(std::uint64_t v) {
@@ -223,8 +226,8 @@ std::vector<Error> ShaderLibrary::reload_changed() {
       newest = std::max(newest, fs::last_write_time(f, ec));
     }
     if (newest <= entry.newest) continue;
-    const Pass pass = Pass(k >> 32);
-    auto rebuilt = build(pass, VariantKey(std::uint32_t(k & 0xffffffffu)), true);
+    const Pass pass = Pass(k >> kPassShift);
+    auto rebuilt = build(pass, VariantKey(k & kKeyBits), true);
     if (!rebuilt) {
       entry.newest = newest;  // report once per change, keep the last good program
       errors.push_back(rebuilt.error());
@@ -239,7 +242,7 @@ std::vector<Error> ShaderLibrary::reload_changed() {
 std::vector<VariantKey> ShaderLibrary::built_keys(Pass pass) const {
   std::vector<VariantKey> keys;
   for (const auto& [k, e] : programs_)
-    if (Pass(k >> 32) == pass) keys.push_back(VariantKey(std::uint32_t(k & 0xffffffffu)));
+    if (Pass(k >> kPassShift) == pass) keys.push_back(VariantKey(k & kKeyBits));
   std::sort(keys.begin(), keys.end());
   return keys;
 }

@@ -1,7 +1,9 @@
-// The variant key: which compile-time features a program has. A 32-bit value with named bits
+// The variant key: which compile-time features a program has. A 64-bit value with named bits
 // and small integer fields (Filament's Variant, Bevy's MeshPipelineKey), split into
 //   material features  (bits 0-15)  what a material uses      -> MATERIAL_* defines
-//   frame features     (bits 16-31) what the frame needs      -> VARIANT_* defines
+//   frame features     (bits 16-47) what the frame needs      -> VARIANT_* defines
+// (bits 48-63 stay free: the shader library keeps the pass there). 32 bits ran out when the
+// soft-shadow techniques and PCF kernels arrived (issue 14).
 //
 // kFeatureTable below is the one place a feature is declared: its name, define, stages, bit
 // offset, value range or value names, and what it requires or excludes. Everything else is
@@ -19,6 +21,7 @@
 //   shadow_projection != ortho has cascade_count 1 (cascades are directional only)
 //   shadow_layered needs shadow; the depth pass keeps it (its vertex shader picks the layer)
 //   shadow_lights != 1 needs shadow (the lookups of lights that do not exist are not compiled)
+//   shadow_technique != pcf and shadow_kernel != k3x3 need shadow
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask, and the projection
 // when it is dual_paraboloid: its vertex shader differs), so every material shares one or two
 // shadow programs.
@@ -53,7 +56,7 @@ enum class ShaderStage : std::uint8_t { vertex = 1, fragment = 2 };
 struct KeyField {
   std::uint8_t offset;
   std::uint8_t width;
-  constexpr std::uint32_t mask() const { return ((1u << width) - 1u) << offset; }
+  constexpr std::uint64_t mask() const { return ((std::uint64_t(1) << width) - 1u) << offset; }
   constexpr std::uint32_t max() const { return (1u << width) - 1u; }
 };
 
@@ -67,7 +70,7 @@ struct FeatureSpec {
   /// Integer features: the value range (a switch: 0..1). Enumerated features: `values` names
   /// the values 0..n-1 and `max` is ignored. The key stores value - min.
   int min = 0, max = 1;
-  std::array<std::string_view, 4> values{};
+  std::array<std::string_view, 8> values{};
   std::array<std::string_view, 2> requires_{};  ///< features that must be on when this one is
   std::array<std::string_view, 2> excludes{};   ///< features that must be off when this one is
 
@@ -129,6 +132,16 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // loops over them get a compile-time bound, so lights that do not exist cost nothing.
     {.name = "shadow_lights", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_LIGHTS",
      .stages = kFragmentStage, .offset = 28, .min = 1, .max = 4, .requires_ = {"shadow"}},
+    // Soft shadows (issue 14), per frame like shadow_filter (the first shadowed light's
+    // ShadowSettings::technique). Bits 32-35 leave the field room for the techniques to come
+    // (backprojection, lom, vsm, evsm).
+    {.name = "shadow_technique", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_TECHNIQUE",
+     .stages = kFragmentStage, .offset = 32, .values = {"pcf", "pcss", "backprojection"}, .requires_ = {"shadow"}},
+    // The PCF footprint of shadow_filter pcf3x3 (ShadowSettings::pcf_kernel): N x N boxes of
+    // nearest compares, or a rotated Poisson-like disc of ShadowSettings::pcf_taps taps.
+    {.name = "shadow_kernel", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_KERNEL",
+     .stages = kFragmentStage, .offset = 36,
+     .values = {"3x3", "5x5", "7x7", "9x9", "poisson"}, .requires_ = {"shadow"}},
 };
 inline constexpr int kFeatureCount = int(std::size(kFeatureTable));
 
@@ -156,7 +169,7 @@ struct BrokenRule {
 namespace feature_detail {
 // The table compiled into masks once, so valid() costs a few dozen bit operations.
 struct Rule {
-  std::uint32_t mask = 0;
+  std::uint64_t mask = 0;
   std::uint8_t offset = 0;
   std::uint32_t max_stored = 0;  ///< value_max - min
   std::array<int, 2> requires_{-1, -1};
@@ -164,7 +177,7 @@ struct Rule {
 };
 consteval std::array<Rule, kFeatureCount> make_rules() {
   std::array<Rule, kFeatureCount> rules{};
-  std::uint32_t taken = 0;
+  std::uint64_t taken = 0;
   for (int i = 0; i < kFeatureCount; ++i) {
     const FeatureSpec& f = kFeatureTable[i];
     Rule& r = rules[std::size_t(i)];
@@ -173,11 +186,11 @@ consteval std::array<Rule, kFeatureCount> make_rules() {
     if (f.name.empty() || f.define.empty() || f.stages == 0) throw "feature without name, define or stage";
     if (feature_index(f.name) != i) throw "duplicate feature name";
     if (f.value_max() < f.min || field.width == 0) throw "empty value range";
-    if (unsigned(field.offset) + field.width > 32u) throw "field past bit 31";
+    if (unsigned(field.offset) + field.width > 48u) throw "field past bit 47";
     if (taken & field.mask()) throw "features overlap in the key";
     const bool material = f.kind == FeatureKind::material;
-    if (material ? (field.mask() & 0xffff0000u) : (field.mask() & 0x0000ffffu))
-      throw "material features live in bits 0-15, frame features in bits 16-31";
+    if (material ? (field.mask() & ~std::uint64_t(0xffffu)) : (field.mask() & 0xffffu))
+      throw "material features live in bits 0-15, frame features in bits 16-47";
     if (!f.define.starts_with(material ? "MATERIAL_" : "VARIANT_"))
       throw "material defines start with MATERIAL_, frame defines with VARIANT_";
     taken |= field.mask();
@@ -198,8 +211,8 @@ consteval std::array<Rule, kFeatureCount> make_rules() {
   return rules;
 }
 inline constexpr std::array<Rule, kFeatureCount> kRules = make_rules();
-consteval std::uint32_t used_bits() {
-  std::uint32_t used = 0;
+consteval std::uint64_t used_bits() {
+  std::uint64_t used = 0;
   for (const Rule& r : kRules) used |= r.mask;
   return used;
 }
@@ -218,7 +231,7 @@ class VariantKey {
   static constexpr Field kReflectionSphere = feature_field("reflection_sphere");
   static constexpr Field kReceiveShadows = feature_field("receive_shadows");
   static constexpr Field kReflectionBox = feature_field("reflection_box");
-  static constexpr std::uint32_t kMaterialMask = 0x0000ffffu;
+  static constexpr std::uint64_t kMaterialMask = 0x0000ffffu;
   // Frame features.
   static constexpr Field kShadow = feature_field("shadow");
   static constexpr Field kShadowFilter = feature_field("shadow_filter");  ///< 0 none, 1 bilinear, 2 pcf3x3
@@ -235,15 +248,19 @@ class VariantKey {
   /// A count, not a switch, so loops over shadowed lights have a compile-time bound and a light
   /// that does not exist costs nothing (llvmpipe runs a zero-trip loop's body once, masked).
   static constexpr Field kShadowLightsMinus1 = feature_field("shadow_lights");
-  static constexpr std::uint32_t kFrameMask = 0xffff0000u;
+  /// ShadowTechnique: 0 pcf, 1 pcss, 2 backprojection.
+  static constexpr Field kShadowTechnique = feature_field("shadow_technique");
+  /// PcfKernel: 0 3x3, 1 5x5, 2 7x7, 3 9x9, 4 poisson.
+  static constexpr Field kShadowKernel = feature_field("shadow_kernel");
+  static constexpr std::uint64_t kFrameMask = 0x0000ffffffff0000u;
 
   constexpr VariantKey() = default;
-  constexpr explicit VariantKey(std::uint32_t bits) : bits_(bits) {}
+  constexpr explicit VariantKey(std::uint64_t bits) : bits_(bits) {}
 
-  constexpr std::uint32_t bits() const { return bits_; }
-  constexpr std::uint32_t get(Field f) const { return (bits_ & f.mask()) >> f.offset; }
+  constexpr std::uint64_t bits() const { return bits_; }
+  constexpr std::uint32_t get(Field f) const { return std::uint32_t((bits_ & f.mask()) >> f.offset); }
   constexpr VariantKey& set(Field f, std::uint32_t value) {
-    bits_ = (bits_ & ~f.mask()) | ((value << f.offset) & f.mask());
+    bits_ = (bits_ & ~f.mask()) | ((std::uint64_t(value) << f.offset) & f.mask());
     return *this;
   }
   constexpr bool has(Field f) const { return get(f) != 0; }
@@ -261,7 +278,7 @@ class VariantKey {
     if (bits_ & ~feature_detail::used_bits()) return {BrokenRule::unused_bits};
     for (int i = 0; i < kFeatureCount; ++i) {
       const feature_detail::Rule& r = kRules[std::size_t(i)];
-      const std::uint32_t stored = (bits_ & r.mask) >> r.offset;
+      const std::uint64_t stored = (bits_ & r.mask) >> r.offset;
       if (stored > r.max_stored) return {BrokenRule::range, i};
       if (stored == 0) continue;
       for (int j : r.requires_)
@@ -279,10 +296,10 @@ class VariantKey {
   /// debug tint); the forward pass needs everything.
   constexpr VariantKey filtered_for(Pass pass) const {
     if (pass == Pass::depth) {
-      const std::uint32_t projection = get(kShadowProjection) == kProjectionDualParaboloid
+      const std::uint64_t projection = get(kShadowProjection) == kProjectionDualParaboloid
                                            ? kShadowProjection.mask() | kShadow.mask()
                                            : 0u;
-      const std::uint32_t layered =
+      const std::uint64_t layered =
           has(kShadowLayered) ? kShadowLayered.mask() | kShadow.mask() : 0u;
       return VariantKey(bits_ & (kAlphaMask.mask() | projection | layered));
     }
@@ -294,7 +311,7 @@ class VariantKey {
   }
 
  private:
-  std::uint32_t bits_ = 0;
+  std::uint64_t bits_ = 0;
 };
 
 static_assert(VariantKey().valid());

@@ -87,6 +87,7 @@ TEST_F(FrameUniformsTest, CppLayoutMatchesTheCompiledBlock) {
         {"texel[0]", offsetof(ShadowViewBlock, texel), sizeof(glm::vec4), 2},
         {"info", offsetof(ShadowViewBlock, info), 0, 0},
         {"params", offsetof(ShadowViewBlock, params), 0, 0},
+        {"soft", offsetof(ShadowViewBlock, soft), 0, 0},
     };
     for (const Member& m : view_members) check(view + m.glsl, m, base);
   }

@@ -69,7 +69,7 @@ TEST_F(PermutationTest, CompilesExactlyTheCombinationsTheSceneUses) {
   Scene s = scene("materials.json");
   FrameContext ctx{320, 180, 0, false};
   const auto requests = render::required_programs(plan_frame(s, ctx));
-  std::set<std::uint32_t> forward, depth;
+  std::set<std::uint64_t> forward, depth;
   for (const auto& r : requests) (r.pass == Pass::forward ? forward : depth).insert(r.key.bits());
   // materials.json: ground (none), checker, bumpy metal, glow, foliage (alpha), textured+bumpy,
   // plain cone (no shadow receiving): 7 distinct forward keys; depth: opaque + alpha mask.

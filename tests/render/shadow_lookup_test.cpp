@@ -82,38 +82,43 @@ void PrintTo(const Format& f, std::ostream* os) { *os << f.name; }
 
 class ShadowLookupTest : public HeadlessGlTest, public ::testing::WithParamInterface<Format> {};
 
-TEST_P(ShadowLookupTest, Pcf3x3IsTheNineNearestComparesAroundThePoint) {
-  // The shaders as shipped, plus the test's own, in a scratch folder (includes resolve there).
+// Draws `frag` (a test shader that writes o.x = the production kernel, o.y = its reference) over
+// a kTarget^2 target with a random kSize^2 x kLayers depth array of `format` bound as the
+// renderer binds its shadow map, and returns the target's RGBA floats. The shaders as shipped
+// are copied, with the test's own, into a scratch folder `dir_name` (includes resolve there).
+constexpr int kSize = 64, kLayers = 3, kTarget = 256;
+std::vector<float> draw_lookup(const std::string& dir_name, const char* frag,
+                               const std::vector<std::pair<const char*, int>>& features,
+                               GLenum format) {
   const fs::path shaders = fs::path(KASKAD_CONTENT_DIR) / "shaders";
-  // One folder per format: ctest runs the instances in parallel.
-  const fs::path dir =
-      fs::path(KASKAD_TEST_TMP) / (std::string("shadow_lookup_") + GetParam().name);
+  const fs::path dir = fs::path(KASKAD_TEST_TMP) / dir_name;
   fs::create_directories(dir);
   for (const char* f : {"common.glsl", "features.glsl", "shadow.glsl", "fullscreen.vert"})
     fs::copy_file(shaders / f, dir / f, fs::copy_options::overwrite_existing);
-  std::ofstream(dir / "test.frag") << kTestFrag;
+  std::ofstream(dir / "test.frag") << frag;
 
   auto manifest = render::FeatureManifest::load(shaders / "features.json");
-  ASSERT_TRUE(manifest.ok()) << manifest.error().to_string();
+  EXPECT_TRUE(manifest.ok()) << manifest.error().to_string();
+  if (!manifest.ok()) return {};
   render::VariantKey key;
-  key = manifest->with(key, *manifest->find("shadow"), 1);
-  key = manifest->with(key, *manifest->find("shadow_filter"), int(ShadowFilter::pcf3x3));
+  for (const auto& [name, value] : features) key = manifest->with(key, *manifest->find(name), value);
   auto vs = gpu::preprocess_shader(dir, "fullscreen.vert",
                                    manifest->defines(key, render::ShaderStage::vertex));
   auto fs = gpu::preprocess_shader(dir, "test.frag",
                                    manifest->defines(key, render::ShaderStage::fragment));
-  ASSERT_TRUE(vs.ok() && fs.ok());
+  EXPECT_TRUE(vs.ok() && fs.ok());
+  if (!vs.ok() || !fs.ok()) return {};
   auto program = gpu::build_program(*vs, *fs);
-  ASSERT_TRUE(program.ok()) << program.error().to_string();
+  EXPECT_TRUE(program.ok()) << program.error().to_string();
+  if (!program.ok()) return {};
 
   // A random depth array, set up as the renderer sets up its shadow map.
-  constexpr int kSize = 64, kLayers = 3, kTarget = 256;
   std::mt19937 rng(13);
   std::uniform_real_distribution<float> depth(0.0f, 1.0f);
   std::vector<float> depths(std::size_t(kSize) * kSize * kLayers);
   for (float& d : depths) d = depth(rng);
   gpu::Texture map = gpu::make_texture(GL_TEXTURE_2D_ARRAY);
-  glTextureStorage3D(map.id(), 1, GetParam().internal_format, kSize, kSize, kLayers);
+  glTextureStorage3D(map.id(), 1, format, kSize, kSize, kLayers);
   glTextureSubImage3D(map.id(), 0, 0, 0, 0, kSize, kSize, kLayers, GL_DEPTH_COMPONENT, GL_FLOAT,
                       depths.data());
   glTextureParameteri(map.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
@@ -144,7 +149,16 @@ TEST_P(ShadowLookupTest, Pcf3x3IsTheNineNearestComparesAroundThePoint) {
   glBindVertexArray(0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glUseProgram(0);
+  return out;
+}
 
+TEST_P(ShadowLookupTest, Pcf3x3IsTheNineNearestComparesAroundThePoint) {
+  // One folder per format: ctest runs the instances in parallel.
+  const std::vector<float> out =
+      draw_lookup(std::string("shadow_lookup_") + GetParam().name, kTestFrag,
+                  {{"shadow", 1}, {"shadow_filter", int(ShadowFilter::pcf3x3)}},
+                  GetParam().internal_format);
+  ASSERT_EQ(out.size(), std::size_t(kTarget) * kTarget * 4);
   int partial = 0, unequal = 0;
   float worst = 0.0f;
   for (std::size_t i = 0; i < out.size(); i += 4) {
@@ -165,6 +179,76 @@ INSTANTIATE_TEST_SUITE_P(Formats, ShadowLookupTest,
                                            Format{"d32f", GL_DEPTH_COMPONENT32F}),
                          [](const auto& info) { return std::string(info.param.name); });
 
+
+// The N x N boxes of pcf_kernel 5, 7, 9 (box_pcf(), compare-gathers) with a flat receiver plane
+// are the N^2 nearest compares at the texel centres around the point's texel.
+constexpr const char* kBoxFrag = R"(#include "common.glsl"
+#include "features.glsl"
+#include "shadow.glsl"
+
+layout(location = 0) out vec4 o;
+layout(location = 20) uniform int u_layers;
+
+uint hash(uint x) {
+  x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;
+  return x;
+}
+float rnd(inout uint s) { s = hash(s); return float(s >> 8) / 16777216.0; }
+
+float box_taps(int layer, vec3 c) {
+  float size = float(textureSize(u_shadow_map, 0).x);
+  vec2 t = floor(c.xy * size);
+  const int h = (PCF_SIDE - 1) / 2;
+  float sum = 0.0;
+  for (int j = -h; j <= h; ++j)
+    for (int i = -h; i <= h; ++i)
+      sum += texture(u_shadow_map, vec4((t + vec2(i, j) + 0.5) / size, float(layer), c.z));
+  return sum / float(PCF_SIDE * PCF_SIDE);
+}
+
+void main() {
+  uint s = uint(gl_FragCoord.x) + 4096u * uint(gl_FragCoord.y);
+  float size = float(textureSize(u_shadow_map, 0).x);
+  vec2 texel = floor(vec2(rnd(s), rnd(s)) * (size + 4.0)) - 2.0;
+  vec2 inside = 0.05 + 0.9 * vec2(rnd(s), rnd(s));
+  int layer = int(rnd(s) * float(u_layers));
+  vec3 c = vec3((texel + inside) / size, rnd(s));
+  o = vec4(box_pcf(layer, c, vec2(0.0)), box_taps(layer, c), 0.0, 1.0);
+}
+)";
+
+class BoxKernelTest : public HeadlessGlTest, public ::testing::WithParamInterface<int> {};
+
+TEST_P(BoxKernelTest, IsTheNxNNearestComparesAroundThePoint) {
+  const int side = 2 * GetParam() + 3;
+  const std::vector<float> out =
+      draw_lookup("box_kernel_" + std::to_string(side), kBoxFrag,
+                  {{"shadow", 1},
+                   {"shadow_filter", int(ShadowFilter::pcf3x3)},
+                   {"shadow_kernel", GetParam()}},
+                  GL_DEPTH_COMPONENT24);
+  ASSERT_EQ(out.size(), std::size_t(kTarget) * kTarget * 4);
+  int partial = 0, unequal = 0;
+  float worst = 0.0f;
+  for (std::size_t i = 0; i < out.size(); i += 4) {
+    const float diff = std::abs(out[i] - out[i + 1]);
+    if (diff > 1e-6f) ++unequal;
+    worst = std::max(worst, diff);
+    if (out[i + 1] > 0.05f && out[i + 1] < 0.95f) ++partial;
+  }
+  std::printf("[ %dx%d ] %d of %d points differ (largest %g)\n", side, side, unequal,
+              kTarget * kTarget, double(worst));
+  EXPECT_EQ(unequal, 0) << side << "x" << side << ": largest difference " << worst;
+  EXPECT_GT(partial, kTarget * kTarget / 2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Kernels, BoxKernelTest,
+                         ::testing::Values(int(PcfKernel::k5x5), int(PcfKernel::k7x7),
+                                           int(PcfKernel::k9x9)),
+                         [](const auto& info) {
+                           const int side = 2 * info.param + 3;
+                           return std::to_string(side) + "x" + std::to_string(side);
+                         });
 
 // Without AOVs the forward pass skips the lookup where the geometric surface faces away from the
 // shadowed light (forward.frag); with AOVs it looks up everywhere, as the AOV contract shows. The

@@ -177,6 +177,74 @@ TEST(SceneIo, CascadeFieldsLoadWithRangeChecksAndPerLightOverrides) {
                {"/shadow/point_mode", "sphere", "cube", "dual_paraboloid"});
 }
 
+// Issue 14's settings: shadow.technique, pcf_kernel, pcf_taps, pcf_radius and the spot/point
+// light radius load, save, override and are rejected out of range with the key and the value.
+TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
+  const fs::path def = kContent / "scenes" / "default.json";
+  auto s = read_scene(def, {"shadow.technique=pcss", "shadow.pcf_kernel=7", "shadow.pcf_taps=32",
+                            "shadow.pcf_radius=4", "sun.light.angular_size_deg=5"});
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  EXPECT_EQ(s->shadow_defaults.technique, ShadowTechnique::pcss);
+  EXPECT_EQ(s->shadow_defaults.pcf_kernel, PcfKernel::k7x7);
+  EXPECT_EQ(s->shadow_defaults.pcf_taps, 32);
+  EXPECT_FLOAT_EQ(s->shadow_defaults.pcf_radius, 4.0f);
+  auto p = read_scene(def, {"shadow.pcf_kernel=\"poisson\""});
+  ASSERT_TRUE(p.ok()) << p.error().to_string();
+  EXPECT_EQ(p->shadow_defaults.pcf_kernel, PcfKernel::poisson);
+  auto unquoted = read_scene(def, {"shadow.pcf_kernel=poisson"});
+  ASSERT_TRUE(unquoted.ok()) << unquoted.error().to_string();
+  EXPECT_EQ(unquoted->shadow_defaults.pcf_kernel, PcfKernel::poisson);
+  // Defaults: today's hard 3x3 PCF.
+  auto d = read_scene(def);
+  ASSERT_TRUE(d.ok());
+  EXPECT_EQ(d->shadow_defaults.technique, ShadowTechnique::pcf);
+  EXPECT_EQ(d->shadow_defaults.pcf_kernel, PcfKernel::k3x3);
+
+  // Saved and read again, with a spot light's radius.
+  const fs::path file = temp_dir() / "soft.json";
+  std::ofstream(file) << R"({ "shadow": { "technique": "pcss", "pcf_kernel": "poisson", "pcf_taps": 24 },
+    "entities": [
+      { "name": "lamp", "transform": { "translation": [0, 4, 0], "direction": [0, -1, 0] },
+        "light": { "type": "spot", "cast_shadows": true, "radius": 0.25 },
+        "shadow": { "pcf_kernel": 9 } } ] })";
+  auto spot = read_scene(file);
+  ASSERT_TRUE(spot.ok()) << spot.error().to_string();
+  EXPECT_FLOAT_EQ(spot->world.get<Light>(find(*spot, "lamp")).radius, 0.25f);
+  EXPECT_EQ(spot->world.get<ShadowSettings>(find(*spot, "lamp")).pcf_kernel, PcfKernel::k9x9);
+  const fs::path out = temp_dir() / "soft_saved.json";
+  ASSERT_TRUE(save_scene(out, *spot).ok());
+  auto again = read_scene(out);
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_FLOAT_EQ(again->world.get<Light>(find(*again, "lamp")).radius, 0.25f);
+  EXPECT_EQ(again->shadow_defaults.technique, ShadowTechnique::pcss);
+  EXPECT_EQ(again->shadow_defaults.pcf_kernel, PcfKernel::poisson);
+  EXPECT_EQ(again->shadow_defaults.pcf_taps, 24);
+  EXPECT_EQ(again->world.get<ShadowSettings>(find(*again, "lamp")).pcf_kernel, PcfKernel::k9x9);
+
+  expect_error(read_scene(def, {"shadow.technique=vsm"}), {"/shadow/technique", "vsm", "pcf", "pcss", "backprojection"});
+  expect_error(read_scene(def, {"shadow.pcf_kernel=4"}), {"/shadow/pcf_kernel", "3, 5, 7, 9", "4"});
+  expect_error(read_scene(def, {"shadow.pcf_kernel=11"}), {"/shadow/pcf_kernel", "11"});
+  expect_error(read_scene(def, {"shadow.pcf_kernel=1"}), {"/shadow/pcf_kernel", "1"});
+  expect_error(read_scene(def, {"shadow.pcf_kernel=gauss"}), {"/shadow/pcf_kernel", "gauss", "poisson"});
+  expect_error(read_scene(def, {"shadow.pcf_kernel=true"}), {"/shadow/pcf_kernel", "poisson"});
+  expect_error(read_scene(def, {"shadow.pcf_taps=7"}), {"/shadow/pcf_taps", "[8, 64]", "7"});
+  expect_error(read_scene(def, {"shadow.pcf_taps=65"}), {"/shadow/pcf_taps", "65"});
+  expect_error(read_scene(def, {"shadow.pcf_radius=0.5"}), {"/shadow/pcf_radius", "0.5"});
+  expect_error(read_scene(def, {"shadow.pcf_radius=17"}), {"/shadow/pcf_radius", "17"});
+  expect_error(read_scene(file, {"lamp.light.radius=-0.1"}), {"/light/radius", "-0.1"});
+  expect_error(read_scene(file, {"lamp.light.radius=101"}), {"/light/radius", "101"});
+  expect_error(read_scene(file, {"lamp.light.angular_size_deg=1"}),
+               {"/light/angular_size_deg", "directional", "radius"});
+  expect_error(read_scene(def, {"sun.light.radius=0.5"}), {"/light/radius", "angular_size_deg"});
+  // The component checks name the field too (API misuse, not only files).
+  ShadowSettings bad;
+  bad.pcf_taps = 100;
+  EXPECT_EQ(validate_shadow_settings(bad), "pcf_taps must be in [8, 64], was 100");
+  bad = {};
+  bad.technique = ShadowTechnique(7);
+  EXPECT_EQ(validate_shadow_settings(bad), "technique must be pcf, pcss or backprojection, was 7");
+}
+
 TEST(SceneIo, OverrideErrorsListValidKeys) {
   const fs::path def = kContent / "scenes" / "default.json";
   expect_error(read_scene(def, {"shadow.map_sise=4"}), {"map_sise", "map_size", "filter"});

@@ -36,21 +36,25 @@ fs::path temp(const std::string& name, const std::string& text) {
 // The rules of variant_key.h's header comment, written out independently of kFeatureTable.
 bool documented_rules_hold(VariantKey k) {
   using V = VariantKey;
-  const std::uint32_t used =
+  const std::uint64_t used =
       V::kBaseColorTexture.mask() | V::kNormalMap.mask() | V::kAlphaMask.mask() |
       V::kEmissive.mask() | V::kReflectionCube.mask() | V::kReflectionSphere.mask() |
       V::kReceiveShadows.mask() | V::kReflectionBox.mask() | V::kShadow.mask() |
       V::kShadowFilter.mask() | V::kCascadeCountMinus1.mask() | V::kAovs.mask() |
       V::kDebugCascades.mask() | V::kCascadeSelection.mask() | V::kShadowProjection.mask() |
-      V::kShadowLayered.mask() | V::kShadowLightsMinus1.mask();
+      V::kShadowLayered.mask() | V::kShadowLightsMinus1.mask() | V::kShadowTechnique.mask() |
+      V::kShadowKernel.mask();
   if (k.bits() & ~used) return false;
-  if (k.get(V::kShadowFilter) > 2) return false;  // none, bilinear, pcf3x3
+  if (k.get(V::kShadowFilter) > 2) return false;     // none, bilinear, pcf3x3
+  if (k.get(V::kShadowTechnique) > 2) return false;  // pcf, pcss, backprojection
+  if (k.get(V::kShadowKernel) > 4) return false;     // 3x3, 5x5, 7x7, 9x9, poisson
   if (k.has(V::kReflectionCube) && k.has(V::kReflectionSphere)) return false;
   if (k.has(V::kReflectionBox) && !k.has(V::kReflectionCube)) return false;
   const bool needs_shadow = k.has(V::kShadowFilter) || k.has(V::kCascadeCountMinus1) ||
                             k.has(V::kDebugCascades) || k.has(V::kCascadeSelection) ||
                             k.has(V::kShadowProjection) || k.has(V::kShadowLayered) ||
-                            k.has(V::kShadowLightsMinus1);
+                            k.has(V::kShadowLightsMinus1) || k.has(V::kShadowTechnique) ||
+                            k.has(V::kShadowKernel);
   if (needs_shadow && !k.has(V::kShadow)) return false;
   if (k.has(V::kShadowProjection) && k.has(V::kCascadeCountMinus1)) return false;
   return true;
@@ -58,35 +62,60 @@ bool documented_rules_hold(VariantKey k) {
 
 TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   const FeatureManifest m = manifest();
-  std::uint32_t used = 0;
-  for (const auto& f : m.features()) used |= f.field.mask();
-  // Every key over the used bits (every subset of them: all values of every field, selection,
-  // projection and layered included): valid() (kFeatureTable's rules) agrees with the rules
-  // written out above, the manifest names a broken rule exactly when valid() is false, and a
-  // valid key filters to itself for the forward pass (it reads everything) and to valid keys
-  // for the others.
-  int valid = 0, disagree = 0;
-  for (std::uint32_t bits = 0;; bits = ((bits | ~used) + 1) & used) {
-    const VariantKey k(bits);
+  std::uint64_t material_used = 0, frame_used = 0;
+  for (const auto& f : m.features())
+    (f.kind == FeatureKind::material ? material_used : frame_used) |= f.field.mask();
+  int disagree = 0;
+  // valid() (kFeatureTable's rules) agrees with the rules written out above, the manifest names
+  // a broken rule exactly when valid() is false, and a valid key filters to itself for the
+  // forward pass (it reads everything) and to valid keys for the others.
+  auto check = [&](VariantKey k) {
     if ((k.valid() != documented_rules_hold(k) || k.valid() != m.check(k).empty()) &&
         disagree++ < 5)
-      ADD_FAILURE() << "key 0x" << std::hex << bits << ": valid() " << k.valid()
+      ADD_FAILURE() << "key 0x" << std::hex << k.bits() << ": valid() " << k.valid()
                     << ", documented rules " << documented_rules_hold(k) << ", manifest: '"
                     << m.check(k) << "' (" << m.describe(k) << ")";
-    if (k.valid()) {
-      ++valid;
-      EXPECT_EQ(k.filtered_for(Pass::forward), k);
-      EXPECT_TRUE(k.filtered_for(Pass::depth).valid());
-      EXPECT_TRUE(k.filtered_for(Pass::shadow_points).valid());
-    }
-    if (bits == used) break;
+    if (!k.valid()) return false;
+    EXPECT_EQ(k.filtered_for(Pass::forward), k);
+    EXPECT_TRUE(k.filtered_for(Pass::depth).valid());
+    EXPECT_TRUE(k.filtered_for(Pass::shadow_points).valid());
+    return true;
+  };
+  // No rule links a material feature to a frame feature, so every subset of the frame bits is
+  // checked with a few material keys, and every subset of the material bits with a few frame
+  // keys (every subset of both: 2^27 keys, too many since the soft-shadow features).
+  const VariantKey some_materials[] = {
+      VariantKey(), VariantKey().set(VariantKey::kReceiveShadows, 1).set(VariantKey::kAlphaMask, 1),
+      VariantKey().set(VariantKey::kReflectionCube, 1).set(VariantKey::kReflectionBox, 1)};
+  const VariantKey some_frames[] = {
+      VariantKey(), VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowFilter, 2),
+      VariantKey()
+          .set(VariantKey::kShadow, 1)
+          .set(VariantKey::kShadowProjection, 3)
+          .set(VariantKey::kShadowTechnique, 1)
+          .set(VariantKey::kShadowKernel, 4)};
+  int valid_frames = 0, valid_materials = 0;
+  for (std::uint64_t bits = 0;; bits = ((bits | ~frame_used) + 1) & frame_used) {
+    int n = 0;
+    for (VariantKey mat : some_materials) n += check(VariantKey(bits | mat.bits())) ? 1 : 0;
+    EXPECT_TRUE(n == 0 || n == 3) << std::hex << bits;
+    valid_frames += n > 0 ? 1 : 0;
+    if (bits == frame_used) break;
+  }
+  for (std::uint64_t bits = 0;; bits = ((bits | ~material_used) + 1) & material_used) {
+    int n = 0;
+    for (VariantKey frame : some_frames) n += check(VariantKey(bits | frame.bits())) ? 1 : 0;
+    EXPECT_TRUE(n == 0 || n == 3) << std::hex << bits;
+    valid_materials += n > 0 ? 1 : 0;
+    if (bits == material_used) break;
   }
   EXPECT_EQ(disagree, 0);
   // Material keys: 2^5 free bits x 4 of the 8 reflection cube/sphere/box combinations = 128.
   // Frame keys: 2 without shadow (aovs), and with shadow 3 filters x 2 aovs x 2 debug x
   // 2 selection x 2 layered x 4 shadowed-light counts x (8 ortho cascade counts + 3 other
-  // projections) = 2112.
-  EXPECT_EQ(valid, 128 * 2114);
+  // projections) x 3 techniques x 5 kernels = 31680.
+  EXPECT_EQ(valid_materials, 128);
+  EXPECT_EQ(valid_frames, 2 + 31680);
 }
 
 // The table is the one source: the manifest's features, their fields and the GLSL bit numbers

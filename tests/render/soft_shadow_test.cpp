@@ -1,0 +1,407 @@
+// Soft shadows (issue 14): ShadowSettings::technique pcss and the wide PCF kernels, measured
+// against independent answers. The penumbra of a slab's edge under a sized sun against the width
+// similar triangles give; the visibility AOV of the default scene with a 5-degree sun against the
+// ray-traced area-light reference (RMSE); world-space flicker of every new lookup under camera
+// translation with stable cascades.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "components/light.h"
+#include "components/transform.h"
+#include "runtime/cli/player.h"
+#include "runtime/cli/stability.h"
+#include "runtime/reference/ray_tracer.h"
+#include "runtime/reference/shadow_metrics.h"
+#include "tests/render/player_fixture.h"
+
+namespace kaskad {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A 4 x 4 m slab, 5 cm thick, its underside 1 m above the ground, under a sun straight down of
+// angular size theta (degrees). Its edge x = 2 casts a straight penumbra along z on the ground.
+constexpr float kSlabBottom = 1.0f, kSlabTop = 1.05f, kEdge = 2.0f;
+
+fs::path write_slab_scene(float theta_deg) {
+  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
+  fs::create_directories(dir);
+  const fs::path file = dir / "slab.json";
+  std::ofstream(file) << R"({ "kaskad_scene": 1,
+    "render": { "width": 320, "height": 180 },
+    "shadow": { "technique": "pcss", "cascade_count": 4, "fit_mode": "stable" },
+    "entities": [
+      { "name": "ground", "transform": { "scale": [40, 1, 40] }, "primitive": { "shape": "plane" } },
+      { "name": "slab", "transform": { "translation": [0, 1.025, 0], "scale": [4, 0.05, 4] },
+        "primitive": { "shape": "box" } },
+      { "name": "sun", "transform": { "direction": [0, -1, 0] },
+        "light": { "type": "directional", "cast_shadows": true, "angular_size_deg": )"
+                      << theta_deg << R"( } },
+      { "name": "camera", "transform": { "translation": [2, 3, 4], "look_at": [2, 0, 0] },
+        "camera": { "fov_y_deg": 45, "near": 0.1, "far": 100, "active": true } } ] })";
+  return file;
+}
+
+// Visibility of the ground at x (z well inside the slab's extent) under a cone of directions of
+// half-angle theta / 2 around the vertical: the fraction of the cone's directions (uniform over
+// the disc of tangents, the small-angle form of uniform over the solid angle) whose ray from
+// (x, 0) misses the slab. A ray with tangent u along x crosses the slab's height range at
+// x + u y, y in [bottom, top]; it is blocked when that interval reaches x <= edge.
+float analytic_visibility(float x, float theta_deg) {
+  const float r = std::tan(0.5f * glm::radians(theta_deg));
+  constexpr int n = 400;
+  int inside = 0, lit = 0;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const float u = (2.0f * (float(i) + 0.5f) / n - 1.0f) * r;
+      const float v = (2.0f * (float(j) + 0.5f) / n - 1.0f) * r;
+      if (u * u + v * v > r * r) continue;
+      ++inside;
+      lit += std::min(x + u * kSlabBottom, x + u * kSlabTop) > kEdge;
+    }
+  }
+  return float(lit) / float(inside);
+}
+
+// The slab plus a bar 10 cm wide over its lit side: a second occluder 3 m up at x in
+// [kBarMin, kBarMax] (z in [-2, 2], 2 cm thick), beside the slab as seen from the light, so
+// both are in the depth map, but seen from a receiver in the slab's penumbra the two cover
+// overlapping parts of the light.
+constexpr float kBarMin = 2.0f, kBarMax = 2.1f, kBarBottom = 3.0f, kBarTop = 3.02f;
+
+fs::path write_two_blocker_scene(float theta_deg) {
+  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
+  fs::create_directories(dir);
+  const fs::path file = dir / "two_blockers.json";
+  std::ofstream(file) << R"({ "kaskad_scene": 1,
+    "render": { "width": 320, "height": 180 },
+    "shadow": { "technique": "backprojection", "cascade_count": 4, "fit_mode": "stable" },
+    "entities": [
+      { "name": "ground", "transform": { "scale": [40, 1, 40] }, "primitive": { "shape": "plane" } },
+      { "name": "slab", "transform": { "translation": [0, 1.025, 0], "scale": [4, 0.05, 4] },
+        "primitive": { "shape": "box" } },
+      { "name": "bar", "transform": { "translation": [2.05, 3.01, 0], "scale": [0.1, 0.02, 4] },
+        "primitive": { "shape": "box" } },
+      { "name": "sun", "transform": { "direction": [0, -1, 0] },
+        "light": { "type": "directional", "cast_shadows": true, "angular_size_deg": )"
+                      << theta_deg << R"( } },
+      { "name": "camera", "transform": { "translation": [2, 3, 4], "look_at": [2, 0, 0] },
+        "camera": { "fov_y_deg": 45, "near": 0.1, "far": 100, "active": true } } ] })";
+  return file;
+}
+
+// As analytic_visibility(), with the bar too: a ray is blocked when it crosses either.
+// `overlap`: the fraction of the light that both cover (what backprojection counts twice).
+float analytic_two_blockers(float x, float theta_deg, float* overlap = nullptr) {
+  const float r = std::tan(0.5f * glm::radians(theta_deg));
+  constexpr int n = 400;
+  int inside = 0, lit = 0, both = 0;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const float u = (2.0f * (float(i) + 0.5f) / n - 1.0f) * r;
+      const float v = (2.0f * (float(j) + 0.5f) / n - 1.0f) * r;
+      if (u * u + v * v > r * r) continue;
+      ++inside;
+      const bool slab = std::min(x + u * kSlabBottom, x + u * kSlabTop) <= kEdge;
+      const float b0 = std::min(x + u * kBarBottom, x + u * kBarTop);
+      const float b1 = std::max(x + u * kBarBottom, x + u * kBarTop);
+      const bool bar = b1 >= kBarMin && b0 <= kBarMax;
+      lit += !slab && !bar;
+      both += slab && bar;
+    }
+  }
+  if (overlap) *overlap = float(both) / float(inside);
+  return float(lit) / float(inside);
+}
+
+// Width of the ramp between 10% and 90% visibility: the count of samples strictly inside
+// (0.1, 0.9) times the spacing. Exact for a monotone profile and robust to the per-point noise of
+// the rotated disc kernels (no search for noisy crossings).
+float ramp_width(const std::vector<float>& v, float spacing) {
+  std::size_t n = 0;
+  for (float x : v) n += x > 0.1f && x < 0.9f;
+  return float(n) * spacing;
+}
+
+class SoftShadowTest : public PlayerTest {
+ protected:
+  static Scene load(const fs::path& file, std::vector<std::string> sets) {
+    auto scene = load_scene(file, sets);
+    EXPECT_TRUE(scene.ok()) << scene.error().to_string();
+    return std::move(scene.value());
+  }
+
+  // The penumbra's 10-90% width on the ground across the slab's edge (metres), averaged over
+  // three lines along x. The lookup runs in the points pass: the forward pass's own code at
+  // exact world points (runtime/cli/stability.h).
+  static float measured_width(Scene& scene, float spacing, float* texel = nullptr) {
+    auto t = render_frames(*player_, scene, {});
+    EXPECT_TRUE(t.ok()) << t.error().to_string();
+    if (!t.ok()) return 0.0f;
+    if (texel) *texel = t->last.shadow().texel_size[0];
+    std::vector<glm::vec3> points, normals;
+    for (float z : {-0.5f, 0.0f, 0.5f})
+      for (float x = kEdge - 0.4f; x <= kEdge + 0.4f; x += spacing) {
+        points.emplace_back(x, 0.0f, z);
+        normals.emplace_back(0.0f, 1.0f, 0.0f);
+      }
+    auto values = player_->renderer->shadow_at_points(points, normals);
+    EXPECT_TRUE(values.ok()) << values.error().to_string();
+    if (!values.ok()) return 0.0f;
+    std::vector<float> v;
+    for (const glm::vec2& s : *values) v.push_back(s.x);
+    EXPECT_LT(*std::min_element(v.begin(), v.end()), 0.05f) << "no umbra under the slab";
+    EXPECT_GT(*std::max_element(v.begin(), v.end()), 0.95f) << "no light beside the slab";
+    return ramp_width(v, spacing) / 3.0f;
+  }
+};
+
+// (a) PCSS's and backprojection's penumbrae have the width similar triangles give:
+// blocker-receiver distance times the tangent of the cone (S1's l (d - z) / z with the light at
+// infinity), within 10%, for a 5 and a 2-degree sun; hard PCF's is far narrower.
+TEST_F(SoftShadowTest, PcssPenumbraWidthMatchesSimilarTriangles) {
+  constexpr float kSpacing = 0.0005f;
+  for (float theta : {5.0f, 2.0f}) {
+    const fs::path file = write_slab_scene(theta);
+    std::vector<float> analytic;
+    for (float x = kEdge - 0.4f; x <= kEdge + 0.4f; x += kSpacing)
+      analytic.push_back(analytic_visibility(x, theta));
+    const float expected = ramp_width(analytic, kSpacing);
+    // Full width by similar triangles: from the umbra's end under the bottom edge to the last
+    // shadow from the top edge, (bottom + top) tan(theta / 2).
+    const float full = (kSlabBottom + kSlabTop) * std::tan(0.5f * glm::radians(theta));
+    Scene pcss = load(file, {});
+    float texel = 0.0f;
+    const float width = measured_width(pcss, kSpacing, &texel);
+    Scene pcf = load(file, {"shadow.technique=pcf"});
+    const float hard = measured_width(pcf, kSpacing);
+    Scene bp = load(file, {"shadow.technique=backprojection"});
+    const float back = measured_width(bp, kSpacing);
+    std::printf("[ sun %.0f deg ] backprojection 10-90%% width %.4f m (%+.1f %%)\n", theta, back,
+                100.0 * (back / expected - 1.0));
+    EXPECT_NEAR(back / expected, 1.0, 0.10) << theta << " degrees, backprojection";
+    std::printf("[ sun %.0f deg ] 10-90%% width: analytic %.4f m (full %.4f m), pcss %.4f m "
+                "(%+.1f %%), pcf 3x3 %.4f m; cascade 0 texel %.4f m\n",
+                theta, expected, full, width, 100.0 * (width / expected - 1.0), hard,
+                texel);
+    EXPECT_NEAR(width / expected, 1.0, 0.10) << theta << " degrees";
+    EXPECT_LT(hard, 0.5f * expected) << "hard PCF should not be soft";
+  }
+}
+
+// S1's point against plain backprojection: where two occluders cover overlapping parts of the
+// light, backprojection counts the overlap twice and comes out too dark. Along a line across the
+// slab's penumbra (10-degree sun), at the points in penumbra where slab and bar overlap on the
+// light by more than 3% of it (computed from the geometry), its mean signed error against the
+// exact visibility is clearly negative; over the whole penumbra without the bar it is small (so
+// the darkening is the double count, not the technique's ordinary error). PCSS is printed for
+// comparison.
+TEST_F(SoftShadowTest, BackprojectionOverDarkensWhereOccludersOverlap) {
+  constexpr float kTheta = 10.0f, kSpacing = 0.002f;
+  std::vector<glm::vec3> points, normals;
+  for (float x = kEdge - 0.3f; x <= kEdge + 0.3f; x += kSpacing) {
+    points.emplace_back(x, 0.0f, 0.0f);
+    normals.emplace_back(0.0f, 1.0f, 0.0f);
+  }
+  struct Case {
+    const char* name;
+    fs::path file;
+    bool two;
+    const char* technique;
+  };
+  const Case cases[] = {{"slab only", write_slab_scene(kTheta), false, "backprojection"},
+                        {"slab + bar", write_two_blocker_scene(kTheta), true, "backprojection"},
+                        {"slab + bar", write_two_blocker_scene(kTheta), true, "pcss"}};
+  double error[3] = {0.0, 0.0, 0.0};
+  for (int c = 0; c < 3; ++c) {
+    Scene scene = load(cases[c].file, {std::string("shadow.technique=") + cases[c].technique});
+    auto t = render_frames(*player_, scene, {});
+    ASSERT_TRUE(t.ok()) << t.error().to_string();
+    auto values = player_->renderer->shadow_at_points(points, normals);
+    ASSERT_TRUE(values.ok()) << values.error().to_string();
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const float x = points[i].x;
+      float overlap = 0.0f;
+      const float exact = cases[c].two ? analytic_two_blockers(x, kTheta, &overlap)
+                                       : analytic_visibility(x, kTheta);
+      if (exact <= 0.02f || exact >= 0.98f) continue;  // the penumbra only
+      if (cases[c].two && overlap < 0.03f) continue;    // where the occluders overlap
+      sum += (*values)[i].x - exact;
+      ++n;
+    }
+    ASSERT_GT(n, 10) << cases[c].name;
+    error[c] = sum / n;
+    std::printf("[ %s, %s ] mean signed error %+.4f over %d penumbra points%s\n",
+                cases[c].name, cases[c].technique, error[c], n,
+                cases[c].two ? " where the occluders overlap" : "");
+  }
+  EXPECT_LT(std::abs(error[0]), 0.03) << "backprojection, one occluder";
+  EXPECT_LT(error[1], -0.05) << "backprojection should over-darken where occluders overlap";
+  EXPECT_LT(error[1], error[0] - 0.04);
+}
+
+// Light leaks into closed geometry: ground points inside a closed 1 x 0.5 x 1 m box (5 cm and
+// more from its walls) under a 5-degree sun, where the reference is 0. Stated bounds: none
+// (<= 0.01) for pcf 3x3, 9x9, the default poisson disc and pcss. A poisson disc of 8 texels
+// reaches past the 5 cm to the wall from the points next to it and reads the ground outside, on
+// the receiver's plane, as lit (measured 0.0625 at 35 of 8281 points: <= 0.07). Backprojection
+// leaks through gaps between micro-occluders at different depths (the box's top and its
+// sunward wall; the paper's gap filling is not implemented): measured 0.0997 at 500 points,
+// bound 0.12.
+TEST_F(SoftShadowTest, NoTechniqueLeaksLightIntoAClosedBox) {
+  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
+  fs::create_directories(dir);
+  const fs::path file = dir / "closed_box.json";
+  std::ofstream(file) << R"({ "kaskad_scene": 1,
+    "render": { "width": 320, "height": 180 },
+    "entities": [
+      { "name": "ground", "transform": { "scale": [40, 1, 40] }, "primitive": { "shape": "plane" } },
+      { "name": "box", "transform": { "translation": [0, 0.25, 0], "scale": [1, 0.5, 1] },
+        "primitive": { "shape": "box" } },
+      { "name": "sun", "transform": { "direction": [0.3, -1, 0.2] },
+        "light": { "type": "directional", "cast_shadows": true, "angular_size_deg": 5 } },
+      { "name": "camera", "transform": { "translation": [0, 3, 4], "look_at": [0, 0, 0] },
+        "camera": { "fov_y_deg": 45, "near": 0.1, "far": 100, "active": true } } ] })";
+  std::vector<glm::vec3> points, normals;
+  for (float z = -0.45f; z <= 0.45f; z += 0.01f)
+    for (float x = -0.45f; x <= 0.45f; x += 0.01f) {
+      points.emplace_back(x, 0.0f, z);
+      normals.emplace_back(0.0f, 1.0f, 0.0f);
+    }
+  const std::vector<std::pair<std::vector<std::string>, float>> cases = {
+      {{"shadow.technique=pcf"}, 0.01f},
+      {{"shadow.pcf_kernel=9"}, 0.01f},
+      {{"shadow.pcf_kernel=poisson"}, 0.01f},
+      {{"shadow.pcf_kernel=poisson", "shadow.pcf_radius=8"}, 0.07f},
+      {{"shadow.technique=pcss"}, 0.01f},
+      {{"shadow.technique=backprojection"}, 0.12f}};
+  for (const auto& [sets, bound] : cases) {
+    Scene scene = load(file, sets);
+    auto t = render_frames(*player_, scene, {});
+    ASSERT_TRUE(t.ok()) << t.error().to_string();
+    auto values = player_->renderer->shadow_at_points(points, normals);
+    ASSERT_TRUE(values.ok()) << values.error().to_string();
+    float worst = 0.0f;
+    glm::vec3 at{0.0f};
+    int leaking = 0;
+    for (std::size_t i = 0; i < values->size(); ++i) {
+      leaking += (*values)[i].x > 0.01f;
+      if ((*values)[i].x > worst) {
+        worst = (*values)[i].x;
+        at = points[i];
+      }
+    }
+    std::printf("[ %s ] largest visibility inside the box %.4f (at x %.2f z %.2f), %d of %zu "
+                "points above 0.01\n",
+                sets.back().c_str(), worst, at.x, at.z, leaking, points.size());
+    EXPECT_LE(worst, bound) << sets.back();
+  }
+}
+
+// (b) On the default scene with a 5-degree sun (content/scenes/soft/sun_5deg.json), PCSS's
+// visibility is closer to the ray-traced area-light reference (256 stratified samples per pixel)
+// than hard 3x3 PCF's, and its RMSE stays below a bound. The same for the spot light of
+// content/scenes/spot.json with a 0.3 m radius (a 0.6 m square emitter), through the
+// perspective map.
+TEST_F(SoftShadowTest, PcssBeatsHardPcfAgainstTheAreaLightReference) {
+  struct Case {
+    const char* name;
+    fs::path file;
+    std::vector<std::string> sets;
+    double bound;
+  };
+  const std::vector<Case> cases = {
+      {"sun 5 deg", content_dir() / "scenes" / "soft" / "sun_5deg.json", {}, 0.02},
+      {"spot r 0.3 m", content_dir() / "scenes" / "spot.json", {"spot.light.radius=0.3"}, 0.03}};
+  for (const Case& c : cases) {
+    double rmse[3] = {0.0, 0.0, 0.0}, mae[3] = {0.0, 0.0, 0.0};
+    int k = 0;
+    for (const char* technique : {"pcss", "pcf", "backprojection"}) {
+      std::vector<std::string> sets = c.sets;
+      sets.insert(sets.end(), {"render.width=400", "render.height=225",
+                               std::string("shadow.technique=") + technique});
+      Scene scene = load(c.file, sets);
+      auto t = render_frames(*player_, scene, {});
+      ASSERT_TRUE(t.ok()) << t.error().to_string();
+      const Image aov = player_->renderer->read_aovs();
+      const ecs::Entity light = t->last.shadow().light;
+      ASSERT_TRUE(light.valid());
+      auto tracer = reference::RayTracer::build(scene);
+      ASSERT_TRUE(tracer.ok()) << tracer.error().to_string();
+      const auto rlight = reference::reference_light(scene.world.get<Light>(light),
+                                                     scene.world.get<WorldTransform>(light).matrix);
+      ASSERT_TRUE(rlight.is_area()) << c.name;
+      auto ref = tracer->shadow_reference(aov, rlight, {});
+      ASSERT_TRUE(ref.ok()) << ref.error().to_string();
+      auto m = reference::compare_shadows(aov, ref->image);
+      ASSERT_TRUE(m.ok()) << m.error().to_string();
+      rmse[k] = m->all.rmse;
+      mae[k] = m->all.mean_abs_error;
+      std::printf("[ %s, %s ] visibility RMSE %.4f, MAE %.4f over %zu receiver pixels\n", c.name,
+                  technique, rmse[k], mae[k], std::size_t(m->all.pixels));
+      ++k;
+    }
+    EXPECT_LT(rmse[0], c.bound) << c.name << " pcss";
+    EXPECT_LT(rmse[0], 0.8 * rmse[1]) << c.name << ": pcss should beat hard pcf by a margin";
+    EXPECT_LT(mae[0], mae[1]) << c.name;
+    EXPECT_LT(rmse[2], c.bound) << c.name << " backprojection";
+    EXPECT_LT(rmse[2], 0.8 * rmse[1]) << c.name << ": backprojection should beat hard pcf";
+  }
+}
+
+// (c) Every new lookup keeps S2's guarantee: with stable cascades and no blend band, camera
+// translation changes no shadow value at fixed world points (flicker exactly 0; PCSS up to float
+// rounding). The disc kernels' rotation comes from the point's cell in the light's texel grid,
+// numbered without the cascade's snapped translation (numbered from map coordinates, the poisson
+// kernel flickered 2.4e-4 with 1.1% of samples changed, PCSS 5.5e-4 / 1.7%).
+TEST_F(SoftShadowTest, WideKernelsAndPcssDoNotFlickerUnderCameraTranslation) {
+  const fs::path file = content_dir() / "scenes" / "soft" / "sun_5deg.json";
+  const std::vector<std::vector<std::string>> cases = {
+      {"shadow.technique=pcf", "shadow.pcf_kernel=5"},
+      {"shadow.technique=pcf", "shadow.pcf_kernel=9"},
+      {"shadow.technique=pcf", "shadow.pcf_kernel=poisson", "shadow.pcf_taps=24"},
+      {"shadow.technique=pcss"},
+      {"shadow.technique=backprojection"}};
+  for (std::vector<std::string> sets : cases) {
+    const std::string name = sets.back();
+    sets.insert(sets.end(), {"render.width=320", "render.height=180", "shadow.blend_band=0",
+                             "shadow.fit_mode=stable"});
+    Scene scene = load(file, sets);
+    auto t = render_frames(*player_, scene, {});
+    ASSERT_TRUE(t.ok()) << t.error().to_string();
+    auto points = stability_points(player_->renderer->read_aovs(), 3000);
+    ASSERT_TRUE(points.ok()) << points.error().to_string();
+    ASSERT_GT(points->positions.size(), 1000u);
+    CameraPath path;
+    path.frames = 8;
+    auto run = measure_stability(*player_, scene, *points, path);
+    ASSERT_TRUE(run.ok()) << run.error().to_string();
+    // Some points must be in partial shadow, or the test would not see a rotation change.
+    std::size_t partial = 0;
+    for (float v : run->visibility.front()) partial += v > 0.02f && v < 0.98f;
+    std::printf("[ %s ] flicker %.6g, %.3f %% of samples changed, %zu points in penumbra\n",
+                name.c_str(), run->stats.flicker, run->stats.changed_pct, partial);
+    EXPECT_GT(partial, 20u) << name;
+    if (name == "shadow.technique=pcss" || name == "shadow.technique=backprojection") {
+      // PCSS and backprojection convert depths to metres with the cascade's depth range, which
+      // moves with the camera's tight near/far by float rounding only: far below one 8-bit
+      // step, no sample counts as changed (as the blend band, stability_test.cpp).
+      EXPECT_LT(run->stats.flicker, 1e-6) << name;
+      EXPECT_EQ(run->stats.changed_pct, 0.0) << name;
+    } else {
+      EXPECT_EQ(run->stats.flicker, 0.0) << name;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace kaskad
