@@ -1,3 +1,4 @@
+#include "runtime/core/median.h"
 #include "runtime/cli/playback.h"
 
 #include <algorithm>
@@ -452,13 +453,6 @@ struct FrameRow {
   int compiles = 0;  ///< programs built after pre-warm, so far
   double misclassified_pct = -1.0;
 };
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // Resident set size of this process, MiB (Linux /proc/self/statm; 0 elsewhere).
 double resident_mib() {

@@ -1,3 +1,4 @@
+#include "runtime/core/median.h"
 #include "runtime/cli/player.h"
 
 #include <algorithm>
@@ -106,11 +107,7 @@ Result<Player> Player::create(const gpu::ContextOptions& options,
 }
 
 double RenderTimings::median_ms() const {
-  if (frame_ms.empty()) return first_frame_ms;
-  std::vector<double> v = frame_ms;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  return frame_ms.empty() ? first_frame_ms : median(frame_ms);
 }
 
 Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRun& run) {

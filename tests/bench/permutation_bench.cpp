@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "runtime/core/median.h"
 #include "runtime/cli/player.h"
 #include "runtime/gpu/context.h"
 #include "systems/frame.h"
@@ -26,12 +27,6 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 fs::path write_scene(int objects) {
   const fs::path materials = fs::absolute(content_dir() / "materials");

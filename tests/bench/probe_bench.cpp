@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/core/median.h"
 #include "runtime/cli/player.h"
 #include "runtime/gpu/context.h"
 #include "runtime/reference/reflection_reference.h"
@@ -29,13 +30,6 @@ using namespace kaskad;
 namespace fs = std::filesystem;
 
 namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 Scene load_or_die(const fs::path& file, const std::vector<std::string>& sets) {
   auto s = load_scene(file, sets);

@@ -23,6 +23,7 @@
 
 #include "components/camera.h"
 #include "components/transform.h"
+#include "runtime/core/median.h"
 #include "runtime/cli/player.h"
 #include "runtime/gpu/context.h"
 #include "systems/frame.h"
@@ -31,13 +32,6 @@ using namespace kaskad;
 namespace fs = std::filesystem;
 
 namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 [[noreturn]] void die(const std::string& what) {
   std::fprintf(stderr, "scaling_bench: %s\n", what.c_str());

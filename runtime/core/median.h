@@ -1,0 +1,18 @@
+// The median of a sample (frame times, per-round ratios): one definition for the player, the
+// bench, playback and the benchmark programs.
+#pragma once
+
+#include <algorithm>
+#include <vector>
+
+namespace kaskad {
+
+/// The middle value of `v` (the mean of the two middle values for an even count); 0 when empty.
+inline double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace kaskad
