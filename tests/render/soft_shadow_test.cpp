@@ -3,6 +3,8 @@
 // similar triangles give; the visibility AOV of the default scene with a 5-degree sun against the
 // ray-traced area-light reference (RMSE); world-space flicker of every new lookup under camera
 // translation with stable cascades.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -33,7 +35,9 @@ constexpr float kSlabBottom = 1.0f, kSlabTop = 1.05f, kEdge = 2.0f;
 fs::path write_slab_scene(float theta_deg) {
   const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
   fs::create_directories(dir);
-  const fs::path file = dir / "slab.json";
+  // Named by process and angle: CTest runs the tests that write it in parallel processes.
+  const fs::path file = dir / ("slab_" + std::to_string(::getpid()) + "_" +
+                               std::to_string(int(theta_deg * 100.0f)) + ".json");
   std::ofstream(file) << R"({ "kaskad_scene": 1,
     "render": { "width": 320, "height": 180 },
     "shadow": { "technique": "pcss", "cascade_count": 4, "fit_mode": "stable" },
@@ -79,7 +83,7 @@ constexpr float kBarMin = 2.0f, kBarMax = 2.1f, kBarBottom = 3.0f, kBarTop = 3.0
 fs::path write_two_blocker_scene(float theta_deg) {
   const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
   fs::create_directories(dir);
-  const fs::path file = dir / "two_blockers.json";
+  const fs::path file = dir / ("two_blockers_" + std::to_string(::getpid()) + ".json");
   std::ofstream(file) << R"({ "kaskad_scene": 1,
     "render": { "width": 320, "height": 180 },
     "shadow": { "technique": "backprojection", "cascade_count": 4, "fit_mode": "stable" },
@@ -260,7 +264,7 @@ TEST_F(SoftShadowTest, BackprojectionOverDarkensWhereOccludersOverlap) {
 TEST_F(SoftShadowTest, NoTechniqueLeaksLightIntoAClosedBox) {
   const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
   fs::create_directories(dir);
-  const fs::path file = dir / "closed_box.json";
+  const fs::path file = dir / ("closed_box_" + std::to_string(::getpid()) + ".json");
   std::ofstream(file) << R"({ "kaskad_scene": 1,
     "render": { "width": 320, "height": 180 },
     "entities": [
