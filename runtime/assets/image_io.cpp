@@ -270,6 +270,30 @@ Status check_png_chunks(const std::uint8_t* d, std::size_t n, const std::string&
   return {};
 }
 
+/// BMP: OIIO's reader seeks to the pixel data offset of the file header (bytes 10..13) without
+/// checking it, and its in-memory reader does not check a seek before the start: a 174-byte file
+/// whose offset was 0xffffffca (-54) made it read 6 bytes in front of the buffer (a heap overflow
+/// found by fuzz_image under ASan). The header is checked first: the info header (size at byte 14)
+/// must fit in the file and the pixel data must start after it and inside the file.
+Status check_bmp_header(const std::uint8_t* d, std::size_t n, const std::string& name) {
+  auto u32 = [&](std::size_t at) {
+    return std::uint32_t(d[at]) | (std::uint32_t(d[at + 1]) << 8) |
+           (std::uint32_t(d[at + 2]) << 16) | (std::uint32_t(d[at + 3]) << 24);
+  };
+  if (n < 18) return Error{name, "byte 0", "truncated BMP: no file and info headers"};
+  const std::uint64_t offset = u32(10), info = u32(14);
+  if (14 + info > n)
+    return Error{name, "byte 14", "corrupt or truncated BMP: the info header claims " +
+                                      std::to_string(info) + " bytes, the file has " +
+                                      std::to_string(n)};
+  if (offset < 14 + info || offset >= n)
+    return Error{name, "byte 10", "corrupt BMP: the pixel data offset " + std::to_string(offset) +
+                                      " is not between the end of the headers (" +
+                                      std::to_string(14 + info) + ") and the end of the file (" +
+                                      std::to_string(n) + ")"};
+  return {};
+}
+
 /// Decodes `size` bytes with the reader for `format`. `name` is only used in messages.
 /// OpenEXR allocates while reading the header, before OIIO hands us anything: a 626-byte file
 /// whose string attribute claimed 2 GB made it take 2 GB (found by scripts/fuzz.sh image), and a
@@ -326,6 +350,7 @@ Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::stri
   if (format == "openexr") KASKAD_TRY(check_exr_windows(data, size, name));
   if (format == "gif") KASKAD_TRY(check_gif_screen(data, size, name));
   if (format == "png") KASKAD_TRY(check_png_chunks(data, size, name));
+  if (format == "bmp") KASKAD_TRY(check_bmp_header(data, size, name));
   OIIO::Filesystem::IOMemReader proxy(data, size);
   // The proxy must travel in the open() configuration: handing it to create() alone is not
   // enough for every reader (the PNG reader then opens `name` as a file). UnassociatedAlpha keeps
