@@ -12,12 +12,20 @@
 namespace kaskad::render {
 namespace {
 
-// The instance record of a draw with model matrix `model` (layer: the layered shadow pass's).
-InstanceRecord instance_of(const glm::mat4& model, std::uint32_t layer = 0) {
+// The instance record of a forward draw with model matrix `model`.
+InstanceRecord instance_of(const glm::mat4& model) {
   InstanceRecord r;
   r.model = model;
   const glm::mat3 n = glm::transpose(glm::inverse(glm::mat3(model)));
   for (int c = 0; c < 3; ++c) r.normal_matrix[c] = glm::vec4(n[c], 0.0f);
+  return r;
+}
+
+// The instance record of a depth draw: shadow_depth.vert reads the model matrix and the layer
+// (the layered pass's) only, so no normal matrix is computed (one per caster and layer).
+InstanceRecord depth_instance_of(const glm::mat4& model, std::uint32_t layer) {
+  InstanceRecord r;
+  r.model = model;
   r.layer = glm::uvec4(layer, 0, 0, 0);
   return r;
 }
@@ -300,7 +308,7 @@ std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list
     previous = i;
     for (int c = 0; c < v.layer_count; ++c)
       if (mask & (1u << c))
-        records.push_back(instance_of(frame.draws[i].model, per_layer ? std::uint32_t(c) : 0u));
+        records.push_back(depth_instance_of(frame.draws[i].model, per_layer ? std::uint32_t(c) : 0u));
     runs.back().count = records.size() - runs.back().first;
   }
   return runs;
