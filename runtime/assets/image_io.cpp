@@ -1,6 +1,6 @@
 // Image files through OpenImageIO 2.4.
 //
-// Every read goes through memory (Filesystem::IOMemReader) with an explicitly chosen reader: the
+// Every read goes through memory (BoundedMemReader, a Filesystem::IOMemReader) with an explicitly chosen reader: the
 // format comes from the file's magic bytes, then the MIME type, then the extension. We never let
 // OIIO "try every reader in turn" on unknown bytes (what ImageInput::open(filename) does when the
 // extension does not match), so corrupt or hostile data reaches at most one decoder.
@@ -338,6 +338,27 @@ Status check_exr_windows(const std::uint8_t* d, std::size_t n, const std::string
   return {};
 }
 
+// OIIO 2.4's IOMemReader::pread copies past the end of its buffer when asked to read from an
+// offset beyond it (the size left underflows): an EXR whose line offset table points past the
+// end of the data overflowed the heap (found by fuzz_image and fuzz_envmap). Here a read stops
+// at the end of the buffer, as a file read does.
+class BoundedMemReader final : public OIIO::Filesystem::IOMemReader {
+ public:
+  using IOMemReader::IOMemReader;
+  size_t pread(void* buf, size_t size, int64_t offset) override {
+    const auto end = std::int64_t(m_buf.size());
+    if (offset < 0 || offset >= end) return 0;
+    size = std::min(size, std::size_t(end - offset));
+    std::memcpy(buf, m_buf.data() + offset, size);
+    return size;
+  }
+  size_t read(void* buf, size_t size) override {
+    const size_t n = pread(buf, size, m_pos);
+    m_pos += int64_t(n);
+    return n;
+  }
+};
+
 Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::string& name,
                      const std::string& format) {
   if (size == 0) return Error{name, "", "empty image data (0 bytes)"};
@@ -351,7 +372,7 @@ Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::stri
   if (format == "gif") KASKAD_TRY(check_gif_screen(data, size, name));
   if (format == "png") KASKAD_TRY(check_png_chunks(data, size, name));
   if (format == "bmp") KASKAD_TRY(check_bmp_header(data, size, name));
-  OIIO::Filesystem::IOMemReader proxy(data, size);
+  BoundedMemReader proxy(data, size);
   // The proxy must travel in the open() configuration: handing it to create() alone is not
   // enough for every reader (the PNG reader then opens `name` as a file). UnassociatedAlpha keeps
   // the stored values: OIIO would otherwise premultiply PNG/TGA colour by alpha on read.
