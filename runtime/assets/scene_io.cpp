@@ -99,8 +99,13 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
       fail(r.at("pcf_kernel"), "must be 3, 5, 7, 9 or \"poisson\", was " + std::to_string(side));
     s.pcf_kernel = PcfKernel((side - 3) / 2);
   } else if (r.has("pcf_kernel")) {
-    if (!r.raw("pcf_kernel").is_string())
-      fail(r.at("pcf_kernel"), "expected 3, 5, 7, 9 or \"poisson\", got " + type_name(r.raw("pcf_kernel")));
+    const json& v = r.raw("pcf_kernel");
+    if (!v.is_string())
+      fail(r.at("pcf_kernel"), "expected 3, 5, 7, 9 or \"poisson\", got " + type_name(v));
+    // The sides are numbers: a string other than "poisson" ("9x9", "5") gets the whole list.
+    if (v.get<std::string>() != "poisson")
+      fail(r.at("pcf_kernel"),
+           "must be 3, 5, 7, 9 or \"poisson\", was '" + v.get<std::string>() + "'");
     r.enumeration("pcf_kernel", s.pcf_kernel, kKernelNames);
   }
   r.integer("pcf_taps", s.pcf_taps, 8, 64);

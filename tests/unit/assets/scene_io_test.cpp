@@ -225,7 +225,8 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   expect_error(read_scene(def, {"shadow.pcf_kernel=4"}), {"/shadow/pcf_kernel", "3, 5, 7, 9", "4"});
   expect_error(read_scene(def, {"shadow.pcf_kernel=11"}), {"/shadow/pcf_kernel", "11"});
   expect_error(read_scene(def, {"shadow.pcf_kernel=1"}), {"/shadow/pcf_kernel", "1"});
-  expect_error(read_scene(def, {"shadow.pcf_kernel=gauss"}), {"/shadow/pcf_kernel", "gauss", "poisson"});
+  expect_error(read_scene(def, {"shadow.pcf_kernel=gauss"}), {"/shadow/pcf_kernel", "gauss", "3, 5, 7, 9", "poisson"});
+  expect_error(read_scene(def, {"shadow.pcf_kernel=9x9"}), {"/shadow/pcf_kernel", "9x9", "3, 5, 7, 9"});
   expect_error(read_scene(def, {"shadow.pcf_kernel=true"}), {"/shadow/pcf_kernel", "poisson"});
   expect_error(read_scene(def, {"shadow.pcf_taps=7"}), {"/shadow/pcf_taps", "[8, 64]", "7"});
   expect_error(read_scene(def, {"shadow.pcf_taps=65"}), {"/shadow/pcf_taps", "65"});
