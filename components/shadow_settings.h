@@ -166,6 +166,14 @@ struct ShadowSettings {
   /// faster; default.json is even (README, "Layered shadow pass"). Dual-paraboloid maps always
   /// draw per layer. Taken from the first shadowed light for all.
   bool layered = false;
+  /// Directional lights with view-depth selection: leave out of a cascade the casters whose
+  /// shadow cannot fall on the receivers it serves (may_shadow(): e.g. a ground plane when every
+  /// receiver of the cascade lies above it). Same images (render test); off for comparisons.
+  bool cull_by_receivers = true;
+  /// Directional lights with view-depth selection: clear and draw only the part of each cascade
+  /// that its receivers' lookups read (ShadowData::read_rect), not the whole layer. Same images
+  /// (render test); off for comparisons.
+  bool scissor_to_receivers = true;
   /// Point lights only. cube by default: exact for any tessellation; dual_paraboloid draws 2
   /// maps instead of 6 (S0's earlier work).
   PointShadowMode point_mode = PointShadowMode::cube;

@@ -248,6 +248,74 @@ std::vector<std::uint32_t> cull_casters(const glm::mat4& light_view_proj,
   return out;
 }
 
+namespace {
+
+// NDC bounds of `box` through the affine map `m` (an orthographic projection): the centre
+// mapped, the half-extent through |m| (Arvo's box transform).
+Aabb ndc_bounds(const glm::mat4& m, const Aabb& box) {
+  const glm::vec3 centre = 0.5f * (box.min + box.max), half = 0.5f * (box.max - box.min);
+  const glm::vec3 c = glm::vec3(m * glm::vec4(centre, 1.0f));
+  glm::vec3 e(0.0f);
+  for (int col = 0; col < 3; ++col)
+    for (int row = 0; row < 3; ++row) e[row] += std::abs(m[col][row]) * half[col];
+  return Aabb{c - e, c + e};
+}
+
+// Whether `box` lies wholly outside the convex slice with corners `c` (near 0-3, far 4-7, in
+// slice_corners_world()'s order): outside one of its six face planes.
+bool outside_slice(const std::array<glm::vec3, 8>& c, const Aabb& box) {
+  static constexpr int kFaces[6][3] = {{0, 1, 2}, {4, 5, 6}, {0, 1, 5},
+                                       {3, 2, 6}, {0, 3, 7}, {1, 2, 6}};
+  glm::vec3 centre(0.0f);
+  for (const glm::vec3& p : c) centre += p * 0.125f;
+  for (const auto& f : kFaces) {
+    glm::vec3 n = glm::cross(c[f[1]] - c[f[0]], c[f[2]] - c[f[0]]);
+    if (!(glm::dot(n, n) > 0.0f)) continue;  // a degenerate face bounds nothing
+    if (glm::dot(n, centre - c[f[0]]) > 0.0f) n = -n;  // n points out of the slice
+    // The box corner farthest against n: outside when even it is in front of the plane.
+    const glm::vec3 v = glm::mix(box.max, box.min, glm::vec3(glm::greaterThan(n, glm::vec3(0.0f))));
+    if (glm::dot(n, v - c[f[0]]) > 0.0f) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+glm::vec4 receiver_rect(const glm::mat4& light_view_proj,
+                        const std::array<glm::vec3, 8>& slice_corners,
+                        std::span<const Aabb> receivers, float margin_ndc, Aabb* touched) {
+  Aabb slice;
+  for (const glm::vec3& p : slice_corners) slice.expand(glm::vec3(light_view_proj * glm::vec4(p, 1.0f)));
+  glm::vec2 lo(std::numeric_limits<float>::infinity()), hi(-lo);
+  for (const Aabb& box : receivers) {
+    if (box.empty() || outside_slice(slice_corners, box)) continue;
+    const Aabb b = ndc_bounds(light_view_proj, box);
+    if (b.max.x < slice.min.x || b.min.x > slice.max.x || b.max.y < slice.min.y ||
+        b.min.y > slice.max.y || b.max.z < slice.min.z || b.min.z > slice.max.z)
+      continue;
+    if (touched) touched->expand(box);
+    lo = glm::min(lo, glm::max(glm::vec2(b.min), glm::vec2(slice.min)));
+    hi = glm::max(hi, glm::min(glm::vec2(b.max), glm::vec2(slice.max)));
+  }
+  if (!(lo.x <= hi.x && lo.y <= hi.y)) return glm::vec4(1.0f, 1.0f, -1.0f, -1.0f);
+  lo = glm::max(lo - margin_ndc, glm::vec2(-1.0f));
+  hi = glm::min(hi + margin_ndc, glm::vec2(1.0f));
+  return glm::vec4(lo, hi);
+}
+
+bool may_shadow(const Aabb& caster, const Aabb& receivers, const glm::vec3& light_dir) {
+  if (receivers.empty()) return false;  // nothing to shadow
+  if (caster.empty()) return true;
+  for (int a = 0; a < 3; ++a) {
+    const float towards_light = -light_dir[a];
+    if (towards_light > 0.0f && receivers.min[a] >= caster.max[a]) return false;
+    if (towards_light < 0.0f && receivers.max[a] <= caster.min[a]) return false;
+    if (towards_light == 0.0f && (receivers.min[a] > caster.max[a] || receivers.max[a] < caster.min[a]))
+      return false;
+  }
+  return true;
+}
+
 float light_size_for_shadows(const Light& light) {
   if (light.type == LightType::directional)
     return 2.0f * std::tan(0.5f * glm::radians(light.angular_size_deg));
@@ -448,8 +516,24 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
       out.skipped[c] = fit.empty || receiver_boxes.empty();
     }
     if (out.skipped[c]) continue;
+    Aabb served;  // the receivers this cascade serves (depth selection)
+    const bool by_depth = s.selection == CascadeSelection::depth;
+    if (by_depth) {
+      // Points of view depth D[c] - band (D[c] - D[c-1]) on blend into this cascade; the first
+      // cascade also serves anything nearer than D[0], so it starts at the camera's near.
+      CameraSlice reads = slice;
+      reads.near = i == 0 ? camera.camera.near
+                          : out.splits[c] - s.blend_band * (out.splits[c] - out.splits[c - 1]);
+      reads.far = out.splits[c + 1];
+      const float margin_texels = filter_reach_texels(s) + s.normal_offset_bias + 1.0f;
+      const glm::vec4 rect = receiver_rect(out.view_proj[c], slice_corners_world(reads),
+                                           receiver_boxes, 2.0f * margin_texels / float(s.map_size),
+                                           &served);
+      if (s.scissor_to_receivers) out.read_rect[c] = rect;
+    }
     for (std::uint32_t k : cull_casters(out.view_proj[c], caster_boxes))
-      out.casters[c].push_back(caster_entities[k]);
+      if (!(by_depth && s.cull_by_receivers) || may_shadow(caster_boxes[k], served, light.direction))
+        out.casters[c].push_back(caster_entities[k]);
     std::sort(out.casters[c].begin(), out.casters[c].end(), entity_less);
   }
   return finish();

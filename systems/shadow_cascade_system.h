@@ -19,6 +19,7 @@
 #include "components/shadow_settings.h"
 #include "runtime/ecs/world.h"
 #include "components/limits.h"
+#include "runtime/render/frame_input.h"
 #include "systems/camera_system.h"
 #include "systems/cascade_math.h"
 #include "systems/shadow_map_system.h"
@@ -71,6 +72,13 @@ struct ShadowData {
   /// Shadow casters overlapping each cascade's light volume, sorted: only these are drawn into
   /// that layer.
   std::array<std::vector<ecs::Entity>, kMaxCascades> casters{};
+  /// The part of each layer the lookups can read, in the layer's NDC x/y (min x, min y, max x,
+  /// max y): the receivers within the cascade's camera slice (from the start of the previous
+  /// cascade's blend band) by receiver_rect(), grown by the lookup's reach, the normal offset
+  /// and a texel. The depth pass clears and draws only this rectangle. The whole layer,
+  /// [-1, 1]^2, where no slice bounds the lookups: map-bounds selection, the basic map (fit
+  /// scene), spot and point lights. Empty (min > max) when no receiver lies in the slice.
+  std::array<glm::vec4, kMaxCascades> read_rect = render::whole_layers();
   /// The view-depth range the cascades could span, [camera near, min(camera far,
   /// max_distance)], and the one they span: the visible receivers' range
   /// (visible_receiver_depths()) clipped to it and rounded outwards (quantize_depth_range()).
@@ -142,6 +150,26 @@ DepthRange visible_receiver_depths(const glm::mat4& view, const glm::mat4& view_
 /// small camera move keeps the same range, splits and stable-fit sizes (S2: a stable cascade
 /// needs a fixed projection size). Needs 0 < near <= far.
 DepthRange quantize_depth_range(DepthRange r);
+
+/// The receivers' part of an orthographic map: the NDC x/y bounds, through `light_view_proj`, of
+/// each box of `receivers` that meets the camera slice with corners `slice_corners` (the points
+/// that read the map; slice_corners_world() order; tested against its six face planes and
+/// against its NDC bounds in x, y and z), clipped to those bounds in x/y; their union grown
+/// by `margin_ndc` on every side, within [-1, 1]^2. As (min x, min y, max x, max y); empty
+/// (min > max) when no box overlaps.
+/// `touched`, when given, gets the world bounds of the boxes that overlap.
+glm::vec4 receiver_rect(const glm::mat4& light_view_proj,
+                        const std::array<glm::vec3, 8>& slice_corners,
+                        std::span<const Aabb> receivers, float margin_ndc,
+                        Aabb* touched = nullptr);
+
+/// Whether a caster in `caster` can shadow a point in `receivers` under a directional light
+/// travelling along `light_dir`. False when a face plane of the caster's box that faces the
+/// light has the whole receiver box on its lit side: a ray from such a point towards the light
+/// never goes back across the plane to the caster (a ray along the plane counts only when the
+/// receiver box lies strictly beside the caster). A flat caster (a ground plane) lies in its own
+/// face plane, so it may serve as its own receiver. True when neither is proven.
+bool may_shadow(const Aabb& caster, const Aabb& receivers, const glm::vec3& light_dir);
 
 /// Indices of the boxes that overlap the clip volume [-1, 1]^3 of `light_view_proj` (corner test
 /// against each plane; conservative), in order.

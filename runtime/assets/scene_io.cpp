@@ -127,6 +127,8 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
   r.enumeration("point_mode", s.point_mode, kPointModes);
   r.boolean("freeze_cascades", s.freeze_cascades);
   r.boolean("layered", s.layered);
+  r.boolean("cull_by_receivers", s.cull_by_receivers);
+  r.boolean("scissor_to_receivers", s.scissor_to_receivers);
   r.finish();
   if (std::string bad = validate_shadow_settings(s); !bad.empty())
     fail(r.at(bad.substr(0, bad.find(' ')).c_str()), bad);
@@ -164,6 +166,9 @@ json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
   put("point_mode", enum_name(s.point_mode, kPointModes), s.point_mode != d.point_mode);
   put("freeze_cascades", s.freeze_cascades, s.freeze_cascades != d.freeze_cascades);
   put("layered", s.layered, s.layered != d.layered);
+  put("cull_by_receivers", s.cull_by_receivers, s.cull_by_receivers != d.cull_by_receivers);
+  put("scissor_to_receivers", s.scissor_to_receivers,
+      s.scissor_to_receivers != d.scissor_to_receivers);
   return j;
 }
 

@@ -305,15 +305,23 @@ int run_bench_command(const Args& a, bool frames_given) {
   return 0;
 }
 
-// Per-layer stats of one shadow view: world units per texel, casters drawn, their triangles,
+// The share of a map_size^2 layer that `r` (FrameStats::layer_rect) covers, in percent.
+double rect_percent(const glm::ivec4& r, int map_size) {
+  if (r.x >= r.z || r.y >= r.w) return 0.0;
+  return 100.0 * double(r.z - r.x) * double(r.w - r.y) / (double(map_size) * double(map_size));
+}
+
+// Per-layer stats of one shadow view: world units per texel, casters drawn, their triangles, the
+// share of the layer the depth pass draws (its read rectangle),
 // receiver pixels (AOV pixels shaded from that cascade, for the view the AOV shows; 0 without
 // AOVs or for the other views).
 void print_layer_table(const render::FrameStats& st, const ShadowData& sh, bool shown_in_aov) {
-  std::printf("          layer  m/texel   casters  triangles  receiver px\n");
+  std::printf("          layer  m/texel   casters  triangles  drawn  receiver px\n");
   for (int i = 0; i < sh.cascade_count; ++i) {
     const auto c = std::size_t(i), l = std::size_t(sh.first_layer + i);
-    std::printf("          %-5zu  %-8.3g  %-7d  %-9zu  %zu%s\n", l, double(st.layer_texel_size[l]),
-                st.layer_casters[l], st.layer_triangles[l],
+    std::printf("          %-5zu  %-8.3g  %-7d  %-9zu  %4.0f%%  %zu%s\n", l,
+                double(st.layer_texel_size[l]), st.layer_casters[l], st.layer_triangles[l],
+                rect_percent(st.layer_rect[l], sh.settings.map_size),
                 shown_in_aov ? st.cascade_receiver_pixels[c] : std::size_t(0),
                 sh.skipped[c] ? "  (skipped)" : "");
   }

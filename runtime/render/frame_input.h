@@ -70,6 +70,13 @@ struct ProbeJob {
 /// A light as the shaders see it (light_shading() in components/light.h makes one).
 using LightItem = LightShading;
 
+/// Every layer read whole: the NDC rectangle [-1, 1]^2 per layer (ShadowView::read_rect).
+inline std::array<glm::vec4, kMaxCascades> whole_layers() {
+  std::array<glm::vec4, kMaxCascades> r;
+  r.fill(glm::vec4(-1.0f, -1.0f, 1.0f, 1.0f));
+  return r;
+}
+
 /// One shadowed light's maps (systems/shadow_cascade_system.h makes them): its layers of the
 /// shared depth texture array and what the depth pass and the shaders need to draw and read
 /// them. Every view is handled by the same code; only the first may be a spot or point light
@@ -88,6 +95,10 @@ struct ShadowView {
   /// Metres per texel per layer; spot/point: at 1 m from the light.
   std::array<float, kMaxCascades> texel_size{};
   std::array<bool, kMaxCascades> skipped{};  ///< no receivers: cleared, nothing drawn
+  /// The part of each layer the lookups read, NDC x/y (min x, min y, max x, max y); empty when
+  /// min > max (ShadowData::read_rect). The depth pass clears and draws only there unless a
+  /// pass that reads anywhere in the map (a probe capture, the layered pass) runs this frame.
+  std::array<glm::vec4, kMaxCascades> read_rect = whole_layers();
   /// Shading: the normal offset in texels of the layer (0 for the basic map, FitMode::scene),
   /// the blend band (fraction of a cascade), the paraboloid margin (dual_paraboloid).
   float normal_offset = 0.0f;

@@ -2,7 +2,9 @@
 
 #include <epoxy/gl.h>
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <type_traits>
@@ -148,6 +150,7 @@ void ShadowMapPass::ensure_storage(int size, int layers, DepthFormat format, Sha
     glTextureParameteri(map_.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
     glTextureParameteri(map_.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
     drawn_from_.assign(std::size_t(layers), 0);  // new storage: nothing to keep
+    drawn_rect_.assign(std::size_t(layers), glm::ivec4(0));
     fbo_ = gpu::make_framebuffer();
     glNamedFramebufferTextureLayer(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0, 0);
     glNamedFramebufferDrawBuffer(fbo_.id(), GL_NONE);
@@ -189,6 +192,29 @@ gpu::TextureRef ShadowMapPass::texture() {
   return map_;
 }
 
+namespace {
+
+// The texels of a layer of `size`^2 that cover the NDC rectangle `ndc` (min x, min y, max x,
+// max y) as (x0, y0, x1, y1), ends exclusive; (0, 0, 0, 0) when it is empty.
+glm::ivec4 texel_rect(const glm::vec4& ndc, int size) {
+  if (!(ndc.x <= ndc.z && ndc.y <= ndc.w)) return glm::ivec4(0);
+  auto texel = [size](float v, bool up) {
+    const float t = (v + 1.0f) * 0.5f * float(size);
+    return std::clamp(int(up ? std::ceil(t) : std::floor(t)), 0, size);
+  };
+  return {texel(ndc.x, false), texel(ndc.y, false), texel(ndc.z, true), texel(ndc.w, true)};
+}
+
+bool empty_rect(const glm::ivec4& r) { return r.x >= r.z || r.y >= r.w; }
+
+// Whether `inner` lies in `outer` (an empty one lies anywhere).
+bool holds(const glm::ivec4& outer, const glm::ivec4& inner) {
+  return empty_rect(inner) || (outer.x <= inner.x && outer.y <= inner.y && outer.z >= inner.z &&
+                               outer.w >= inner.w);
+}
+
+}  // namespace
+
 Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
                               const AssetStore& assets, bool layered, bool features_by_uniform,
                               FrameStats& stats) {
@@ -198,6 +224,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   stats.layer_casters.fill(0);
   stats.layer_triangles.fill(0);
   stats.layer_texel_size.fill(0.0f);
+  stats.layer_rect.fill(glm::ivec4(0));
   stats.shadow_layers = total;
   stats.shadow_layers_rendered = 0;
   stats.shadow_draw_calls = 0;
@@ -235,12 +262,23 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
     }
     return h.value();
   };
+  // The texels each layer needs: its read rectangle, or all of it when a pass that reads
+  // anywhere in the maps runs this frame (a probe face selects cascades by map bounds; the
+  // layered pass draws every layer through one viewport). A layer is kept when its inputs are
+  // unchanged and it was drawn over at least those texels.
+  const bool whole = layered || std::any_of(frame.probes.begin(), frame.probes.end(),
+                                            [](const ProbeJob& p) { return p.faces != 0; });
   inputs_.assign(std::size_t(total), 0);
+  rects_.assign(std::size_t(total), glm::ivec4(0, 0, map.size, map.size));
   for (std::size_t view = 0; view < views.size(); ++view)
     for (int c = 0; c < views[view].layer_count; ++c) {
       const std::size_t layer = std::size_t(views[view].first_layer + c);
       inputs_[layer] = layer_inputs(view, c);
-      if (inputs_[layer] != drawn_from_[layer] || !frame.shadow_cache) redraw_ |= 1u << layer;
+      if (!whole && !views[view].skipped[std::size_t(c)])
+        rects_[layer] = texel_rect(views[view].read_rect[std::size_t(c)], map.size);
+      if (inputs_[layer] != drawn_from_[layer] || !frame.shadow_cache ||
+          !holds(drawn_rect_[layer], rects_[layer]))
+        redraw_ |= 1u << layer;
     }
   // The layered pass draws every layer at once: it redraws all of them or none.
   if (layered && redraw_ != 0) redraw_ = ~0u >> (32 - total);  // total <= 32: no 1u << 32
@@ -269,6 +307,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   for (const ShadowView& v : views)
     for (int c = 0; c < v.layer_count; ++c)
       stats.layer_texel_size[std::size_t(v.first_layer + c)] = v.texel_size[std::size_t(c)];
+  for (int l = 0; l < total; ++l) stats.layer_rect[std::size_t(l)] = rects_[std::size_t(l)];
   return {};
 }
 
@@ -395,8 +434,23 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
     for (int c = 0; c < v.layer_count && status; ++c) {
       const int layer = v.first_layer + c;
       if (!((redraw_ >> layer) & 1u)) continue;
+      // Only the texels lookups read are cleared and drawn (ShadowView::read_rect). On llvmpipe
+      // a scissored glClear draws a quad and cost more than clearing the whole layer, so part of
+      // a layer is cleared as a texture region (about half the time for half the texels) and a
+      // whole layer by the framebuffer clear (faster than the same as a texture region).
+      const glm::ivec4 r = rects_[std::size_t(layer)];
+      if (empty_rect(r)) continue;
       glNamedFramebufferTextureLayer(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0, layer);
-      glClear(GL_DEPTH_BUFFER_BIT);
+      if (r == glm::ivec4(0, 0, size_, size_)) {
+        glDisable(GL_SCISSOR_TEST);
+        glClear(GL_DEPTH_BUFFER_BIT);
+      } else {
+        const float far_depth = 1.0f;
+        glClearTexSubImage(map_.id(), 0, r.x, r.y, layer, r.z - r.x, r.w - r.y, 1,
+                           GL_DEPTH_COMPONENT, GL_FLOAT, &far_depth);
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(r.x, r.y, r.z - r.x, r.w - r.y);
+      }
       if (v.skipped[std::size_t(c)]) continue;
       const auto runs = caster_runs(frame, list, cache, state, view, 1u << c, false, records);
       status = draw_runs(frame, list, cache, state, stats, view, runs, records,
@@ -405,9 +459,13 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
   }
   glDisable(GL_POLYGON_OFFSET_FILL);
   glDisable(GL_CLIP_DISTANCE0);
+  glDisable(GL_SCISSOR_TEST);
   if (!status) return status;
   for (std::size_t layer = 0; layer < inputs_.size(); ++layer)
-    if ((redraw_ >> layer) & 1u) drawn_from_[layer] = inputs_[layer];
+    if ((redraw_ >> layer) & 1u) {
+      drawn_from_[layer] = inputs_[layer];
+      drawn_rect_[layer] = rects_[layer];
+    }
   return {};
 }
 

@@ -90,9 +90,13 @@ class ShadowMapPass {
   gpu::Sampler raw_depth_;       ///< compare off: UNIT_SHADOW_DEPTH
   gpu::Sampler linear_compare_;  ///< compare, linear: UNIT_SHADOW_LINEAR
   bool layered_ = false;
-  /// Per layer: a hash of what its depth was last drawn from; 0 = nothing valid.
+  /// Per layer: a hash of what its depth was last drawn from (0 = nothing valid) and the texels
+  /// it was drawn in (x0, y0, x1, y1; ends exclusive): outside them the layer holds stale depth
+  /// no lookup reads.
   std::vector<std::uint64_t> drawn_from_;
+  std::vector<glm::ivec4> drawn_rect_;
   std::vector<std::uint64_t> inputs_;  // this frame's hashes
+  std::vector<glm::ivec4> rects_;      // this frame's texels to clear and draw per layer
   std::uint32_t redraw_ = 0;           // bit l: layer l is drawn this frame
 };
 

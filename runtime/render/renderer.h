@@ -52,6 +52,11 @@ struct FrameStats {
   std::array<int, kMaxShadowLayers> layer_casters{};
   std::array<std::size_t, kMaxShadowLayers> layer_triangles{};
   std::array<float, kMaxShadowLayers> layer_texel_size{};
+  /// The texels of each layer that lookups read this frame, (x0, y0, x1, y1) with exclusive
+  /// ends: its read rectangle (ShadowView::read_rect), the whole layer when a pass that reads
+  /// anywhere runs. The depth pass clears and draws only these when it redraws the layer;
+  /// outside them a layer may hold stale depth. Empty (x0 >= x1) when nothing reads it.
+  std::array<glm::ivec4, kMaxShadowLayers> layer_rect{};
   /// Receiver pixels per cascade: pixels of the frame's AOV whose `cascade` channel is i (visible
   /// shadow-receiving surfaces shaded from cascade i; the first one where blending). Counted by
   /// cascade_pixel_counts(), which render_frames() calls after its last frame when AOVs are

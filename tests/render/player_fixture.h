@@ -5,8 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
+#include <vector>
 
+#include <glm/glm.hpp>
+
+#include "components/limits.h"
 #include "runtime/cli/player.h"
 #include "runtime/gpu/context.h"
 
@@ -31,6 +36,23 @@ class PlayerTest : public ::testing::Test {
   void TearDown() override { EXPECT_EQ(gpu::debug_error_count(), 0) << "GL errors were logged"; }
 
   static inline Player* player_ = nullptr;  ///< the suite's player (suites run one at a time)
+
+  /// The depth of `map` (Renderer::read_shadow_map(): layers stacked top to bottom, rows top to
+  /// bottom) that lookups can read: texels outside each layer's `rects` entry
+  /// (FrameStats::layer_rect) become -1, since a layer may keep stale depth there.
+  static std::vector<float> read_part(const Image& map,
+                                      const std::array<glm::ivec4, kMaxShadowLayers>& rects) {
+    std::vector<float> out = map.pixels;
+    const int size = map.width;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const int layer = int(i / (std::size_t(size) * std::size_t(size)));
+      const int x = int(i % std::size_t(size));
+      const int y = size - 1 - int((i / std::size_t(size)) % std::size_t(size));
+      const glm::ivec4 r = rects[std::size_t(layer)];
+      if (x < r.x || x >= r.z || y < r.y || y >= r.w) out[i] = -1.0f;
+    }
+    return out;
+  }
 };
 
 }  // namespace kaskad

@@ -34,7 +34,8 @@ class ShadowCacheTest : public PlayerTest {
 
   struct Frame {
     render::FrameStats stats;
-    std::vector<float> map;         // every layer's depth
+    Image raw_map;                  // every layer's depth
+    std::vector<float> map;         // what lookups can read of it (read_part())
     std::vector<float> visibility;  // the AOV's visibility channel
   };
 
@@ -47,7 +48,8 @@ class ShadowCacheTest : public PlayerTest {
     EXPECT_TRUE(t.ok()) << t.error().to_string();
     if (!t.ok()) return f;
     f.stats = t->last.stats;
-    f.map = player.renderer->read_shadow_map().pixels;
+    f.raw_map = player.renderer->read_shadow_map();
+    f.map = read_part(f.raw_map, f.stats.layer_rect);
     const Image aov = player.renderer->read_aovs();
     for (int y = 0; y < aov.height; ++y)
       for (int x = 0; x < aov.width; ++x) f.visibility.push_back(aov.at(x, y, 7));
@@ -146,7 +148,8 @@ TEST_F(ShadowCacheTest, TheLayeredPassRedrawsAllLayersOrNone) {
   // Against one pass per layer drawn from scratch: the same maps (LocalLightTest's
   // LayeredPassWritesTheSameMapsAsOnePassPerLayer), through the other code path.
   const Frame moved_fresh = fresh(scene);
-  EXPECT_EQ(moved.map, moved_fresh.map);
+  // Layered layers are drawn whole; one pass per layer draws what lookups read.
+  EXPECT_EQ(read_part(moved.raw_map, moved_fresh.stats.layer_rect), moved_fresh.map);
   EXPECT_EQ(moved.visibility, moved_fresh.visibility);
 }
 
@@ -164,6 +167,61 @@ TEST_F(ShadowCacheTest, CacheOffDrawsEveryLayerEveryFrame) {
   EXPECT_GT(drawn.stats.shadow_draw_calls, 0);
   EXPECT_EQ(drawn.map, kept.map);
   EXPECT_EQ(drawn.visibility, kept.visibility);
+}
+
+// Casters culled by receivers (shadow.cull_by_receivers) and layers drawn only where receivers
+// read them (shadow.scissor_to_receivers) change no pixel of the default scene: colour and every
+// AOV equal those drawn with both off, with the camera still, walking (stable cascades reuse
+// layers drawn over larger rectangles) and turning, and they do less: the ground is left out of
+// some cascade and some layer is drawn in part. The same on the probes' scene, whose faces read
+// the maps anywhere (whole layers are drawn on capture frames).
+TEST_F(ShadowCacheTest, ReceiverCullingAndScissorChangeNoPixel) {
+  struct Case {
+    const char* scene;
+    const char* camera;
+  };
+  for (const Case& c : {Case{"default.json", "camera"}, Case{"reflections.json", "camera"}}) {
+    std::array<std::vector<Image>, 2> frames;
+    std::array<std::vector<render::FrameStats>, 2> stats;
+    for (int on = 1; on >= 0; --on) {
+      // New map storage first, so no depth of an earlier run survives outside what is drawn.
+      auto other = load_scene(content_dir() / "scenes" / "default.json", {"shadow.map_size=256"});
+      ASSERT_TRUE(other.ok()) << other.error().to_string();
+      render(*player_, *other);
+      const std::string flag = on ? "true" : "false";
+      auto loaded = load_scene(content_dir() / "scenes" / c.scene,
+                               {"shadow.cull_by_receivers=" + flag,
+                                "shadow.scissor_to_receivers=" + flag});
+      ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+      Scene& scene = *loaded;
+      Transform& cam = scene.world.get<Transform>(named(scene, c.camera));
+      for (int step = 0; step < 6; ++step) {
+        if (step >= 2 && step < 4) cam.translation += glm::vec3(0.05f, 0.0f, -0.03f);
+        if (step >= 4) cam.rotation = glm::angleAxis(0.04f, glm::vec3(0, 1, 0)) * cam.rotation;
+        RenderRun run;
+        run.width = 320;
+        run.height = 180;
+        run.frames = 1;
+        auto t = render_frames(*player_, scene, run);
+        ASSERT_TRUE(t.ok()) << t.error().to_string();
+        stats[std::size_t(on)].push_back(t->last.stats);
+        frames[std::size_t(on)].push_back(player_->renderer->read_color());
+        frames[std::size_t(on)].push_back(player_->renderer->read_aovs());
+      }
+    }
+    for (std::size_t i = 0; i < frames[0].size(); ++i)
+      EXPECT_EQ(frames[0][i].pixels, frames[1][i].pixels) << c.scene << ", image " << i;
+    int fewer_casters = 0, part_drawn = 0;
+    for (std::size_t f = 0; f < stats[0].size(); ++f)
+      for (int l = 0; l < stats[0][f].shadow_layers; ++l) {
+        const auto li = std::size_t(l);
+        fewer_casters += stats[1][f].layer_casters[li] < stats[0][f].layer_casters[li];
+        const glm::ivec4 r = stats[1][f].layer_rect[li], whole = stats[0][f].layer_rect[li];
+        part_drawn += (r.z - r.x) * (r.w - r.y) < (whole.z - whole.x) * (whole.w - whole.y);
+      }
+    EXPECT_GT(fewer_casters, 0) << c.scene;
+    EXPECT_GT(part_drawn, 0) << c.scene;
+  }
 }
 
 }  // namespace

@@ -177,6 +177,27 @@ TEST(SceneIo, CascadeFieldsLoadWithRangeChecksAndPerLightOverrides) {
                {"/shadow/point_mode", "sphere", "cube", "dual_paraboloid"});
 }
 
+// Issue 13's switches: both on by default, off by override, saved only when off, and not
+// numbers.
+TEST(SceneIo, ReceiverCullingSwitchesLoadAndSave) {
+  const fs::path def = kContent / "scenes" / "default.json";
+  auto d = read_scene(def);
+  ASSERT_TRUE(d.ok()) << d.error().to_string();
+  EXPECT_TRUE(d->shadow_defaults.cull_by_receivers);
+  EXPECT_TRUE(d->shadow_defaults.scissor_to_receivers);
+  auto off = read_scene(def, {"shadow.cull_by_receivers=false", "shadow.scissor_to_receivers=false"});
+  ASSERT_TRUE(off.ok()) << off.error().to_string();
+  EXPECT_FALSE(off->shadow_defaults.cull_by_receivers);
+  EXPECT_FALSE(off->shadow_defaults.scissor_to_receivers);
+  const fs::path out = temp_dir() / "switches_saved.json";
+  ASSERT_TRUE(save_scene(out, *off).ok());
+  auto again = read_scene(out);
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_FALSE(again->shadow_defaults.cull_by_receivers);
+  EXPECT_FALSE(again->shadow_defaults.scissor_to_receivers);
+  expect_error(read_scene(def, {"shadow.cull_by_receivers=1"}), {"/shadow/cull_by_receivers"});
+}
+
 // Issue 14's settings: shadow.technique, pcf_kernel, pcf_taps, pcf_radius and the spot/point
 // light radius load, save, override and are rejected out of range with the key and the value.
 TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {

@@ -252,6 +252,100 @@ TEST(ShadowCascadeSystem, CullCastersKeepsBoxesOverlappingTheLightVolume) {
   EXPECT_EQ(cull_casters(vp, boxes), (std::vector<std::uint32_t>{0, 1}));
 }
 
+// may_shadow(): a face plane of the caster's box that faces the light, with every receiver on
+// its lit side, proves the caster cannot shadow them.
+TEST(ShadowCascadeSystem, MayShadowKeepsEveryCasterThatCanReachAReceiver) {
+  const glm::vec3 sun = glm::normalize(glm::vec3(0.5f, -0.6f, -0.45f));  // travels down
+  const Aabb ground = Aabb::from_corners({-20, 0, -20}, {20, 0, 20});     // flat, at y = 0
+  const Aabb above = Aabb::from_corners({-5, 0, -5}, {5, 3, 5});          // boxes resting on it
+  const Aabb dipping = Aabb::from_corners({-5, -0.02f, -5}, {5, 3, 5});   // one dips below
+  // The ground cannot shadow what rests on it, itself included (it is flat).
+  EXPECT_FALSE(may_shadow(ground, above, sun));
+  Aabb both = above;
+  both.expand(ground);
+  EXPECT_FALSE(may_shadow(ground, both, sun));
+  EXPECT_TRUE(may_shadow(ground, dipping, sun));  // 2 cm below the plane can be in its shadow
+  // A box resting on the ground shadows it.
+  EXPECT_TRUE(may_shadow(Aabb::from_corners({0, 0, 0}, {1, 1, 1}), ground, sun));
+  // A box is its own receiver: never left out of a layer it serves.
+  EXPECT_TRUE(may_shadow(above, above, sun));
+  // Under a light from below, the ground may shadow what lies above it.
+  EXPECT_TRUE(may_shadow(ground, above, -sun));
+  // Light along the plane: only a receiver strictly beside the caster is out of reach.
+  const glm::vec3 grazing(1.0f, 0.0f, 0.0f);
+  EXPECT_TRUE(may_shadow(ground, above, grazing));
+  EXPECT_FALSE(may_shadow(ground, Aabb::from_corners({-5, 0.5f, -5}, {5, 3, 5}), grazing));
+  // Nothing to shadow; an empty caster box proves nothing.
+  EXPECT_FALSE(may_shadow(ground, Aabb{}, sun));
+  EXPECT_TRUE(may_shadow(Aabb{}, above, sun));
+}
+
+// receiver_rect(): the receivers inside the camera slice, clipped to the slice's light-space
+// bounds, grown by the margin, within [-1, 1]^2; empty when none meets the slice.
+TEST(ShadowCascadeSystem, ReceiverRectCoversTheReceiversInTheSlice) {
+  // Light looking down -y onto x/z: NDC x = world x / 10, NDC y = -world z / 10.
+  const glm::mat4 vp = glm::ortho(-10.0f, 10.0f, -10.0f, 10.0f, 0.0f, 40.0f) *
+                       glm::lookAt(glm::vec3(0, 20, 0), glm::vec3(0), glm::vec3(0, 0, -1));
+  // A camera slice seen from above: near face z = -2, x in [-1, 1]; far face z = -8, x in
+  // [-4, 4]; y in [0, 2] (corners in slice_corners_world() order).
+  const std::array<glm::vec3, 8> slice{glm::vec3(-1, 2, -2), glm::vec3(1, 2, -2),
+                                       glm::vec3(1, 0, -2),  glm::vec3(-1, 0, -2),
+                                       glm::vec3(-4, 2, -8), glm::vec3(4, 2, -8),
+                                       glm::vec3(4, 0, -8),  glm::vec3(-4, 0, -8)};
+  const std::array receivers{
+      Aabb::from_corners({-1, 0, -5}, {1, 1, -3}),          // inside
+      Aabb::from_corners({3, 0, -8}, {6, 1, -7}),           // half outside in x
+      Aabb::from_corners({3, 0, -2.5f}, {3.5f, 1, -2.2f}),  // in the slice's bounds, beside it
+      Aabb::from_corners({-1, 0, 5}, {1, 1, 7}),            // behind the camera
+      Aabb::from_corners({-1, 5, -5}, {1, 6, -3})};         // above the slice
+  Aabb touched;
+  const glm::vec4 r = receiver_rect(vp, slice, receivers, 0.0f, &touched);
+  EXPECT_NEAR(r.x, -0.1f, 1e-5f);  // x from -1 (first box) ..
+  EXPECT_NEAR(r.z, 0.4f, 1e-5f);   // .. to 4 (the second, clipped to the slice's bounds)
+  EXPECT_NEAR(r.y, 0.3f, 1e-5f);   // z from -3 ..
+  EXPECT_NEAR(r.w, 0.8f, 1e-5f);   // .. to -8
+  EXPECT_EQ(touched.min, glm::vec3(-1, 0, -8));
+  EXPECT_EQ(touched.max, glm::vec3(6, 1, -3));
+  const glm::vec4 grown = receiver_rect(vp, slice, receivers, 0.7f);
+  EXPECT_NEAR(grown.x, -0.8f, 1e-5f);
+  EXPECT_EQ(grown.z, 1.0f);  // within the map
+  // Only boxes outside the slice: empty.
+  const glm::vec4 none = receiver_rect(vp, slice, std::span(receivers).subspan(2), 0.5f);
+  EXPECT_GT(none.x, none.z);
+}
+
+// The default scene's sun over a ground plane and boxes resting on it: the ground is left out of
+// the cascades whose receivers all lie on or above it, and each cascade's read rectangle lies in
+// the map; with both switches off, every caster in every cascade and whole layers.
+TEST(ShadowCascadeSystem, GroundLeftOutWhereAllReceiversRestOnIt) {
+  for (bool on : {true, false}) {
+    ecs::World w;
+    ShadowSettings s;
+    s.cull_by_receivers = on;
+    s.scissor_to_receivers = on;
+    sun(w, s, {0.5f, -0.6f, -0.45f});
+    const ecs::Entity ground = mesh(w, Aabb::from_corners({-60, -6, -120}, {60, -6, 0}));
+    const ecs::Entity box = mesh(w, Aabb::from_corners({-1, -6, -12}, {1, -4, -10}));
+    CameraState cam = camera(w, 40.0f);
+    ShadowCascadeState state;
+    const ShadowData d = update_shadow_cascades(w, cam, state);
+    ASSERT_TRUE(d.light.valid()) << d.error;
+    for (int i = 0; i < d.cascade_count; ++i) {
+      const auto c = std::size_t(i);
+      if (d.skipped[c]) continue;
+      EXPECT_NE(contains(d.casters[c], ground), on) << "cascade " << i;
+      const glm::vec4 r = d.read_rect[c];
+      if (on) {
+        EXPECT_TRUE(r.x >= -1.0f && r.y >= -1.0f && r.z <= 1.0f && r.w <= 1.0f) << i;
+        EXPECT_LT((r.z - r.x) * (r.w - r.y), 4.0f) << "cascade " << i << " is read whole";
+      } else {
+        EXPECT_EQ(r, glm::vec4(-1, -1, 1, 1));
+      }
+    }
+    EXPECT_TRUE(contains(d.casters[0], box) || contains(d.casters[1], box));
+  }
+}
+
 TEST(ShadowCascadeSystem, NanLightTransformIsRejectedWithAnError) {
   ecs::World w;
   const ecs::Entity l = sun(w, ShadowSettings{});
