@@ -174,6 +174,12 @@ struct ShadowSettings {
   /// that its receivers' lookups read (ShadowData::read_rect), not the whole layer. Same images
   /// (render test); off for comparisons.
   bool scissor_to_receivers = true;
+  /// Directional lights, in [1, 16]: cascade i >= 1 is refitted and redrawn at most every k-th
+  /// frame (staggered: when (frame + i) % k == 0); between, it keeps its matrix and depth while
+  /// that map still covers every point that reads it (else it is refitted at once). Moving
+  /// casters' shadows in those cascades lag by up to k - 1 frames. 1 (off) by default, as in
+  /// Godot's and Unity's optional far-cascade update rates.
+  int far_cascade_interval = 1;
   /// Point lights only. cube by default: exact for any tessellation; dual_paraboloid draws 2
   /// maps instead of 6 (S0's earlier work).
   PointShadowMode point_mode = PointShadowMode::cube;
@@ -255,6 +261,9 @@ inline std::string validate_shadow_settings(const ShadowSettings& s) {
     return "normal_offset_bias must be in [0, 16] texels, was " + str(s.normal_offset_bias);
   if (!(s.blend_band >= 0.0f && s.blend_band <= 1.0f))
     return "blend_band must be in [0, 1], was " + str(s.blend_band);
+  if (s.far_cascade_interval < 1 || s.far_cascade_interval > 16)
+    return "far_cascade_interval must be in [1, 16] frames, was " +
+           std::to_string(s.far_cascade_interval);
   const int selection = static_cast<int>(s.selection);
   if (selection < 0 || selection > static_cast<int>(CascadeSelection::map_bounds))
     return "selection must be depth or map_bounds, was " + std::to_string(selection);

@@ -108,6 +108,7 @@ bool shadow_panel(ShadowSettings& s) {
   changed |= ImGui::Checkbox("debug: freeze cascades", &s.freeze_cascades);
   changed |= ImGui::Checkbox("cull casters by receivers", &s.cull_by_receivers);
   changed |= ImGui::Checkbox("draw only what receivers read", &s.scissor_to_receivers);
+  changed |= ImGui::SliderInt("far cascades every N frames", &s.far_cascade_interval, 1, 16);
   int point_mode = int(s.point_mode);
   const char* point_modes[] = {"cube (6 faces)", "dual paraboloid (2)"};
   if (ImGui::Combo("point light maps", &point_mode, point_modes, 2)) {

@@ -37,6 +37,7 @@ render::ShadowView shadow_view(const ShadowData& d, int light_index) {
   v.texel_size = d.texel_size;
   v.skipped = d.skipped;
   v.read_rect = d.read_rect;
+  v.held = d.held;
   // The basic map (fit scene) is biased by polygon offset alone, as before the cascades.
   v.normal_offset = d.projection == ShadowProjection::ortho && s.fit_mode == FitMode::scene
                         ? 0.0f

@@ -334,7 +334,7 @@ namespace {
 ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera, ecs::Entity e,
                               const Light& light_component, const glm::mat4& light_matrix,
                               const ShadowData& previous, std::string& last_error,
-                              const ShadowSettings* shared = nullptr) {
+                              std::uint64_t frame, const ShadowSettings* shared = nullptr) {
   ShadowData out;
   // 1. The light: its settings and a finite transform.
   out.light = e;
@@ -501,8 +501,49 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
     out.near_used = previous.near_used;
     out.far_used = previous.far_used;
   }
+  const bool by_depth = s.selection == CascadeSelection::depth;
+  const float margin_ndc =
+      2.0f * (filter_reach_texels(s) + s.normal_offset_bias + 1.0f) / float(s.map_size);
+  // Far-cascade cadence: last frame's fit of cascade c still serves when its map holds the
+  // corners of every point that reads it now and the receivers' rectangle it was drawn over
+  // holds theirs (a drawn layer is valid only there).
+  const bool same_fit = previous.light == out.light &&
+                        previous.projection == ShadowProjection::ortho &&
+                        previous.cascade_count == s.cascade_count &&
+                        previous.settings.map_size == s.map_size &&
+                        previous.settings.fit_mode == s.fit_mode;
+  const int k = s.far_cascade_interval;
+  auto still_serves = [&](std::size_t c, const std::array<glm::vec3, 8>& reads) {
+    if (!same_fit || previous.skipped[c]) return false;
+    for (const glm::vec3& p : reads) {
+      const glm::vec3 ndc = glm::vec3(previous.view_proj[c] * glm::vec4(p, 1.0f));
+      if (!(std::abs(ndc.x) <= 1.0f - margin_ndc && std::abs(ndc.y) <= 1.0f - margin_ndc &&
+            std::abs(ndc.z) <= 1.0f))
+        return false;
+    }
+    const glm::vec4 need = receiver_rect(previous.view_proj[c], reads, receiver_boxes, margin_ndc);
+    const glm::vec4 have = previous.read_rect[c];
+    return need.x > need.z || (need.x >= have.x && need.y >= have.y && need.z <= have.z &&
+                               need.w <= have.w);
+  };
   for (int i = 0; i < s.cascade_count; ++i) {
     const auto c = std::size_t(i);
+    // Points of view depth D[c] - band (D[c] - D[c-1]) on blend into this cascade; the first
+    // cascade also serves anything nearer than D[0], so it starts at the camera's near.
+    CameraSlice reads = slice;
+    reads.near = i == 0 ? camera.camera.near
+                        : out.splits[c] - s.blend_band * (out.splits[c] - out.splits[c - 1]);
+    reads.far = out.splits[c + 1];
+    const std::array<glm::vec3, 8> read_corners = slice_corners_world(reads);
+    if (!frozen && k > 1 && i >= 1 && (frame + std::uint64_t(i)) % std::uint64_t(k) != 0 &&
+        still_serves(c, read_corners)) {
+      out.view_proj[c] = previous.view_proj[c];
+      out.texel_size[c] = previous.texel_size[c];
+      out.read_rect[c] = previous.read_rect[c];
+      out.casters[c] = previous.casters[c];
+      out.held |= 1u << i;
+      continue;
+    }
     if (frozen) {
       out.view_proj[c] = previous.view_proj[c];
       out.texel_size[c] = previous.texel_size[c];
@@ -517,18 +558,16 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
     }
     if (out.skipped[c]) continue;
     Aabb served;  // the receivers this cascade serves (depth selection)
-    const bool by_depth = s.selection == CascadeSelection::depth;
     if (by_depth) {
-      // Points of view depth D[c] - band (D[c] - D[c-1]) on blend into this cascade; the first
-      // cascade also serves anything nearer than D[0], so it starts at the camera's near.
-      CameraSlice reads = slice;
-      reads.near = i == 0 ? camera.camera.near
-                          : out.splits[c] - s.blend_band * (out.splits[c] - out.splits[c - 1]);
-      reads.far = out.splits[c + 1];
-      const float margin_texels = filter_reach_texels(s) + s.normal_offset_bias + 1.0f;
-      const glm::vec4 rect = receiver_rect(out.view_proj[c], slice_corners_world(reads),
-                                           receiver_boxes, 2.0f * margin_texels / float(s.map_size),
-                                           &served);
+      glm::vec4 rect =
+          receiver_rect(out.view_proj[c], read_corners, receiver_boxes, margin_ndc, &served);
+      if (k > 1 && i >= 1 && rect.x <= rect.z) {
+        // Kept for up to k - 1 frames while the camera moves on: drawn a quarter wider on every
+        // side, so that the receivers of the next frames still fall inside what was drawn.
+        const glm::vec2 grow = 0.25f * glm::vec2(rect.z - rect.x, rect.w - rect.y);
+        rect = glm::vec4(glm::max(glm::vec2(rect) - grow, glm::vec2(-1.0f)),
+                         glm::min(glm::vec2(rect.z, rect.w) + grow, glm::vec2(1.0f)));
+      }
       if (s.scissor_to_receivers) out.read_rect[c] = rect;
     }
     for (std::uint32_t k : cull_casters(out.view_proj[c], caster_boxes))
@@ -588,7 +627,8 @@ std::vector<ShadowData> fit_shadowed_lights(const ecs::World& world, const Camer
       break;
     }
     ShadowData d = fit_shadowed_light(world, camera, l.entity, l.light, l.matrix,
-                                      state.previous[slot], state.last_errors[slot], shared);
+                                      state.previous[slot], state.last_errors[slot], state.frame,
+                                      shared);
     state.previous[slot] = d;
     ++slot;
     if (d.light.valid()) {
@@ -625,6 +665,7 @@ std::vector<ShadowData> fit_shadowed_lights(const ecs::World& world, const Camer
     if (!notice.empty()) log::warn_once("shadows: %s", notice.c_str());
     state.last_notice = notice;
   }
+  ++state.frame;
   return out;
 }
 

@@ -79,6 +79,9 @@ struct ShadowData {
   /// [-1, 1]^2, where no slice bounds the lookups: map-bounds selection, the basic map (fit
   /// scene), spot and point lights. Empty (min > max) when no receiver lies in the slice.
   std::array<glm::vec4, kMaxCascades> read_rect = render::whole_layers();
+  /// Bit i: cascade i kept last frame's fit (ShadowSettings::far_cascade_interval): matrix,
+  /// texel size, read rectangle and casters; the renderer keeps its depth.
+  std::uint32_t held = 0;
   /// The view-depth range the cascades could span, [camera near, min(camera far,
   /// max_distance)], and the one they span: the visible receivers' range
   /// (visible_receiver_depths()) clipped to it and rounded outwards (quantize_depth_range()).
@@ -99,6 +102,8 @@ struct ShadowCascadeState {
   std::string last_notice;
   /// Each slot's last result: ShadowSettings::freeze_cascades keeps its splits and matrices.
   std::array<ShadowData, kMaxShadowedLights> previous;
+  /// Frames fitted so far (the far-cascade cadence counts them).
+  std::uint64_t frame = 0;
 };
 
 /// The view of the first Light with cast_shadows (entity order), as update_shadows() fits it, or

@@ -129,6 +129,7 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
   r.boolean("layered", s.layered);
   r.boolean("cull_by_receivers", s.cull_by_receivers);
   r.boolean("scissor_to_receivers", s.scissor_to_receivers);
+  r.integer("far_cascade_interval", s.far_cascade_interval, 1, 16);
   r.finish();
   if (std::string bad = validate_shadow_settings(s); !bad.empty())
     fail(r.at(bad.substr(0, bad.find(' ')).c_str()), bad);
@@ -169,6 +170,8 @@ json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
   put("cull_by_receivers", s.cull_by_receivers, s.cull_by_receivers != d.cull_by_receivers);
   put("scissor_to_receivers", s.scissor_to_receivers,
       s.scissor_to_receivers != d.scissor_to_receivers);
+  put("far_cascade_interval", s.far_cascade_interval,
+      s.far_cascade_interval != d.far_cascade_interval);
   return j;
 }
 

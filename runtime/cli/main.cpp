@@ -323,7 +323,9 @@ void print_layer_table(const render::FrameStats& st, const ShadowData& sh, bool 
                 double(st.layer_texel_size[l]), st.layer_casters[l], st.layer_triangles[l],
                 rect_percent(st.layer_rect[l], sh.settings.map_size),
                 shown_in_aov ? st.cascade_receiver_pixels[c] : std::size_t(0),
-                sh.skipped[c] ? "  (skipped)" : "");
+                sh.skipped[c] ? "  (skipped)"
+                : (sh.held >> i) & 1u ? "  (held: far_cascade_interval)"
+                                      : "");
   }
 }
 

@@ -99,6 +99,10 @@ struct ShadowView {
   /// min > max (ShadowData::read_rect). The depth pass clears and draws only there unless a
   /// pass that reads anywhere in the map (a probe capture, the layered pass) runs this frame.
   std::array<glm::vec4, kMaxCascades> read_rect = whole_layers();
+  /// Bit c: layer c keeps its depth from when it was last drawn even if its casters moved (a far
+  /// cascade between updates, ShadowSettings::far_cascade_interval), when it holds the texels
+  /// needed now. Its matrix is the one it was drawn with.
+  std::uint32_t held = 0;
   /// Shading: the normal offset in texels of the layer (0 for the basic map, FitMode::scene),
   /// the blend band (fraction of a cascade), the paraboloid margin (dual_paraboloid).
   float normal_offset = 0.0f;

@@ -264,8 +264,8 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   };
   // The texels each layer needs: its read rectangle, or all of it when a pass that reads
   // anywhere in the maps runs this frame (a probe face selects cascades by map bounds; the
-  // layered pass draws every layer through one viewport). A layer is kept when its inputs are
-  // unchanged and it was drawn over at least those texels.
+  // layered pass draws every layer through one viewport). A layer is kept when it was drawn
+  // over at least those texels and its inputs are unchanged or it is held (ShadowView::held).
   const bool whole = layered || std::any_of(frame.probes.begin(), frame.probes.end(),
                                             [](const ProbeJob& p) { return p.faces != 0; });
   inputs_.assign(std::size_t(total), 0);
@@ -276,8 +276,9 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
       inputs_[layer] = layer_inputs(view, c);
       if (!whole && !views[view].skipped[std::size_t(c)])
         rects_[layer] = texel_rect(views[view].read_rect[std::size_t(c)], map.size);
-      if (inputs_[layer] != drawn_from_[layer] || !frame.shadow_cache ||
-          !holds(drawn_rect_[layer], rects_[layer]))
+      const bool drawn = drawn_from_[layer] != 0 && holds(drawn_rect_[layer], rects_[layer]);
+      const bool held = ((views[view].held >> c) & 1u) != 0;
+      if (!frame.shadow_cache || !drawn || (inputs_[layer] != drawn_from_[layer] && !held))
         redraw_ |= 1u << layer;
     }
   // The layered pass draws every layer at once: it redraws all of them or none.

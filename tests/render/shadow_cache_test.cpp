@@ -224,5 +224,42 @@ TEST_F(ShadowCacheTest, ReceiverCullingAndScissorChangeNoPixel) {
   }
 }
 
+// shadow.far_cascade_interval = 3 with a caster moving under a still camera: cascade 0 is
+// redrawn every frame, the far cascades at most every third frame (their shadows lag, so some
+// frame differs from the interval-1 run), and a few frames after the caster stops the images
+// are exactly those of interval 1 again.
+TEST_F(ShadowCacheTest, FarCascadesAreRedrawnEveryKthFrame) {
+  std::array<std::vector<std::vector<float>>, 2> visibility;
+  std::array<std::array<int, kMaxShadowLayers>, 2> redraws{};
+  const int intervals[2] = {1, 3};
+  for (int run = 0; run < 2; ++run) {
+    auto loaded = load_scene(content_dir() / "scenes" / "default.json",
+                             {"shadow.far_cascade_interval=" + std::to_string(intervals[run])});
+    ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+    Scene& scene = *loaded;
+    render(*player_, scene);
+    Transform& box = scene.world.get<Transform>(named(scene, "box_floating"));
+    for (int f = 0; f < 12; ++f) {
+      if (f < 9) box.translation += glm::vec3(0.05f, 0.0f, 0.03f);
+      const Frame frame = render(*player_, scene);
+      for (int l = 0; l < frame.stats.shadow_layers; ++l)
+        redraws[std::size_t(run)][std::size_t(l)] += (frame.stats.shadow_layers_rendered >> l) & 1u;
+      visibility[std::size_t(run)].push_back(frame.visibility);
+    }
+  }
+  EXPECT_EQ(redraws[0][0], 9);
+  EXPECT_EQ(redraws[1][0], 9);  // cascade 0: every frame the caster moved
+  for (int l = 1; l < 4; ++l) {
+    EXPECT_LE(redraws[1][std::size_t(l)], 4) << "layer " << l;
+    if (redraws[0][std::size_t(l)] > 0) {
+      EXPECT_LT(redraws[1][std::size_t(l)], redraws[0][std::size_t(l)]) << "layer " << l;
+    }
+  }
+  int lagging = 0;
+  for (std::size_t f = 0; f < 9; ++f) lagging += visibility[0][f] != visibility[1][f];
+  EXPECT_GT(lagging, 0) << "the far cascades should lag while the caster moves";
+  EXPECT_EQ(visibility[0].back(), visibility[1].back());
+}
+
 }  // namespace
 }  // namespace kaskad

@@ -178,7 +178,7 @@ TEST(SceneIo, CascadeFieldsLoadWithRangeChecksAndPerLightOverrides) {
 }
 
 // Issue 13's switches: both on by default, off by override, saved only when off, and not
-// numbers.
+// numbers; the far-cascade interval within [1, 16].
 TEST(SceneIo, ReceiverCullingSwitchesLoadAndSave) {
   const fs::path def = kContent / "scenes" / "default.json";
   auto d = read_scene(def);
@@ -196,6 +196,11 @@ TEST(SceneIo, ReceiverCullingSwitchesLoadAndSave) {
   EXPECT_FALSE(again->shadow_defaults.cull_by_receivers);
   EXPECT_FALSE(again->shadow_defaults.scissor_to_receivers);
   expect_error(read_scene(def, {"shadow.cull_by_receivers=1"}), {"/shadow/cull_by_receivers"});
+  auto cadence = read_scene(def, {"shadow.far_cascade_interval=4"});
+  ASSERT_TRUE(cadence.ok()) << cadence.error().to_string();
+  EXPECT_EQ(cadence->shadow_defaults.far_cascade_interval, 4);
+  expect_error(read_scene(def, {"shadow.far_cascade_interval=0"}), {"/shadow/far_cascade_interval", "0"});
+  expect_error(read_scene(def, {"shadow.far_cascade_interval=17"}), {"/shadow/far_cascade_interval", "17"});
 }
 
 // Issue 14's settings: shadow.technique, pcf_kernel, pcf_taps, pcf_radius and the spot/point

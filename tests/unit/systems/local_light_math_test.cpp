@@ -357,5 +357,58 @@ TEST(ShadowCascadeSystem, FrozenCascadesKeepTheirMatricesWhileTheCameraMoves) {
   EXPECT_FALSE(same_matrices(before, moved));
 }
 
+// far_cascade_interval k: cascade i >= 1 keeps last frame's fit except on frames where
+// (frame + i) % k == 0; cascade 0 is fitted every frame; a camera that moves away from what a
+// kept map covers gets that cascade refitted at once; k = 1 keeps nothing.
+TEST(ShadowCascadeSystem, FarCascadesAreRefittedEveryKthFrameStaggered) {
+  ecs::World w;
+  box(w, Aabb::from_corners({-50, -0.1f, -50}, {50, 0, 50}), false, true);
+  box(w, Aabb::from_corners({-0.5f, 0, -0.5f}, {0.5f, 2, 0.5f}), true, true);
+  const ecs::Entity sun =
+      light(w, LightType::directional, {0, 10, 0}, glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f)));
+  auto camera_at = [&](glm::vec3 eye) {
+    CameraState cam;
+    cam.entity = w.create();
+    cam.camera.near = 0.5f;
+    cam.camera.far = 80.0f;
+    cam.aspect = 1.5f;
+    cam.view = glm::lookAt(eye, eye + glm::vec3(0, -0.3f, -1), glm::vec3(0, 1, 0));
+    cam.proj = glm::perspective(glm::radians(cam.camera.fov_y_deg), 1.5f, 0.5f, 80.0f);
+    return cam;
+  };
+  w.get<ShadowSettings>(sun).far_cascade_interval = 3;
+  ShadowCascadeState state;
+  std::vector<std::uint32_t> held;
+  ShadowData last;
+  for (int f = 0; f < 7; ++f) {
+    // A camera creeping sideways: each fit differs a little, each kept map still covers it.
+    const ShadowData d = update_shadow_cascades(w, camera_at({0.01f * float(f), 3, 8}), state);
+    ASSERT_TRUE(d.light.valid()) << d.error;
+    ASSERT_EQ(d.cascade_count, 4);
+    held.push_back(d.held);
+    for (int i = 0; i < 4; ++i)
+      if ((d.held >> i) & 1u) {
+        EXPECT_EQ(d.view_proj[std::size_t(i)], last.view_proj[std::size_t(i)]) << f << " " << i;
+        EXPECT_EQ(d.casters[std::size_t(i)], last.casters[std::size_t(i)]);
+      }
+    last = d;
+  }
+  // Frame 0 has nothing to keep; then cascade i is refitted when (f + i) % 3 == 0.
+  EXPECT_EQ(held[0], 0u);
+  for (int f = 1; f < 7; ++f) {
+    std::uint32_t expected = 0;
+    for (int i = 1; i < 4; ++i)
+      if ((f + i) % 3 != 0) expected |= 1u << i;
+    EXPECT_EQ(held[std::size_t(f)], expected) << "frame " << f;
+  }
+  // A jump far away: no kept map covers the new slices, all are refitted.
+  EXPECT_EQ(update_shadow_cascades(w, camera_at({30, 3, -20}), state).held, 0u);
+  // Off: nothing kept.
+  w.get<ShadowSettings>(sun).far_cascade_interval = 1;
+  ShadowCascadeState fresh;
+  for (int f = 0; f < 3; ++f)
+    EXPECT_EQ(update_shadow_cascades(w, camera_at({0.01f * float(f), 3, 8}), fresh).held, 0u);
+}
+
 }  // namespace
 }  // namespace kaskad
