@@ -815,18 +815,25 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
 
 namespace {
 
-// Gives entity e a copy of the entities an earlier import made under `first` (Imported{first}):
-// the same meshes, textures and materials, so N instances of one model load and upload it once
-// and draw it instanced. Parents are remapped into the copy; copied cameras are not active.
-void copy_import(ecs::World& w, ecs::Entity first, ecs::Entity e) {
-  std::vector<ecs::Entity> originals;
-  w.view<Imported>().each([&](ecs::Entity x, const Imported& imp) {
-    if (imp.source == first) originals.push_back(x);
-  });
-  std::sort(originals.begin(), originals.end(), entity_less);
+// A model file's first import: the model entity and the entities imported under it
+// (Imported{first}), in entity order.
+struct FirstImport {
+  ecs::Entity first;
+  std::vector<ecs::Entity> made;
+};
+
+// Gives entity e a copy of `originals`, the entities an earlier import made under `first`: the
+// same meshes, textures and materials, so N instances of one model load and upload it once and
+// draw it instanced. Parents are remapped into the copy; copied cameras are not active. Returns
+// the copies. (Scanning every Imported entity per copy made loading N instances O(N^2): 5 s for
+// 33,000 copies of a one-node model.)
+std::vector<ecs::Entity> copy_import(ecs::World& w, const FirstImport& from, ecs::Entity e) {
+  const ecs::Entity first = from.first;
+  const std::vector<ecs::Entity>& originals = from.made;
   auto key = [](ecs::Entity x) { return (std::uint64_t(x.generation) << 32) | x.index; };
   std::map<std::uint64_t, ecs::Entity> copy_of;  // every copy first, so any parent maps
-  for (ecs::Entity original : originals) copy_of[key(original)] = w.create();
+  std::vector<ecs::Entity> copies;
+  for (ecs::Entity original : originals) copies.push_back(copy_of[key(original)] = w.create());
   for (ecs::Entity original : originals) {
     const ecs::Entity c = copy_of[key(original)];
     w.emplace<Imported>(c, Imported{e});
@@ -850,41 +857,45 @@ void copy_import(ecs::World& w, ecs::Entity first, ecs::Entity e) {
       w.emplace<Camera>(c, copy);
     }
   }
+  return copies;
 }
 
 // Imports entity e's glTF model (ModelRef): the meshes take e's renderer flags and layer, the
 // lights the scene's shadow settings. `imported` (file -> the first entity that imported it):
 // a file imported before is copied from that entity's import instead of read again.
 Status import_model(Scene& scene, ecs::Entity e, bool activate_first_camera,
-                    std::map<std::string, ecs::Entity>* imported = nullptr) {
+                    std::map<std::string, FirstImport>* imported = nullptr) {
   ecs::World& w = scene.world;
   const fs::path path = scene.file.parent_path() / w.get<ModelRef>(e).path;
   std::error_code ec;
   const std::string file_key = fs::weakly_canonical(path, ec).string();
-  const auto earlier = imported ? imported->find(file_key) : std::map<std::string, ecs::Entity>::iterator{};
+  const auto earlier = imported ? imported->find(file_key) : std::map<std::string, FirstImport>::iterator{};
+  std::vector<ecs::Entity> made;  // the entities imported under e
   if (imported && earlier != imported->end()) {
-    copy_import(w, earlier->second, e);
+    made = copy_import(w, earlier->second, e);
   } else {
     auto report = import_gltf(path, w, scene.assets, e, e, activate_first_camera);
     if (!report) return report.error();
     for (const auto& warning : report->warnings) log::warn("%s: %s", path.string().c_str(), warning.c_str());
-    if (imported) imported->emplace(file_key, e);
+    w.view<Imported>().each([&](ecs::Entity x, const Imported& imp) {
+      if (imp.source == e) made.push_back(x);
+    });
+    std::sort(made.begin(), made.end(), entity_less);
+    if (imported) imported->emplace(file_key, FirstImport{e, made});
   }
-  // The model entity's renderer flags apply to everything imported under it.
+  // The model entity's renderer flags apply to everything imported under it; the scene's shadow
+  // settings to the model's own lights as to any other (a glTF has none of its own); --set
+  // ENTITY.shadow.* on the imported light refines them afterwards.
   const MeshRenderer flags = w.get<MeshRenderer>(e);
-  w.view<MeshRenderer, Imported>().each([&](ecs::Entity, MeshRenderer& mr, Imported& imp) {
-    if (imp.source == e) {
-      mr.cast_shadows = flags.cast_shadows;
-      mr.receive_shadows = flags.receive_shadows;
-      mr.layer = flags.layer;
-    }
-  });
-  // The scene's shadow settings apply to the model's own lights as to any other (a glTF has
-  // none of its own); --set ENTITY.shadow.* on the imported light refines them afterwards.
   std::vector<ecs::Entity> lights;
-  w.view<Light, Imported>().each([&](ecs::Entity l, Light&, Imported& imp) {
-    if (imp.source == e) lights.push_back(l);
-  });
+  for (ecs::Entity x : made) {
+    if (auto* mr = w.try_get<MeshRenderer>(x)) {
+      mr->cast_shadows = flags.cast_shadows;
+      mr->receive_shadows = flags.receive_shadows;
+      mr->layer = flags.layer;
+    }
+    if (w.has<Light>(x)) lights.push_back(x);
+  }
   for (ecs::Entity l : lights) {
     if (w.has<ShadowSettings>(l))
       w.get<ShadowSettings>(l) = scene.shadow_defaults;
@@ -957,7 +968,7 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
       it = shared.emplace(key, scene.assets.add_mesh(make_primitive(p.shape, p.segments))).first;
     w.get<MeshRenderer>(e).mesh = it->second;
   }
-  std::map<std::string, ecs::Entity> imported;  // each file is read once (copy_import)
+  std::map<std::string, FirstImport> imported;  // each file is read once (copy_import)
   for (auto& model : models)
     KASKAD_TRY(import_model(scene, model.first, /*activate_first_camera=*/true, &imported));
   return {};
