@@ -177,6 +177,12 @@ Range box_range_in_rect(const dmat4& light_view, const Aabb& box, const Rect& r)
     hi = glm::max(hi, p);
   }
   if (hi.x < r.min_x || lo.x > r.max_x || hi.y < r.min_y || lo.y > r.max_y) return out;
+  // Wholly inside the rectangle (most boxes of a cascade): nothing is clipped, the corners are
+  // the vertices.
+  if (lo.x >= r.min_x && hi.x <= r.max_x && lo.y >= r.min_y && hi.y <= r.max_y) {
+    out.add(-hi.z, -lo.z);
+    return out;
+  }
   // 2. The 6 faces as 12 triangles, each clipped against the 4 side planes; 3. min/max z of the
   //    clipped vertices (depth = -z).
   static constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4},

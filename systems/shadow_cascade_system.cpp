@@ -183,6 +183,16 @@ DepthRange visible_receiver_depths(const glm::mat4& view, const glm::mat4& view_
     const auto clip = clip_corners(view_proj, b);
     if (!maybe_inside(clip)) continue;
     const glm::dvec3 lo(b.min), hi(b.max);
+    // A box whose corners' depths lie within the range found so far cannot widen it (what the
+    // frustum leaves of it lies between them): most boxes of a large scene, unclipped.
+    float box_near = std::numeric_limits<float>::max(), box_far = -box_near;
+    for (int i = 0; i < 8; ++i) {
+      const glm::dvec3 p{(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z};
+      const float depth = float(-(v * glm::dvec4(p, 1.0)).z);
+      box_near = std::min(box_near, depth);
+      box_far = std::max(box_far, depth);
+    }
+    if (box_near >= out.near && box_far <= out.far) continue;
     // Wholly inside (the common case): its corners are the vertices.
     bool inside = true;
     for (const glm::vec4& c : clip)

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -129,6 +130,38 @@ TEST(ShadowCascadeSystem, VisibleReceiverDepthsClipBoxesToTheFrustum) {
   const DepthRange g = visible_receiver_depths(view, proj * view, std::array{ground});
   EXPECT_NEAR(g.near, 1.0f / std::tan(glm::radians(10.0f)), 1e-3f);
   EXPECT_NEAR(g.far, 100.0f, 1e-3f);
+}
+
+// Many boxes at once give exactly the union of each box's own range: boxes skipped because
+// their corners lie within the range found so far (the fast path for large scenes) change
+// nothing, whatever the order.
+TEST(ShadowCascadeSystem, VisibleReceiverDepthsOfManyBoxesIsTheUnionOfEach) {
+  const glm::mat4 view = glm::lookAt(glm::vec3(3, 4, 10), glm::vec3(0), glm::vec3(0, 1, 0));
+  const glm::mat4 proj = glm::perspective(glm::radians(50.0f), 1.5f, 0.3f, 60.0f);
+  std::uint32_t seed = 12345;
+  auto next = [&] {  // a small LCG: the same boxes on every platform
+    seed = seed * 1664525u + 1013904223u;
+    return float(seed >> 8) / float(1u << 24);
+  };
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<Aabb> boxes;
+    for (int i = 0; i < 60; ++i) {
+      const glm::vec3 c(next() * 120 - 60, next() * 10 - 5, next() * 120 - 90);
+      const glm::vec3 h(next() * 6 + 0.01f, next() * 3 + 0.01f, next() * 6 + 0.01f);
+      boxes.push_back(Aabb::from_corners(c - h, c + h));
+    }
+    DepthRange each{std::numeric_limits<float>::max(), 0.0f};
+    for (const Aabb& b : boxes) {
+      const DepthRange one = visible_receiver_depths(view, proj * view, std::array{b});
+      if (one.empty()) continue;
+      each.near = std::min(each.near, one.near);
+      each.far = std::max(each.far, one.far);
+    }
+    const DepthRange all = visible_receiver_depths(view, proj * view, boxes);
+    ASSERT_FALSE(all.empty());
+    EXPECT_EQ(all.near, each.near) << "trial " << trial;
+    EXPECT_EQ(all.far, each.far) << "trial " << trial;
+  }
 }
 
 TEST(ShadowCascadeSystem, TheRangeKeepsLastFramesWhileItStillFits) {
