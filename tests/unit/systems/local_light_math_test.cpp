@@ -316,6 +316,19 @@ TEST(ShadowCascadeSystem, SharedSettingsOfLaterLightsAreNamedInTheNotice) {
       << state.last_notice;
 }
 
+// A camera at `eye` looking ahead and a little down (near 0.5, far 80, aspect 1.5), for the
+// tests that move it between fits.
+CameraState walking_camera(ecs::World& w, glm::vec3 eye) {
+  CameraState cam;
+  cam.entity = w.create();
+  cam.camera.near = 0.5f;
+  cam.camera.far = 80.0f;
+  cam.aspect = 1.5f;
+  cam.view = glm::lookAt(eye, eye + glm::vec3(0, -0.3f, -1), glm::vec3(0, 1, 0));
+  cam.proj = glm::perspective(glm::radians(cam.camera.fov_y_deg), 1.5f, 0.5f, 80.0f);
+  return cam;
+}
+
 // freeze_cascades keeps the splits and matrices while the camera moves, and unfreezing fits
 // them to the camera again.
 TEST(ShadowCascadeSystem, FrozenCascadesKeepTheirMatricesWhileTheCameraMoves) {
@@ -325,16 +338,7 @@ TEST(ShadowCascadeSystem, FrozenCascadesKeepTheirMatricesWhileTheCameraMoves) {
       box(w, Aabb::from_corners({-0.5f, 0, -0.5f}, {0.5f, 2, 0.5f}), true, true);
   const ecs::Entity sun =
       light(w, LightType::directional, {0, 10, 0}, glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f)));
-  auto camera_at = [&](glm::vec3 eye) {
-    CameraState cam;
-    cam.entity = w.create();
-    cam.camera.near = 0.5f;
-    cam.camera.far = 80.0f;
-    cam.aspect = 1.5f;
-    cam.view = glm::lookAt(eye, eye + glm::vec3(0, -0.3f, -1), glm::vec3(0, 1, 0));
-    cam.proj = glm::perspective(glm::radians(cam.camera.fov_y_deg), 1.5f, 0.5f, 80.0f);
-    return cam;
-  };
+  auto camera_at = [&](glm::vec3 eye) { return walking_camera(w, eye); };
   auto same_matrices = [](const ShadowData& a, const ShadowData& b) {
     for (int i = 0; i < a.cascade_count; ++i)
       if (a.view_proj[std::size_t(i)] != b.view_proj[std::size_t(i)]) return false;
@@ -366,16 +370,7 @@ TEST(ShadowCascadeSystem, FarCascadesAreRefittedEveryKthFrameStaggered) {
   box(w, Aabb::from_corners({-0.5f, 0, -0.5f}, {0.5f, 2, 0.5f}), true, true);
   const ecs::Entity sun =
       light(w, LightType::directional, {0, 10, 0}, glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f)));
-  auto camera_at = [&](glm::vec3 eye) {
-    CameraState cam;
-    cam.entity = w.create();
-    cam.camera.near = 0.5f;
-    cam.camera.far = 80.0f;
-    cam.aspect = 1.5f;
-    cam.view = glm::lookAt(eye, eye + glm::vec3(0, -0.3f, -1), glm::vec3(0, 1, 0));
-    cam.proj = glm::perspective(glm::radians(cam.camera.fov_y_deg), 1.5f, 0.5f, 80.0f);
-    return cam;
-  };
+  auto camera_at = [&](glm::vec3 eye) { return walking_camera(w, eye); };
   w.get<ShadowSettings>(sun).far_cascade_interval = 3;
   ShadowCascadeState state;
   std::vector<std::uint32_t> held;
