@@ -12,7 +12,7 @@ in vec2 v_uv;
 layout(location = 0) out vec4 o_color;
 #if VARIANT_HAS_AOVS
 layout(location = 1) out vec4 o_position;    // xyz world position, w mask (1 = geometry)
-layout(location = 2) out vec4 o_normal;      // xyz world normal facing the camera, w view depth
+layout(location = 2) out vec4 o_normal;      // xyz world normal (reversed on back faces), w view depth
 layout(location = 3) out vec2 o_visibility;  // x shadow visibility of the shadow view
                                              // u_counts.z names (the first by default),
                                              // y its cascade (-1 outside every cascade)
@@ -67,8 +67,12 @@ void main() {
 #endif
   vec3 view_vec = u_camera_pos.xyz - v_world_pos;
   vec3 v = normalize(view_vec);
+  // The interpolated normal, reversed on back faces: only double-sided materials show those
+  // (the renderer culls the others, with the winding of mirrored transforms reversed). Never
+  // flipped by the view direction: a smooth normal may face slightly away from the camera at a
+  // silhouette or ridge, and flipping it there shaded the surface from below (dark specks).
   vec3 geometric_n = normalize(v_world_normal);
-  if (dot(geometric_n, v) < 0.0) geometric_n = -geometric_n;  // back faces face the camera
+  if (!gl_FrontFacing) geometric_n = -geometric_n;
   vec3 n = geometric_n;
 #if MATERIAL_HAS_NORMAL_MAP
   if (ENABLED(BIT_NORMAL_MAP)) {

@@ -18,7 +18,7 @@ namespace kaskad {
 /// finite position and normal) on a regular pixel grid, at most `max_points` of them.
 struct StabilityPoints {
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;  ///< unit, facing the camera that rendered the AOV
+  std::vector<glm::vec3> normals;  ///< unit, the AOV's N (the side the camera sees)
   std::vector<glm::ivec2> pixels;  ///< where each point was taken from (x right, y down)
 };
 Result<StabilityPoints> stability_points(const Image& aov, int max_points = 4096);

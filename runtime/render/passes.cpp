@@ -132,6 +132,14 @@ bool DrawState::depth_reads_material(VariantKey key) const {
   return key.has(VariantKey::kAlphaMask) || features_by_uniform_;
 }
 
+namespace {
+
+// Whether `model` mirrors (negative determinant): its triangles wind the other way on screen, so
+// the front face is the clockwise one (glTF 2.0, "Transformations").
+bool mirrors(const glm::mat4& model) { return glm::determinant(glm::mat3(model)) < 0.0f; }
+
+}  // namespace
+
 // ---- ShadowMapPass ------------------------------------------------------------------------------
 
 void ShadowMapPass::ensure_storage(int size, int layers, DepthFormat format, ShadowFilter filter) {
@@ -319,6 +327,7 @@ namespace {
 struct CasterRun {
   std::uint32_t draw;
   std::size_t first, count;
+  bool mirrored;  ///< the casters' transforms mirror (negative determinant): reversed winding
 };
 
 // The casters of view `view` in `layers` (bit c: layer c of the view; a caster goes to the layers
@@ -332,8 +341,9 @@ std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list
   auto same_batch = [&](std::uint32_t i, std::uint32_t j) {
     const DrawItem& a = frame.draws[i];
     const DrawItem& b = frame.draws[j];
-    if (a.mesh != b.mesh || list.depth_key(view, i).filtered_for(Pass::depth) !=
-                                list.depth_key(view, j).filtered_for(Pass::depth))
+    if (a.mesh != b.mesh || mirrors(a.model) != mirrors(b.model) ||
+        list.depth_key(view, i).filtered_for(Pass::depth) !=
+            list.depth_key(view, j).filtered_for(Pass::depth))
       return false;
     return !state.depth_reads_material(list.keys[i]) ||
            (a.material == b.material && list.keys[i].material() == list.keys[j].material());
@@ -344,7 +354,8 @@ std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list
   for (std::uint32_t i : list.depth_order) {
     const std::uint32_t mask = layers & caster_mask(v, frame.draws[i]);
     if (mask == 0 || cache.mesh(frame.draws[i].mesh).index_count == 0) continue;
-    if (runs.empty() || !same_batch(previous, i)) runs.push_back({i, records.size(), 0});
+    if (runs.empty() || !same_batch(previous, i))
+      runs.push_back({i, records.size(), 0, mirrors(frame.draws[i].model)});
     previous = i;
     for (int c = 0; c < v.layer_count; ++c)
       if (mask & (1u << c))
@@ -391,11 +402,13 @@ Status draw_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache,
       glProgramUniformMatrix4fv(prog, kLocLayerViewProj, v.layer_count, GL_FALSE,
                                 &v.view_proj[0][0][0]);
     }
+    glFrontFace(run.mirrored ? GL_CW : GL_CCW);
     glBindVertexArray(m.vao.id());
     glDrawElementsInstancedBaseInstance(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
                                         GLsizei(run.count), GLuint(base + run.first));
     ++stats.shadow_draw_calls;
   }
+  glFrontFace(GL_CCW);
   return {};
 }
 
@@ -508,15 +521,17 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
   auto reflective = [&](std::uint32_t i) {
     return keys[i].has(VariantKey::kReflectionCube) || keys[i].has(VariantKey::kReflectionSphere);
   };
-  // Runs of visible draws with the same mesh, program and material become one instanced draw;
-  // a reflective draw (its own probe map and k_s * p_r) stays alone.
+  // Runs of visible draws with the same mesh, program, material and winding become one
+  // instanced draw; a reflective draw (its own probe map and k_s * p_r) stays alone.
   for (std::size_t first = 0; first < visible.size();) {
     const std::uint32_t i = visible[first];
     const DrawItem& d = frame.draws[i];
+    const bool mirrored = mirrors(d.model);
     std::size_t end = first + 1;
     if (!reflective(i))
       while (end < visible.size() && frame.draws[visible[end]].mesh == d.mesh &&
-             keys[visible[end]] == keys[i] && frame.draws[visible[end]].material == d.material)
+             keys[visible[end]] == keys[i] && frame.draws[visible[end]].material == d.material &&
+             mirrors(frame.draws[visible[end]].model) == mirrored)
         ++end;
     const GpuMesh& m = cache.mesh(d.mesh);
     KASKAD_TRY(state.use_program(Pass::forward, keys[i]));
@@ -527,6 +542,7 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
       glEnable(GL_CULL_FACE);
       glCullFace(GL_BACK);
     }
+    glFrontFace(mirrored ? GL_CW : GL_CCW);
     state.bind_material(d, keys[i]);
     // A draw reflecting a probe gets its map: `visible` as of before this frame's captures (a
     // probe never sees a cube being captured), and k_s * p_r.
@@ -555,6 +571,7 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
     stats.triangles += (end - first) * std::size_t(m.index_count / 3);
     first = end;
   }
+  glFrontFace(GL_CCW);
   return {};
 }
 
