@@ -249,6 +249,10 @@ Status check_gif_screen(const std::uint8_t* d, std::size_t n, const std::string&
 /// scripts/fuzz.sh envmap, as a timeout under ASan). The chunks are walked first (8-byte
 /// signature, then per chunk: length, type, data, CRC, up to IEND): each must fit in the file.
 Status check_png_chunks(const std::uint8_t* d, std::size_t n, const std::string& name) {
+  // The format can come from the extension alone: say so before reading garbage as chunks.
+  static constexpr std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (n < 8 || std::memcmp(d, kSignature, 8) != 0)
+    return Error{name, "", "not a PNG file (no PNG signature in its first 8 bytes)"};
   std::size_t at = 8;
   while (at < n) {
     if (n - at < 12)
