@@ -1,0 +1,849 @@
+#include "editor/editor.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include <glm/gtc/constants.hpp>
+#include <nlohmann/json.hpp>
+
+#include "components/bounds.h"
+#include "components/camera.h"
+#include "components/name.h"
+#include "components/transform.h"
+#include "editor/script.h"
+#include "runtime/assets/image_io.h"
+#include "runtime/assets/scene_io.h"
+#include "runtime/cli/player.h"
+#include "runtime/gpu/context.h"
+#include "runtime/gpu/gl_handles.h"
+#include "systems/transform_system.h"
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace kaskad::editor {
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: kaskad edit [SCENE] [--set key=value]... [--size WxH] [--script FILE]\n"
+    "  SCENE          a scene file (.json, .gltf, .glb); default content/scenes/default.json\n"
+    "  --set K=V      an override, as for `kaskad render` (repeatable)\n"
+    "  --size WxH     the window size (default 1280x720)\n"
+    "  --script FILE  replay actions, one per line (README \"Editor: kaskad edit\")\n";
+
+[[noreturn]] void usage_error(const std::string& msg) {
+  std::fprintf(stderr, "kaskad edit: %s\n%s", msg.c_str(), kUsage);
+  std::exit(2);
+}
+
+struct Options {
+  fs::path scene;
+  std::vector<std::string> sets;
+  int width = 1280, height = 720;
+  fs::path script;
+};
+
+int parse_dimension(const std::string& what, const std::string& v) {
+  int n = 0;
+  try {
+    std::size_t used = 0;
+    n = std::stoi(v, &used);
+    if (used != v.size()) n = 0;
+  } catch (const std::exception&) {
+    n = 0;
+  }
+  if (n < 64 || n > 16384) usage_error("--size " + what + " must be an integer in [64, 16384], got '" + v + "'");
+  return n;
+}
+
+Options parse_options(int argc, char** argv) {
+  Options o;
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage_error(arg + " needs a value");
+      return argv[++i];
+    };
+    if (arg == "-h" || arg == "--help") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (arg == "--set") {
+      o.sets.push_back(value());
+    } else if (arg == "--size") {
+      const std::string v = value();
+      const auto x = v.find('x');
+      if (x == std::string::npos) usage_error("--size expects WxH, e.g. 1280x720, got '" + v + "'");
+      o.width = parse_dimension("width", v.substr(0, x));
+      o.height = parse_dimension("height", v.substr(x + 1));
+    } else if (arg == "--script") {
+      o.script = value();
+    } else if (!arg.empty() && arg[0] == '-') {
+      usage_error("unknown option '" + arg + "'");
+    } else if (o.scene.empty()) {
+      o.scene = arg;
+    } else {
+      usage_error("unexpected argument '" + arg + "' (one SCENE only)");
+    }
+  }
+  if (o.scene.empty()) o.scene = content_dir() / "scenes" / "default.json";
+  return o;
+}
+
+// The fly camera: a position and a heading, written into the scene's active camera when moved.
+struct FlyCamera {
+  glm::vec3 position{0.0f};
+  float yaw = 0.0f;    ///< radians about +Y; 0 looks down -Z
+  float pitch = 0.0f;  ///< radians above the horizon
+  bool moved = false;  ///< the user moved it since load (then it is kept over undo and redo)
+
+  glm::vec3 forward() const {
+    return {std::sin(yaw) * std::cos(pitch), std::sin(pitch), -std::cos(yaw) * std::cos(pitch)};
+  }
+  void look_along(const glm::vec3& d) {
+    const glm::vec3 n = glm::normalize(d);
+    pitch = std::asin(std::clamp(n.y, -1.0f, 1.0f));
+    yaw = std::atan2(n.x, -n.z);
+  }
+};
+
+// The panels, as fractions of the window with limits in pixels; the viewport is what is left.
+struct Layout {
+  float left = 0, right = 0;  ///< panel widths
+  int view_x = 0, view_w = 0, view_h = 0;
+};
+
+Layout layout_for(int w, int h) {
+  Layout l;
+  l.left = std::clamp(0.2f * float(w), 160.0f, 300.0f);
+  l.right = std::clamp(0.32f * float(w), 260.0f, 460.0f);
+  l.view_x = int(l.left);
+  l.view_w = std::max(0, w - int(l.left) - int(l.right));
+  l.view_h = h;
+  return l;
+}
+
+// The window as drawn (panels and viewport), top row first.
+Image read_window(int w, int h) {
+  Image img;
+  img.width = w;
+  img.height = h;
+  img.channels = 3;
+  std::vector<unsigned char> bytes(std::size_t(w) * std::size_t(h) * 3);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_BACK);
+  glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, bytes.data());
+  img.pixels.resize(bytes.size());
+  const std::size_t row = std::size_t(w) * 3;
+  for (std::size_t y = 0; y < std::size_t(h); ++y)
+    for (std::size_t i = 0; i < row; ++i)
+      img.pixels[y * row + i] = float(bytes[(std::size_t(h) - 1 - y) * row + i]) / 255.0f;
+  return img;
+}
+
+class Editor {
+ public:
+  Editor(Options options, Scene scene, Player& player)
+      : opt_(std::move(options)), scene_(std::move(scene)), player_(player) {
+    history_.push_back(scene_to_json(scene_));
+    take_camera_from_scene();
+    update_bounds_speed();
+  }
+
+  int run();
+
+ private:
+  // Edits: one --set assignment through scene IO's own override path.
+  Status edit(const std::string& assignment, bool merge);
+  Status restore(std::size_t index);
+  Status undo();
+  Status redo();
+  Status save(const fs::path& file);
+  bool dirty() const { return position_ != saved_; }
+
+  // The camera.
+  std::optional<ecs::Entity> active_camera() const;
+  void take_camera_from_scene();
+  void write_camera();
+  void update_bounds_speed();
+  Status press(const std::string& key, float seconds);
+  Status frame_selection();
+  std::optional<ecs::Entity> find(const std::string& name) const;
+
+  // A frame and the UI.
+  Status render_viewport(int w, int h);
+  void draw_ui(int w, int h);
+  void entity_list();
+  void entity_node(ecs::Entity e, const std::map<std::uint32_t, std::vector<ecs::Entity>>& children);
+  void inspector();
+  void field(const std::string& key, const std::string& label, const json& value);
+  void request(const std::string& assignment);
+  void interactive_input(float dt);
+  Status run_action(const ScriptAction& a, bool& quit);
+
+  const json& document() {
+    if (doc_stale_) {
+      doc_ = scene_to_json(scene_);
+      doc_stale_ = false;
+    }
+    return doc_;
+  }
+  void report(const std::string& message) {
+    message_ = message;
+    std::fprintf(stderr, "kaskad edit: %s\n", message.c_str());
+  }
+
+  Options opt_;
+  Scene scene_;
+  Player& player_;  ///< outlives the editor: its context outlives the UI's GL objects
+  std::vector<json> history_;     ///< canonical documents, one per edit; [0] as loaded
+  std::size_t position_ = 0;      ///< the document the scene is now
+  std::size_t saved_ = 0;         ///< the document last saved (or loaded); npos: none of them
+  std::string last_drag_key_;     ///< a drag in progress edits one history entry, not one a frame
+  std::vector<std::pair<std::string, bool>> requests_;  ///< UI edits, applied after the frame
+  std::string selected_;
+  std::string message_;           ///< the last error or notice, shown in the inspector
+  std::string set_line_;          ///< the inspector's free "key=value" field
+  json doc_;
+  bool doc_stale_ = true;
+  FlyCamera camera_;
+  float speed_ = 1.0f;            ///< fly speed, metres per second (from the scene's size)
+  bool prewarm_ = true;           ///< compile the scene's programs before its first frame
+  bool changed_since_frame_ = true;
+  bool viewport_hovered_ = false;
+  bool ask_quit_ = false;
+  gpu::Texture view_texture_;
+  int texture_w_ = 0, texture_h_ = 0;
+  Image last_frame_;              ///< the viewport's colour, for screenshots
+  fs::path window_shot_;          ///< window_screenshot: written after the next frame's UI
+};
+
+std::optional<ecs::Entity> Editor::find(const std::string& name) const {
+  std::optional<ecs::Entity> found;
+  scene_.world.view<Name>().each([&](ecs::Entity e, const Name& n) {
+    if (n.value == name && !found) found = e;
+  });
+  return found;
+}
+
+std::optional<ecs::Entity> Editor::active_camera() const {
+  // As the camera system picks it: the first active camera, else the first camera.
+  std::optional<ecs::Entity> first, active;
+  std::vector<ecs::Entity> cams;
+  scene_.world.view<Camera>().each([&](ecs::Entity e, const Camera&) { cams.push_back(e); });
+  std::sort(cams.begin(), cams.end(), [](ecs::Entity a, ecs::Entity b) { return a.index < b.index; });
+  for (ecs::Entity e : cams) {
+    if (!first) first = e;
+    if (!active && scene_.world.get<Camera>(e).active) active = e;
+  }
+  return active ? active : first;
+}
+
+void Editor::take_camera_from_scene() {
+  const auto cam = active_camera();
+  if (!cam) return;
+  const auto* wt = scene_.world.try_get<WorldTransform>(*cam);
+  if (!wt) return;
+  camera_.position = glm::vec3(wt->matrix[3]);
+  camera_.look_along(-glm::vec3(wt->matrix[2]));
+}
+
+void Editor::write_camera() {
+  const auto cam = active_camera();
+  if (!cam) return;
+  Transform& t = scene_.world.get<Transform>(*cam);
+  // A camera under a parent is moved in its parent's space: the fly camera drives roots only.
+  t.translation = camera_.position;
+  t.rotation = look_rotation(camera_.forward());
+  camera_.moved = true;
+  doc_stale_ = true;
+  changed_since_frame_ = true;
+}
+
+void Editor::update_bounds_speed() {
+  const Aabb b = scene_bounds(scene_.world);
+  // About five seconds to cross the scene, whatever its units.
+  const float size = b.empty() ? 10.0f : glm::length(b.max - b.min);
+  speed_ = std::max(size / 5.0f, 0.01f);
+}
+
+Status Editor::edit(const std::string& assignment, bool merge) {
+  Status live = apply_live_override(scene_, assignment);
+  if (!live) {
+    // Sections a loaded entity does not take live (material, primitive, model, name) are set on
+    // the canonical document and the scene remade from it: the same override and readers.
+    json doc = scene_to_json(scene_);
+    if (!apply_override(doc, assignment)) return live;
+    auto remade = load_scene_document(doc, opt_.scene);
+    if (!remade) return remade.error();
+    scene_ = std::move(remade.value());
+    prewarm_ = true;
+  }
+  update_transforms(scene_.world, scene_.assets);
+  doc_stale_ = true;
+  changed_since_frame_ = true;
+  json snapshot = scene_to_json(scene_);
+  if (merge && position_ + 1 == history_.size() && position_ != saved_ && position_ > 0) {
+    history_[position_] = std::move(snapshot);
+  } else {
+    history_.resize(position_ + 1);
+    if (saved_ != std::string::npos && saved_ > position_) saved_ = std::string::npos;
+    history_.push_back(std::move(snapshot));
+    ++position_;
+  }
+  return {};
+}
+
+Status Editor::restore(std::size_t index) {
+  auto scene = load_scene_document(history_[index], opt_.scene);
+  if (!scene) return scene.error();
+  scene_ = std::move(scene.value());
+  position_ = index;
+  prewarm_ = true;
+  doc_stale_ = true;
+  changed_since_frame_ = true;
+  if (camera_.moved) {
+    write_camera();
+    update_transforms(scene_.world, scene_.assets);
+  } else {
+    take_camera_from_scene();
+  }
+  return {};
+}
+
+Status Editor::undo() {
+  if (position_ == 0) return Error{"", "", "nothing to undo"};
+  return restore(position_ - 1);
+}
+
+Status Editor::redo() {
+  if (position_ + 1 >= history_.size()) return Error{"", "", "nothing to redo"};
+  return restore(position_ + 1);
+}
+
+Status Editor::save(const fs::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext != ".json")
+    return Error{file.string(), "", "scenes are saved as .json (a glTF file is never overwritten)"};
+  KASKAD_TRY(save_scene(file, scene_));
+  if (fs::absolute(file) == fs::absolute(opt_.scene)) saved_ = position_;
+  message_ = "saved " + file.string();
+  std::printf("kaskad edit: wrote %s\n", file.string().c_str());
+  return {};
+}
+
+Status Editor::press(const std::string& key, float seconds) {
+  if (key == "f") return frame_selection();
+  if (key == "ctrl+z") return undo();
+  if (key == "ctrl+y") return redo();
+  if (key == "ctrl+s") return save(opt_.scene);
+  const glm::vec3 fwd = camera_.forward();
+  const glm::vec3 right = glm::normalize(glm::cross(fwd, glm::vec3(0, 1, 0)));
+  glm::vec3 move{0.0f};
+  if (key == "w") move = fwd;
+  if (key == "s") move = -fwd;
+  if (key == "d") move = right;
+  if (key == "a") move = -right;
+  if (key == "e") move = glm::vec3(0, 1, 0);
+  if (key == "q") move = glm::vec3(0, -1, 0);
+  camera_.position += move * speed_ * seconds;
+  write_camera();
+  return {};
+}
+
+Status Editor::frame_selection() {
+  const auto e = find(selected_);
+  if (!e) return Error{"", "", "F frames the selection: select an entity first"};
+  Aabb box;
+  if (const auto* b = scene_.world.try_get<WorldBounds>(*e)) box = b->box;
+  if (box.empty()) {
+    const auto* wt = scene_.world.try_get<WorldTransform>(*e);
+    const glm::vec3 p = wt ? glm::vec3(wt->matrix[3]) : glm::vec3(0.0f);
+    box.expand(p - glm::vec3(0.5f));
+    box.expand(p + glm::vec3(0.5f));
+  }
+  const glm::vec3 centre = 0.5f * (box.min + box.max);
+  const float radius = std::max(0.5f * glm::length(box.max - box.min), 0.01f);
+  float fov = glm::radians(45.0f);
+  if (const auto cam = active_camera()) fov = glm::radians(scene_.world.get<Camera>(*cam).fov_y_deg);
+  // The bounding sphere fills the vertical field of view, with a margin.
+  const float distance = 1.2f * radius / std::sin(0.5f * fov);
+  camera_.position = centre - camera_.forward() * distance;
+  write_camera();
+  return {};
+}
+
+Status Editor::render_viewport(int w, int h) {
+  RenderRun run;
+  run.frames = 1;
+  run.width = w;
+  run.height = h;
+  run.write_aovs = false;
+  run.prewarm = prewarm_;
+  auto t = render_frames(player_, scene_, run);
+  if (!t) return t.error();
+  prewarm_ = false;
+  changed_since_frame_ = false;
+  last_frame_ = player_.renderer->read_color();
+  if (!opt_.script.empty()) {
+    // The stats line the editor tests read: which frames captured probe faces and drew layers.
+    const auto& st = t->last.stats;
+    std::printf("frame %llu: %d probe faces, %d draws, %zu shadow triangles\n",
+                static_cast<unsigned long long>(scene_.frames_rendered - 1), st.probe_faces,
+                st.draw_calls, st.shadow_triangles);
+  }
+  if (texture_w_ != last_frame_.width || texture_h_ != last_frame_.height) {
+    view_texture_ = gpu::make_texture(GL_TEXTURE_2D);
+    glTextureStorage2D(view_texture_.id(), 1, GL_RGBA8, last_frame_.width, last_frame_.height);
+    // No mipmaps: the default minifying filter would leave the texture incomplete (black).
+    glTextureParameteri(view_texture_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(view_texture_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    texture_w_ = last_frame_.width;
+    texture_h_ = last_frame_.height;
+  }
+  const GLenum format = last_frame_.channels == 4 ? GL_RGBA : last_frame_.channels == 3 ? GL_RGB
+                                                                                         : GL_RED;
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(view_texture_.id(), 0, 0, 0, last_frame_.width, last_frame_.height, format,
+                      GL_FLOAT, last_frame_.pixels.data());
+  return {};
+}
+
+void Editor::request(const std::string& assignment) {
+  // A drag edits one history entry while the mouse is held, not one per frame.
+  const std::string key = assignment.substr(0, assignment.find('='));
+  const bool merge = key == last_drag_key_;
+  last_drag_key_ = ImGui::IsItemActive() ? key : "";
+  requests_.emplace_back(assignment, merge);
+}
+
+void Editor::field(const std::string& key, const std::string& label, const json& v) {
+  ImGui::PushID(key.c_str());
+  if (v.is_boolean()) {
+    bool b = v.get<bool>();
+    if (ImGui::Checkbox(label.c_str(), &b)) request(key + "=" + (b ? "true" : "false"));
+  } else if (v.is_number_integer() || v.is_number_unsigned()) {
+    // Drag fields without limits: the scene readers decide what is valid (one source of truth),
+    // and a rejected value shows their message.
+    int i = v.get<int>();
+    if (ImGui::DragInt(label.c_str(), &i, 1.0f)) request(key + "=" + std::to_string(i));
+  } else if (v.is_number_float()) {
+    float f = v.get<float>();
+    const float speed = std::max(std::abs(f) * 0.01f, 0.001f);
+    if (ImGui::DragFloat(label.c_str(), &f, speed, 0.0f, 0.0f, "%.5g"))
+      request(key + "=" + json(double(f)).dump());
+  } else if (v.is_string()) {
+    // Enumerations are shown as the file spells them, a value outside the list included.
+    char buf[512];
+    std::snprintf(buf, sizeof buf, "%s", v.get<std::string>().c_str());
+    if (ImGui::InputText(label.c_str(), buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue))
+      request(key + "=" + json(std::string(buf)).dump());
+  } else if (v.is_array() && v.size() >= 2 && v.size() <= 4 &&
+             std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); })) {
+    float f[4] = {};
+    for (std::size_t i = 0; i < v.size(); ++i) f[i] = v[i].get<float>();
+    float largest = 0.0f;
+    for (float x : f) largest = std::max(largest, std::abs(x));
+    const float speed = std::max(largest * 0.01f, 0.001f);
+    if (ImGui::DragScalarN(label.c_str(), ImGuiDataType_Float, f, int(v.size()), speed, nullptr,
+                           nullptr, "%.4g")) {
+      json a = json::array();
+      for (std::size_t i = 0; i < v.size(); ++i) a.push_back(double(f[i]));
+      request(key + "=" + a.dump());
+    }
+  } else if (v.is_object() || v.is_array()) {
+    if (ImGui::TreeNode(label.c_str())) {
+      if (v.is_object())
+        for (auto it = v.begin(); it != v.end(); ++it) field(key + "." + it.key(), it.key(), it.value());
+      else
+        for (std::size_t i = 0; i < v.size(); ++i) field(key + "." + std::to_string(i), std::to_string(i), v[i]);
+      ImGui::TreePop();
+    }
+  } else {
+    ImGui::TextDisabled("%s: %s", label.c_str(), v.dump().c_str());
+  }
+  ImGui::PopID();
+}
+
+void Editor::entity_node(ecs::Entity e,
+                         const std::map<std::uint32_t, std::vector<ecs::Entity>>& children) {
+  const auto* n = scene_.world.try_get<Name>(e);
+  const std::string name = n ? n->value : "(unnamed " + std::to_string(e.index) + ")";
+  const auto kids = children.find(e.index);
+  ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_SpanAvailWidth |
+                             ImGuiTreeNodeFlags_DefaultOpen;
+  if (kids == children.end()) flags |= ImGuiTreeNodeFlags_Leaf;
+  if (n && n->value == selected_) flags |= ImGuiTreeNodeFlags_Selected;
+  ImGui::PushID(int(e.index));
+  const bool open = ImGui::TreeNodeEx(name.c_str(), flags);
+  if (ImGui::IsItemClicked() && n) selected_ = n->value;
+  if (open) {
+    if (kids != children.end())
+      for (ecs::Entity c : kids->second) entity_node(c, children);
+    ImGui::TreePop();
+  }
+  ImGui::PopID();
+}
+
+void Editor::entity_list() {
+  std::vector<ecs::Entity> all;
+  scene_.world.view<Transform>().each([&](ecs::Entity e, const Transform&) { all.push_back(e); });
+  std::sort(all.begin(), all.end(), [](ecs::Entity a, ecs::Entity b) { return a.index < b.index; });
+  std::map<std::uint32_t, std::vector<ecs::Entity>> children;
+  std::vector<ecs::Entity> roots;
+  for (ecs::Entity e : all) {
+    const ecs::Entity p = scene_.world.get<Transform>(e).parent;
+    if (p.valid() && scene_.world.alive(p) && p != e)
+      children[p.index].push_back(e);
+    else
+      roots.push_back(e);
+  }
+  for (ecs::Entity e : roots) entity_node(e, children);
+}
+
+void Editor::inspector() {
+  if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
+  ImGui::TextDisabled("%s%s", opt_.scene.filename().string().c_str(), dirty() ? " (unsaved)" : "");
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "%s", set_line_.c_str());
+  if (ImGui::InputText("--set", buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue)) {
+    set_line_ = buf;
+    requests_.emplace_back(set_line_, false);
+  } else {
+    set_line_ = buf;
+  }
+  const json& doc = document();
+  if (!selected_.empty()) {
+    const json* ent = nullptr;
+    for (const json& e : doc.at("entities"))
+      if (e.value("name", std::string()) == selected_) ent = &e;
+    if (ent) {
+      ImGui::Separator();
+      ImGui::TextUnformatted(selected_.c_str());
+      for (auto it = ent->begin(); it != ent->end(); ++it) {
+        if (it.key() == "name" || !it.value().is_object()) continue;
+        if (ImGui::CollapsingHeader(it.key().c_str(), ImGuiTreeNodeFlags_DefaultOpen))
+          for (auto f = it.value().begin(); f != it.value().end(); ++f)
+            field(selected_ + "." + it.key() + "." + f.key(), f.key(), f.value());
+      }
+    } else {
+      ImGui::TextWrapped("'%s' is imported from a model: its transform, light and camera are set "
+                         "with --set %s.SECTION.FIELD=VALUE", selected_.c_str(), selected_.c_str());
+    }
+  }
+  for (const char* section : {"render", "shadow"}) {
+    if (!doc.contains(section)) continue;
+    if (ImGui::CollapsingHeader(section))
+      for (auto f = doc[section].begin(); f != doc[section].end(); ++f)
+        field(std::string(section) + "." + f.key(), f.key(), f.value());
+  }
+}
+
+void Editor::draw_ui(int w, int h) {
+  const Layout l = layout_for(w, h);
+  const ImGuiWindowFlags fixed = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize |
+                                 ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
+  ImGui::SetNextWindowPos(ImVec2(0, 0));
+  ImGui::SetNextWindowSize(ImVec2(l.left, float(h)));
+  ImGui::Begin("Entities", nullptr, fixed);
+  entity_list();
+  ImGui::End();
+
+  ImGui::SetNextWindowPos(ImVec2(float(l.view_x), 0));
+  ImGui::SetNextWindowSize(ImVec2(float(l.view_w), float(l.view_h)));
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
+  ImGui::Begin("Viewport", nullptr, fixed | ImGuiWindowFlags_NoDecoration |
+                                        ImGuiWindowFlags_NoBringToFrontOnFocus);
+  if (view_texture_)
+    ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<std::uintptr_t>(view_texture_.id())),
+                 ImVec2(float(texture_w_), float(texture_h_)));
+  viewport_hovered_ = ImGui::IsWindowHovered();
+  ImGui::End();
+  ImGui::PopStyleVar();
+
+  ImGui::SetNextWindowPos(ImVec2(float(w) - l.right, 0));
+  ImGui::SetNextWindowSize(ImVec2(l.right, float(h)));
+  ImGui::Begin("Inspector", nullptr, fixed);
+  // Labels keep a fixed share of the panel, so long field names are not clipped.
+  ImGui::PushItemWidth(-std::max(120.0f, 0.42f * l.right));
+  inspector();
+  ImGui::PopItemWidth();
+  ImGui::End();
+
+  if (ask_quit_) ImGui::OpenPopup("Unsaved changes");
+  if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+    ImGui::Text("%s has unsaved changes.", opt_.scene.filename().string().c_str());
+    GLFWwindow* window = player_.context->window();
+    if (ImGui::Button("Save and quit")) {
+      if (Status st = save(opt_.scene); st) glfwSetWindowShouldClose(window, true);
+      else report(st.error().to_string());
+      ask_quit_ = false;
+      ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Quit without saving")) {
+      saved_ = position_;
+      glfwSetWindowShouldClose(window, true);
+      ask_quit_ = false;
+      ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel")) {
+      ask_quit_ = false;
+      ImGui::CloseCurrentPopup();
+    }
+    ImGui::EndPopup();
+  }
+}
+
+void Editor::interactive_input(float dt) {
+  ImGuiIO& io = ImGui::GetIO();
+  if (!ImGui::IsAnyItemActive()) last_drag_key_.clear();
+  // The Dear ImGui 1.86 GLFW backend indexes keys by GLFW key code.
+  if (!io.WantTextInput) {
+    const char* shortcut = nullptr;
+    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Z, false)) shortcut = "ctrl+z";
+    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Y, false)) shortcut = "ctrl+y";
+    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_S, false)) shortcut = "ctrl+s";
+    if (!io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_F, false)) shortcut = "f";
+    if (shortcut)
+      if (Status st = press(shortcut, 0.0f); !st) report(st.error().to_string());
+  }
+  if (viewport_hovered_ && ImGui::IsMouseDown(ImGuiMouseButton_Right)) {
+    const float radians_per_pixel = 0.004f;
+    camera_.yaw += io.MouseDelta.x * radians_per_pixel;
+    camera_.pitch = std::clamp(camera_.pitch - io.MouseDelta.y * radians_per_pixel, -1.55f, 1.55f);
+    const float step = dt * (io.KeyShift ? 4.0f : 1.0f);
+    static constexpr std::pair<int, const char*> kFly[] = {
+        {GLFW_KEY_W, "w"}, {GLFW_KEY_A, "a"}, {GLFW_KEY_S, "s"},
+        {GLFW_KEY_D, "d"}, {GLFW_KEY_Q, "q"}, {GLFW_KEY_E, "e"}};
+    for (const auto& [glfw_key, name] : kFly)
+      if (ImGui::IsKeyDown(glfw_key)) (void)press(name, step);
+    if (io.MouseDelta.x != 0.0f || io.MouseDelta.y != 0.0f) write_camera();
+  }
+}
+
+Status Editor::run_action(const ScriptAction& a, bool& quit) {
+  switch (a.kind) {
+    case ActionKind::set:
+      return edit(a.args[0], false);
+    case ActionKind::select:
+      if (!find(a.args[0])) return Error{"", "", "select: no entity named '" + a.args[0] + "'"};
+      selected_ = a.args[0];
+      return {};
+    case ActionKind::camera: {
+      float v[6] = {};
+      for (std::size_t i = 0; i < a.args.size(); ++i) v[i] = std::stof(a.args[i]);
+      camera_.position = glm::vec3(v[0], v[1], v[2]);
+      if (a.args.size() == 6) {
+        const glm::vec3 d = glm::vec3(v[3], v[4], v[5]) - camera_.position;
+        if (glm::length(d) <= 0.0f) return Error{"", "", "camera: the look-at point is the position"};
+        camera_.look_along(d);
+      }
+      write_camera();
+      return {};
+    }
+    case ActionKind::key:
+      // One fly step is a frame's worth at 30 Hz; a key that fails (nothing to undo, a save
+      // refused) fails the script.
+      return press(a.args[0], 1.0f / 30.0f);
+    case ActionKind::frames:
+      return {};
+    case ActionKind::screenshot:
+      if (last_frame_.width == 0) return Error{"", "", "screenshot: no frame rendered yet"};
+      KASKAD_TRY(save_image(a.args[0], last_frame_));
+      std::printf("kaskad edit: wrote %s\n", a.args[0].c_str());
+      return {};
+    case ActionKind::window_screenshot:
+      KASKAD_TRY(check_image_output(a.args[0]));
+      window_shot_ = a.args[0];
+      return {};
+    case ActionKind::save:
+      return save(a.args.empty() ? opt_.scene : fs::path(a.args[0]));
+    case ActionKind::undo:
+      return undo();
+    case ActionKind::redo:
+      return redo();
+    case ActionKind::quit:
+      if (dirty())
+        return Error{"", "", "quit with unsaved changes (save first, or quit! to discard them)"};
+      quit = true;
+      return {};
+    case ActionKind::force_quit:
+      quit = true;
+      return {};
+  }
+  return {};
+}
+
+int Editor::run() {
+  GLFWwindow* window = player_.context->window();
+  std::vector<ScriptAction> script;
+  if (!opt_.script.empty()) {
+    auto parsed = parse_script(opt_.script);
+    if (!parsed) {
+      std::fprintf(stderr, "kaskad edit: error: %s\n", parsed.error().to_string().c_str());
+      return 1;
+    }
+    script = std::move(parsed.value());
+  }
+  std::size_t next = 0;
+  int frames_left = 0;
+  auto last = std::chrono::steady_clock::now();
+  auto last_reload_check = last;
+  for (;;) {
+    glfwPollEvents();
+    // Shader hot reload, twice a second: a failed compile keeps the last good program and its
+    // log (mapped to file:line) stays shown until a later save fixes it.
+    if (std::chrono::steady_clock::now() - last_reload_check > std::chrono::milliseconds(500)) {
+      last_reload_check = std::chrono::steady_clock::now();
+      const auto before = player_.renderer->shaders().stats().reloads;
+      for (const auto& e : player_.renderer->shaders().reload_changed()) report(e.to_string());
+      if (player_.renderer->shaders().stats().reloads > before) message_.clear();
+    }
+    bool quit = false;
+    if (!opt_.script.empty()) {
+      // Script actions run between frames; `frames N` lets N frames render, and a screenshot
+      // after a change first renders the frame that shows it.
+      while (frames_left == 0 && next < script.size()) {
+        const ScriptAction& a = script[next];
+        if (a.kind == ActionKind::screenshot && changed_since_frame_) {
+          frames_left = 1;
+          break;
+        }
+        if (Status st = run_action(a, quit); !st) {
+          Error e = st.error();
+          const std::string where = "line " + std::to_string(a.line);
+          std::fprintf(stderr, "kaskad edit: error: %s: %s: %s\n", opt_.script.string().c_str(),
+                       where.c_str(), e.to_string().c_str());
+          return 1;
+        }
+        ++next;
+        if (a.kind == ActionKind::frames) frames_left = std::stoi(a.args[0]);
+        if (a.kind == ActionKind::window_screenshot) frames_left = 1;
+        if (quit) break;
+      }
+      if (!quit && frames_left == 0 && next == script.size()) {
+        std::fprintf(stderr, "kaskad edit: error: %s: the script ended without quit or quit!\n",
+                     opt_.script.string().c_str());
+        return 1;
+      }
+    } else if (glfwWindowShouldClose(window)) {
+      if (!dirty()) quit = true;
+      else {
+        glfwSetWindowShouldClose(window, false);
+        ask_quit_ = true;
+      }
+    }
+    if (quit) break;
+
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window, &w, &h);
+    if (w <= 0 || h <= 0) continue;  // minimised
+    const Layout l = layout_for(w, h);
+    if (l.view_w > 0 && l.view_h > 0) {
+      if (Status st = render_viewport(l.view_w, l.view_h); !st) {
+        std::fprintf(stderr, "kaskad edit: error: %s\n", st.error().to_string().c_str());
+        return 1;
+      }
+    }
+    if (frames_left > 0) --frames_left;
+
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    const auto now = std::chrono::steady_clock::now();
+    const float dt = std::min(std::chrono::duration<float>(now - last).count(), 0.1f);
+    last = now;
+    if (opt_.script.empty()) interactive_input(dt);
+    draw_ui(w, h);
+    ImGui::Render();
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, w, h);
+    glClearColor(0.1f, 0.1f, 0.1f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    if (!window_shot_.empty()) {
+      if (Status st = save_image(window_shot_, read_window(w, h)); !st) {
+        std::fprintf(stderr, "kaskad edit: error: %s\n", st.error().to_string().c_str());
+        return 1;
+      }
+      std::printf("kaskad edit: wrote %s\n", window_shot_.string().c_str());
+      window_shot_.clear();
+    }
+    player_.context->swap_buffers();
+
+    // Edits from the panels, in the order made; a rejected one shows its error and changes nothing.
+    for (const auto& [assignment, merge] : requests_) {
+      if (Status st = edit(assignment, merge); !st) report(st.error().to_string());
+      else message_.clear();
+    }
+    requests_.clear();
+  }
+  if (gpu::debug_error_count() > 0) {
+    std::fprintf(stderr, "kaskad edit: error: %d OpenGL errors were reported (see log above)\n",
+                 gpu::debug_error_count());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int run_edit_command(int argc, char** argv) {
+  Options opt = parse_options(argc, argv);
+  auto scene = load_scene(opt.scene, opt.sets);
+  if (!scene) {
+    std::fprintf(stderr, "kaskad edit: error: %s\n", scene.error().to_string().c_str());
+    return 1;
+  }
+  if (!gpu::display_available()) {
+    std::fprintf(stderr, "kaskad edit: error: no display (DISPLAY or WAYLAND_DISPLAY): the editor "
+                         "needs a window; under CI run it with xvfb-run -a\n");
+    return 1;
+  }
+  gpu::ContextOptions copt;
+  copt.headless = false;
+  copt.window_width = opt.width;
+  copt.window_height = opt.height;
+  copt.title = "Kaskad editor - " + opt.scene.string();
+  auto player = Player::create(copt);
+  if (!player) {
+    std::fprintf(stderr, "kaskad edit: error: %s\n", player.error().to_string().c_str());
+    return 1;
+  }
+  GLFWwindow* window = player->context->window();
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini dropped into the working directory
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 450 core");
+  int status = 0;
+  {
+    Editor editor(std::move(opt), std::move(scene.value()), player.value());
+    status = editor.run();
+  }
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  return status;
+}
+
+}  // namespace kaskad::editor
