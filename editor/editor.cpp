@@ -24,6 +24,7 @@
 
 #include "components/bounds.h"
 #include "components/camera.h"
+#include "components/light.h"
 #include "components/name.h"
 #include "components/transform.h"
 #include "editor/script.h"
@@ -194,6 +195,7 @@ class Editor {
   void inspector();
   void field(const std::string& key, const std::string& label, const json& value);
   void request(const std::string& assignment);
+  void direction_helpers();
   void interactive_input(float dt);
   Status run_action(const ScriptAction& a, bool& quit);
 
@@ -231,6 +233,8 @@ class Editor {
   gpu::Texture view_texture_;
   int texture_w_ = 0, texture_h_ = 0;
   Image last_frame_;              ///< the viewport's colour, for screenshots
+  std::string stats_;             ///< the last frame's time and counters, shown in the inspector
+  glm::vec3 look_at_{0.0f};       ///< the inspector's look-at point for the selection
   fs::path window_shot_;          ///< window_screenshot: written after the next frame's UI
 };
 
@@ -402,6 +406,14 @@ Status Editor::render_viewport(int w, int h) {
   prewarm_ = false;
   changed_since_frame_ = false;
   last_frame_ = player_.renderer->read_color();
+  {
+    const auto& st = t->last.stats;
+    char line[256];
+    std::snprintf(line, sizeof line, "%.1f ms, %d draws, %zu shadow tris, %d probe faces, %d programs",
+                  t->first_frame_ms, st.draw_calls, st.shadow_triangles, st.probe_faces,
+                  int(player_.renderer->shaders().program_count()));
+    stats_ = line;
+  }
   if (!opt_.script.empty()) {
     // The stats line the editor tests read: which frames captured probe faces and drew layers.
     const auto& st = t->last.stats;
@@ -482,6 +494,25 @@ void Editor::field(const std::string& key, const std::string& label, const json&
   ImGui::PopID();
 }
 
+void Editor::direction_helpers() {
+  // Lights and cameras are aimed: their direction and a look-at point, set through the scene
+  // files' own rotation forms (transform.direction, transform.look_at).
+  const auto e = find(selected_);
+  if (!e || !(scene_.world.has<Light>(*e) || scene_.world.has<Camera>(*e))) return;
+  const auto* wt = scene_.world.try_get<WorldTransform>(*e);
+  if (!wt) return;
+  if (!ImGui::CollapsingHeader("aim", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  glm::vec3 d = glm::normalize(-glm::vec3(wt->matrix[2]));
+  if (ImGui::DragFloat3("direction", &d.x, 0.01f, -1.0f, 1.0f, "%.3f") && glm::length(d) > 1e-4f)
+    request(selected_ + ".transform.direction=" +
+            json::array({double(d.x), double(d.y), double(d.z)}).dump());
+  ImGui::DragFloat3("look-at point", &look_at_.x, 0.05f, 0.0f, 0.0f, "%.3g");
+  if (ImGui::Button("look at it"))
+    requests_.emplace_back(selected_ + ".transform.look_at=" +
+                               json::array({double(look_at_.x), double(look_at_.y), double(look_at_.z)}).dump(),
+                           false);
+}
+
 void Editor::entity_node(ecs::Entity e,
                          const std::map<std::uint32_t, std::vector<ecs::Entity>>& children) {
   const auto* n = scene_.world.try_get<Name>(e);
@@ -519,7 +550,14 @@ void Editor::entity_list() {
 }
 
 void Editor::inspector() {
-  if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
+  ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+  ImGui::TextWrapped("%s", stats_.c_str());
+  ImGui::PopStyleColor();
+  if (!message_.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.35f, 1.0f));
+    ImGui::TextWrapped("%s", message_.c_str());
+    ImGui::PopStyleColor();
+  }
   ImGui::TextDisabled("%s%s", opt_.scene.filename().string().c_str(), dirty() ? " (unsaved)" : "");
   char buf[512];
   std::snprintf(buf, sizeof buf, "%s", set_line_.c_str());
@@ -543,6 +581,7 @@ void Editor::inspector() {
           for (auto f = it.value().begin(); f != it.value().end(); ++f)
             field(selected_ + "." + it.key() + "." + f.key(), f.key(), f.value());
       }
+      direction_helpers();
     } else {
       ImGui::TextWrapped("'%s' is imported from a model: its transform, light and camera are set "
                          "with --set %s.SECTION.FIELD=VALUE", selected_.c_str(), selected_.c_str());
