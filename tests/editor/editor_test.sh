@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # `kaskad edit` end to end in a real window on a virtual X display (xvfb-run), driven by --script:
-#   toggles   each toggle changes the viewport's image; with nothing changed, frames are identical
+#   toggles   each toggle changes the viewport's image; with nothing changed, frames are identical;
+#             the fly camera (key w) and F (frame the selection) move the view
 #   saving    save -> reload -> save gives the same bytes; edits then undo give the canonical bytes
-#   every_n   a reflector with update every_n = 3 captures on editor frames 0, 3, 6, 9 only
+#   every_n   a reflector with update every_n = 3 captures on editor frames 0, 3, 6, 9 only; a
+#             probe's map type changed live changes the image
 #   input     unknown flags, bad script lines, rejected values and unsaved quits fail clearly
 # usage: editor_test.sh toggles|saving|every_n|input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
 set -u
@@ -54,6 +56,13 @@ frames 2
 screenshot $tmp/4.png
 frames 2
 screenshot $tmp/4b.png
+key w
+frames 1
+screenshot $tmp/5.png
+select sphere
+key f
+frames 1
+screenshot $tmp/6.png
 quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
   if [ "$rc" -ne 0 ]; then fail "toggle script exit $rc"; tail -20 "$tmp/out"; fi
   same "nothing changed: identical frames" 0.png 0b.png
@@ -62,10 +71,12 @@ quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
   differ "filter pcf3x3 -> none" 2.png 3.png
   differ "sun.transform.direction moved" 3.png 4.png
   same "nothing changed after the edits: identical frames" 4.png 4b.png
-  # Frames kept coming: one stats line per frame, seven `frames 2` (a screenshot after them needs
-  # no frame of its own).
+  differ "the fly camera moved forward (key w)" 4b.png 5.png
+  differ "F framed the selected sphere" 5.png 6.png
+  # Frames kept coming: one stats line per frame, seven `frames 2` and two `frames 1` (a
+  # screenshot after them needs no frame of its own).
   n=$(grep -c '^frame [0-9]*:' "$tmp/out")
-  if [ "$n" -eq 14 ]; then ok "14 frames rendered"; else fail "expected 14 frame lines, got $n"; fi
+  if [ "$n" -eq 16 ]; then ok "16 frames rendered"; else fail "expected 16 frame lines, got $n"; fi
   ;;
 saving)
   "$KASKAD" save "$scene" -o "$tmp/canonical.json" >/dev/null || fail "kaskad save"
@@ -105,17 +116,22 @@ quit" "$tmp/work.json"
   ;;
 every_n)
   edit "frames 10
-quit" "$KASKAD_CONTENT/scenes/reflections.json" \
+screenshot $tmp/cube.png
+set mirror_sphere.reflector.map=sphere
+frames 3
+screenshot $tmp/sphere.png
+quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
     --set mirror_sphere.reflector.every_n=3 --set mirror_plane.reflector.every_n=3 \
     --set mirror_plane.reflector.faces_per_frame=6
   [ "$rc" -eq 0 ] || { fail "every_n script exit $rc"; tail -5 "$tmp/out"; }
-  captured=$(awk '/^frame [0-9]+:/ { sub(":", "", $2); if ($3 > 0) printf "%s ", $2 }' "$tmp/out")
+  captured=$(awk '/^frame [0-9]+:/ { sub(":", "", $2); if ($2 + 0 < 10 && $3 > 0) printf "%s ", $2 }' "$tmp/out")
   if [ "$captured" = "0 3 6 9 " ]; then
     ok "every_n = 3 captured on frames $captured"
   else
     fail "every_n = 3: probe faces on frames '$captured', expected '0 3 6 9 '"
     grep '^frame' "$tmp/out"
   fi
+  differ "probe map cube -> sphere changes the reflection" cube.png sphere.png
   ;;
 input)
   out=$("$KASKAD" edit --screenshot x.png 2>&1); code=$?
