@@ -124,16 +124,23 @@ struct FlyCamera {
   }
 };
 
-// The panels, as fractions of the window with limits in pixels; the viewport is what is left.
+// The panels: full height at the window's sides, resizable in width (each at most 45% of the
+// window); the viewport is what is left between them.
 struct Layout {
-  float left = 0, right = 0;  ///< panel widths
+  float left = 0, right = 0;  ///< panel widths in pixels
   int view_x = 0, view_w = 0, view_h = 0;
 };
 
-Layout layout_for(int w, int h) {
+constexpr float kMinPanel = 120.0f;
+float max_panel(int window_width) { return std::max(kMinPanel, 0.45f * float(window_width)); }
+
+/// `left` and `right` < 0: the first layout, a share of the window with limits in pixels.
+Layout layout_for(int w, int h, float left, float right) {
   Layout l;
-  l.left = std::clamp(0.2f * float(w), 160.0f, 300.0f);
-  l.right = std::clamp(0.32f * float(w), 260.0f, 460.0f);
+  l.left = left < 0 ? std::clamp(0.2f * float(w), 160.0f, 300.0f) : left;
+  l.right = right < 0 ? std::clamp(0.32f * float(w), 260.0f, 460.0f) : right;
+  l.left = std::clamp(l.left, kMinPanel, max_panel(w));
+  l.right = std::clamp(l.right, kMinPanel, max_panel(w));
   l.view_x = int(l.left);
   l.view_w = std::max(0, w - int(l.left) - int(l.right));
   l.view_h = h;
@@ -233,6 +240,7 @@ class Editor {
   gpu::Texture view_texture_;
   int texture_w_ = 0, texture_h_ = 0;
   Image last_frame_;              ///< the viewport's colour, for screenshots
+  float left_w_ = -1.0f, right_w_ = -1.0f;  ///< panel widths as the user left them; < 0: default
   std::string stats_;             ///< the last frame's time and counters, shown in the inspector
   glm::vec3 look_at_{0.0f};       ///< the inspector's look-at point for the selection
   fs::path window_shot_;          ///< window_screenshot: written after the next frame's UI
@@ -596,13 +604,17 @@ void Editor::inspector() {
 }
 
 void Editor::draw_ui(int w, int h) {
-  const Layout l = layout_for(w, h);
-  const ImGuiWindowFlags fixed = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize |
-                                 ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
+  const Layout l = layout_for(w, h, left_w_, right_w_);
+  const ImGuiWindowFlags panel = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse |
+                                 ImGuiWindowFlags_NoSavedSettings;
+  const ImGuiWindowFlags fixed = panel | ImGuiWindowFlags_NoResize;
+  // Panels keep the window's height; only their inner edge moves.
   ImGui::SetNextWindowPos(ImVec2(0, 0));
   ImGui::SetNextWindowSize(ImVec2(l.left, float(h)));
-  ImGui::Begin("Entities", nullptr, fixed);
+  ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
+  ImGui::Begin("Entities", nullptr, panel);
   entity_list();
+  left_w_ = ImGui::GetWindowWidth();
   ImGui::End();
 
   ImGui::SetNextWindowPos(ImVec2(float(l.view_x), 0));
@@ -619,7 +631,9 @@ void Editor::draw_ui(int w, int h) {
 
   ImGui::SetNextWindowPos(ImVec2(float(w) - l.right, 0));
   ImGui::SetNextWindowSize(ImVec2(l.right, float(h)));
-  ImGui::Begin("Inspector", nullptr, fixed);
+  ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
+  ImGui::Begin("Inspector", nullptr, panel);
+  right_w_ = ImGui::GetWindowWidth();
   // Labels keep a fixed share of the panel, so long field names are not clipped.
   ImGui::PushItemWidth(-std::max(120.0f, 0.42f * l.right));
   inspector();
@@ -796,7 +810,7 @@ int Editor::run() {
     int w = 0, h = 0;
     glfwGetFramebufferSize(window, &w, &h);
     if (w <= 0 || h <= 0) continue;  // minimised
-    const Layout l = layout_for(w, h);
+    const Layout l = layout_for(w, h, left_w_, right_w_);
     if (l.view_w > 0 && l.view_h > 0) {
       if (Status st = render_viewport(l.view_w, l.view_h); !st) {
         std::fprintf(stderr, "kaskad edit: error: %s\n", st.error().to_string().c_str());
