@@ -167,8 +167,8 @@ Image read_window(int w, int h) {
 
 class Editor {
  public:
-  Editor(Options options, Scene scene, Player& player)
-      : opt_(std::move(options)), scene_(std::move(scene)), player_(player) {
+  Editor(Options options, Scene scene, Player& player, std::vector<ScriptAction> script)
+      : opt_(std::move(options)), scene_(std::move(scene)), player_(player), script_(std::move(script)) {
     history_.push_back(scene_to_json(scene_));
     take_camera_from_scene();
     update_bounds_speed();
@@ -221,6 +221,7 @@ class Editor {
   Options opt_;
   Scene scene_;
   Player& player_;  ///< outlives the editor: its context outlives the UI's GL objects
+  std::vector<ScriptAction> script_;  ///< --script, parsed before the window opened
   std::vector<json> history_;     ///< canonical documents, one per edit; [0] as loaded
   std::size_t position_ = 0;      ///< the document the scene is now
   std::size_t saved_ = 0;         ///< the document last saved (or loaded); npos: none of them
@@ -355,7 +356,9 @@ Status Editor::save(const fs::path& file) {
   if (ext != ".json")
     return Error{file.string(), "", "scenes are saved as .json (a glTF file is never overwritten)"};
   KASKAD_TRY(save_scene(file, scene_));
-  if (fs::absolute(file) == fs::absolute(opt_.scene)) saved_ = position_;
+  // Another path is a copy: the scene's own file is still the one with unsaved changes.
+  std::error_code ec;
+  if (fs::weakly_canonical(file, ec) == fs::weakly_canonical(opt_.scene, ec)) saved_ = position_;
   message_ = "saved " + file.string();
   std::printf("kaskad edit: wrote %s\n", file.string().c_str());
   return {};
@@ -748,15 +751,7 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
 
 int Editor::run() {
   GLFWwindow* window = player_.context->window();
-  std::vector<ScriptAction> script;
-  if (!opt_.script.empty()) {
-    auto parsed = parse_script(opt_.script);
-    if (!parsed) {
-      std::fprintf(stderr, "kaskad edit: error: %s\n", parsed.error().to_string().c_str());
-      return 1;
-    }
-    script = std::move(parsed.value());
-  }
+  const std::vector<ScriptAction>& script = script_;
   std::size_t next = 0;
   int frames_left = 0;
   auto last = std::chrono::steady_clock::now();
@@ -862,6 +857,15 @@ int Editor::run() {
 
 int run_edit_command(int argc, char** argv) {
   Options opt = parse_options(argc, argv);
+  std::vector<ScriptAction> script;
+  if (!opt.script.empty()) {
+    auto parsed = parse_script(opt.script);
+    if (!parsed) {
+      std::fprintf(stderr, "kaskad edit: error: %s\n", parsed.error().to_string().c_str());
+      return 1;
+    }
+    script = std::move(parsed.value());
+  }
   auto scene = load_scene(opt.scene, opt.sets);
   if (!scene) {
     std::fprintf(stderr, "kaskad edit: error: %s\n", scene.error().to_string().c_str());
@@ -890,7 +894,7 @@ int run_edit_command(int argc, char** argv) {
   ImGui_ImplOpenGL3_Init("#version 450 core");
   int status = 0;
   {
-    Editor editor(std::move(opt), std::move(scene.value()), player.value());
+    Editor editor(std::move(opt), std::move(scene.value()), player.value(), std::move(script));
     status = editor.run();
   }
   ImGui_ImplOpenGL3_Shutdown();
