@@ -3,6 +3,8 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <cfloat>
+#include <iterator>
 #include <chrono>
 #include <cstdint>
 #include <cmath>
@@ -165,6 +167,60 @@ Image read_window(int w, int h) {
   return img;
 }
 
+// An AOV view as an RGB image; `aovs` has the channels of Renderer::read_aovs().
+Image aov_view(View view, const Image& aovs) {
+  Image out;
+  out.width = aovs.width;
+  out.height = aovs.height;
+  out.channels = 3;
+  out.pixels.assign(std::size_t(aovs.width) * std::size_t(aovs.height) * 3, 0.0f);
+  // Cascades 0..7 in distinct colours (outside every cascade: black).
+  static const glm::vec3 kCascade[] = {{1, 0.2f, 0.2f}, {0.2f, 1, 0.2f}, {0.3f, 0.4f, 1},
+                                       {1, 1, 0.2f},    {1, 0.3f, 1},    {0.2f, 1, 1},
+                                       {1, 0.6f, 0.2f}, {0.7f, 0.7f, 0.7f}};
+  float far = 0.0f;  // the depth view spans the visible depths
+  if (view == View::depth)
+    for (int y = 0; y < aovs.height; ++y)
+      for (int x = 0; x < aovs.width; ++x)
+        if (aovs.at(x, y, 8) > 0.5f) far = std::max(far, aovs.at(x, y, 6));
+  for (int y = 0; y < aovs.height; ++y)
+    for (int x = 0; x < aovs.width; ++x) {
+      glm::vec3 c{0.0f};
+      if (aovs.at(x, y, 8) > 0.5f) {
+        switch (view) {
+          case View::visibility: c = glm::vec3(aovs.at(x, y, 7)); break;
+          case View::cascade: {
+            const int k = int(std::lround(aovs.at(x, y, 9)));
+            if (k >= 0) c = kCascade[k % 8] * (0.4f + 0.6f * aovs.at(x, y, 7));
+            break;
+          }
+          case View::normal:
+            c = 0.5f * glm::vec3(aovs.at(x, y, 3), aovs.at(x, y, 4), aovs.at(x, y, 5)) + 0.5f;
+            break;
+          case View::depth: c = glm::vec3(far > 0.0f ? 1.0f - aovs.at(x, y, 6) / far : 0.0f); break;
+          default: break;
+        }
+      }
+      float* p = &out.pixels[(std::size_t(y) * std::size_t(out.width) + std::size_t(x)) * 3];
+      p[0] = c.r;
+      p[1] = c.g;
+      p[2] = c.b;
+    }
+  return out;
+}
+
+// A one-channel image as grey RGB.
+Image grey(const Image& one) {
+  Image out;
+  out.width = one.width;
+  out.height = one.height;
+  out.channels = 3;
+  out.pixels.resize(one.pixels.size() * 3);
+  for (std::size_t i = 0; i < one.pixels.size(); ++i)
+    out.pixels[3 * i] = out.pixels[3 * i + 1] = out.pixels[3 * i + 2] = one.pixels[i];
+  return out;
+}
+
 class Editor {
  public:
   Editor(Options options, Scene scene, Player& player, std::vector<ScriptAction> script)
@@ -240,7 +296,9 @@ class Editor {
   bool ask_quit_ = false;
   gpu::Texture view_texture_;
   int texture_w_ = 0, texture_h_ = 0;
-  Image last_frame_;              ///< the viewport's colour, for screenshots
+  Image last_frame_;              ///< what the viewport shows (the colour, or a debug view)
+  View view_ = View::colour;
+  std::vector<float> frame_ms_;   ///< the last frames' times, for the graph
   float left_w_ = -1.0f, right_w_ = -1.0f;  ///< panel widths as the user left them; < 0: default
   std::string stats_;             ///< the last frame's time and counters, shown in the inspector
   glm::vec3 look_at_{0.0f};       ///< the inspector's look-at point for the selection
@@ -410,13 +468,23 @@ Status Editor::render_viewport(int w, int h) {
   run.frames = 1;
   run.width = w;
   run.height = h;
-  run.write_aovs = false;
+  // The AOV targets cost fill rate: only for the views that show them.
+  run.write_aovs = view_ != View::colour && view_ != View::shadow_map;
   run.prewarm = prewarm_;
   auto t = render_frames(player_, scene_, run);
   if (!t) return t.error();
   prewarm_ = false;
   changed_since_frame_ = false;
-  last_frame_ = player_.renderer->read_color();
+  if (view_ == View::colour) {
+    last_frame_ = player_.renderer->read_color();
+  } else if (view_ == View::shadow_map) {
+    last_frame_ = grey(player_.renderer->read_shadow_map());
+    if (last_frame_.width == 0) last_frame_ = player_.renderer->read_color();  // no shadowed light
+  } else {
+    last_frame_ = aov_view(view_, player_.renderer->read_aovs());
+  }
+  frame_ms_.push_back(float(t->first_frame_ms));
+  if (frame_ms_.size() > 120) frame_ms_.erase(frame_ms_.begin());
   {
     const auto& st = t->last.stats;
     char line[256];
@@ -564,6 +632,14 @@ void Editor::inspector() {
   ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
   ImGui::TextWrapped("%s", stats_.c_str());
   ImGui::PopStyleColor();
+  if (!frame_ms_.empty())
+    ImGui::PlotLines("frame ms", frame_ms_.data(), int(frame_ms_.size()), 0, nullptr, 0.0f,
+                     FLT_MAX, ImVec2(0, 40));
+  int view = int(view_);
+  if (ImGui::Combo("view", &view, kViewNames, int(std::size(kViewNames)))) {
+    view_ = View(view);
+    changed_since_frame_ = true;
+  }
   if (!message_.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.35f, 1.0f));
     ImGui::TextWrapped("%s", message_.c_str());
@@ -625,9 +701,13 @@ void Editor::draw_ui(int w, int h) {
   ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
   ImGui::Begin("Viewport", nullptr, fixed | ImGuiWindowFlags_NoDecoration |
                                         ImGuiWindowFlags_NoBringToFrontOnFocus);
-  if (view_texture_)
+  if (view_texture_) {
+    // Scaled to fit: the shadow map view is the map's size, its layers stacked.
+    const float scale = std::min({1.0f, float(l.view_w) / float(texture_w_),
+                                  float(l.view_h) / float(texture_h_)});
     ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<std::uintptr_t>(view_texture_.id())),
-                 ImVec2(float(texture_w_), float(texture_h_)));
+                 ImVec2(float(texture_w_) * scale, float(texture_h_) * scale));
+  }
   viewport_hovered_ = ImGui::IsWindowHovered();
   ImGui::End();
   ImGui::PopStyleVar();
@@ -721,6 +801,10 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       // refused) fails the script.
       return press(a.args[0], 1.0f / 30.0f);
     case ActionKind::frames:
+      return {};
+    case ActionKind::view:
+      view_ = *view_named(a.args[0]);  // checked by parse_script
+      changed_since_frame_ = true;
       return {};
     case ActionKind::screenshot:
       if (last_frame_.width == 0) return Error{"", "", "screenshot: no frame rendered yet"};

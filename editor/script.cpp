@@ -27,6 +27,7 @@ constexpr Verb kVerbs[] = {
     {"select", ActionKind::select, 1, 1, "select NAME"},
     {"camera", ActionKind::camera, 3, 6, "camera X Y Z [LOOK_X LOOK_Y LOOK_Z]"},
     {"key", ActionKind::key, 1, 1, "key K (w a s d q e f ctrl+z ctrl+y ctrl+s)"},
+    {"view", ActionKind::view, 1, 1, "view colour|visibility|cascade|normal|depth|shadow_map"},
     {"frames", ActionKind::frames, 1, 1, "frames N (1..100000)"},
     {"screenshot", ActionKind::screenshot, 1, 1, "screenshot PATH.png"},
     {"window_screenshot", ActionKind::window_screenshot, 1, 1, "window_screenshot PATH.png"},
@@ -61,7 +62,7 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
       if (verb == candidate.name) v = &candidate;
     if (!v)
       return Error{file.string(), where,
-                   "unknown action '" + verb + "' (set, select, camera, key, frames, screenshot, "
+                   "unknown action '" + verb + "' (set, select, camera, key, view, frames, screenshot, "
                    "window_screenshot, save, undo, redo, quit, quit!)"};
     ScriptAction a;
     a.kind = v->kind;
@@ -88,6 +89,8 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
           return Error{file.string(), where, "camera: '" + c + "' is not a number"};
     if (a.kind == ActionKind::key && !is_script_key(a.args[0]))
       return Error{file.string(), where, "unknown key '" + a.args[0] + "'; expected " + v->usage};
+    if (a.kind == ActionKind::view && !view_named(a.args[0]))
+      return Error{file.string(), where, "unknown view '" + a.args[0] + "'; expected " + v->usage};
     if (a.kind == ActionKind::frames) {
       int frames = 0;
       const std::string& s = a.args[0];

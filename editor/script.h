@@ -3,6 +3,8 @@
 #pragma once
 
 #include <filesystem>
+#include <iterator>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,8 +13,21 @@
 namespace kaskad::editor {
 
 enum class ActionKind {
-  set, select, camera, key, frames, screenshot, window_screenshot, save, undo, redo, quit, force_quit
+  set, select, camera, key, view, frames, screenshot, window_screenshot, save, undo, redo, quit,
+  force_quit
 };
+
+/// What the viewport shows: the colour, or as a debug view one of the frame's AOVs (README "AOV
+/// contract") or the shadow map (its layers stacked).
+enum class View { colour, visibility, cascade, normal, depth, shadow_map };
+/// The views' names, in View order: the viewport's combo and the script's `view NAME`.
+inline constexpr const char* kViewNames[] = {"colour", "visibility", "cascade", "normal", "depth",
+                                             "shadow_map"};
+inline std::optional<View> view_named(const std::string& name) {
+  for (std::size_t i = 0; i < std::size(kViewNames); ++i)
+    if (name == kViewNames[i]) return View(i);
+  return std::nullopt;
+}
 
 struct ScriptAction {
   ActionKind kind = ActionKind::frames;

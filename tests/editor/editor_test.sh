@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `kaskad edit` end to end in a real window on a virtual X display (xvfb-run), driven by --script:
 #   toggles   each toggle changes the viewport's image; with nothing changed, frames are identical;
-#             the fly camera (key w) and F (frame the selection) move the view
+#             the fly camera (key w) and F (frame the selection) move the view; the debug views
+#             (visibility, cascade, shadow map) differ and leave the colour as it was
 #   saving    save -> reload -> save gives the same bytes; edits then undo give the canonical bytes
 #   every_n   a reflector with update every_n = 3 captures on editor frames 0, 3, 6, 9 only; a
 #             probe's map type changed live changes the image
@@ -15,7 +16,7 @@ if ! command -v xvfb-run >/dev/null 2>&1; then
 fi
 tmp="${TMPDIR:-/tmp}/editor_test.$1.$$"
 mkdir -p "$tmp"
-trap 'rm -rf "$tmp"' EXIT
+trap '[ -n "${KEEP:-}" ] || rm -rf "$tmp"' EXIT
 scene="$KASKAD_CONTENT/scenes/default.json"
 failed=0
 fail() { echo "FAIL $*"; failed=1; }
@@ -63,6 +64,15 @@ select sphere
 key f
 frames 1
 screenshot $tmp/6.png
+view visibility
+screenshot $tmp/visibility.png
+view cascade
+screenshot $tmp/cascade.png
+view shadow_map
+screenshot $tmp/shadow_map.png
+view colour
+frames 1
+screenshot $tmp/6b.png
 quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
   if [ "$rc" -ne 0 ]; then fail "toggle script exit $rc"; tail -20 "$tmp/out"; fi
   same "nothing changed: identical frames" 0.png 0b.png
@@ -73,10 +83,14 @@ quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
   same "nothing changed after the edits: identical frames" 4.png 4b.png
   differ "the fly camera moved forward (key w)" 4b.png 5.png
   differ "F framed the selected sphere" 5.png 6.png
-  # Frames kept coming: one stats line per frame, seven `frames 2` and two `frames 1` (a
-  # screenshot after them needs no frame of its own).
+  differ "view visibility (AOV)" 6.png visibility.png
+  differ "view cascade (AOV)" visibility.png cascade.png
+  differ "view shadow_map" cascade.png shadow_map.png
+  same "debug views leave the colour as it was" 6.png 6b.png
+  # Frames kept coming: one stats line per frame, seven `frames 2`, three `frames 1` and one
+  # frame before each screenshot of a new view (after `frames` a screenshot needs none).
   n=$(grep -c '^frame [0-9]*:' "$tmp/out")
-  if [ "$n" -eq 16 ]; then ok "16 frames rendered"; else fail "expected 16 frame lines, got $n"; fi
+  if [ "$n" -eq 20 ]; then ok "20 frames rendered"; else fail "expected 20 frame lines, got $n"; fi
   ;;
 saving)
   "$KASKAD" save "$scene" -o "$tmp/canonical.json" >/dev/null || fail "kaskad save"
