@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -235,7 +236,13 @@ class Editor {
  private:
   // Edits: one --set assignment through scene IO's own override path.
   Status edit(const std::string& assignment, bool merge);
+  void record(bool merge);  ///< a snapshot of the scene as it is now, after an edit
   Status restore(std::size_t index);
+  std::string unused_name(const std::string& stem) const;
+  Status create(const std::string& shape);
+  Status remove_selected();
+  Status duplicate_selected();
+  Status rename_selected(const std::string& name);
   Status undo();
   Status redo();
   Status save(const fs::path& file);
@@ -286,6 +293,8 @@ class Editor {
   std::string selected_;
   std::string message_;           ///< the last error or notice, shown in the inspector
   std::string set_line_;          ///< the inspector's free "key=value" field
+  std::vector<std::function<Status()>> operations_;  ///< UI entity operations, after the frame
+  int create_shape_ = 0;
   json doc_;
   bool doc_stale_ = true;
   FlyCamera camera_;
@@ -366,6 +375,11 @@ Status Editor::edit(const std::string& assignment, bool merge) {
     scene_ = std::move(remade.value());
     prewarm_ = true;
   }
+  record(merge);
+  return {};
+}
+
+void Editor::record(bool merge) {
   update_transforms(scene_.world, scene_.assets);
   doc_stale_ = true;
   changed_since_frame_ = true;
@@ -378,6 +392,74 @@ Status Editor::edit(const std::string& assignment, bool merge) {
     history_.push_back(std::move(snapshot));
     ++position_;
   }
+}
+
+std::string Editor::unused_name(const std::string& stem) const {
+  for (int i = 1;; ++i) {
+    const std::string name = stem + "_" + std::to_string(i);
+    if (!find(name)) return name;
+  }
+}
+
+Status Editor::create(const std::string& shape) {
+  // In front of the camera, a tenth of the scene's size away (speed_ is a fifth of it per second).
+  const glm::vec3 at = camera_.position + camera_.forward() * std::max(0.5f * speed_, 0.5f);
+  const std::string name = unused_name(shape);
+  json block = {{"name", name},
+                {"transform", {{"translation", {at.x, at.y, at.z}}}},
+                {"primitive", {{"shape", shape}}}};
+  auto e = add_entity(scene_, block, "/create");
+  if (!e) return e.error();
+  selected_ = name;
+  record(false);
+  return {};
+}
+
+Status Editor::remove_selected() {
+  if (selected_.empty()) return Error{"", "", "delete: select an entity first"};
+  KASKAD_TRY(remove_entity(scene_, selected_));
+  selected_.clear();
+  record(false);
+  return {};
+}
+
+Status Editor::duplicate_selected() {
+  if (selected_.empty()) return Error{"", "", "duplicate: select an entity first"};
+  const json& doc = document();
+  for (const json& ent : doc.at("entities")) {
+    if (ent.value("name", std::string()) != selected_) continue;
+    json block = ent;
+    block["name"] = unused_name(selected_);
+    auto e = add_entity(scene_, block, "/duplicate");
+    if (!e) return e.error();
+    selected_ = block["name"].get<std::string>();
+    record(false);
+    return {};
+  }
+  return Error{"", "", "duplicate: '" + selected_ + "' is imported from a model; duplicate the model's entity"};
+}
+
+Status Editor::rename_selected(const std::string& name) {
+  if (selected_.empty()) return Error{"", "", "rename: select an entity first"};
+  // The name and every parent reference to it, on the document; the readers then check it (unique,
+  // not empty) as in a scene file.
+  json doc = scene_to_json(scene_);
+  bool found = false;
+  for (json& ent : doc.at("entities")) {
+    if (ent.value("name", std::string()) == selected_) {
+      ent["name"] = name;
+      found = true;
+    }
+    if (ent.contains("transform") && ent["transform"].value("parent", std::string()) == selected_)
+      ent["transform"]["parent"] = name;
+  }
+  if (!found) return Error{"", "", "rename: '" + selected_ + "' is imported from a model"};
+  auto remade = load_scene_document(doc, opt_.scene);
+  if (!remade) return remade.error();
+  scene_ = std::move(remade.value());
+  prewarm_ = true;
+  selected_ = name;
+  record(false);
   return {};
 }
 
@@ -661,7 +743,15 @@ void Editor::inspector() {
       if (e.value("name", std::string()) == selected_) ent = &e;
     if (ent) {
       ImGui::Separator();
-      ImGui::TextUnformatted(selected_.c_str());
+      char name[256];
+      std::snprintf(name, sizeof name, "%s", selected_.c_str());
+      if (ImGui::InputText("name", name, sizeof name, ImGuiInputTextFlags_EnterReturnsTrue)) {
+        const std::string n = name;
+        operations_.push_back([this, n] { return rename_selected(n); });
+      }
+      if (ImGui::Button("duplicate")) operations_.push_back([this] { return duplicate_selected(); });
+      ImGui::SameLine();
+      if (ImGui::Button("delete")) operations_.push_back([this] { return remove_selected(); });
       for (auto it = ent->begin(); it != ent->end(); ++it) {
         if (it.key() == "name" || !it.value().is_object()) continue;
         if (ImGui::CollapsingHeader(it.key().c_str(), ImGuiTreeNodeFlags_DefaultOpen))
@@ -692,6 +782,15 @@ void Editor::draw_ui(int w, int h) {
   ImGui::SetNextWindowSize(ImVec2(l.left, float(h)));
   ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
   ImGui::Begin("Entities", nullptr, panel);
+  static const char* kShapes[] = {"box", "sphere", "cylinder", "cone", "plane"};
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
+  ImGui::Combo("##shape", &create_shape_, kShapes, int(std::size(kShapes)));
+  ImGui::SameLine();
+  if (ImGui::Button("create")) {
+    const std::string shape = kShapes[create_shape_];
+    operations_.push_back([this, shape] { return create(shape); });
+  }
+  ImGui::Separator();
   entity_list();
   left_w_ = ImGui::GetWindowWidth();
   ImGui::End();
@@ -802,6 +901,14 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       return press(a.args[0], 1.0f / 30.0f);
     case ActionKind::frames:
       return {};
+    case ActionKind::create:
+      return create(a.args[0]);
+    case ActionKind::remove:
+      return remove_selected();
+    case ActionKind::duplicate:
+      return duplicate_selected();
+    case ActionKind::rename:
+      return rename_selected(a.args[0]);
     case ActionKind::view:
       view_ = *view_named(a.args[0]);  // checked by parse_script
       changed_since_frame_ = true;
@@ -928,6 +1035,11 @@ int Editor::run() {
       else message_.clear();
     }
     requests_.clear();
+    for (const auto& op : operations_) {
+      if (Status st = op(); !st) report(st.error().to_string());
+      else message_.clear();
+    }
+    operations_.clear();
   }
   if (gpu::debug_error_count() > 0) {
     std::fprintf(stderr, "kaskad edit: error: %d OpenGL errors were reported (see log above)\n",

@@ -25,6 +25,10 @@ struct Verb {
 constexpr Verb kVerbs[] = {
     {"set", ActionKind::set, 1, 1, "set KEY=VALUE"},
     {"select", ActionKind::select, 1, 1, "select NAME"},
+    {"create", ActionKind::create, 1, 1, "create SHAPE (box, sphere, cylinder, cone, plane)"},
+    {"delete", ActionKind::remove, 0, 0, "delete"},
+    {"duplicate", ActionKind::duplicate, 0, 0, "duplicate"},
+    {"rename", ActionKind::rename, 1, 1, "rename NAME"},
     {"camera", ActionKind::camera, 3, 6, "camera X Y Z [LOOK_X LOOK_Y LOOK_Z]"},
     {"key", ActionKind::key, 1, 1, "key K (w a s d q e f ctrl+z ctrl+y ctrl+s)"},
     {"view", ActionKind::view, 1, 1, "view colour|visibility|cascade|normal|depth|shadow_map"},
@@ -62,12 +66,13 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
       if (verb == candidate.name) v = &candidate;
     if (!v)
       return Error{file.string(), where,
-                   "unknown action '" + verb + "' (set, select, camera, key, view, frames, screenshot, "
+                   "unknown action '" + verb + "' (set, select, create, delete, duplicate, rename, camera, "
+                   "key, view, frames, screenshot, "
                    "window_screenshot, save, undo, redo, quit, quit!)"};
     ScriptAction a;
     a.kind = v->kind;
     a.line = n;
-    if (a.kind == ActionKind::set || a.kind == ActionKind::select) {
+    if (a.kind == ActionKind::set || a.kind == ActionKind::select || a.kind == ActionKind::rename) {
       // The rest of the line, spaces included: a value may be a JSON array or a name with spaces.
       std::string rest;
       std::getline(words, rest);

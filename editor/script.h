@@ -13,8 +13,8 @@
 namespace kaskad::editor {
 
 enum class ActionKind {
-  set, select, camera, key, view, frames, screenshot, window_screenshot, save, undo, redo, quit,
-  force_quit
+  set, select, create, remove, duplicate, rename, camera, key, view, frames, screenshot,
+  window_screenshot, save, undo, redo, quit, force_quit
 };
 
 /// What the viewport shows: the colour, or as a debug view one of the frame's AOVs (README "AOV
