@@ -157,8 +157,10 @@ quit" "$scene"
   [ "$rc" -eq 0 ] || { fail "entities script exit $rc"; tail -5 "$tmp/out"; }
   differ "a duplicated sphere moved up shows" before.png duplicated.png
   differ "a created box shows" duplicated.png created.png
-  # Not compared with duplicated.png: the cascade system's hysteresis (carried from frame to
-  # frame) keeps splits the box widened, which moves a few shadow texels.
+  # Not compared with duplicated.png: after remove_entity() on the live scene, the shadow pass
+  # draws 2 triangles fewer (the ground plane in one layer fewer) than before the box was created,
+  # and a few shadow texels differ; reloading the same document (undo, redo) gives duplicated.png
+  # exactly. Found here; left to the shadow-caster culling's owners (see the issue 16 notes).
   differ "the deleted box is gone" created.png deleted.png
   if grep -q '"name": "sphere_1"' "$tmp/ops.json" && grep -q '"name": "crate"' "$tmp/ops.json" &&
      ! grep -q '"name": "box_1"' "$tmp/ops.json" && ! grep -q '"name": "box_resting"' "$tmp/ops.json"; then
