@@ -243,6 +243,8 @@ class Editor {
   Status remove_selected();
   Status duplicate_selected();
   Status rename_selected(const std::string& name);
+  /// `parent` empty: make the selection a root. Its local transform is kept.
+  Status reparent_selected(const std::string& parent);
   Status undo();
   Status redo();
   Status save(const fs::path& file);
@@ -437,6 +439,32 @@ Status Editor::duplicate_selected() {
     return {};
   }
   return Error{"", "", "duplicate: '" + selected_ + "' is imported from a model; duplicate the model's entity"};
+}
+
+Status Editor::reparent_selected(const std::string& parent) {
+  if (selected_.empty()) return Error{"", "", "parent: select an entity first"};
+  json doc = scene_to_json(scene_);
+  std::map<std::string, std::string> parent_of;
+  json* child = nullptr;
+  for (json& ent : doc.at("entities")) {
+    const std::string name = ent.value("name", std::string());
+    if (ent.contains("transform")) parent_of[name] = ent["transform"].value("parent", std::string());
+    if (name == selected_) child = &ent;
+  }
+  if (!child) return Error{"", "", "parent: '" + selected_ + "' is imported from a model"};
+  // Up from the new parent: reaching the child would make a cycle (the transform system would
+  // then treat both as roots).
+  for (std::string p = parent; !p.empty(); p = parent_of.count(p) ? parent_of[p] : "")
+    if (p == selected_)
+      return Error{"", "", "parent: '" + parent + "' is '" + selected_ + "' or below it"};
+  if (parent.empty()) (*child)["transform"].erase("parent");
+  else (*child)["transform"]["parent"] = parent;
+  auto remade = load_scene_document(doc, opt_.scene);
+  if (!remade) return remade.error();
+  scene_ = std::move(remade.value());
+  prewarm_ = true;
+  record(false);
+  return {};
 }
 
 Status Editor::rename_selected(const std::string& name) {
@@ -686,6 +714,23 @@ void Editor::entity_node(ecs::Entity e,
   ImGui::PushID(int(e.index));
   const bool open = ImGui::TreeNodeEx(name.c_str(), flags);
   if (ImGui::IsItemClicked() && n) selected_ = n->value;
+  // Drag an entity onto another to parent it there.
+  if (n && ImGui::BeginDragDropSource()) {
+    ImGui::SetDragDropPayload("kaskad_entity", n->value.data(), n->value.size());
+    ImGui::TextUnformatted(n->value.c_str());
+    ImGui::EndDragDropSource();
+  }
+  if (n && ImGui::BeginDragDropTarget()) {
+    if (const ImGuiPayload* p = ImGui::AcceptDragDropPayload("kaskad_entity")) {
+      const std::string child(static_cast<const char*>(p->Data), std::size_t(p->DataSize));
+      const std::string parent = n->value;
+      operations_.push_back([this, child, parent] {
+        selected_ = child;
+        return reparent_selected(parent);
+      });
+    }
+    ImGui::EndDragDropTarget();
+  }
   if (open) {
     if (kids != children.end())
       for (ecs::Entity c : kids->second) entity_node(c, children);
@@ -752,6 +797,11 @@ void Editor::inspector() {
       if (ImGui::Button("duplicate")) operations_.push_back([this] { return duplicate_selected(); });
       ImGui::SameLine();
       if (ImGui::Button("delete")) operations_.push_back([this] { return remove_selected(); });
+      if (ent->contains("transform") && ent->at("transform").contains("parent")) {
+        ImGui::SameLine();
+        if (ImGui::Button("make root")) operations_.push_back([this] { return reparent_selected(""); });
+      }
+      ImGui::TextDisabled("drag an entity onto another to parent it");
       for (auto it = ent->begin(); it != ent->end(); ++it) {
         if (it.key() == "name" || !it.value().is_object()) continue;
         if (ImGui::CollapsingHeader(it.key().c_str(), ImGuiTreeNodeFlags_DefaultOpen))
@@ -909,6 +959,8 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       return duplicate_selected();
     case ActionKind::rename:
       return rename_selected(a.args[0]);
+    case ActionKind::parent:
+      return reparent_selected(a.args[0] == "-" ? std::string() : a.args[0]);
     case ActionKind::view:
       view_ = *view_named(a.args[0]);  // checked by parse_script
       changed_since_frame_ = true;

@@ -29,6 +29,7 @@ constexpr Verb kVerbs[] = {
     {"delete", ActionKind::remove, 0, 0, "delete"},
     {"duplicate", ActionKind::duplicate, 0, 0, "duplicate"},
     {"rename", ActionKind::rename, 1, 1, "rename NAME"},
+    {"parent", ActionKind::parent, 1, 1, "parent NAME (or - for none)"},
     {"camera", ActionKind::camera, 3, 6, "camera X Y Z [LOOK_X LOOK_Y LOOK_Z]"},
     {"key", ActionKind::key, 1, 1, "key K (w a s d q e f ctrl+z ctrl+y ctrl+s)"},
     {"view", ActionKind::view, 1, 1, "view colour|visibility|cascade|normal|depth|shadow_map"},
@@ -66,13 +67,14 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
       if (verb == candidate.name) v = &candidate;
     if (!v)
       return Error{file.string(), where,
-                   "unknown action '" + verb + "' (set, select, create, delete, duplicate, rename, camera, "
-                   "key, view, frames, screenshot, "
+                   "unknown action '" + verb + "' (set, select, create, delete, duplicate, rename, parent, "
+                   "camera, key, view, frames, screenshot, "
                    "window_screenshot, save, undo, redo, quit, quit!)"};
     ScriptAction a;
     a.kind = v->kind;
     a.line = n;
-    if (a.kind == ActionKind::set || a.kind == ActionKind::select || a.kind == ActionKind::rename) {
+    if (a.kind == ActionKind::set || a.kind == ActionKind::select || a.kind == ActionKind::rename ||
+        a.kind == ActionKind::parent) {
       // The rest of the line, spaces included: a value may be a JSON array or a name with spaces.
       std::string rest;
       std::getline(words, rest);

@@ -13,7 +13,7 @@
 namespace kaskad::editor {
 
 enum class ActionKind {
-  set, select, create, remove, duplicate, rename, camera, key, view, frames, screenshot,
+  set, select, create, remove, duplicate, rename, parent, camera, key, view, frames, screenshot,
   window_screenshot, save, undo, redo, quit, force_quit
 };
 

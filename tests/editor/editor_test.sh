@@ -146,7 +146,15 @@ frames 1
 screenshot $tmp/deleted.png
 select box_resting
 rename crate
+select pole
+parent crate
+frames 1
+screenshot $tmp/parented.png
+select crate
+parent sphere
 save $tmp/ops.json
+undo
+undo
 undo
 undo
 undo
@@ -168,7 +176,19 @@ quit" "$scene"
   else
     fail "ops.json does not hold the entity operations"
   fi
-  same "five operations, five undos: the original bytes" canonical.json undone.json
+  differ "the pole parented to the crate moved with it" deleted.png parented.png
+  if /usr/bin/env python3 - "$tmp/ops.json" <<'PY'
+import json, sys
+ents = {e["name"]: e for e in json.load(open(sys.argv[1]))["entities"]}
+assert ents["pole"]["transform"]["parent"] == "crate", ents["pole"]["transform"]
+assert ents["crate"]["transform"]["parent"] == "sphere", ents["crate"]["transform"]
+PY
+  then
+    ok "parents saved: pole under crate under sphere"
+  else
+    fail "ops.json does not hold the entity operations"
+  fi
+  same "seven operations, seven undos: the original bytes" canonical.json undone.json
   ;;
 every_n)
   edit "frames 10
@@ -220,6 +240,16 @@ quit!" "$scene"
     ok "rename to a taken name: exit 1, the readers' message"
   else
     fail "rename to a taken name: exit $rc"; cat "$tmp/out"
+  fi
+  edit "select pole
+parent box_large
+select box_large
+parent pole
+quit!" "$scene"
+  if [ "$rc" -eq 1 ] && grep -q "line 4: parent: 'pole' is 'box_large' or below it" "$tmp/out"; then
+    ok "a parent cycle is refused: exit 1, line named"
+  else
+    fail "parent cycle: exit $rc"; cat "$tmp/out"
   fi
   edit "set sun.light.intensity=2
 quit" "$scene"
