@@ -246,6 +246,8 @@ class Editor {
   /// `parent` empty: make the selection a root. Its local transform is kept.
   Status reparent_selected(const std::string& parent);
   Status undo();
+  Status open(const fs::path& file);     ///< refused while there are unsaved changes
+  Status save_as(const fs::path& file);  ///< save, and make `file` the scene's own file
   Status redo();
   Status save(const fs::path& file);
   bool dirty() const { return position_ != saved_; }
@@ -296,6 +298,7 @@ class Editor {
   std::string message_;           ///< the last error or notice, shown in the inspector
   std::string set_line_;          ///< the inspector's free "key=value" field
   std::vector<std::function<Status()>> operations_;  ///< UI entity operations, after the frame
+  std::string file_line_;         ///< the inspector's path field for open and save as
   int create_shape_ = 0;
   json doc_;
   bool doc_stale_ = true;
@@ -505,6 +508,36 @@ Status Editor::restore(std::size_t index) {
   } else {
     take_camera_from_scene();
   }
+  return {};
+}
+
+Status Editor::open(const fs::path& file) {
+  if (dirty())
+    return Error{"", "", "open: " + opt_.scene.string() + " has unsaved changes (save first, or undo them)"};
+  auto scene = load_scene(file);
+  if (!scene) return scene.error();
+  scene_ = std::move(scene.value());
+  opt_.scene = file;
+  history_.assign(1, scene_to_json(scene_));
+  position_ = saved_ = 0;
+  selected_.clear();
+  prewarm_ = true;
+  doc_stale_ = true;
+  changed_since_frame_ = true;
+  camera_ = FlyCamera{};
+  take_camera_from_scene();
+  update_bounds_speed();
+  glfwSetWindowTitle(player_.context->window(), ("Kaskad editor - " + file.string()).c_str());
+  message_ = "opened " + file.string();
+  return {};
+}
+
+Status Editor::save_as(const fs::path& file) {
+  KASKAD_TRY(save(file));
+  // From now on the scene is that file: Ctrl+S writes it and it is what "unsaved" refers to.
+  opt_.scene = file;
+  saved_ = position_;
+  glfwSetWindowTitle(player_.context->window(), ("Kaskad editor - " + file.string()).c_str());
   return {};
 }
 
@@ -773,6 +806,21 @@ void Editor::inspector() {
     ImGui::PopStyleColor();
   }
   ImGui::TextDisabled("%s%s", opt_.scene.filename().string().c_str(), dirty() ? " (unsaved)" : "");
+  {
+    char path[1024];
+    std::snprintf(path, sizeof path, "%s", file_line_.c_str());
+    ImGui::InputText("file", path, sizeof path);
+    file_line_ = path;
+    if (ImGui::Button("open (Ctrl+O)") && !file_line_.empty()) {
+      const fs::path f = file_line_;
+      operations_.push_back([this, f] { return open(f); });
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("save as") && !file_line_.empty()) {
+      const fs::path f = file_line_;
+      operations_.push_back([this, f] { return save_as(f); });
+    }
+  }
   char buf[512];
   std::snprintf(buf, sizeof buf, "%s", set_line_.c_str());
   if (ImGui::InputText("--set", buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue)) {
@@ -908,6 +956,10 @@ void Editor::interactive_input(float dt) {
     if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Y, false)) shortcut = "ctrl+y";
     if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_S, false)) shortcut = "ctrl+s";
     if (!io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_F, false)) shortcut = "f";
+    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_O, false) && !file_line_.empty()) {
+      const fs::path f = file_line_;
+      operations_.push_back([this, f] { return open(f); });
+    }
     if (shortcut)
       if (Status st = press(shortcut, 0.0f); !st) report(st.error().to_string());
   }
@@ -976,6 +1028,10 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       return {};
     case ActionKind::save:
       return save(a.args.empty() ? opt_.scene : fs::path(a.args[0]));
+    case ActionKind::open:
+      return open(a.args[0]);
+    case ActionKind::save_as:
+      return save_as(a.args[0]);
     case ActionKind::undo:
       return undo();
     case ActionKind::redo:

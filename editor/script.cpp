@@ -36,7 +36,9 @@ constexpr Verb kVerbs[] = {
     {"frames", ActionKind::frames, 1, 1, "frames N (1..100000)"},
     {"screenshot", ActionKind::screenshot, 1, 1, "screenshot PATH.png"},
     {"window_screenshot", ActionKind::window_screenshot, 1, 1, "window_screenshot PATH.png"},
+    {"open", ActionKind::open, 1, 1, "open SCENE"},
     {"save", ActionKind::save, 0, 1, "save [PATH]"},
+    {"save_as", ActionKind::save_as, 1, 1, "save_as PATH"},
     {"undo", ActionKind::undo, 0, 0, "undo"},
     {"redo", ActionKind::redo, 0, 0, "redo"},
     {"quit", ActionKind::quit, 0, 0, "quit"},
@@ -69,7 +71,7 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
       return Error{file.string(), where,
                    "unknown action '" + verb + "' (set, select, create, delete, duplicate, rename, parent, "
                    "camera, key, view, frames, screenshot, "
-                   "window_screenshot, save, undo, redo, quit, quit!)"};
+                   "window_screenshot, open, save, save_as, undo, redo, quit, quit!)"};
     ScriptAction a;
     a.kind = v->kind;
     a.line = n;

@@ -14,7 +14,7 @@ namespace kaskad::editor {
 
 enum class ActionKind {
   set, select, create, remove, duplicate, rename, parent, camera, key, view, frames, screenshot,
-  window_screenshot, save, undo, redo, quit, force_quit
+  window_screenshot, open, save, save_as, undo, redo, quit, force_quit
 };
 
 /// What the viewport shows: the colour, or as a debug view one of the frame's AOVs (README "AOV

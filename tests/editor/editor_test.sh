@@ -127,6 +127,16 @@ quit" "$tmp/work.json"
     fail "redone.json does not hold exactly the first two edits"
   fi
   same "ctrl+s writes the scene's own file (atomically, via save_scene)" redone.json work.json
+  edit "save_as $tmp/as.json
+set sun.light.intensity=4
+key ctrl+s
+open $tmp/a.json
+save $tmp/opened.json
+quit" "$scene"
+  [ "$rc" -eq 0 ] || { fail "save_as/open script exit $rc"; tail -5 "$tmp/out"; }
+  grep -q '"intensity": 4' "$tmp/as.json" && ok "after save_as, ctrl+s writes the new file" ||
+    fail "as.json lacks the edit saved with ctrl+s"
+  same "open another scene, save it: its canonical bytes" a.json opened.json
   ls "$tmp" | grep -q '\.tmp' && fail "a temporary file was left behind"
   ;;
 entities)
@@ -250,6 +260,14 @@ quit!" "$scene"
     ok "a parent cycle is refused: exit 1, line named"
   else
     fail "parent cycle: exit $rc"; cat "$tmp/out"
+  fi
+  edit "set sun.light.intensity=2
+open $scene
+quit!" "$scene"
+  if [ "$rc" -eq 1 ] && grep -q "line 2: open: .*unsaved changes" "$tmp/out"; then
+    ok "open with unsaved changes is refused"
+  else
+    fail "open with unsaved changes: exit $rc"; cat "$tmp/out"
   fi
   edit "set sun.light.intensity=2
 quit" "$scene"
