@@ -31,6 +31,7 @@
 #include "components/name.h"
 #include "components/transform.h"
 #include "editor/script.h"
+#include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
 #include "runtime/cli/player.h"
@@ -207,6 +208,25 @@ Image aov_view(View view, const Image& aovs) {
       p[1] = c.g;
       p[2] = c.b;
     }
+  return out;
+}
+
+// A cube map's faces side by side (+X -X +Y -Y +Z -Z), linear colour encoded for display with a
+// 2.2 gamma (an approximation of sRGB is enough for a debug view).
+Image cube_strip(const CubeMap& cube) {
+  Image out;
+  out.width = cube.size * 6;
+  out.height = cube.size;
+  out.channels = 3;
+  out.pixels.resize(std::size_t(out.width) * std::size_t(out.height) * 3);
+  for (int f = 0; f < 6; ++f)
+    for (int y = 0; y < cube.size; ++y)
+      for (int x = 0; x < cube.size; ++x) {
+        const glm::vec4 c = cube.at(CubeFace(f), x, y);
+        float* p = &out.pixels[(std::size_t(y) * std::size_t(out.width) +
+                                std::size_t(f * cube.size + x)) * 3];
+        for (int k = 0; k < 3; ++k) p[k] = std::pow(std::clamp(c[k], 0.0f, 1.0f), 1.0f / 2.2f);
+      }
   return out;
 }
 
@@ -620,6 +640,15 @@ Status Editor::render_viewport(int w, int h) {
   changed_since_frame_ = false;
   if (view_ == View::colour) {
     last_frame_ = player_.renderer->read_color();
+  } else if (view_ == View::probe_faces) {
+    const auto& probes = t->last.probes.probes;
+    const auto sel = find(selected_);
+    const ProbeData::Entry* shown = probes.empty() ? nullptr : &probes.front();
+    for (const auto& p : probes)
+      if (sel && p.entity == *sel) shown = &p;
+    CubeMap cube;
+    if (shown) cube = player_.renderer->read_probe_cube(shown->job.handle, shown->job.visible);
+    last_frame_ = cube.size > 0 ? cube_strip(cube) : player_.renderer->read_color();
   } else if (view_ == View::shadow_map) {
     last_frame_ = grey(player_.renderer->read_shadow_map());
     if (last_frame_.width == 0) last_frame_ = player_.renderer->read_color();  // no shadowed light
@@ -984,6 +1013,7 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
     case ActionKind::select:
       if (!find(a.args[0])) return Error{"", "", "select: no entity named '" + a.args[0] + "'"};
       selected_ = a.args[0];
+      changed_since_frame_ = true;  // the probe faces view follows the selection
       return {};
     case ActionKind::camera: {
       float v[6] = {};

@@ -206,6 +206,11 @@ screenshot $tmp/cube.png
 set mirror_sphere.reflector.map=sphere
 frames 3
 screenshot $tmp/sphere.png
+select mirror_plane
+view probe_faces
+screenshot $tmp/plane_faces.png
+select mirror_sphere
+screenshot $tmp/sphere_faces.png
 quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
     --set mirror_sphere.reflector.every_n=3 --set mirror_plane.reflector.every_n=3 \
     --set mirror_plane.reflector.faces_per_frame=6
@@ -218,6 +223,8 @@ quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
     grep '^frame' "$tmp/out"
   fi
   differ "probe map cube -> sphere changes the reflection" cube.png sphere.png
+  differ "the probe faces view shows the probe's faces" sphere.png plane_faces.png
+  differ "the selected entity's probe is the one shown" plane_faces.png sphere_faces.png
   ;;
 input)
   out=$("$KASKAD" edit --screenshot x.png 2>&1); code=$?
