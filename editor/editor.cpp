@@ -279,6 +279,8 @@ class Editor {
   void update_bounds_speed();
   Status press(const std::string& key, float seconds);
   Status frame_selection();
+  /// Turns the camera about the selection's centre by `yaw` and `pitch` radians.
+  Status orbit(float yaw, float pitch);
   std::optional<ecs::Entity> find(const std::string& name) const;
 
   // A frame and the UI.
@@ -600,6 +602,24 @@ Status Editor::press(const std::string& key, float seconds) {
   if (key == "e") move = glm::vec3(0, 1, 0);
   if (key == "q") move = glm::vec3(0, -1, 0);
   camera_.position += move * speed_ * seconds;
+  write_camera();
+  return {};
+}
+
+Status Editor::orbit(float yaw, float pitch) {
+  const auto e = find(selected_);
+  if (!e) return Error{"", "", "orbit: select an entity first (the camera turns about it)"};
+  glm::vec3 centre{0.0f};
+  if (const auto* b = scene_.world.try_get<WorldBounds>(*e); b && !b->box.empty())
+    centre = 0.5f * (b->box.min + b->box.max);
+  else if (const auto* wt = scene_.world.try_get<WorldTransform>(*e))
+    centre = glm::vec3(wt->matrix[3]);
+  // The camera keeps its distance to the centre and looks at it from the turned heading.
+  const float distance = std::max(glm::length(camera_.position - centre), 0.01f);
+  camera_.look_along(centre - camera_.position);
+  camera_.yaw += yaw;
+  camera_.pitch = std::clamp(camera_.pitch + pitch, -1.55f, 1.55f);
+  camera_.position = centre - camera_.forward() * distance;
   write_camera();
   return {};
 }
@@ -992,6 +1012,11 @@ void Editor::interactive_input(float dt) {
     if (shortcut)
       if (Status st = press(shortcut, 0.0f); !st) report(st.error().to_string());
   }
+  if (viewport_hovered_ && io.KeyAlt && ImGui::IsMouseDown(ImGuiMouseButton_Left) &&
+      (io.MouseDelta.x != 0.0f || io.MouseDelta.y != 0.0f)) {
+    if (Status st = orbit(-io.MouseDelta.x * 0.008f, io.MouseDelta.y * 0.008f); !st)
+      report(st.error().to_string());
+  }
   if (viewport_hovered_ && ImGui::IsMouseDown(ImGuiMouseButton_Right)) {
     const float radians_per_pixel = 0.004f;
     camera_.yaw += io.MouseDelta.x * radians_per_pixel;
@@ -1043,6 +1068,8 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       return rename_selected(a.args[0]);
     case ActionKind::parent:
       return reparent_selected(a.args[0] == "-" ? std::string() : a.args[0]);
+    case ActionKind::orbit:
+      return orbit(glm::radians(std::stof(a.args[0])), glm::radians(std::stof(a.args[1])));
     case ActionKind::view:
       view_ = *view_named(a.args[0]);  // checked by parse_script
       changed_since_frame_ = true;

@@ -31,6 +31,7 @@ constexpr Verb kVerbs[] = {
     {"rename", ActionKind::rename, 1, 1, "rename NAME"},
     {"parent", ActionKind::parent, 1, 1, "parent NAME (or - for none)"},
     {"camera", ActionKind::camera, 3, 6, "camera X Y Z [LOOK_X LOOK_Y LOOK_Z]"},
+    {"orbit", ActionKind::orbit, 2, 2, "orbit YAW_DEG PITCH_DEG"},
     {"key", ActionKind::key, 1, 1, "key K (w a s d q e f ctrl+z ctrl+y ctrl+s)"},
     {"view", ActionKind::view, 1, 1, "view colour|visibility|cascade|normal|depth|shadow_map|probe_faces"},
     {"frames", ActionKind::frames, 1, 1, "frames N (1..100000)"},
@@ -70,7 +71,7 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
     if (!v)
       return Error{file.string(), where,
                    "unknown action '" + verb + "' (set, select, create, delete, duplicate, rename, parent, "
-                   "camera, key, view, frames, screenshot, "
+                   "camera, orbit, key, view, frames, screenshot, "
                    "window_screenshot, open, save, save_as, undo, redo, quit, quit!)"};
     ScriptAction a;
     a.kind = v->kind;
@@ -92,10 +93,10 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
       return Error{file.string(), where, std::string("expected '") + v->usage + "'"};
     if (a.kind == ActionKind::set && a.args[0].find('=') == std::string::npos)
       return Error{file.string(), where, "expected 'set KEY=VALUE', got 'set " + a.args[0] + "'"};
-    if (a.kind == ActionKind::camera)
+    if (a.kind == ActionKind::camera || a.kind == ActionKind::orbit)
       for (const std::string& c : a.args)
         if (!is_number(c))
-          return Error{file.string(), where, "camera: '" + c + "' is not a number"};
+          return Error{file.string(), where, verb + ": '" + c + "' is not a number"};
     if (a.kind == ActionKind::key && !is_script_key(a.args[0]))
       return Error{file.string(), where, "unknown key '" + a.args[0] + "'; expected " + v->usage};
     if (a.kind == ActionKind::view && !view_named(a.args[0]))

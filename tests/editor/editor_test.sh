@@ -64,6 +64,9 @@ screenshot $tmp/5.png
 select sphere
 key f
 frames 1
+screenshot $tmp/framed.png
+orbit 40 10
+frames 1
 screenshot $tmp/6.png
 view visibility
 screenshot $tmp/visibility.png
@@ -83,15 +86,16 @@ quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
   differ "sun.transform.direction moved" 3.png 4.png
   same "nothing changed after the edits: identical frames" 4.png 4b.png
   differ "the fly camera moved forward (key w)" 4b.png 5.png
-  differ "F framed the selected sphere" 5.png 6.png
+  differ "F framed the selected sphere" 5.png framed.png
+  differ "the camera orbited the sphere" framed.png 6.png
   differ "view visibility (AOV)" 6.png visibility.png
   differ "view cascade (AOV)" visibility.png cascade.png
   differ "view shadow_map" cascade.png shadow_map.png
   same "debug views leave the colour as it was" 6.png 6b.png
-  # Frames kept coming: one stats line per frame, seven `frames 2`, three `frames 1` and one
+  # Frames kept coming: one stats line per frame, seven `frames 2`, four `frames 1` and one
   # frame before each screenshot of a new view (after `frames` a screenshot needs none).
   n=$(grep -c '^frame [0-9]*:' "$tmp/out")
-  if [ "$n" -eq 20 ]; then ok "20 frames rendered"; else fail "expected 20 frame lines, got $n"; fi
+  if [ "$n" -eq 21 ]; then ok "21 frames rendered"; else fail "expected 21 frame lines, got $n"; fi
   ;;
 saving)
   "$KASKAD" save "$scene" -o "$tmp/canonical.json" >/dev/null || fail "kaskad save"

@@ -39,8 +39,11 @@ TEST(EditorScript, EveryActionParses) {
 TEST(EditorScript, BadLinesNameTheFileAndLine) {
   EXPECT_EQ(error_of("frames 1\nsett a=1\n"),
             "s.txt: line 2: unknown action 'sett' (set, select, create, delete, duplicate, rename, "
-            "parent, camera, key, view, frames, screenshot, window_screenshot, open, save, save_as, "
-            "undo, redo, quit, quit!)");
+            "parent, camera, orbit, key, view, frames, screenshot, window_screenshot, open, save, "
+            "save_as, undo, redo, quit, quit!)");
+  EXPECT_NE(error_of("orbit 10\n").find("line 1: expected 'orbit YAW_DEG PITCH_DEG'"),
+            std::string::npos);
+  EXPECT_NE(error_of("orbit 10 up\n").find("orbit: 'up' is not a number"), std::string::npos);
   EXPECT_NE(error_of("set shadow.cascade_count\n").find("line 1: expected 'set KEY=VALUE'"),
             std::string::npos);
   EXPECT_NE(error_of("camera 1 2\n").find("line 1: expected 'camera X Y Z"), std::string::npos);
