@@ -304,6 +304,7 @@ class Editor {
   }
   void report(const std::string& message) {
     message_ = message;
+    message_is_error_ = true;
     std::fprintf(stderr, "kaskad edit: %s\n", message.c_str());
   }
 
@@ -318,6 +319,7 @@ class Editor {
   std::vector<std::pair<std::string, bool>> requests_;  ///< UI edits, applied after the frame
   std::string selected_;
   std::string message_;           ///< the last error or notice, shown in the inspector
+  bool message_is_error_ = false;
   std::string set_line_;          ///< the inspector's free "key=value" field
   std::vector<std::function<Status()>> operations_;  ///< UI entity operations, after the frame
   std::string file_line_;         ///< the inspector's path field for open and save as
@@ -551,6 +553,7 @@ Status Editor::open(const fs::path& file) {
   update_bounds_speed();
   glfwSetWindowTitle(player_.context->window(), ("Kaskad editor - " + file.string()).c_str());
   message_ = "opened " + file.string();
+  message_is_error_ = false;
   return {};
 }
 
@@ -583,6 +586,7 @@ Status Editor::save(const fs::path& file) {
   std::error_code ec;
   if (fs::weakly_canonical(file, ec) == fs::weakly_canonical(opt_.scene, ec)) saved_ = position_;
   message_ = "saved " + file.string();
+  message_is_error_ = false;
   std::printf("kaskad edit: wrote %s\n", file.string().c_str());
   return {};
 }
@@ -850,7 +854,8 @@ void Editor::inspector() {
     changed_since_frame_ = true;
   }
   if (!message_.empty()) {
-    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.35f, 1.0f));
+    ImGui::PushStyleColor(ImGuiCol_Text, message_is_error_ ? ImVec4(1.0f, 0.45f, 0.35f, 1.0f)
+                                                           : ImVec4(0.55f, 0.85f, 0.55f, 1.0f));
     ImGui::TextWrapped("%s", message_.c_str());
     ImGui::PopStyleColor();
   }
