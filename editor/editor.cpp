@@ -1174,8 +1174,13 @@ int Editor::run() {
     const Layout l = layout_for(w, h, left_w_, right_w_);
     if (l.view_w > 0 && l.view_h > 0) {
       if (Status st = render_viewport(l.view_w, l.view_h); !st) {
-        std::fprintf(stderr, "kaskad edit: error: %s\n", st.error().to_string().c_str());
-        return 1;
+        if (!opt_.script.empty()) {
+          std::fprintf(stderr, "kaskad edit: error: %s\n", st.error().to_string().c_str());
+          return 1;
+        }
+        // A scene that cannot be drawn (its camera deleted, say) is shown as an error until an
+        // edit or an undo fixes it; the window stays.
+        if (message_ != st.error().to_string()) report(st.error().to_string());
       }
     }
     if (frames_left > 0) --frames_left;
