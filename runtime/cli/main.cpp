@@ -28,6 +28,9 @@
 #include "runtime/core/atomic_file.h"
 #include "runtime/core/log.h"
 #include "runtime/gpu/context.h"
+#ifdef KASKAD_HAS_EDITOR
+#include "editor/editor.h"
+#endif
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -62,6 +65,10 @@ usage:
                                     replay playback files (camera keys, timeline, captures) and
                                     check their expectations (README "Scene playback"); writes
                                     DIR/<file>/frame_NNNN.png, frames.csv, diffs, DIR/summary.json
+  kaskad edit [SCENE] [--set key=value]... [--size WxH] [--script FILE]
+                                    the editor: a window with an entity list, inspectors, a
+                                    fly camera, undo and saving; --script replays actions
+                                    (README "Editor: kaskad edit"); needs a display (xvfb-run -a)
   kaskad info [SCENE] [--set K=V]   print the OpenGL context kaskad gets on this machine; with
                                     a SCENE, its entities instead (name, parent, components): the
                                     names --set addresses, a glTF file's own nodes included
@@ -537,6 +544,15 @@ int run_render(Args a) {
 int run_command(int argc, char** argv) {
   if (argc >= 2 && std::strcmp(argv[1], "envmap") == 0) return run_envmap_command(argc, argv);
   if (argc >= 2 && std::strcmp(argv[1], "play") == 0) return run_play_command(argc, argv);
+  if (argc >= 2 && std::strcmp(argv[1], "edit") == 0) {
+#ifdef KASKAD_HAS_EDITOR
+    return editor::run_edit_command(argc, argv);
+#else
+    std::fprintf(stderr, "kaskad: this build has no editor (configure with "
+                         "-DKASKAD_BUILD_EDITOR=ON: GLFW and Dear ImGui)\n");
+    return 2;
+#endif
+  }
   const Args a = parse_args(argc, argv);
   if (a.command == "info") return run_info(a);
   if (a.command == "save") return run_save(a);

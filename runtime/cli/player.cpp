@@ -48,11 +48,12 @@ glm::vec3 sun_direction(const ecs::World& world) {
 
 }  // namespace
 
-Result<Scene> load_scene(const std::filesystem::path& file,
-                         const std::vector<std::string>& overrides) {
-  log::set_context(file.string());  // per-frame warnings name the scene they come from
-  std::vector<std::string> later;  // overrides of entities the document does not hold
-  auto scene = read_scene(file, overrides, &later);
+namespace {
+
+// Everything after parsing: instantiation, then the load phase (see load_scene in player.h);
+// `later` are overrides of entities only instantiation makes.
+Result<Scene> finish_load(Result<Scene> scene, const std::filesystem::path& file,
+                          const std::vector<std::string>& later) {
   if (!scene) return scene.error();
   auto manifest = render::FeatureManifest::load(content_dir() / "shaders" / "features.json");
   if (!manifest) return manifest.error();
@@ -60,7 +61,9 @@ Result<Scene> load_scene(const std::filesystem::path& file,
   update_transforms(scene->world, scene->assets);
   // The models' bounds, before a ground is added: what auto_frame cameras frame.
   const Aabb models = scene_bounds(scene->world);
-  GroundMode& ground = scene->render.ground;
+  // Resolved here, not written back: the scene keeps "auto", so saving it (the editor) writes
+  // what the file said.
+  GroundMode ground = scene->render.ground;
   if (ground == GroundMode::automatic) ground = is_gltf(file) ? GroundMode::on : GroundMode::none;
   ecs::Entity ground_entity = ecs::kNullEntity;
   if (ground == GroundMode::on && !models.empty())
@@ -86,6 +89,21 @@ Result<Scene> load_scene(const std::filesystem::path& file,
     scene->render.height = fitted.y;
   }
   return scene;
+}
+
+}  // namespace
+
+Result<Scene> load_scene(const std::filesystem::path& file,
+                         const std::vector<std::string>& overrides) {
+  log::set_context(file.string());  // per-frame warnings name the scene they come from
+  std::vector<std::string> later;  // overrides of entities the document does not hold
+  auto scene = read_scene(file, overrides, &later);
+  return finish_load(std::move(scene), file, later);
+}
+
+Result<Scene> load_scene_document(const nlohmann::json& document,
+                                  const std::filesystem::path& file) {
+  return finish_load(parse_scene(document, file), file, {});
 }
 
 render::RendererOptions Player::defaults() {

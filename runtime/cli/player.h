@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "runtime/assets/scene.h"
 #include "runtime/core/result.h"
 #include "runtime/gpu/context.h"
@@ -23,6 +25,11 @@ std::filesystem::path content_dir();
 /// the load phase: transforms, and framing of auto_frame cameras for render.width/height.
 Result<Scene> load_scene(const std::filesystem::path& file,
                          const std::vector<std::string>& overrides = {});
+
+/// load_scene() of a scene document already in memory (a canonical one, scene_to_json()), read
+/// as if it were `file` (relative model paths): the editor's undo restores its snapshots so.
+Result<Scene> load_scene_document(const nlohmann::json& document,
+                                  const std::filesystem::path& file);
 
 /// A GL context plus a renderer reading shaders from content_dir()/shaders.
 struct Player {

@@ -1,0 +1,1282 @@
+#include "editor/editor.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <iterator>
+#include <chrono>
+#include <cstdint>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include <glm/gtc/constants.hpp>
+#include <nlohmann/json.hpp>
+
+#include "components/bounds.h"
+#include "components/camera.h"
+#include "components/light.h"
+#include "components/name.h"
+#include "components/transform.h"
+#include "editor/script.h"
+#include "runtime/assets/env_map.h"
+#include "runtime/assets/image_io.h"
+#include "runtime/assets/scene_io.h"
+#include "runtime/cli/player.h"
+#include "runtime/gpu/context.h"
+#include "runtime/gpu/gl_handles.h"
+#include "systems/transform_system.h"
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace kaskad::editor {
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: kaskad edit [SCENE] [--set key=value]... [--size WxH] [--script FILE]\n"
+    "  SCENE          a scene file (.json, .gltf, .glb); default content/scenes/default.json\n"
+    "  --set K=V      an override, as for `kaskad render` (repeatable)\n"
+    "  --size WxH     the window size (default 1280x720)\n"
+    "  --script FILE  replay actions, one per line (README \"Editor: kaskad edit\")\n";
+
+[[noreturn]] void usage_error(const std::string& msg) {
+  std::fprintf(stderr, "kaskad edit: %s\n%s", msg.c_str(), kUsage);
+  std::exit(2);
+}
+
+struct Options {
+  fs::path scene;
+  std::vector<std::string> sets;
+  int width = 1280, height = 720;
+  fs::path script;
+};
+
+int parse_dimension(const std::string& what, const std::string& v) {
+  int n = 0;
+  try {
+    std::size_t used = 0;
+    n = std::stoi(v, &used);
+    if (used != v.size()) n = 0;
+  } catch (const std::exception&) {
+    n = 0;
+  }
+  if (n < 64 || n > 16384) usage_error("--size " + what + " must be an integer in [64, 16384], got '" + v + "'");
+  return n;
+}
+
+Options parse_options(int argc, char** argv) {
+  Options o;
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage_error(arg + " needs a value");
+      return argv[++i];
+    };
+    if (arg == "-h" || arg == "--help") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (arg == "--set") {
+      o.sets.push_back(value());
+    } else if (arg == "--size") {
+      const std::string v = value();
+      const auto x = v.find('x');
+      if (x == std::string::npos) usage_error("--size expects WxH, e.g. 1280x720, got '" + v + "'");
+      o.width = parse_dimension("width", v.substr(0, x));
+      o.height = parse_dimension("height", v.substr(x + 1));
+    } else if (arg == "--script") {
+      o.script = value();
+    } else if (!arg.empty() && arg[0] == '-') {
+      usage_error("unknown option '" + arg + "'");
+    } else if (o.scene.empty()) {
+      o.scene = arg;
+    } else {
+      usage_error("unexpected argument '" + arg + "' (one SCENE only)");
+    }
+  }
+  if (o.scene.empty()) o.scene = content_dir() / "scenes" / "default.json";
+  return o;
+}
+
+// The fly camera: a position and a heading, written into the scene's active camera when moved.
+struct FlyCamera {
+  glm::vec3 position{0.0f};
+  float yaw = 0.0f;    ///< radians about +Y; 0 looks down -Z
+  float pitch = 0.0f;  ///< radians above the horizon
+  bool moved = false;  ///< the user moved it since load (then it is kept over undo and redo)
+
+  glm::vec3 forward() const {
+    return {std::sin(yaw) * std::cos(pitch), std::sin(pitch), -std::cos(yaw) * std::cos(pitch)};
+  }
+  void look_along(const glm::vec3& d) {
+    const glm::vec3 n = glm::normalize(d);
+    pitch = std::asin(std::clamp(n.y, -1.0f, 1.0f));
+    yaw = std::atan2(n.x, -n.z);
+  }
+};
+
+// The panels: full height at the window's sides, resizable in width (each at most 45% of the
+// window); the viewport is what is left between them.
+struct Layout {
+  float left = 0, right = 0;  ///< panel widths in pixels
+  int view_x = 0, view_w = 0, view_h = 0;
+};
+
+constexpr float kMinPanel = 120.0f;
+float max_panel(int window_width) { return std::max(kMinPanel, 0.45f * float(window_width)); }
+
+/// `left` and `right` < 0: the first layout, a share of the window with limits in pixels.
+Layout layout_for(int w, int h, float left, float right) {
+  Layout l;
+  l.left = left < 0 ? std::clamp(0.2f * float(w), 160.0f, 300.0f) : left;
+  l.right = right < 0 ? std::clamp(0.32f * float(w), 260.0f, 460.0f) : right;
+  l.left = std::clamp(l.left, kMinPanel, max_panel(w));
+  l.right = std::clamp(l.right, kMinPanel, max_panel(w));
+  l.view_x = int(l.left);
+  l.view_w = std::max(0, w - int(l.left) - int(l.right));
+  l.view_h = h;
+  return l;
+}
+
+// The window as drawn (panels and viewport), top row first.
+Image read_window(int w, int h) {
+  Image img;
+  img.width = w;
+  img.height = h;
+  img.channels = 3;
+  std::vector<unsigned char> bytes(std::size_t(w) * std::size_t(h) * 3);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_BACK);
+  glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, bytes.data());
+  img.pixels.resize(bytes.size());
+  const std::size_t row = std::size_t(w) * 3;
+  for (std::size_t y = 0; y < std::size_t(h); ++y)
+    for (std::size_t i = 0; i < row; ++i)
+      img.pixels[y * row + i] = float(bytes[(std::size_t(h) - 1 - y) * row + i]) / 255.0f;
+  return img;
+}
+
+// An AOV view as an RGB image; `aovs` has the channels of Renderer::read_aovs().
+Image aov_view(View view, const Image& aovs) {
+  Image out;
+  out.width = aovs.width;
+  out.height = aovs.height;
+  out.channels = 3;
+  out.pixels.assign(std::size_t(aovs.width) * std::size_t(aovs.height) * 3, 0.0f);
+  // Cascades 0..7 in distinct colours (outside every cascade: black).
+  static const glm::vec3 kCascade[] = {{1, 0.2f, 0.2f}, {0.2f, 1, 0.2f}, {0.3f, 0.4f, 1},
+                                       {1, 1, 0.2f},    {1, 0.3f, 1},    {0.2f, 1, 1},
+                                       {1, 0.6f, 0.2f}, {0.7f, 0.7f, 0.7f}};
+  float far = 0.0f;  // the depth view spans the visible depths
+  if (view == View::depth)
+    for (int y = 0; y < aovs.height; ++y)
+      for (int x = 0; x < aovs.width; ++x)
+        if (aovs.at(x, y, 8) > 0.5f) far = std::max(far, aovs.at(x, y, 6));
+  for (int y = 0; y < aovs.height; ++y)
+    for (int x = 0; x < aovs.width; ++x) {
+      glm::vec3 c{0.0f};
+      if (aovs.at(x, y, 8) > 0.5f) {
+        switch (view) {
+          case View::visibility: c = glm::vec3(aovs.at(x, y, 7)); break;
+          case View::cascade: {
+            const int k = int(std::lround(aovs.at(x, y, 9)));
+            if (k >= 0) c = kCascade[k % 8] * (0.4f + 0.6f * aovs.at(x, y, 7));
+            break;
+          }
+          case View::normal:
+            c = 0.5f * glm::vec3(aovs.at(x, y, 3), aovs.at(x, y, 4), aovs.at(x, y, 5)) + 0.5f;
+            break;
+          case View::depth: c = glm::vec3(far > 0.0f ? 1.0f - aovs.at(x, y, 6) / far : 0.0f); break;
+          default: break;
+        }
+      }
+      float* p = &out.pixels[(std::size_t(y) * std::size_t(out.width) + std::size_t(x)) * 3];
+      p[0] = c.r;
+      p[1] = c.g;
+      p[2] = c.b;
+    }
+  return out;
+}
+
+// A cube map's faces side by side (+X -X +Y -Y +Z -Z), linear colour encoded for display with a
+// 2.2 gamma (an approximation of sRGB is enough for a debug view).
+Image cube_strip(const CubeMap& cube) {
+  Image out;
+  out.width = cube.size * 6;
+  out.height = cube.size;
+  out.channels = 3;
+  out.pixels.resize(std::size_t(out.width) * std::size_t(out.height) * 3);
+  for (int f = 0; f < 6; ++f)
+    for (int y = 0; y < cube.size; ++y)
+      for (int x = 0; x < cube.size; ++x) {
+        const glm::vec4 c = cube.at(CubeFace(f), x, y);
+        float* p = &out.pixels[(std::size_t(y) * std::size_t(out.width) +
+                                std::size_t(f * cube.size + x)) * 3];
+        for (int k = 0; k < 3; ++k) p[k] = std::pow(std::clamp(c[k], 0.0f, 1.0f), 1.0f / 2.2f);
+      }
+  return out;
+}
+
+// A one-channel image as grey RGB.
+Image grey(const Image& one) {
+  Image out;
+  out.width = one.width;
+  out.height = one.height;
+  out.channels = 3;
+  out.pixels.resize(one.pixels.size() * 3);
+  for (std::size_t i = 0; i < one.pixels.size(); ++i)
+    out.pixels[3 * i] = out.pixels[3 * i + 1] = out.pixels[3 * i + 2] = one.pixels[i];
+  return out;
+}
+
+class Editor {
+ public:
+  Editor(Options options, Scene scene, Player& player, std::vector<ScriptAction> script)
+      : opt_(std::move(options)), scene_(std::move(scene)), player_(player), script_(std::move(script)) {
+    history_.push_back(scene_to_json(scene_));
+    take_camera_from_scene();
+    update_bounds_speed();
+  }
+
+  int run();
+
+ private:
+  // Edits: one --set assignment through scene IO's own override path.
+  Status edit(const std::string& assignment, bool merge);
+  void record(bool merge);  ///< a snapshot of the scene as it is now, after an edit
+  Status restore(std::size_t index);
+  std::string unused_name(const std::string& stem) const;
+  Status create(const std::string& shape);
+  Status remove_selected();
+  Status duplicate_selected();
+  Status rename_selected(const std::string& name);
+  /// `parent` empty: make the selection a root. Its local transform is kept.
+  Status reparent_selected(const std::string& parent);
+  Status undo();
+  Status open(const fs::path& file);     ///< refused while there are unsaved changes
+  Status save_as(const fs::path& file);  ///< save, and make `file` the scene's own file
+  Status redo();
+  Status save(const fs::path& file);
+  bool dirty() const { return position_ != saved_; }
+
+  // The camera.
+  std::optional<ecs::Entity> active_camera() const;
+  void take_camera_from_scene();
+  void write_camera();
+  void update_bounds_speed();
+  Status press(const std::string& key, float seconds);
+  Status frame_selection();
+  /// Turns the camera about the selection's centre by `yaw` and `pitch` radians.
+  Status orbit(float yaw, float pitch);
+  std::optional<ecs::Entity> find(const std::string& name) const;
+
+  // A frame and the UI.
+  Status render_viewport(int w, int h);
+  void draw_ui(int w, int h);
+  void entity_list();
+  void entity_node(ecs::Entity e, const std::map<std::uint32_t, std::vector<ecs::Entity>>& children);
+  void inspector();
+  void field(const std::string& key, const std::string& label, const json& value);
+  void request(const std::string& assignment);
+  void direction_helpers();
+  void interactive_input(float dt);
+  Status run_action(const ScriptAction& a, bool& quit);
+
+  const json& document() {
+    if (doc_stale_) {
+      doc_ = scene_to_json(scene_);
+      doc_stale_ = false;
+    }
+    return doc_;
+  }
+  void report(const std::string& message) {
+    message_ = message;
+    message_is_error_ = true;
+    std::fprintf(stderr, "kaskad edit: %s\n", message.c_str());
+  }
+
+  Options opt_;
+  Scene scene_;
+  Player& player_;  ///< outlives the editor: its context outlives the UI's GL objects
+  std::vector<ScriptAction> script_;  ///< --script, parsed before the window opened
+  std::vector<json> history_;     ///< canonical documents, one per edit; [0] as loaded
+  std::size_t position_ = 0;      ///< the document the scene is now
+  std::size_t saved_ = 0;         ///< the document last saved (or loaded); npos: none of them
+  std::string last_drag_key_;     ///< a drag in progress edits one history entry, not one a frame
+  std::vector<std::pair<std::string, bool>> requests_;  ///< UI edits, applied after the frame
+  std::string selected_;
+  std::string message_;           ///< the last error or notice, shown in the inspector
+  bool message_is_error_ = false;
+  std::string set_line_;          ///< the inspector's free "key=value" field
+  std::vector<std::function<Status()>> operations_;  ///< UI entity operations, after the frame
+  std::string file_line_;         ///< the inspector's path field for open and save as
+  int create_shape_ = 0;
+  json doc_;
+  bool doc_stale_ = true;
+  FlyCamera camera_;
+  float speed_ = 1.0f;            ///< fly speed, metres per second (from the scene's size)
+  bool prewarm_ = true;           ///< compile the scene's programs before its first frame
+  bool changed_since_frame_ = true;
+  bool viewport_hovered_ = false;
+  bool ask_quit_ = false;
+  gpu::Texture view_texture_;
+  int texture_w_ = 0, texture_h_ = 0;
+  Image last_frame_;              ///< what the viewport shows (the colour, or a debug view)
+  View view_ = View::colour;
+  std::vector<float> frame_ms_;   ///< the last frames' times, for the graph
+  float left_w_ = -1.0f, right_w_ = -1.0f;  ///< panel widths as the user left them; < 0: default
+  std::string stats_;             ///< the last frame's time and counters, shown in the inspector
+  glm::vec3 look_at_{0.0f};       ///< the inspector's look-at point for the selection
+  fs::path window_shot_;          ///< window_screenshot: written after the next frame's UI
+};
+
+std::optional<ecs::Entity> Editor::find(const std::string& name) const {
+  std::optional<ecs::Entity> found;
+  scene_.world.view<Name>().each([&](ecs::Entity e, const Name& n) {
+    if (n.value == name && !found) found = e;
+  });
+  return found;
+}
+
+std::optional<ecs::Entity> Editor::active_camera() const {
+  // As the camera system picks it: the first active camera, else the first camera.
+  std::optional<ecs::Entity> first, active;
+  std::vector<ecs::Entity> cams;
+  scene_.world.view<Camera>().each([&](ecs::Entity e, const Camera&) { cams.push_back(e); });
+  std::sort(cams.begin(), cams.end(), [](ecs::Entity a, ecs::Entity b) { return a.index < b.index; });
+  for (ecs::Entity e : cams) {
+    if (!first) first = e;
+    if (!active && scene_.world.get<Camera>(e).active) active = e;
+  }
+  return active ? active : first;
+}
+
+void Editor::take_camera_from_scene() {
+  const auto cam = active_camera();
+  if (!cam) return;
+  const auto* wt = scene_.world.try_get<WorldTransform>(*cam);
+  if (!wt) return;
+  camera_.position = glm::vec3(wt->matrix[3]);
+  camera_.look_along(-glm::vec3(wt->matrix[2]));
+}
+
+void Editor::write_camera() {
+  const auto cam = active_camera();
+  if (!cam) return;
+  Transform& t = scene_.world.get<Transform>(*cam);
+  // A camera under a parent is moved in its parent's space: the fly camera drives roots only.
+  t.translation = camera_.position;
+  t.rotation = look_rotation(camera_.forward());
+  camera_.moved = true;
+  doc_stale_ = true;
+  changed_since_frame_ = true;
+}
+
+void Editor::update_bounds_speed() {
+  const Aabb b = scene_bounds(scene_.world);
+  // About five seconds to cross the scene, whatever its units.
+  const float size = b.empty() ? 10.0f : glm::length(b.max - b.min);
+  speed_ = std::max(size / 5.0f, 0.01f);
+}
+
+Status Editor::edit(const std::string& assignment, bool merge) {
+  Status live = apply_live_override(scene_, assignment);
+  if (!live) {
+    // Sections a loaded entity does not take live (material, primitive, model, name) are set on
+    // the canonical document and the scene remade from it: the same override and readers.
+    json doc = scene_to_json(scene_);
+    if (!apply_override(doc, assignment)) return live;
+    auto remade = load_scene_document(doc, opt_.scene);
+    if (!remade) return remade.error();
+    scene_ = std::move(remade.value());
+    prewarm_ = true;
+  }
+  record(merge);
+  return {};
+}
+
+void Editor::record(bool merge) {
+  update_transforms(scene_.world, scene_.assets);
+  doc_stale_ = true;
+  changed_since_frame_ = true;
+  json snapshot = scene_to_json(scene_);
+  if (merge && position_ + 1 == history_.size() && position_ != saved_ && position_ > 0) {
+    history_[position_] = std::move(snapshot);
+  } else {
+    history_.resize(position_ + 1);
+    if (saved_ != std::string::npos && saved_ > position_) saved_ = std::string::npos;
+    history_.push_back(std::move(snapshot));
+    ++position_;
+  }
+}
+
+std::string Editor::unused_name(const std::string& stem) const {
+  for (int i = 1;; ++i) {
+    const std::string name = stem + "_" + std::to_string(i);
+    if (!find(name)) return name;
+  }
+}
+
+Status Editor::create(const std::string& shape) {
+  // In front of the camera, a tenth of the scene's size away (speed_ is a fifth of it per second).
+  const glm::vec3 at = camera_.position + camera_.forward() * std::max(0.5f * speed_, 0.5f);
+  const std::string name = unused_name(shape);
+  json block = {{"name", name},
+                {"transform", {{"translation", {at.x, at.y, at.z}}}},
+                {"primitive", {{"shape", shape}}}};
+  auto e = add_entity(scene_, block, "/create");
+  if (!e) return e.error();
+  selected_ = name;
+  record(false);
+  return {};
+}
+
+Status Editor::remove_selected() {
+  if (selected_.empty()) return Error{"", "", "delete: select an entity first"};
+  KASKAD_TRY(remove_entity(scene_, selected_));
+  selected_.clear();
+  record(false);
+  return {};
+}
+
+Status Editor::duplicate_selected() {
+  if (selected_.empty()) return Error{"", "", "duplicate: select an entity first"};
+  const json& doc = document();
+  for (const json& ent : doc.at("entities")) {
+    if (ent.value("name", std::string()) != selected_) continue;
+    json block = ent;
+    block["name"] = unused_name(selected_);
+    auto e = add_entity(scene_, block, "/duplicate");
+    if (!e) return e.error();
+    selected_ = block["name"].get<std::string>();
+    record(false);
+    return {};
+  }
+  return Error{"", "", "duplicate: '" + selected_ + "' is imported from a model; duplicate the model's entity"};
+}
+
+Status Editor::reparent_selected(const std::string& parent) {
+  if (selected_.empty()) return Error{"", "", "parent: select an entity first"};
+  json doc = scene_to_json(scene_);
+  std::map<std::string, std::string> parent_of;
+  json* child = nullptr;
+  for (json& ent : doc.at("entities")) {
+    const std::string name = ent.value("name", std::string());
+    if (ent.contains("transform")) parent_of[name] = ent["transform"].value("parent", std::string());
+    if (name == selected_) child = &ent;
+  }
+  if (!child) return Error{"", "", "parent: '" + selected_ + "' is imported from a model"};
+  // Up from the new parent: reaching the child would make a cycle (the transform system would
+  // then treat both as roots).
+  for (std::string p = parent; !p.empty(); p = parent_of.count(p) ? parent_of[p] : "")
+    if (p == selected_)
+      return Error{"", "", "parent: '" + parent + "' is '" + selected_ + "' or below it"};
+  if (parent.empty()) (*child)["transform"].erase("parent");
+  else (*child)["transform"]["parent"] = parent;
+  auto remade = load_scene_document(doc, opt_.scene);
+  if (!remade) return remade.error();
+  scene_ = std::move(remade.value());
+  prewarm_ = true;
+  record(false);
+  return {};
+}
+
+Status Editor::rename_selected(const std::string& name) {
+  if (selected_.empty()) return Error{"", "", "rename: select an entity first"};
+  // The name and every parent reference to it, on the document; the readers then check it (unique,
+  // not empty) as in a scene file.
+  json doc = scene_to_json(scene_);
+  bool found = false;
+  for (json& ent : doc.at("entities")) {
+    if (ent.value("name", std::string()) == selected_) {
+      ent["name"] = name;
+      found = true;
+    }
+    if (ent.contains("transform") && ent["transform"].value("parent", std::string()) == selected_)
+      ent["transform"]["parent"] = name;
+  }
+  if (!found) return Error{"", "", "rename: '" + selected_ + "' is imported from a model"};
+  auto remade = load_scene_document(doc, opt_.scene);
+  if (!remade) return remade.error();
+  scene_ = std::move(remade.value());
+  prewarm_ = true;
+  selected_ = name;
+  record(false);
+  return {};
+}
+
+Status Editor::restore(std::size_t index) {
+  auto scene = load_scene_document(history_[index], opt_.scene);
+  if (!scene) return scene.error();
+  scene_ = std::move(scene.value());
+  position_ = index;
+  prewarm_ = true;
+  doc_stale_ = true;
+  changed_since_frame_ = true;
+  if (camera_.moved) {
+    write_camera();
+    update_transforms(scene_.world, scene_.assets);
+  } else {
+    take_camera_from_scene();
+  }
+  return {};
+}
+
+Status Editor::open(const fs::path& file) {
+  if (dirty())
+    return Error{"", "", "open: " + opt_.scene.string() + " has unsaved changes (save first, or undo them)"};
+  auto scene = load_scene(file);
+  if (!scene) return scene.error();
+  scene_ = std::move(scene.value());
+  opt_.scene = file;
+  history_.assign(1, scene_to_json(scene_));
+  position_ = saved_ = 0;
+  selected_.clear();
+  prewarm_ = true;
+  doc_stale_ = true;
+  changed_since_frame_ = true;
+  camera_ = FlyCamera{};
+  take_camera_from_scene();
+  update_bounds_speed();
+  glfwSetWindowTitle(player_.context->window(), ("Kaskad editor - " + file.string()).c_str());
+  message_ = "opened " + file.string();
+  message_is_error_ = false;
+  return {};
+}
+
+Status Editor::save_as(const fs::path& file) {
+  KASKAD_TRY(save(file));
+  // From now on the scene is that file: Ctrl+S writes it and it is what "unsaved" refers to.
+  opt_.scene = file;
+  saved_ = position_;
+  glfwSetWindowTitle(player_.context->window(), ("Kaskad editor - " + file.string()).c_str());
+  return {};
+}
+
+Status Editor::undo() {
+  if (position_ == 0) return Error{"", "", "nothing to undo"};
+  return restore(position_ - 1);
+}
+
+Status Editor::redo() {
+  if (position_ + 1 >= history_.size()) return Error{"", "", "nothing to redo"};
+  return restore(position_ + 1);
+}
+
+Status Editor::save(const fs::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext != ".json")
+    return Error{file.string(), "", "scenes are saved as .json (a glTF file is never overwritten)"};
+  KASKAD_TRY(save_scene(file, scene_));
+  // Another path is a copy: the scene's own file is still the one with unsaved changes.
+  std::error_code ec;
+  if (fs::weakly_canonical(file, ec) == fs::weakly_canonical(opt_.scene, ec)) saved_ = position_;
+  message_ = "saved " + file.string();
+  message_is_error_ = false;
+  std::printf("kaskad edit: wrote %s\n", file.string().c_str());
+  return {};
+}
+
+Status Editor::press(const std::string& key, float seconds) {
+  if (key == "f") return frame_selection();
+  if (key == "ctrl+z") return undo();
+  if (key == "ctrl+y") return redo();
+  if (key == "ctrl+s") return save(opt_.scene);
+  const glm::vec3 fwd = camera_.forward();
+  const glm::vec3 right = glm::normalize(glm::cross(fwd, glm::vec3(0, 1, 0)));
+  glm::vec3 move{0.0f};
+  if (key == "w") move = fwd;
+  if (key == "s") move = -fwd;
+  if (key == "d") move = right;
+  if (key == "a") move = -right;
+  if (key == "e") move = glm::vec3(0, 1, 0);
+  if (key == "q") move = glm::vec3(0, -1, 0);
+  camera_.position += move * speed_ * seconds;
+  write_camera();
+  return {};
+}
+
+Status Editor::orbit(float yaw, float pitch) {
+  const auto e = find(selected_);
+  if (!e) return Error{"", "", "orbit: select an entity first (the camera turns about it)"};
+  glm::vec3 centre{0.0f};
+  if (const auto* b = scene_.world.try_get<WorldBounds>(*e); b && !b->box.empty())
+    centre = 0.5f * (b->box.min + b->box.max);
+  else if (const auto* wt = scene_.world.try_get<WorldTransform>(*e))
+    centre = glm::vec3(wt->matrix[3]);
+  // The camera keeps its distance to the centre and looks at it from the turned heading.
+  const float distance = std::max(glm::length(camera_.position - centre), 0.01f);
+  camera_.look_along(centre - camera_.position);
+  camera_.yaw += yaw;
+  camera_.pitch = std::clamp(camera_.pitch + pitch, -1.55f, 1.55f);
+  camera_.position = centre - camera_.forward() * distance;
+  write_camera();
+  return {};
+}
+
+Status Editor::frame_selection() {
+  const auto e = find(selected_);
+  if (!e) return Error{"", "", "F frames the selection: select an entity first"};
+  Aabb box;
+  if (const auto* b = scene_.world.try_get<WorldBounds>(*e)) box = b->box;
+  if (box.empty()) {
+    const auto* wt = scene_.world.try_get<WorldTransform>(*e);
+    const glm::vec3 p = wt ? glm::vec3(wt->matrix[3]) : glm::vec3(0.0f);
+    box.expand(p - glm::vec3(0.5f));
+    box.expand(p + glm::vec3(0.5f));
+  }
+  const glm::vec3 centre = 0.5f * (box.min + box.max);
+  const float radius = std::max(0.5f * glm::length(box.max - box.min), 0.01f);
+  float fov = glm::radians(45.0f);
+  if (const auto cam = active_camera()) fov = glm::radians(scene_.world.get<Camera>(*cam).fov_y_deg);
+  // The bounding sphere fills the vertical field of view, with a margin.
+  const float distance = 1.2f * radius / std::sin(0.5f * fov);
+  camera_.position = centre - camera_.forward() * distance;
+  write_camera();
+  return {};
+}
+
+Status Editor::render_viewport(int w, int h) {
+  RenderRun run;
+  run.frames = 1;
+  run.width = w;
+  run.height = h;
+  // The AOV targets cost fill rate: only for the views that show them.
+  run.write_aovs = view_ != View::colour && view_ != View::shadow_map;
+  run.prewarm = prewarm_;
+  auto t = render_frames(player_, scene_, run);
+  if (!t) return t.error();
+  prewarm_ = false;
+  changed_since_frame_ = false;
+  if (view_ == View::colour) {
+    last_frame_ = player_.renderer->read_color();
+  } else if (view_ == View::probe_faces) {
+    const auto& probes = t->last.probes.probes;
+    const auto sel = find(selected_);
+    const ProbeData::Entry* shown = probes.empty() ? nullptr : &probes.front();
+    for (const auto& p : probes)
+      if (sel && p.entity == *sel) shown = &p;
+    CubeMap cube;
+    if (shown) cube = player_.renderer->read_probe_cube(shown->job.handle, shown->job.visible);
+    last_frame_ = cube.size > 0 ? cube_strip(cube) : player_.renderer->read_color();
+  } else if (view_ == View::shadow_map) {
+    last_frame_ = grey(player_.renderer->read_shadow_map());
+    if (last_frame_.width == 0) last_frame_ = player_.renderer->read_color();  // no shadowed light
+  } else {
+    last_frame_ = aov_view(view_, player_.renderer->read_aovs());
+  }
+  frame_ms_.push_back(float(t->first_frame_ms));
+  if (frame_ms_.size() > 120) frame_ms_.erase(frame_ms_.begin());
+  {
+    const auto& st = t->last.stats;
+    char line[256];
+    // GPU times from timer queries; on llvmpipe a pass's work can land in the next pass's timer
+    // (DESIGN.md, "Facts about these machines"), so they are indications only.
+    std::snprintf(line, sizeof line,
+                  "%.1f ms (GPU shadow %.2f, forward %.2f), %d draws, %zu shadow tris, "
+                  "%d probe faces, %d programs",
+                  t->first_frame_ms, st.shadow_gpu_ms, st.forward_gpu_ms, st.draw_calls,
+                  st.shadow_triangles, st.probe_faces,
+                  int(player_.renderer->shaders().program_count()));
+    stats_ = line;
+  }
+  if (!opt_.script.empty()) {
+    // The stats line the editor tests read: which frames captured probe faces and drew layers.
+    const auto& st = t->last.stats;
+    std::printf("frame %llu: %d probe faces, %d draws, %zu shadow triangles\n",
+                static_cast<unsigned long long>(scene_.frames_rendered - 1), st.probe_faces,
+                st.draw_calls, st.shadow_triangles);
+  }
+  if (texture_w_ != last_frame_.width || texture_h_ != last_frame_.height) {
+    view_texture_ = gpu::make_texture(GL_TEXTURE_2D);
+    glTextureStorage2D(view_texture_.id(), 1, GL_RGBA8, last_frame_.width, last_frame_.height);
+    // No mipmaps: the default minifying filter would leave the texture incomplete (black).
+    glTextureParameteri(view_texture_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(view_texture_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    texture_w_ = last_frame_.width;
+    texture_h_ = last_frame_.height;
+  }
+  const GLenum format = last_frame_.channels == 4 ? GL_RGBA : last_frame_.channels == 3 ? GL_RGB
+                                                                                         : GL_RED;
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(view_texture_.id(), 0, 0, 0, last_frame_.width, last_frame_.height, format,
+                      GL_FLOAT, last_frame_.pixels.data());
+  return {};
+}
+
+void Editor::request(const std::string& assignment) {
+  // A drag edits one history entry while the mouse is held, not one per frame.
+  const std::string key = assignment.substr(0, assignment.find('='));
+  const bool merge = key == last_drag_key_;
+  last_drag_key_ = ImGui::IsItemActive() ? key : "";
+  requests_.emplace_back(assignment, merge);
+}
+
+void Editor::field(const std::string& key, const std::string& label, const json& v) {
+  ImGui::PushID(key.c_str());
+  if (v.is_boolean()) {
+    bool b = v.get<bool>();
+    if (ImGui::Checkbox(label.c_str(), &b)) request(key + "=" + (b ? "true" : "false"));
+  } else if (v.is_number_integer() || v.is_number_unsigned()) {
+    // Drag fields without limits: the scene readers decide what is valid (one source of truth),
+    // and a rejected value shows their message.
+    int i = v.get<int>();
+    if (ImGui::DragInt(label.c_str(), &i, 1.0f)) request(key + "=" + std::to_string(i));
+  } else if (v.is_number_float()) {
+    float f = v.get<float>();
+    const float speed = std::max(std::abs(f) * 0.01f, 0.001f);
+    if (ImGui::DragFloat(label.c_str(), &f, speed, 0.0f, 0.0f, "%.5g"))
+      request(key + "=" + json(double(f)).dump());
+  } else if (v.is_string()) {
+    // Enumerations are shown as the file spells them, a value outside the list included.
+    char buf[512];
+    std::snprintf(buf, sizeof buf, "%s", v.get<std::string>().c_str());
+    if (ImGui::InputText(label.c_str(), buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue))
+      request(key + "=" + json(std::string(buf)).dump());
+  } else if (v.is_array() && v.size() >= 2 && v.size() <= 4 &&
+             std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); })) {
+    float f[4] = {};
+    for (std::size_t i = 0; i < v.size(); ++i) f[i] = v[i].get<float>();
+    float largest = 0.0f;
+    for (float x : f) largest = std::max(largest, std::abs(x));
+    const float speed = std::max(largest * 0.01f, 0.001f);
+    if (ImGui::DragScalarN(label.c_str(), ImGuiDataType_Float, f, int(v.size()), speed, nullptr,
+                           nullptr, "%.4g")) {
+      json a = json::array();
+      for (std::size_t i = 0; i < v.size(); ++i) a.push_back(double(f[i]));
+      request(key + "=" + a.dump());
+    }
+  } else if (v.is_object() || v.is_array()) {
+    if (ImGui::TreeNode(label.c_str())) {
+      if (v.is_object())
+        for (auto it = v.begin(); it != v.end(); ++it) field(key + "." + it.key(), it.key(), it.value());
+      else
+        for (std::size_t i = 0; i < v.size(); ++i) field(key + "." + std::to_string(i), std::to_string(i), v[i]);
+      ImGui::TreePop();
+    }
+  } else {
+    ImGui::TextDisabled("%s: %s", label.c_str(), v.dump().c_str());
+  }
+  ImGui::PopID();
+}
+
+void Editor::direction_helpers() {
+  // Lights and cameras are aimed: their direction and a look-at point, set through the scene
+  // files' own rotation forms (transform.direction, transform.look_at).
+  const auto e = find(selected_);
+  if (!e || !(scene_.world.has<Light>(*e) || scene_.world.has<Camera>(*e))) return;
+  const auto* wt = scene_.world.try_get<WorldTransform>(*e);
+  if (!wt) return;
+  if (!ImGui::CollapsingHeader("aim", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  glm::vec3 d = glm::normalize(-glm::vec3(wt->matrix[2]));
+  if (ImGui::DragFloat3("direction", &d.x, 0.01f, -1.0f, 1.0f, "%.3f") && glm::length(d) > 1e-4f)
+    request(selected_ + ".transform.direction=" +
+            json::array({double(d.x), double(d.y), double(d.z)}).dump());
+  ImGui::DragFloat3("look-at point", &look_at_.x, 0.05f, 0.0f, 0.0f, "%.3g");
+  if (ImGui::Button("look at it"))
+    requests_.emplace_back(selected_ + ".transform.look_at=" +
+                               json::array({double(look_at_.x), double(look_at_.y), double(look_at_.z)}).dump(),
+                           false);
+}
+
+void Editor::entity_node(ecs::Entity e,
+                         const std::map<std::uint32_t, std::vector<ecs::Entity>>& children) {
+  const auto* n = scene_.world.try_get<Name>(e);
+  const std::string name = n ? n->value : "(unnamed " + std::to_string(e.index) + ")";
+  const auto kids = children.find(e.index);
+  ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_SpanAvailWidth |
+                             ImGuiTreeNodeFlags_DefaultOpen;
+  if (kids == children.end()) flags |= ImGuiTreeNodeFlags_Leaf;
+  if (n && n->value == selected_) flags |= ImGuiTreeNodeFlags_Selected;
+  ImGui::PushID(int(e.index));
+  const bool open = ImGui::TreeNodeEx(name.c_str(), flags);
+  if (ImGui::IsItemClicked() && n) selected_ = n->value;
+  // Drag an entity onto another to parent it there.
+  if (n && ImGui::BeginDragDropSource()) {
+    ImGui::SetDragDropPayload("kaskad_entity", n->value.data(), n->value.size());
+    ImGui::TextUnformatted(n->value.c_str());
+    ImGui::EndDragDropSource();
+  }
+  if (n && ImGui::BeginDragDropTarget()) {
+    if (const ImGuiPayload* p = ImGui::AcceptDragDropPayload("kaskad_entity")) {
+      const std::string child(static_cast<const char*>(p->Data), std::size_t(p->DataSize));
+      const std::string parent = n->value;
+      operations_.push_back([this, child, parent] {
+        selected_ = child;
+        return reparent_selected(parent);
+      });
+    }
+    ImGui::EndDragDropTarget();
+  }
+  if (open) {
+    if (kids != children.end())
+      for (ecs::Entity c : kids->second) entity_node(c, children);
+    ImGui::TreePop();
+  }
+  ImGui::PopID();
+}
+
+void Editor::entity_list() {
+  std::vector<ecs::Entity> all;
+  scene_.world.view<Transform>().each([&](ecs::Entity e, const Transform&) { all.push_back(e); });
+  std::sort(all.begin(), all.end(), [](ecs::Entity a, ecs::Entity b) { return a.index < b.index; });
+  std::map<std::uint32_t, std::vector<ecs::Entity>> children;
+  std::vector<ecs::Entity> roots;
+  for (ecs::Entity e : all) {
+    const ecs::Entity p = scene_.world.get<Transform>(e).parent;
+    if (p.valid() && scene_.world.alive(p) && p != e)
+      children[p.index].push_back(e);
+    else
+      roots.push_back(e);
+  }
+  for (ecs::Entity e : roots) entity_node(e, children);
+}
+
+void Editor::inspector() {
+  ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+  ImGui::TextWrapped("%s", stats_.c_str());
+  ImGui::PopStyleColor();
+  if (!frame_ms_.empty())
+    ImGui::PlotLines("frame ms", frame_ms_.data(), int(frame_ms_.size()), 0, nullptr, 0.0f,
+                     FLT_MAX, ImVec2(0, 40));
+  int view = int(view_);
+  if (ImGui::Combo("view", &view, kViewNames, int(std::size(kViewNames)))) {
+    view_ = View(view);
+    changed_since_frame_ = true;
+  }
+  if (!message_.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, message_is_error_ ? ImVec4(1.0f, 0.45f, 0.35f, 1.0f)
+                                                           : ImVec4(0.55f, 0.85f, 0.55f, 1.0f));
+    ImGui::TextWrapped("%s", message_.c_str());
+    ImGui::PopStyleColor();
+  }
+  ImGui::TextDisabled("%s%s", opt_.scene.filename().string().c_str(), dirty() ? " (unsaved)" : "");
+  {
+    char path[1024];
+    std::snprintf(path, sizeof path, "%s", file_line_.c_str());
+    ImGui::InputText("file", path, sizeof path);
+    file_line_ = path;
+    if (ImGui::Button("open (Ctrl+O)") && !file_line_.empty()) {
+      const fs::path f = file_line_;
+      operations_.push_back([this, f] { return open(f); });
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("save as") && !file_line_.empty()) {
+      const fs::path f = file_line_;
+      operations_.push_back([this, f] { return save_as(f); });
+    }
+  }
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "%s", set_line_.c_str());
+  if (ImGui::InputText("--set", buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue)) {
+    set_line_ = buf;
+    requests_.emplace_back(set_line_, false);
+  } else {
+    set_line_ = buf;
+  }
+  const json& doc = document();
+  if (!selected_.empty()) {
+    const json* ent = nullptr;
+    for (const json& e : doc.at("entities"))
+      if (e.value("name", std::string()) == selected_) ent = &e;
+    if (ent) {
+      ImGui::Separator();
+      char name[256];
+      std::snprintf(name, sizeof name, "%s", selected_.c_str());
+      if (ImGui::InputText("name", name, sizeof name, ImGuiInputTextFlags_EnterReturnsTrue)) {
+        const std::string n = name;
+        operations_.push_back([this, n] { return rename_selected(n); });
+      }
+      if (ImGui::Button("duplicate")) operations_.push_back([this] { return duplicate_selected(); });
+      ImGui::SameLine();
+      if (ImGui::Button("delete")) operations_.push_back([this] { return remove_selected(); });
+      if (ent->contains("transform") && ent->at("transform").contains("parent")) {
+        ImGui::SameLine();
+        if (ImGui::Button("make root")) operations_.push_back([this] { return reparent_selected(""); });
+      }
+      ImGui::TextDisabled("drag an entity onto another to parent it");
+      for (auto it = ent->begin(); it != ent->end(); ++it) {
+        if (it.key() == "name" || !it.value().is_object()) continue;
+        if (ImGui::CollapsingHeader(it.key().c_str(), ImGuiTreeNodeFlags_DefaultOpen))
+          for (auto f = it.value().begin(); f != it.value().end(); ++f)
+            field(selected_ + "." + it.key() + "." + f.key(), f.key(), f.value());
+      }
+      direction_helpers();
+    } else {
+      ImGui::TextWrapped("'%s' is imported from a model: its transform, light and camera are set "
+                         "with --set %s.SECTION.FIELD=VALUE", selected_.c_str(), selected_.c_str());
+    }
+  }
+  for (const char* section : {"render", "shadow"}) {
+    if (!doc.contains(section)) continue;
+    if (ImGui::CollapsingHeader(section))
+      for (auto f = doc[section].begin(); f != doc[section].end(); ++f)
+        field(std::string(section) + "." + f.key(), f.key(), f.value());
+  }
+}
+
+void Editor::draw_ui(int w, int h) {
+  const Layout l = layout_for(w, h, left_w_, right_w_);
+  const ImGuiWindowFlags panel = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse |
+                                 ImGuiWindowFlags_NoSavedSettings;
+  const ImGuiWindowFlags fixed = panel | ImGuiWindowFlags_NoResize;
+  // Panels keep the window's height; only their inner edge moves.
+  ImGui::SetNextWindowPos(ImVec2(0, 0));
+  ImGui::SetNextWindowSize(ImVec2(l.left, float(h)));
+  ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
+  ImGui::Begin("Entities", nullptr, panel);
+  static const char* kShapes[] = {"box", "sphere", "cylinder", "cone", "plane"};
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
+  ImGui::Combo("##shape", &create_shape_, kShapes, int(std::size(kShapes)));
+  ImGui::SameLine();
+  if (ImGui::Button("create")) {
+    const std::string shape = kShapes[create_shape_];
+    operations_.push_back([this, shape] { return create(shape); });
+  }
+  ImGui::Separator();
+  entity_list();
+  left_w_ = ImGui::GetWindowWidth();
+  ImGui::End();
+
+  ImGui::SetNextWindowPos(ImVec2(float(l.view_x), 0));
+  ImGui::SetNextWindowSize(ImVec2(float(l.view_w), float(l.view_h)));
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
+  ImGui::Begin("Viewport", nullptr, fixed | ImGuiWindowFlags_NoDecoration |
+                                        ImGuiWindowFlags_NoBringToFrontOnFocus);
+  if (view_texture_) {
+    // Scaled to fit: the shadow map view is the map's size, its layers stacked.
+    const float scale = std::min({1.0f, float(l.view_w) / float(texture_w_),
+                                  float(l.view_h) / float(texture_h_)});
+    ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<std::uintptr_t>(view_texture_.id())),
+                 ImVec2(float(texture_w_) * scale, float(texture_h_) * scale));
+  }
+  viewport_hovered_ = ImGui::IsWindowHovered();
+  ImGui::End();
+  ImGui::PopStyleVar();
+
+  ImGui::SetNextWindowPos(ImVec2(float(w) - l.right, 0));
+  ImGui::SetNextWindowSize(ImVec2(l.right, float(h)));
+  ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
+  ImGui::Begin("Inspector", nullptr, panel);
+  right_w_ = ImGui::GetWindowWidth();
+  // Labels keep a fixed share of the panel, so long field names are not clipped.
+  ImGui::PushItemWidth(-std::max(120.0f, 0.42f * l.right));
+  inspector();
+  ImGui::PopItemWidth();
+  ImGui::End();
+
+  if (ask_quit_) ImGui::OpenPopup("Unsaved changes");
+  if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+    ImGui::Text("%s has unsaved changes.", opt_.scene.filename().string().c_str());
+    GLFWwindow* window = player_.context->window();
+    if (ImGui::Button("Save and quit")) {
+      if (Status st = save(opt_.scene); st) glfwSetWindowShouldClose(window, true);
+      else report(st.error().to_string());
+      ask_quit_ = false;
+      ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Quit without saving")) {
+      saved_ = position_;
+      glfwSetWindowShouldClose(window, true);
+      ask_quit_ = false;
+      ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel")) {
+      ask_quit_ = false;
+      ImGui::CloseCurrentPopup();
+    }
+    ImGui::EndPopup();
+  }
+}
+
+void Editor::interactive_input(float dt) {
+  ImGuiIO& io = ImGui::GetIO();
+  if (!ImGui::IsAnyItemActive()) last_drag_key_.clear();
+  // The Dear ImGui 1.86 GLFW backend indexes keys by GLFW key code.
+  if (!io.WantTextInput) {
+    const char* shortcut = nullptr;
+    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Z, false)) shortcut = "ctrl+z";
+    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Y, false)) shortcut = "ctrl+y";
+    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_S, false)) shortcut = "ctrl+s";
+    if (!io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_F, false)) shortcut = "f";
+    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_O, false) && !file_line_.empty()) {
+      const fs::path f = file_line_;
+      operations_.push_back([this, f] { return open(f); });
+    }
+    if (shortcut)
+      if (Status st = press(shortcut, 0.0f); !st) report(st.error().to_string());
+  }
+  if (viewport_hovered_ && io.KeyAlt && ImGui::IsMouseDown(ImGuiMouseButton_Left) &&
+      (io.MouseDelta.x != 0.0f || io.MouseDelta.y != 0.0f)) {
+    if (Status st = orbit(-io.MouseDelta.x * 0.008f, io.MouseDelta.y * 0.008f); !st)
+      report(st.error().to_string());
+  }
+  if (viewport_hovered_ && ImGui::IsMouseDown(ImGuiMouseButton_Right)) {
+    const float radians_per_pixel = 0.004f;
+    camera_.yaw += io.MouseDelta.x * radians_per_pixel;
+    camera_.pitch = std::clamp(camera_.pitch - io.MouseDelta.y * radians_per_pixel, -1.55f, 1.55f);
+    const float step = dt * (io.KeyShift ? 4.0f : 1.0f);
+    static constexpr std::pair<int, const char*> kFly[] = {
+        {GLFW_KEY_W, "w"}, {GLFW_KEY_A, "a"}, {GLFW_KEY_S, "s"},
+        {GLFW_KEY_D, "d"}, {GLFW_KEY_Q, "q"}, {GLFW_KEY_E, "e"}};
+    for (const auto& [glfw_key, name] : kFly)
+      if (ImGui::IsKeyDown(glfw_key)) (void)press(name, step);
+    if (io.MouseDelta.x != 0.0f || io.MouseDelta.y != 0.0f) write_camera();
+  }
+}
+
+Status Editor::run_action(const ScriptAction& a, bool& quit) {
+  switch (a.kind) {
+    case ActionKind::set:
+      return edit(a.args[0], false);
+    case ActionKind::select:
+      if (!find(a.args[0])) return Error{"", "", "select: no entity named '" + a.args[0] + "'"};
+      selected_ = a.args[0];
+      changed_since_frame_ = true;  // the probe faces view follows the selection
+      return {};
+    case ActionKind::camera: {
+      float v[6] = {};
+      for (std::size_t i = 0; i < a.args.size(); ++i) v[i] = std::stof(a.args[i]);
+      camera_.position = glm::vec3(v[0], v[1], v[2]);
+      if (a.args.size() == 6) {
+        const glm::vec3 d = glm::vec3(v[3], v[4], v[5]) - camera_.position;
+        if (glm::length(d) <= 0.0f) return Error{"", "", "camera: the look-at point is the position"};
+        camera_.look_along(d);
+      }
+      write_camera();
+      return {};
+    }
+    case ActionKind::key:
+      // One fly step is a frame's worth at 30 Hz; a key that fails (nothing to undo, a save
+      // refused) fails the script.
+      return press(a.args[0], 1.0f / 30.0f);
+    case ActionKind::frames:
+      return {};
+    case ActionKind::create:
+      return create(a.args[0]);
+    case ActionKind::remove:
+      return remove_selected();
+    case ActionKind::duplicate:
+      return duplicate_selected();
+    case ActionKind::rename:
+      return rename_selected(a.args[0]);
+    case ActionKind::parent:
+      return reparent_selected(a.args[0] == "-" ? std::string() : a.args[0]);
+    case ActionKind::orbit:
+      return orbit(glm::radians(std::stof(a.args[0])), glm::radians(std::stof(a.args[1])));
+    case ActionKind::view:
+      view_ = *view_named(a.args[0]);  // checked by parse_script
+      changed_since_frame_ = true;
+      return {};
+    case ActionKind::screenshot:
+      if (last_frame_.width == 0) return Error{"", "", "screenshot: no frame rendered yet"};
+      KASKAD_TRY(save_image(a.args[0], last_frame_));
+      std::printf("kaskad edit: wrote %s\n", a.args[0].c_str());
+      return {};
+    case ActionKind::window_screenshot:
+      KASKAD_TRY(check_image_output(a.args[0]));
+      window_shot_ = a.args[0];
+      return {};
+    case ActionKind::save:
+      return save(a.args.empty() ? opt_.scene : fs::path(a.args[0]));
+    case ActionKind::open:
+      return open(a.args[0]);
+    case ActionKind::save_as:
+      return save_as(a.args[0]);
+    case ActionKind::undo:
+      return undo();
+    case ActionKind::redo:
+      return redo();
+    case ActionKind::quit:
+      if (dirty())
+        return Error{"", "", "quit with unsaved changes (save first, or quit! to discard them)"};
+      quit = true;
+      return {};
+    case ActionKind::force_quit:
+      quit = true;
+      return {};
+  }
+  return {};
+}
+
+int Editor::run() {
+  GLFWwindow* window = player_.context->window();
+  const std::vector<ScriptAction>& script = script_;
+  std::size_t next = 0;
+  int frames_left = 0;
+  auto last = std::chrono::steady_clock::now();
+  auto last_reload_check = last;
+  for (;;) {
+    glfwPollEvents();
+    // Shader hot reload, twice a second: a failed compile keeps the last good program and its
+    // log (mapped to file:line) stays shown until a later save fixes it.
+    if (std::chrono::steady_clock::now() - last_reload_check > std::chrono::milliseconds(500)) {
+      last_reload_check = std::chrono::steady_clock::now();
+      const auto before = player_.renderer->shaders().stats().reloads;
+      for (const auto& e : player_.renderer->shaders().reload_changed()) report(e.to_string());
+      if (player_.renderer->shaders().stats().reloads > before) message_.clear();
+    }
+    bool quit = false;
+    if (!opt_.script.empty()) {
+      // Script actions run between frames; `frames N` lets N frames render, and a screenshot
+      // after a change first renders the frame that shows it.
+      while (frames_left == 0 && next < script.size()) {
+        const ScriptAction& a = script[next];
+        if (a.kind == ActionKind::screenshot && changed_since_frame_) {
+          frames_left = 1;
+          break;
+        }
+        if (Status st = run_action(a, quit); !st) {
+          Error e = st.error();
+          const std::string where = "line " + std::to_string(a.line);
+          std::fprintf(stderr, "kaskad edit: error: %s: %s: %s\n", opt_.script.string().c_str(),
+                       where.c_str(), e.to_string().c_str());
+          return 1;
+        }
+        ++next;
+        if (a.kind == ActionKind::frames) frames_left = std::stoi(a.args[0]);
+        if (a.kind == ActionKind::window_screenshot) frames_left = 1;
+        if (quit) break;
+      }
+      if (!quit && frames_left == 0 && next == script.size()) {
+        std::fprintf(stderr, "kaskad edit: error: %s: the script ended without quit or quit!\n",
+                     opt_.script.string().c_str());
+        return 1;
+      }
+    } else if (glfwWindowShouldClose(window)) {
+      if (!dirty()) quit = true;
+      else {
+        glfwSetWindowShouldClose(window, false);
+        ask_quit_ = true;
+      }
+    }
+    if (quit) break;
+
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window, &w, &h);
+    if (w <= 0 || h <= 0) continue;  // minimised
+    const Layout l = layout_for(w, h, left_w_, right_w_);
+    if (l.view_w > 0 && l.view_h > 0) {
+      if (Status st = render_viewport(l.view_w, l.view_h); !st) {
+        if (!opt_.script.empty()) {
+          std::fprintf(stderr, "kaskad edit: error: %s\n", st.error().to_string().c_str());
+          return 1;
+        }
+        // A scene that cannot be drawn (its camera deleted, say) is shown as an error until an
+        // edit or an undo fixes it; the window stays.
+        if (message_ != st.error().to_string()) report(st.error().to_string());
+      }
+    }
+    if (frames_left > 0) --frames_left;
+
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    const auto now = std::chrono::steady_clock::now();
+    const float dt = std::min(std::chrono::duration<float>(now - last).count(), 0.1f);
+    last = now;
+    if (opt_.script.empty()) interactive_input(dt);
+    draw_ui(w, h);
+    ImGui::Render();
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, w, h);
+    glClearColor(0.1f, 0.1f, 0.1f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    if (!window_shot_.empty()) {
+      if (Status st = save_image(window_shot_, read_window(w, h)); !st) {
+        std::fprintf(stderr, "kaskad edit: error: %s\n", st.error().to_string().c_str());
+        return 1;
+      }
+      std::printf("kaskad edit: wrote %s\n", window_shot_.string().c_str());
+      window_shot_.clear();
+    }
+    player_.context->swap_buffers();
+
+    // Edits from the panels, in the order made; a rejected one shows its error and changes nothing.
+    for (const auto& [assignment, merge] : requests_) {
+      if (Status st = edit(assignment, merge); !st) report(st.error().to_string());
+      else message_.clear();
+    }
+    requests_.clear();
+    for (const auto& op : operations_) {
+      if (Status st = op(); !st) report(st.error().to_string());
+      else message_.clear();
+    }
+    operations_.clear();
+  }
+  if (gpu::debug_error_count() > 0) {
+    std::fprintf(stderr, "kaskad edit: error: %d OpenGL errors were reported (see log above)\n",
+                 gpu::debug_error_count());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int run_edit_command(int argc, char** argv) {
+  Options opt = parse_options(argc, argv);
+  std::vector<ScriptAction> script;
+  if (!opt.script.empty()) {
+    auto parsed = parse_script(opt.script);
+    if (!parsed) {
+      std::fprintf(stderr, "kaskad edit: error: %s\n", parsed.error().to_string().c_str());
+      return 1;
+    }
+    script = std::move(parsed.value());
+  }
+  auto scene = load_scene(opt.scene, opt.sets);
+  if (!scene) {
+    std::fprintf(stderr, "kaskad edit: error: %s\n", scene.error().to_string().c_str());
+    return 1;
+  }
+  if (!gpu::display_available()) {
+    std::fprintf(stderr, "kaskad edit: error: no display (DISPLAY or WAYLAND_DISPLAY): the editor "
+                         "needs a window; under CI run it with xvfb-run -a\n");
+    return 1;
+  }
+  gpu::ContextOptions copt;
+  copt.headless = false;
+  copt.window_width = opt.width;
+  copt.window_height = opt.height;
+  copt.title = "Kaskad editor - " + opt.scene.string();
+  auto player = Player::create(copt);
+  if (!player) {
+    std::fprintf(stderr, "kaskad edit: error: %s\n", player.error().to_string().c_str());
+    return 1;
+  }
+  GLFWwindow* window = player->context->window();
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini dropped into the working directory
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 450 core");
+  int status = 0;
+  {
+    Editor editor(std::move(opt), std::move(scene.value()), player.value(), std::move(script));
+    status = editor.run();
+  }
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  return status;
+}
+
+}  // namespace kaskad::editor

@@ -1,0 +1,125 @@
+#include "editor/script.h"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace kaskad::editor {
+
+namespace {
+
+bool is_number(const std::string& s) {
+  float v = 0.0f;
+  auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  return ec == std::errc() && ptr == s.data() + s.size() && std::isfinite(v);
+}
+
+struct Verb {
+  const char* name;
+  ActionKind kind;
+  int min_args, max_args;
+  const char* usage;
+};
+
+constexpr Verb kVerbs[] = {
+    {"set", ActionKind::set, 1, 1, "set KEY=VALUE"},
+    {"select", ActionKind::select, 1, 1, "select NAME"},
+    {"create", ActionKind::create, 1, 1, "create SHAPE (box, sphere, cylinder, cone, plane)"},
+    {"delete", ActionKind::remove, 0, 0, "delete"},
+    {"duplicate", ActionKind::duplicate, 0, 0, "duplicate"},
+    {"rename", ActionKind::rename, 1, 1, "rename NAME"},
+    {"parent", ActionKind::parent, 1, 1, "parent NAME (or - for none)"},
+    {"camera", ActionKind::camera, 3, 6, "camera X Y Z [LOOK_X LOOK_Y LOOK_Z]"},
+    {"orbit", ActionKind::orbit, 2, 2, "orbit YAW_DEG PITCH_DEG"},
+    {"key", ActionKind::key, 1, 1, "key K (w a s d q e f ctrl+z ctrl+y ctrl+s)"},
+    {"view", ActionKind::view, 1, 1, "view colour|visibility|cascade|normal|depth|shadow_map|probe_faces"},
+    {"frames", ActionKind::frames, 1, 1, "frames N (1..100000)"},
+    {"screenshot", ActionKind::screenshot, 1, 1, "screenshot PATH.png"},
+    {"window_screenshot", ActionKind::window_screenshot, 1, 1, "window_screenshot PATH.png"},
+    {"open", ActionKind::open, 1, 1, "open SCENE"},
+    {"save", ActionKind::save, 0, 1, "save [PATH]"},
+    {"save_as", ActionKind::save_as, 1, 1, "save_as PATH"},
+    {"undo", ActionKind::undo, 0, 0, "undo"},
+    {"redo", ActionKind::redo, 0, 0, "redo"},
+    {"quit", ActionKind::quit, 0, 0, "quit"},
+    {"quit!", ActionKind::force_quit, 0, 0, "quit!"},
+};
+
+}  // namespace
+
+bool is_script_key(const std::string& name) {
+  for (const char* k : {"w", "a", "s", "d", "q", "e", "f", "ctrl+z", "ctrl+y", "ctrl+s"})
+    if (name == k) return true;
+  return false;
+}
+
+Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
+                                                    const std::filesystem::path& file) {
+  std::vector<ScriptAction> actions;
+  std::istringstream in(text);
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::string verb;
+    if (!(words >> verb) || verb[0] == '#') continue;
+    const std::string where = "line " + std::to_string(n);
+    const Verb* v = nullptr;
+    for (const Verb& candidate : kVerbs)
+      if (verb == candidate.name) v = &candidate;
+    if (!v)
+      return Error{file.string(), where,
+                   "unknown action '" + verb + "' (set, select, create, delete, duplicate, rename, parent, "
+                   "camera, orbit, key, view, frames, screenshot, "
+                   "window_screenshot, open, save, save_as, undo, redo, quit, quit!)"};
+    ScriptAction a;
+    a.kind = v->kind;
+    a.line = n;
+    if (a.kind == ActionKind::set || a.kind == ActionKind::select || a.kind == ActionKind::rename ||
+        a.kind == ActionKind::parent) {
+      // The rest of the line, spaces included: a value may be a JSON array or a name with spaces.
+      std::string rest;
+      std::getline(words, rest);
+      const auto first = rest.find_first_not_of(" \t");
+      const auto last = rest.find_last_not_of(" \t");
+      if (first != std::string::npos) a.args.push_back(rest.substr(first, last - first + 1));
+    } else {
+      for (std::string w; words >> w;) a.args.push_back(w);
+    }
+    const int count = int(a.args.size());
+    if (count < v->min_args || count > v->max_args || (a.kind == ActionKind::camera && count == 4) ||
+        (a.kind == ActionKind::camera && count == 5))
+      return Error{file.string(), where, std::string("expected '") + v->usage + "'"};
+    if (a.kind == ActionKind::set && a.args[0].find('=') == std::string::npos)
+      return Error{file.string(), where, "expected 'set KEY=VALUE', got 'set " + a.args[0] + "'"};
+    if (a.kind == ActionKind::camera || a.kind == ActionKind::orbit)
+      for (const std::string& c : a.args)
+        if (!is_number(c))
+          return Error{file.string(), where, verb + ": '" + c + "' is not a number"};
+    if (a.kind == ActionKind::key && !is_script_key(a.args[0]))
+      return Error{file.string(), where, "unknown key '" + a.args[0] + "'; expected " + v->usage};
+    if (a.kind == ActionKind::view && !view_named(a.args[0]))
+      return Error{file.string(), where, "unknown view '" + a.args[0] + "'; expected " + v->usage};
+    if (a.kind == ActionKind::frames) {
+      int frames = 0;
+      const std::string& s = a.args[0];
+      auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), frames);
+      if (ec != std::errc() || ptr != s.data() + s.size() || frames < 1 || frames > 100000)
+        return Error{file.string(), where, "frames: expected a count in [1, 100000], got '" + s + "'"};
+    }
+    actions.push_back(std::move(a));
+  }
+  return actions;
+}
+
+Result<std::vector<ScriptAction>> parse_script(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return Error{file.string(), "", "cannot open the script"};
+  std::stringstream text;
+  text << in.rdbuf();
+  if (in.bad()) return Error{file.string(), "", "cannot read the script"};
+  return parse_script_text(text.str(), file);
+}
+
+}  // namespace kaskad::editor

@@ -1,0 +1,51 @@
+// `kaskad edit --script FILE`: UI actions replayed one per line, for tests and demos. The language
+// is documented in README.md ("Editor: kaskad edit"); parsing is pure (no window, no scene).
+#pragma once
+
+#include <filesystem>
+#include <iterator>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "runtime/core/result.h"
+
+namespace kaskad::editor {
+
+enum class ActionKind {
+  set, select, create, remove, duplicate, rename, parent, camera, orbit, key, view, frames, screenshot,
+  window_screenshot, open, save, save_as, undo, redo, quit, force_quit
+};
+
+/// What the viewport shows: the colour, or as a debug view one of the frame's AOVs (README "AOV
+/// contract"), the shadow map (its layers stacked) or a reflection probe's six cube faces (the
+/// selected entity's probe, else the first; +X -X +Y -Y +Z -Z left to right).
+enum class View { colour, visibility, cascade, normal, depth, shadow_map, probe_faces };
+/// The views' names, in View order: the viewport's combo and the script's `view NAME`.
+inline constexpr const char* kViewNames[] = {"colour", "visibility", "cascade", "normal", "depth",
+                                             "shadow_map", "probe_faces"};
+inline std::optional<View> view_named(const std::string& name) {
+  for (std::size_t i = 0; i < std::size(kViewNames); ++i)
+    if (name == kViewNames[i]) return View(i);
+  return std::nullopt;
+}
+
+struct ScriptAction {
+  ActionKind kind = ActionKind::frames;
+  std::vector<std::string> args;  ///< checked by parse_script: counts and numbers are valid
+  int line = 0;                   ///< 1-based line in the script, for messages
+};
+
+/// The names `key` takes (the same keys a user presses): w a s d q e (one fly step of 1/30 s),
+/// f (frame the selection), ctrl+z, ctrl+y, ctrl+s.
+bool is_script_key(const std::string& name);
+
+/// Parses a whole script before anything runs, so a bad line fails before the first frame.
+/// Blank lines and lines starting with '#' are skipped. Errors name the file and the line.
+Result<std::vector<ScriptAction>> parse_script(const std::filesystem::path& file);
+
+/// parse_script() of text already read (`file` only names it in messages).
+Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
+                                                    const std::filesystem::path& file);
+
+}  // namespace kaskad::editor

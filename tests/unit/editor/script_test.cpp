@@ -1,0 +1,66 @@
+// The editor's script language (editor/script.h): every action parses, and every bad line is an
+// error naming the file and the line, found before anything runs.
+#include "editor/script.h"
+
+#include <gtest/gtest.h>
+
+using namespace kaskad::editor;
+
+namespace {
+
+std::string error_of(const std::string& text) {
+  auto r = parse_script_text(text, "s.txt");
+  EXPECT_FALSE(r.ok()) << text;
+  return r.ok() ? std::string() : r.error().to_string();
+}
+
+}  // namespace
+
+TEST(EditorScript, EveryActionParses) {
+  auto r = parse_script_text(
+      "# a comment\n\nset sun.transform.direction=[0.2, -0.8, -0.3]\nselect box resting\n"
+      "camera 1 2 3\ncamera 1 2 3 0 0 0\nkey ctrl+z\nview cascade\nframes 12\nscreenshot a.png\n"
+      "window_screenshot w.png\nsave\nsave b.json\nundo\nredo\nquit\nquit!\r\n",
+      "s.txt");
+  ASSERT_TRUE(r.ok()) << r.error().to_string();
+  ASSERT_EQ(r->size(), 15u);
+  EXPECT_EQ((*r)[0].kind, ActionKind::set);
+  EXPECT_EQ((*r)[0].args.at(0), "sun.transform.direction=[0.2, -0.8, -0.3]");  // spaces kept
+  EXPECT_EQ((*r)[0].line, 3);
+  EXPECT_EQ((*r)[1].args.at(0), "box resting");
+  EXPECT_EQ((*r)[3].args.size(), 6u);
+  EXPECT_EQ((*r)[5].kind, ActionKind::view);
+  EXPECT_EQ((*r)[6].args.at(0), "12");
+  EXPECT_TRUE((*r)[9].args.empty());
+  EXPECT_EQ((*r)[13].kind, ActionKind::quit);
+  EXPECT_EQ((*r)[14].kind, ActionKind::force_quit);
+}
+
+TEST(EditorScript, BadLinesNameTheFileAndLine) {
+  EXPECT_EQ(error_of("frames 1\nsett a=1\n"),
+            "s.txt: line 2: unknown action 'sett' (set, select, create, delete, duplicate, rename, "
+            "parent, camera, orbit, key, view, frames, screenshot, window_screenshot, open, save, "
+            "save_as, undo, redo, quit, quit!)");
+  EXPECT_NE(error_of("orbit 10\n").find("line 1: expected 'orbit YAW_DEG PITCH_DEG'"),
+            std::string::npos);
+  EXPECT_NE(error_of("orbit 10 up\n").find("orbit: 'up' is not a number"), std::string::npos);
+  EXPECT_NE(error_of("set shadow.cascade_count\n").find("line 1: expected 'set KEY=VALUE'"),
+            std::string::npos);
+  EXPECT_NE(error_of("camera 1 2\n").find("line 1: expected 'camera X Y Z"), std::string::npos);
+  EXPECT_NE(error_of("camera 1 2 3 4\n").find("line 1: expected 'camera"), std::string::npos);
+  EXPECT_NE(error_of("camera 1 2 x\n").find("'x' is not a number"), std::string::npos);
+  EXPECT_NE(error_of("camera 1 2 nan\n").find("'nan' is not a number"), std::string::npos);
+  EXPECT_NE(error_of("key ctrl+q\n").find("unknown key 'ctrl+q'"), std::string::npos);
+  EXPECT_NE(error_of("view shadows\n").find("unknown view 'shadows'"), std::string::npos);
+  EXPECT_NE(error_of("frames 0\n").find("[1, 100000]"), std::string::npos);
+  EXPECT_NE(error_of("frames 3x\n").find("'3x'"), std::string::npos);
+  EXPECT_NE(error_of("undo now\n").find("expected 'undo'"), std::string::npos);
+  EXPECT_NE(error_of("screenshot\n").find("expected 'screenshot PATH.png'"), std::string::npos);
+  EXPECT_NE(error_of("save a b\n").find("expected 'save [PATH]'"), std::string::npos);
+}
+
+TEST(EditorScript, MissingFileIsAnError) {
+  auto r = parse_script("/nonexistent/script.txt");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().to_string(), "/nonexistent/script.txt: cannot open the script");
+}
