@@ -79,6 +79,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.ambient = scene.render.ambient;
   in.clear_color = scene.render.clear_color;
   in.exposure = scene.render.exposure;
+  in.tone_mapping = scene.render.tone_mapping;
   in.write_aovs = ctx.write_aovs;
   in.shadow_cache = scene.render.shadow_cache;
   if (!shadows.empty()) {

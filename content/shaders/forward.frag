@@ -4,6 +4,7 @@
 #include "common.glsl"
 #include "features.glsl"
 #include "shadow.glsl"
+#include "tone_mapping.glsl"
 
 in vec3 v_world_pos;
 in vec3 v_world_normal;
@@ -193,7 +194,7 @@ void main() {
 #if VARIANT_HAS_SHADOW && VARIANT_DEBUG_CASCADES
   color *= cascade_tint(tint_cascade);
 #endif
-  o_color = vec4(color * u_frame.x, 1.0);
+  o_color = vec4(tone_map(color * u_frame.x), 1.0);
 #if VARIANT_HAS_AOVS
   o_position = vec4(v_world_pos, 1.0);
   o_normal = vec4(geometric_n, view_depth);

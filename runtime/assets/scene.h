@@ -7,6 +7,7 @@
 #include <glm/glm.hpp>
 
 #include "components/shadow_settings.h"
+#include "components/tone_mapping.h"
 #include "runtime/assets/asset_store.h"
 #include "runtime/ecs/world.h"
 
@@ -26,6 +27,8 @@ struct RenderSettings {
   glm::vec3 ambient{0.08f, 0.09f, 0.11f}; ///< linear ambient radiance added to every surface
   glm::vec3 clear_color{0.55f, 0.65f, 0.8f};  ///< linear background colour
   float exposure = 1.0f;                  ///< multiplies linear colour before sRGB encoding
+  /// The curve applied after the exposure (components/tone_mapping.h); none by default.
+  ToneMapping tone_mapping = ToneMapping::none;
   /// Which shadowed light the AOV's visibility and cascade channels show: 0 the first, k the
   /// k-th further shadowed directional light (a debug path; colour is not affected).
   int aov_shadow_light = 0;

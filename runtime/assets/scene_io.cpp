@@ -66,6 +66,8 @@ const std::vector<std::pair<const char*, PrimitiveShape>> kShapes = {
     {"cylinder", PrimitiveShape::cylinder}, {"cone", PrimitiveShape::cone},
     {"terrain", PrimitiveShape::terrain}};
 
+const std::vector<std::pair<const char*, ToneMapping>> kToneMappings = {
+    {"none", ToneMapping::none}, {"khr_pbr_neutral", ToneMapping::khr_pbr_neutral}, {"aces", ToneMapping::aces}};
 const std::vector<std::pair<const char*, GroundMode>> kGroundModes = {
     {"auto", GroundMode::automatic}, {"none", GroundMode::none}, {"on", GroundMode::on}};
 
@@ -231,6 +233,7 @@ void read_render(ObjectReader& r, RenderSettings& s) {
   r.vector<3>("ambient", s.ambient, 0.0f, 1.0e4f);
   r.vector<3>("clear_color", s.clear_color, 0.0f, 1.0e4f);
   r.number("exposure", s.exposure, 0.0f, 1.0e4f);
+  r.enumeration("tone_mapping", s.tone_mapping, kToneMappings);
   r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
   r.enumeration("ground", s.ground, kGroundModes);
   r.boolean("shadow_cache", s.shadow_cache);
@@ -1097,6 +1100,7 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
                    {"ambient", vec(r.ambient)},
                    {"clear_color", vec(r.clear_color)},
                    {"exposure", num(r.exposure)},
+                   {"tone_mapping", enum_name(r.tone_mapping, kToneMappings)},
                    {"aov_shadow_light", r.aov_shadow_light},
                    {"ground", enum_name(r.ground, kGroundModes)},
                    {"shadow_cache", r.shadow_cache}};

@@ -32,11 +32,13 @@ VariantKey frame_variant(const FrameInput& frame) {
     k.set(VariantKey::kDebugCascades, s.debug_cascades ? 1u : 0u);
   }
   if (frame.write_aovs) k.set(VariantKey::kAovs, 1);
+  k.set(VariantKey::kToneMapping, std::uint32_t(frame.tone_mapping));
   return k;
 }
 
 VariantKey capture_frame_variant(VariantKey frame) {
-  VariantKey k = VariantKey(frame.bits() & ~VariantKey::kAovs.mask());
+  // Cubes hold linear radiance: no AOVs, no tone mapping.
+  VariantKey k = VariantKey(frame.bits() & ~VariantKey::kAovs.mask() & ~VariantKey::kToneMapping.mask());
   if (k.has(VariantKey::kShadow) && k.get(VariantKey::kShadowProjection) == 0)  // ortho cascades
     k.set(VariantKey::kCascadeSelection, 1);
   return k;

@@ -14,6 +14,7 @@
 #include "components/material.h"
 #include "components/mesh_renderer.h"
 #include "components/probe_state.h"
+#include "components/tone_mapping.h"
 #include "components/shadow_settings.h"
 
 namespace kaskad::render {
@@ -148,6 +149,9 @@ struct FrameInput {
   glm::vec3 ambient{0.05f};
   glm::vec3 clear_color{0.0f};
   float exposure = 1.0f;
+  /// The curve the colour output goes through after the exposure (the AOVs and probe cubes stay
+  /// linear); also applied to the clear colour.
+  ToneMapping tone_mapping = ToneMapping::none;
   /// Write the AOV targets (position, normal + depth, visibility). Off, the forward pass writes
   /// colour only: on llvmpipe the three float targets cost more than the shading itself.
   bool write_aovs = true;

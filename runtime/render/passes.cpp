@@ -670,9 +670,8 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list, GpuCac
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
   glViewport(0, 0, frame.width, frame.height);
   glEnable(GL_FRAMEBUFFER_SRGB);
-  const float clear_color[4] = {frame.clear_color.r * frame.exposure,
-                                frame.clear_color.g * frame.exposure,
-                                frame.clear_color.b * frame.exposure, 1.0f};
+  const glm::vec3 background = tone_map(frame.tone_mapping, frame.clear_color * frame.exposure);
+  const float clear_color[4] = {background.r, background.g, background.b, 1.0f};
   const float zero[4] = {0, 0, 0, 0};
   const float one = 1.0f;
   glClearBufferfv(GL_COLOR, 0, clear_color);

@@ -142,6 +142,9 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     {.name = "shadow_kernel", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_KERNEL",
      .stages = kFragmentStage, .offset = 36,
      .values = {"3x3", "5x5", "7x7", "9x9", "poisson"}, .requires_ = {"shadow"}},
+    // render.tone_mapping (components/tone_mapping.h): the curve the colour output goes through.
+    {.name = "tone_mapping", .kind = FeatureKind::frame, .define = "VARIANT_TONE_MAPPING",
+     .stages = kFragmentStage, .offset = 40, .values = {"none", "khr_pbr_neutral", "aces"}},
 };
 inline constexpr int kFeatureCount = int(std::size(kFeatureTable));
 
@@ -252,6 +255,8 @@ class VariantKey {
   static constexpr Field kShadowTechnique = feature_field("shadow_technique");
   /// PcfKernel: 0 3x3, 1 5x5, 2 7x7, 3 9x9, 4 poisson.
   static constexpr Field kShadowKernel = feature_field("shadow_kernel");
+  /// ToneMapping: 0 none, 1 khr_pbr_neutral, 2 aces.
+  static constexpr Field kToneMapping = feature_field("tone_mapping");
   static constexpr std::uint64_t kFrameMask = 0x0000ffffffff0000u;
 
   constexpr VariantKey() = default;
@@ -305,7 +310,7 @@ class VariantKey {
     }
     if (pass == Pass::shadow_points)
       return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask() &
-                         ~kShadowLayered.mask()) |
+                         ~kShadowLayered.mask() & ~kToneMapping.mask()) |
                         kReceiveShadows.mask());
     return *this;
   }

@@ -43,8 +43,9 @@ bool documented_rules_hold(VariantKey k) {
       V::kShadowFilter.mask() | V::kCascadeCountMinus1.mask() | V::kAovs.mask() |
       V::kDebugCascades.mask() | V::kCascadeSelection.mask() | V::kShadowProjection.mask() |
       V::kShadowLayered.mask() | V::kShadowLightsMinus1.mask() | V::kShadowTechnique.mask() |
-      V::kShadowKernel.mask();
+      V::kShadowKernel.mask() | V::kToneMapping.mask();
   if (k.bits() & ~used) return false;
+  if (k.get(V::kToneMapping) > 2) return false;      // none, khr_pbr_neutral, aces
   if (k.get(V::kShadowFilter) > 2) return false;     // none, bilinear, pcf3x3
   if (k.get(V::kShadowTechnique) > 2) return false;  // pcf, pcss, backprojection
   if (k.get(V::kShadowKernel) > 4) return false;     // 3x3, 5x5, 7x7, 9x9, poisson
@@ -113,9 +114,9 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   // Material keys: 2^5 free bits x 4 of the 8 reflection cube/sphere/box combinations = 128.
   // Frame keys: 2 without shadow (aovs), and with shadow 3 filters x 2 aovs x 2 debug x
   // 2 selection x 2 layered x 4 shadowed-light counts x (8 ortho cascade counts + 3 other
-  // projections) x 3 techniques x 5 kernels = 31680.
+  // projections) x 3 techniques x 5 kernels = 31680; all of them x 3 tone mappings.
   EXPECT_EQ(valid_materials, 128);
-  EXPECT_EQ(valid_frames, 2 + 31680);
+  EXPECT_EQ(valid_frames, 3 * (2 + 31680));
 }
 
 // The table is the one source: the manifest's features, their fields and the GLSL bit numbers

@@ -1,0 +1,94 @@
+// Tone mapping on the GPU (render.tone_mapping): an emissive card of known radiance filling the
+// view comes out as components/tone_mapping.h's curve of that radiance times the exposure (sRGB
+// encoded, within 8-bit rounding) for every mode, the clear colour likewise, and the AOVs are the
+// same whatever the mode.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "components/tone_mapping.h"
+#include "runtime/cli/player.h"
+#include "tests/render/player_fixture.h"
+
+namespace kaskad {
+namespace {
+
+class ToneMappingTest : public PlayerTest {
+ protected:
+  static float srgb(float linear) {
+    const float c = std::clamp(linear, 0.0f, 1.0f);
+    return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+  }
+  // An emissive card of radiance `e` filling the middle of the view, black clear colour
+  // `clear` around it, no lights, no ambient.
+  static std::filesystem::path card(glm::vec3 e, glm::vec3 clear) {
+    const std::filesystem::path file = std::filesystem::path(KASKAD_TEST_TMP) / "tone_card.json";
+    std::ofstream out(file);
+    out << R"({ "kaskad_scene": 1,
+      "render": { "ambient": [0, 0, 0], "ground": "none", "clear_color": [)"
+        << clear.r << ", " << clear.g << ", " << clear.b << R"(] },
+      "entities": [
+        { "name": "card", "transform": { "euler_deg": [90, 0, 0], "scale": [1, 1, 1] },
+          "primitive": { "shape": "plane" },
+          "material": { "base_color": [0, 0, 0, 1], "emissive": [)"
+        << e.r << ", " << e.g << ", " << e.b << R"(] } },
+        { "name": "camera", "transform": { "translation": [0, 0, 4], "look_at": [0, 0, 0] },
+          "camera": { "fov_y_deg": 40, "near": 0.1, "far": 20, "active": true } } ] })";
+    return file;
+  }
+  struct Frame {
+    Image color, aovs;
+  };
+  static Frame render(const std::filesystem::path& file, const std::vector<std::string>& sets) {
+    Frame f;
+    auto scene = load_scene(file, sets);
+    EXPECT_TRUE(scene.ok()) << scene.error().to_string();
+    if (!scene.ok()) return f;
+    RenderRun run;
+    run.width = 32;
+    run.height = 32;
+    auto t = render_frames(*player_, *scene, run);
+    EXPECT_TRUE(t.ok()) << t.error().to_string();
+    if (!t.ok()) return f;
+    f.color = player_->renderer->read_color();
+    f.aovs = player_->renderer->read_aovs();
+    return f;
+  }
+};
+
+TEST_F(ToneMappingTest, ColourFollowsTheCurveOfRadianceTimesExposure) {
+  const char* modes[] = {"none", "khr_pbr_neutral", "aces"};
+  const glm::vec3 clear(0.9f, 0.6f, 2.0f);
+  for (int m = 0; m < 3; ++m)
+    for (glm::vec3 e : {glm::vec3(0.05f), glm::vec3(0.3f), glm::vec3(1.0f), glm::vec3(3.0f),
+                        glm::vec3(4.0f, 1.0f, 0.2f)}) {
+      const float exposure = 1.5f;
+      const Frame f = render(card(e, clear), {std::string("render.tone_mapping=") + modes[m],
+                                              "render.exposure=1.5"});
+      ASSERT_EQ(f.color.width, 32);
+      const glm::vec3 want = tone_map(ToneMapping(m), e * exposure);
+      const glm::vec3 want_clear = tone_map(ToneMapping(m), clear * exposure);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(f.color.at(16, 16, c), srgb(want[c]), 1.5f / 255.0f)
+            << modes[m] << " e " << e[c] << " channel " << c;
+        EXPECT_NEAR(f.color.at(0, 0, c), srgb(want_clear[c]), 1.5f / 255.0f)
+            << modes[m] << " clear channel " << c;
+      }
+    }
+}
+
+TEST_F(ToneMappingTest, AovsStayLinear) {
+  const auto file = card(glm::vec3(2.0f), glm::vec3(0.5f));
+  const Frame none = render(file, {"render.tone_mapping=none"});
+  const Frame aces = render(file, {"render.tone_mapping=aces"});
+  EXPECT_EQ(none.aovs.pixels, aces.aovs.pixels);
+  EXPECT_NE(none.color.pixels, aces.color.pixels);
+}
+
+}  // namespace
+}  // namespace kaskad
