@@ -1221,12 +1221,7 @@ int Editor::run() {
     }
     operations_.clear();
   }
-  if (gpu::debug_error_count() > 0) {
-    std::fprintf(stderr, "kaskad edit: error: %d OpenGL errors were reported (see log above)\n",
-                 gpu::debug_error_count());
-    return 1;
-  }
-  return 0;
+  return gpu::exit_status_for_gl_errors("kaskad edit");
 }
 
 }  // namespace

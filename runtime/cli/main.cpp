@@ -485,11 +485,8 @@ int run_render(Args a) {
               timings->prewarm_ms, st.shaders.runtime_compiles);
 
   // A frame with GL errors is not written over a previous good image.
-  if (gpu::debug_error_count() > 0) {
-    std::fprintf(stderr, "kaskad: error: %d OpenGL errors were reported (see log above); "
-                 "no output written\n", gpu::debug_error_count());
-    return 1;
-  }
+  if (gpu::debug_error_count() > 0)
+    return gpu::exit_status_for_gl_errors("kaskad", "; no output written");
   if (a.output.empty()) {
     std::error_code ec;
     fs::create_directory(out.parent_path(), ec);  // the documented default, out/<scene>.png
@@ -531,12 +528,7 @@ int run_render(Args a) {
       }
     }
   }
-  if (gpu::debug_error_count() > 0) {
-    std::fprintf(stderr, "kaskad: error: %d OpenGL errors were reported (see log above)\n",
-                 gpu::debug_error_count());
-    return 1;
-  }
-  return 0;
+  return gpu::exit_status_for_gl_errors("kaskad");
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <GLFW/glfw3.h>
 
 #include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <vector>
@@ -76,6 +77,13 @@ bool display_available() {
 }
 
 int debug_error_count() { return g_debug_errors; }
+
+int exit_status_for_gl_errors(const char* who, const char* detail) {
+  if (g_debug_errors == 0) return 0;
+  std::fprintf(stderr, "%s: error: %d OpenGL errors were reported (see log above)%s\n", who,
+               g_debug_errors.load(), detail);
+  return 1;
+}
 void reset_debug_error_count() { g_debug_errors = 0; }
 
 void install_debug_output() {

@@ -52,6 +52,9 @@ bool display_available();
 /// GL errors are bugs: tests assert this stays 0.
 int debug_error_count();
 void reset_debug_error_count();
+/// A command's exit status for the GL errors so far: 0 without any; 1 after printing
+/// "<who>: error: N OpenGL errors were reported (see log above)<detail>" to stderr.
+int exit_status_for_gl_errors(const char* who, const char* detail = "");
 
 /// Installs the KHR_debug callback on the current context (done by Context::create when debug).
 void install_debug_output();

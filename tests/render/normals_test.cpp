@@ -20,24 +20,10 @@ namespace {
 
 class NormalsTest : public PlayerTest {
  protected:
-  struct Frame {
-    Image color, aovs;
-  };
+  using Frame = Shot;
   static Frame render(const std::filesystem::path& file, const std::vector<std::string>& sets,
                       int width = 320, int height = 180) {
-    Frame f;
-    auto scene = load_scene(file, sets);
-    EXPECT_TRUE(scene.ok()) << scene.error().to_string();
-    if (!scene.ok()) return f;
-    RenderRun run;
-    run.width = width;
-    run.height = height;
-    auto t = render_frames(*player_, *scene, run);
-    EXPECT_TRUE(t.ok()) << t.error().to_string();
-    if (!t.ok()) return f;
-    f.color = player_->renderer->read_color();
-    f.aovs = player_->renderer->read_aovs();
-    return f;
+    return shoot(file, sets, width, height);
   }
   static int channel(const Image& img, const std::string& name) {
     for (std::size_t c = 0; c < img.channel_names.size(); ++c)

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -36,6 +37,28 @@ class PlayerTest : public ::testing::Test {
   void TearDown() override { EXPECT_EQ(gpu::debug_error_count(), 0) << "GL errors were logged"; }
 
   static inline Player* player_ = nullptr;  ///< the suite's player (suites run one at a time)
+
+  /// One frame of the scene file `file` (with `sets` overrides) at width x height: its colour
+  /// and AOVs (empty images, with a test failure, when it does not load or render).
+  struct Shot {
+    Image color, aovs;
+  };
+  static Shot shoot(const std::filesystem::path& file, const std::vector<std::string>& sets,
+                    int width, int height) {
+    Shot f;
+    auto scene = load_scene(file, sets);
+    EXPECT_TRUE(scene.ok()) << scene.error().to_string();
+    if (!scene.ok()) return f;
+    RenderRun run;
+    run.width = width;
+    run.height = height;
+    auto t = render_frames(*player_, *scene, run);
+    EXPECT_TRUE(t.ok()) << t.error().to_string();
+    if (!t.ok()) return f;
+    f.color = player_->renderer->read_color();
+    f.aovs = player_->renderer->read_aovs();
+    return f;
+  }
 
   /// The depth of `map` (Renderer::read_shadow_map(): layers stacked top to bottom, rows top to
   /// bottom) that lookups can read: texels outside each layer's `rects` entry

@@ -41,23 +41,9 @@ class ToneMappingTest : public PlayerTest {
           "camera": { "fov_y_deg": 40, "near": 0.1, "far": 20, "active": true } } ] })";
     return file;
   }
-  struct Frame {
-    Image color, aovs;
-  };
+  using Frame = Shot;
   static Frame render(const std::filesystem::path& file, const std::vector<std::string>& sets) {
-    Frame f;
-    auto scene = load_scene(file, sets);
-    EXPECT_TRUE(scene.ok()) << scene.error().to_string();
-    if (!scene.ok()) return f;
-    RenderRun run;
-    run.width = 32;
-    run.height = 32;
-    auto t = render_frames(*player_, *scene, run);
-    EXPECT_TRUE(t.ok()) << t.error().to_string();
-    if (!t.ok()) return f;
-    f.color = player_->renderer->read_color();
-    f.aovs = player_->renderer->read_aovs();
-    return f;
+    return shoot(file, sets, 32, 32);
   }
 };
 
