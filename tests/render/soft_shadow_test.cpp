@@ -32,19 +32,22 @@ namespace fs = std::filesystem;
 // angular size theta (degrees). Its edge x = 2 casts a straight penumbra along z on the ground.
 constexpr float kSlabBottom = 1.0f, kSlabTop = 1.05f, kEdge = 2.0f;
 
-fs::path write_slab_scene(float theta_deg) {
+// The slab scene under a sun of angular size theta_deg, with `extra` entities (JSON, each
+// followed by a comma) and the shadow technique `technique`; named `name`, the process and the
+// angle, since CTest runs the tests that write it in parallel processes.
+fs::path write_scene(const std::string& name, float theta_deg, const std::string& technique,
+                     const std::string& extra) {
   const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
   fs::create_directories(dir);
-  // Named by process and angle: CTest runs the tests that write it in parallel processes.
-  const fs::path file = dir / ("slab_" + std::to_string(::getpid()) + "_" +
+  const fs::path file = dir / (name + "_" + std::to_string(::getpid()) + "_" +
                                std::to_string(int(theta_deg * 100.0f)) + ".json");
   std::ofstream(file) << R"({ "kaskad_scene": 1,
     "render": { "width": 320, "height": 180 },
-    "shadow": { "technique": "pcss", "cascade_count": 4, "fit_mode": "stable" },
+    "shadow": { "technique": ")" << technique << R"(", "cascade_count": 4, "fit_mode": "stable" },
     "entities": [
       { "name": "ground", "transform": { "scale": [40, 1, 40] }, "primitive": { "shape": "plane" } },
       { "name": "slab", "transform": { "translation": [0, 1.025, 0], "scale": [4, 0.05, 4] },
-        "primitive": { "shape": "box" } },
+        "primitive": { "shape": "box" } },)" << extra << R"(
       { "name": "sun", "transform": { "direction": [0, -1, 0] },
         "light": { "type": "directional", "cast_shadows": true, "angular_size_deg": )"
                       << theta_deg << R"( } },
@@ -52,6 +55,8 @@ fs::path write_slab_scene(float theta_deg) {
         "camera": { "fov_y_deg": 45, "near": 0.1, "far": 100, "active": true } } ] })";
   return file;
 }
+
+fs::path write_slab_scene(float theta_deg) { return write_scene("slab", theta_deg, "pcss", ""); }
 
 // Visibility of the ground at x (z well inside the slab's extent) under a cone of directions of
 // half-angle theta / 2 around the vertical: the fraction of the cone's directions (uniform over
@@ -81,24 +86,9 @@ float analytic_visibility(float x, float theta_deg) {
 constexpr float kBarMin = 2.0f, kBarMax = 2.1f, kBarBottom = 3.0f, kBarTop = 3.02f;
 
 fs::path write_two_blocker_scene(float theta_deg) {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
-  fs::create_directories(dir);
-  const fs::path file = dir / ("two_blockers_" + std::to_string(::getpid()) + ".json");
-  std::ofstream(file) << R"({ "kaskad_scene": 1,
-    "render": { "width": 320, "height": 180 },
-    "shadow": { "technique": "backprojection", "cascade_count": 4, "fit_mode": "stable" },
-    "entities": [
-      { "name": "ground", "transform": { "scale": [40, 1, 40] }, "primitive": { "shape": "plane" } },
-      { "name": "slab", "transform": { "translation": [0, 1.025, 0], "scale": [4, 0.05, 4] },
-        "primitive": { "shape": "box" } },
+  return write_scene("two_blockers", theta_deg, "backprojection", R"(
       { "name": "bar", "transform": { "translation": [2.05, 3.01, 0], "scale": [0.1, 0.02, 4] },
-        "primitive": { "shape": "box" } },
-      { "name": "sun", "transform": { "direction": [0, -1, 0] },
-        "light": { "type": "directional", "cast_shadows": true, "angular_size_deg": )"
-                      << theta_deg << R"( } },
-      { "name": "camera", "transform": { "translation": [2, 3, 4], "look_at": [2, 0, 0] },
-        "camera": { "fov_y_deg": 45, "near": 0.1, "far": 100, "active": true } } ] })";
-  return file;
+        "primitive": { "shape": "box" } },)");
 }
 
 // As analytic_visibility(), with the bar too: a ray is blocked when it crosses either.
