@@ -568,7 +568,7 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
     }
     if (out.skipped[c]) continue;
     Aabb served;  // the receivers this cascade serves (depth selection)
-    if (by_depth) {
+    if (by_depth && (s.scissor_to_receivers || s.cull_by_receivers)) {
       glm::vec4 rect =
           receiver_rect(out.view_proj[c], read_corners, receiver_boxes, margin_ndc, &served);
       if (k > 1 && i >= 1 && rect.x <= rect.z) {
