@@ -34,7 +34,9 @@ namespace {
 namespace fs = std::filesystem;
 
 // The test's fragment shader: o.x the production kernel, o.y the nine-tap reference.
-constexpr const char* kTestFrag = R"(#include "common.glsl"
+// What both test fragment shaders start with: the production lookup, the output, the layer
+// count and a hash for random points.
+constexpr const char* kFragPrelude = R"(#include "common.glsl"
 #include "features.glsl"
 #include "shadow.glsl"
 
@@ -46,7 +48,9 @@ uint hash(uint x) {
   return x;
 }
 float rnd(inout uint s) { s = hash(s); return float(s >> 8) / 16777216.0; }
+)";
 
+const std::string kTestFrag = std::string(kFragPrelude) + R"(
 float nine_taps(int layer, vec3 c) {
   vec4 tc = vec4(c.xy, float(layer), c.z);
   float sum = 0.0;
@@ -87,7 +91,7 @@ class ShadowLookupTest : public HeadlessGlTest, public ::testing::WithParamInter
 // renderer binds its shadow map, and returns the target's RGBA floats. The shaders as shipped
 // are copied, with the test's own, into a scratch folder `dir_name` (includes resolve there).
 constexpr int kSize = 64, kLayers = 3, kTarget = 256;
-std::vector<float> draw_lookup(const std::string& dir_name, const char* frag,
+std::vector<float> draw_lookup(const std::string& dir_name, const std::string& frag,
                                const std::vector<std::pair<const char*, int>>& features,
                                GLenum format) {
   const fs::path shaders = fs::path(KASKAD_CONTENT_DIR) / "shaders";
@@ -182,19 +186,7 @@ INSTANTIATE_TEST_SUITE_P(Formats, ShadowLookupTest,
 
 // The N x N boxes of pcf_kernel 5, 7, 9 (box_pcf(), compare-gathers) with a flat receiver plane
 // are the N^2 nearest compares at the texel centres around the point's texel.
-constexpr const char* kBoxFrag = R"(#include "common.glsl"
-#include "features.glsl"
-#include "shadow.glsl"
-
-layout(location = 0) out vec4 o;
-layout(location = 20) uniform int u_layers;
-
-uint hash(uint x) {
-  x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;
-  return x;
-}
-float rnd(inout uint s) { s = hash(s); return float(s >> 8) / 16777216.0; }
-
+const std::string kBoxFrag = std::string(kFragPrelude) + R"(
 float box_taps(int layer, vec3 c) {
   float size = float(textureSize(u_shadow_map, 0).x);
   vec2 t = floor(c.xy * size);
