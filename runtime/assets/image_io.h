@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "runtime/core/result.h"
@@ -22,6 +23,12 @@ struct Image {
   float& at(int x, int y, int c) { return pixels[(std::size_t(y) * width + x) * channels + c]; }
   float at(int x, int y, int c) const {
     return pixels[(std::size_t(y) * width + x) * channels + c];
+  }
+  /// Index of the channel named `name` (channel_names), or -1.
+  int channel(std::string_view name) const {
+    for (int c = 0; c < channels && c < int(channel_names.size()); ++c)
+      if (channel_names[std::size_t(c)] == name) return c;
+    return -1;
   }
 };
 

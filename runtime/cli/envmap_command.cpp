@@ -8,7 +8,11 @@
 
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
+#include "components/light.h"
+#include "components/transform.h"
+#include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/reflection_reference.h"
+#include "runtime/reference/shadow_metrics.h"
 
 namespace kaskad {
 namespace {
@@ -138,6 +142,44 @@ Status write_reflection_reference(const Scene& scene, const Image& aov, const gl
       "%.1f ms, %.2f Mrays/s)\n",
       fs::absolute(out).string().c_str(), static_cast<unsigned long long>(ref->rays),
       ref->seconds * 1e3, ref->seconds > 0.0 ? double(ref->rays) / ref->seconds * 1e-6 : 0.0);
+  return {};
+}
+
+Status write_shadow_reference(const Scene& scene, const Image& aov, ecs::Entity light,
+                              const std::string& out) {
+  auto tracer = reference::RayTracer::build(scene);
+  if (!tracer) return tracer.error();
+  const auto rlight = reference::reference_light(scene.world.get<Light>(light),
+                                                 scene.world.get<WorldTransform>(light).matrix);
+  auto ref = tracer->shadow_reference(aov, rlight, {});
+  if (!ref) return ref.error();
+  auto metrics = reference::compare_shadows(aov, ref->image);
+  if (!metrics) return metrics.error();
+  const int method_ch = aov.channel("visibility");
+  const int ref_ch = ref->image.channel("visibility");
+  const int receiver_ch = ref->image.channel("receiver");
+  Image img;
+  img.width = aov.width;
+  img.height = aov.height;
+  img.channels = 4;
+  img.channel_names = {"reference", "visibility", "error", "receiver"};
+  const std::size_t n = std::size_t(aov.width) * std::size_t(aov.height);
+  img.pixels.resize(n * 4);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float v = aov.pixels[i * std::size_t(aov.channels) + std::size_t(method_ch)];
+    const float r = ref->image.pixels[i * std::size_t(ref->image.channels) + std::size_t(ref_ch)];
+    const float rec =
+        ref->image.pixels[i * std::size_t(ref->image.channels) + std::size_t(receiver_ch)];
+    img.pixels[i * 4 + 0] = r;
+    img.pixels[i * 4 + 1] = v;
+    img.pixels[i * 4 + 2] = rec > 0.0f ? v - r : 0.0f;
+    img.pixels[i * 4 + 3] = rec;
+  }
+  KASKAD_TRY(save_image(out, img));
+  std::printf("wrote     %s (shadow reference: reference visibility error receiver; %zu receiver "
+              "pixels, RMSE %.4f, MAE %.4f; %.1f ms)\n",
+              fs::absolute(out).string().c_str(), metrics->all.pixels, metrics->all.rmse,
+              metrics->all.mean_abs_error, ref->seconds * 1e3);
   return {};
 }
 

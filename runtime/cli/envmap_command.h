@@ -1,5 +1,6 @@
-// CLI pieces for environment maps and the reflection reference (README "Environment maps"):
-// `kaskad envmap` and `kaskad render --reflection-reference`.
+// CLI pieces for environment maps and the ray-traced references (README "Environment maps",
+// "Soft shadows"): `kaskad envmap`, `kaskad render --reflection-reference` and
+// `--shadow-reference`.
 #pragma once
 
 #include <string>
@@ -23,5 +24,12 @@ int run_envmap_command(int argc, char** argv);
 /// clear colour. Prints rays and speed.
 Status write_reflection_reference(const Scene& scene, const Image& aov, const glm::vec3& eye,
                                   const std::string& environment, const std::string& out);
+
+/// Traces the visibility of `light` (area lights sampled, reference::reference_light()) at the
+/// surfaces of an AOV image and writes, as EXR to `out`, the channels reference, visibility (the
+/// AOV's), error (visibility - reference on receivers, else 0) and receiver. Prints RMSE and MAE
+/// over the receivers (reference::compare_shadows()).
+Status write_shadow_reference(const Scene& scene, const Image& aov, ecs::Entity light,
+                              const std::string& out);
 
 }  // namespace kaskad

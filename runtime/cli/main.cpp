@@ -86,6 +86,10 @@ render options:
   --reflection-reference FILE.exr
                          ray-traced reflected radiance C_t of every pixel (README "Environment maps")
   --env PATH             environment map for the reflection reference's misses (any layout)
+  --shadow-reference FILE.exr
+                         the ray-traced visibility of the light the visibility AOV shows (area
+                         lights sampled), the AOV's, and their difference, per pixel; prints
+                         RMSE and MAE over the receivers (README "Soft shadows")
   --headless             never open a window (default when there is no display)
   --window               open a window even if --headless would be the default
   -v, --verbose          debug logging (GL debug messages of every severity)
@@ -106,6 +110,7 @@ struct Args {
   std::string shadow_map;
   std::string probe_maps;
   std::string reflection_reference;  ///< render: reference EXR to write
+  std::string shadow_reference;      ///< render: shadow visibility reference EXR to write
   std::string env;                   ///< render: environment map of the reflection reference
   std::vector<std::string> sets;
   int width = 0, height = 0, frames = 10;
@@ -163,10 +168,14 @@ Args parse_args(int argc, char** argv) {
       a.reflection_reference = value();
     } else if (arg == "--env") {
       a.env = value();
-    } else if (arg == "--sweep") {
+    } else if (arg == "--shadow-reference" && a.command == "render") {
+      a.shadow_reference = value();
+    } else if (arg == "--sweep" && a.command == "bench") {
       a.sweep = value();
-    } else if (arg == "--out") {
+    } else if (arg == "--out" && a.command == "bench") {
       a.out_dir = value();
+    } else if ((arg == "--out" || arg == "--sweep") && a.command == "render") {
+      usage_error(arg + " is a bench option; kaskad render writes its image to -o FILE");
     } else if (arg == "--stability-frames" && a.command == "bench") {
       a.stability_frames = parse_int(arg, value(), 0, 10000);
     } else if (arg == "--shard" && a.command == "bench") {
@@ -177,7 +186,7 @@ Args parse_args(int argc, char** argv) {
       a.shard_index = parse_int("--shard i", v.substr(0, slash), 0, a.shard_count - 1);
     } else if (arg == "--merge" && a.command == "bench") {
       a.merge = true;
-    } else if (arg == "--no-chart") {
+    } else if (arg == "--no-chart" && a.command == "bench") {
       a.chart = false;
     } else if (arg == "--set") {
       a.sets.push_back(value());
@@ -362,7 +371,8 @@ Status check_render_outputs(const Args& a, const fs::path& out) {
   } else {
     KASKAD_TRY(check_image_output(out));
   }
-  for (const std::string* extra : {&a.aov, &a.shadow_map, &a.reflection_reference})
+  for (const std::string* extra :
+       {&a.aov, &a.shadow_map, &a.reflection_reference, &a.shadow_reference})
     if (!extra->empty()) KASKAD_TRY(check_image_output(*extra));
   if (!a.probe_maps.empty()) KASKAD_TRY(make_named_folder(a.probe_maps));
   return {};
@@ -406,7 +416,8 @@ int run_render(Args a) {
   RenderRun run;
   run.frames = a.frames;
   // The AOV targets cost fill rate: only when asked for.
-  run.write_aovs = !a.aov.empty() || !a.reflection_reference.empty();
+  run.write_aovs =
+      !a.aov.empty() || !a.reflection_reference.empty() || !a.shadow_reference.empty();
   auto timings = render_frames(*player, *scene, run);
   if (!timings) return fail(timings.error());
   if (!player->context->headless()) {
@@ -502,6 +513,18 @@ int run_render(Args a) {
     if (auto s = write_reflection_reference(*scene, player->renderer->read_aovs(),
                                             timings->last.camera.position, a.env,
                                             a.reflection_reference);
+        !s)
+      return fail(s.error());
+  }
+  if (!a.shadow_reference.empty()) {
+    const std::vector<ShadowData>& shadows = timings->last.shadows;
+    const ecs::Entity light =
+        shadows.empty() ? ecs::kNullEntity
+                        : shadows[std::size_t(aov_shadow_index(*scene, shadows.size()))].light;
+    if (!light.valid())
+      return fail(Error{"", "--shadow-reference", "the scene has no shadowed light"});
+    if (auto s = write_shadow_reference(*scene, player->renderer->read_aovs(), light,
+                                        a.shadow_reference);
         !s)
       return fail(s.error());
   }

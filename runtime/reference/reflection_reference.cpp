@@ -32,13 +32,6 @@ float smoothstep(float e0, float e1, float x) {
   return t * t * (3.0f - 2.0f * t);
 }
 
-int find_channel(const Image& image, const char* name) {
-  const auto it = std::find(image.channel_names.begin(), image.channel_names.end(), name);
-  if (it == image.channel_names.end() || it - image.channel_names.begin() >= image.channels)
-    return -1;
-  return int(it - image.channel_names.begin());
-}
-
 Status check_sizes(const Image& image, const char* what) {
   if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
       image.pixels.size() !=
@@ -235,7 +228,7 @@ Result<ReflectionReference> reflection_reference(const RayTracer& tracer, const 
     ch = kCanonical;
   } else {
     for (std::size_t i = 0; i < kNames.size(); ++i) {
-      ch[i] = find_channel(aov, kNames[i]);
+      ch[i] = aov.channel(kNames[i]);
       if (ch[i] < 0)
         return Error{"", "AOV image", std::string("has no channel '") + kNames[i] + "'"};
     }
@@ -291,8 +284,8 @@ Result<ReflectionErrorStats> compare_reflections(const Image& method, const Imag
   }
   std::array<int, 3> m{}, r{};
   for (int i = 0; i < 3; ++i) {
-    m[std::size_t(i)] = find_channel(method, kReflectionChannels[i]);
-    r[std::size_t(i)] = find_channel(reference, kReflectionChannels[i]);
+    m[std::size_t(i)] = method.channel(kReflectionChannels[i]);
+    r[std::size_t(i)] = reference.channel(kReflectionChannels[i]);
     if (m[std::size_t(i)] < 0)
       return Error{"", "reflection image",
                    std::string("has no channel '") + kReflectionChannels[i] + "'"};
@@ -300,9 +293,9 @@ Result<ReflectionErrorStats> compare_reflections(const Image& method, const Imag
       return Error{"", "reflection reference",
                    std::string("has no channel '") + kReflectionChannels[i] + "'"};
   }
-  const int mask = find_channel(reference, "mask");
+  const int mask = reference.channel("mask");
   if (mask < 0) return Error{"", "reflection reference", "has no channel 'mask'"};
-  const int reflector = find_channel(method, "reflector");  // optional
+  const int reflector = method.channel("reflector");  // optional
 
   ReflectionErrorStats stats;
   double sum_sq = 0.0, sum_abs = 0.0;

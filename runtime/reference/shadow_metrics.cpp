@@ -43,14 +43,6 @@ struct Accumulator {
   }
 };
 
-/// Index of a named channel, or -1.
-int find_channel(const Image& image, const char* name) {
-  const auto it = std::find(image.channel_names.begin(), image.channel_names.end(), name);
-  if (it == image.channel_names.end() || it - image.channel_names.begin() >= image.channels)
-    return -1;
-  return int(it - image.channel_names.begin());
-}
-
 bool consistent(const Image& image) {
   return image.width > 0 && image.height > 0 && image.channels > 0 &&
          image.pixels.size() ==
@@ -119,9 +111,9 @@ Result<ShadowMetrics> compare_shadows(const Image& aov, const Image& reference) 
                      " but the AOV image is " + std::to_string(aov.width) + "x" +
                      std::to_string(aov.height)};
   }
-  const int method_ch = find_channel(aov, "visibility");
-  const int reference_ch = find_channel(reference, "visibility");
-  const int receiver_ch = find_channel(reference, "receiver");
+  const int method_ch = aov.channel("visibility");
+  const int reference_ch = reference.channel("visibility");
+  const int receiver_ch = reference.channel("receiver");
   if (method_ch < 0) return Error{"", "AOV image", "has no channel 'visibility'"};
   if (reference_ch < 0) return Error{"", "reference image", "has no channel 'visibility'"};
   if (receiver_ch < 0) return Error{"", "reference image", "has no channel 'receiver'"};
