@@ -45,6 +45,11 @@ enum class ShadowTechnique {
                    ///< PCSS searches that lies in front of the receiver is back-projected from
                    ///< the receiver onto the light and the covered parts of the light summed
                    ///< (overlaps are counted twice: too dark where blockers overlap, S1's point)
+  /// S1's layered occlusion map (Xu 2016): pass 1 peels lom_layers depth layers from the light
+  /// and stores, per stored point, the fraction of the light its nearest occluders block
+  /// (backprojection, each part of the light counted once); pass 2 interpolates those factors
+  /// trilinearly at the shaded point. Needs a light with a size, as pcss.
+  lom,
 };
 
 /// The PCF footprint when filter is pcf3x3 and technique pcf.
@@ -117,6 +122,9 @@ struct ShadowSettings {
   int pcf_taps = 16;
   /// Radius of the poisson kernel in texels, in [1, 16]. 2.5: about the reach of a 5x5 box.
   float pcf_radius = 2.5f;
+  /// technique lom: depth layers peeled per shadow-map layer, in [2, 16]. 8: S1's experiments.
+  /// Each costs one more scene render per cascade (or face) and map_size^2 x 5 bytes.
+  int lom_layers = 8;
 
   /// N, in [1, 8]. 4: S0 recommends 3..5 (fewer is barely better than one map; each more costs
   /// a scene render).
@@ -186,11 +194,13 @@ struct ShadowSettings {
 };
 
 /// Texels a lookup reaches from the point's texel: 1.5 for S4's 3x3 (and the single taps), N / 2
-/// for an N x N box, the disc's radius plus one (its taps filter linearly) for poisson, and PCSS's
-/// largest radius plus one. Local lights keep this (plus the normal offset and one spare) free at
-/// their maps' edges; map_bounds selection likewise (shadow.glsl's filter_reach(); change
-/// together).
+/// for an N x N box, the disc's radius plus one (its taps filter linearly) for poisson, PCSS's
+/// largest radius plus one, and one for lom (its four neighbouring samples; the occlusion factors
+/// already hold the light's reach). Local lights keep this (plus the normal offset and one spare)
+/// free at their maps' edges; map_bounds selection likewise (ShadowView::filter_reach carries it
+/// to shadow.glsl's map_border()).
 inline float filter_reach_texels(const ShadowSettings& s) {
+  if (s.technique == ShadowTechnique::lom) return 1.0f;
   if (s.technique != ShadowTechnique::pcf) return float(kPcssMaxRadiusTexels) + 1.0f;
   if (s.filter != ShadowFilter::pcf3x3) return 1.5f;
   switch (s.pcf_kernel) {
@@ -229,8 +239,10 @@ inline std::string validate_shadow_settings(const ShadowSettings& s) {
   if (filter < 0 || filter > static_cast<int>(ShadowFilter::pcf3x3))
     return "filter must be none, bilinear or pcf3x3, was " + std::to_string(filter);
   const int technique = static_cast<int>(s.technique);
-  if (technique < 0 || technique > static_cast<int>(ShadowTechnique::backprojection))
-    return "technique must be pcf, pcss or backprojection, was " + std::to_string(technique);
+  if (technique < 0 || technique > static_cast<int>(ShadowTechnique::lom))
+    return "technique must be pcf, pcss, backprojection or lom, was " + std::to_string(technique);
+  if (s.lom_layers < 2 || s.lom_layers > 16)
+    return "lom_layers must be in [2, 16], was " + std::to_string(s.lom_layers);
   const int kernel = static_cast<int>(s.pcf_kernel);
   if (kernel < 0 || kernel > static_cast<int>(PcfKernel::poisson))
     return "pcf_kernel must be 3, 5, 7, 9 or poisson, was " + std::to_string(kernel);

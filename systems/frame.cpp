@@ -47,6 +47,7 @@ render::ShadowView shadow_view(const ShadowData& d, int light_index) {
   v.light_size = d.light_size;
   v.pcf_taps = s.pcf_taps;
   v.pcf_radius = s.pcf_radius;
+  v.filter_reach = filter_reach_texels(s);
   v.slope_bias = s.slope_bias;
   v.constant_bias = s.constant_bias;
   v.cull = s.cull;
@@ -84,8 +85,8 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.shadow_cache = scene.render.shadow_cache;
   if (!shadows.empty()) {
     const ShadowSettings& s = shadows.front().settings;  // shared by every view (ShadowData)
-    in.shadow_map = {s.map_size,  s.depth_format, s.filter,         s.technique,
-                     s.pcf_kernel, s.selection,   s.layered,        s.debug_cascades};
+    in.shadow_map = {s.map_size,  s.depth_format, s.filter,  s.technique,     s.pcf_kernel,
+                     s.lom_layers, s.selection,    s.layered, s.debug_cascades};
     in.aov_shadow_view = aov_shadow_index(scene, shadows.size());
   }
 

@@ -12,7 +12,8 @@ struct ShadowView {
   vec4 texel[2];                 // metres per texel per layer: view_texel(k, i)
   ivec4 info;                    // x light index, y first layer, z layer count
   vec4 params;                   // x normal offset (texels), y blend band, z paraboloid margin
-  vec4 soft;                     // x light size (ShadowView::light_size), y disc radius (texels), z taps
+  vec4 soft;                     // x light size (ShadowView::light_size), y disc radius (texels), z taps,
+                                 // w the lookup's reach in texels (ShadowView::filter_reach)
 };
 
 layout(std140, binding = 0) uniform FrameBlock {
@@ -20,7 +21,7 @@ layout(std140, binding = 0) uniform FrameBlock {
   mat4 u_view;
   vec4 u_camera_pos;                // xyz: world position
   vec4 u_ambient;                   // rgb: linear ambient radiance
-  vec4 u_frame;                     // x exposure, y shadow map size (texels a side)
+  vec4 u_frame;                     // x exposure, y shadow map size (texels a side), z lom layers
   ivec4 u_counts;                   // x lights, y shadow views, z the view the AOV shows
   vec4 u_light_color[MAX_LIGHTS];   // rgb: colour * intensity
   ivec4 u_light_info[MAX_LIGHTS];   // x type (LIGHT_*), y its shadow view (-1: none)

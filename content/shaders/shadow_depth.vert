@@ -13,7 +13,14 @@ layout(location = LOC_LIGHT_VIEW_PROJ) uniform mat4 u_light_view_proj;
 // array layer u_layer_base + a_layer.
 layout(location = LOC_LAYER_BASE) uniform int u_layer_base;
 layout(location = LOC_LAYER_VIEW_PROJ) uniform mat4 u_layer_view_proj[MAX_CASCADES];
+#endif
+#if VARIANT_SHADOW_LAYERED || VARIANT_SHADOW_PEEL
+// Layered: the layer of the view; peel (one layer per pass): 1 for a draw that receives
+// shadows but does not cast them (stored so that it is shaded, never used as an occluder).
 layout(location = ATTR_LAYER) in uint a_layer;
+#endif
+#if VARIANT_SHADOW_PEEL
+flat out uint v_receiver_only;
 #endif
 
 layout(location = ATTR_POSITION) in vec3 a_position;
@@ -25,6 +32,9 @@ out vec2 v_uv;
 void main() {
 #if MATERIAL_HAS_ALPHA_MASK
   v_uv = a_uv;
+#endif
+#if VARIANT_SHADOW_PEEL
+  v_receiver_only = a_layer;
 #endif
 #if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_DUAL_PARABOLOID
   // u_light_view_proj is the hemisphere's view; the paraboloid is not a matrix. xy as

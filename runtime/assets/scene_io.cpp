@@ -56,7 +56,7 @@ const std::vector<std::pair<const char*, ShadowFilter>> kFilters = {
     {"none", ShadowFilter::none}, {"bilinear", ShadowFilter::bilinear}, {"pcf3x3", ShadowFilter::pcf3x3}};
 const std::vector<std::pair<const char*, ShadowTechnique>> kTechniques = {
     {"pcf", ShadowTechnique::pcf}, {"pcss", ShadowTechnique::pcss},
-    {"backprojection", ShadowTechnique::backprojection}};
+    {"backprojection", ShadowTechnique::backprojection}, {"lom", ShadowTechnique::lom}};
 // pcf_kernel is written as the box side (3, 5, 7, 9) or "poisson".
 const std::vector<std::pair<const char*, PcfKernel>> kKernelNames = {{"poisson", PcfKernel::poisson}};
 const std::vector<std::pair<const char*, Projection>> kProjections = {
@@ -112,6 +112,7 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
   }
   r.integer("pcf_taps", s.pcf_taps, 8, 64);
   r.number("pcf_radius", s.pcf_radius, 1.0f, 16.0f);
+  r.integer("lom_layers", s.lom_layers, 2, 16);
   r.integer("cascade_count", s.cascade_count, 1, 8);
   r.enumeration("split_scheme", s.split_scheme, kSplitSchemes);
   r.number("lambda", s.lambda, 0.0f, 1.0f);
@@ -154,6 +155,7 @@ json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
       s.pcf_kernel != d.pcf_kernel);
   put("pcf_taps", s.pcf_taps, s.pcf_taps != d.pcf_taps);
   put("pcf_radius", num(s.pcf_radius), s.pcf_radius != d.pcf_radius);
+  put("lom_layers", s.lom_layers, s.lom_layers != d.lom_layers);
   put("cascade_count", s.cascade_count, s.cascade_count != d.cascade_count);
   put("split_scheme", enum_name(s.split_scheme, kSplitSchemes), s.split_scheme != d.split_scheme);
   put("lambda", num(s.lambda), s.lambda != d.lambda);

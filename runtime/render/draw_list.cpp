@@ -60,6 +60,15 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   for (const DrawItem& d : frame.draws) {
     const VariantKey k = material_variant(d) | fk;
     out.push_back({Pass::forward, k.filtered_for(Pass::forward)});
+    if (fk.get(VariantKey::kShadowTechnique) == VariantKey::kTechniqueLom &&
+        (d.cast_shadows || d.receive_shadows)) {  // LomPass's peels
+      const VariantKey peel =
+          VariantKey(k).set(VariantKey::kShadowPeel, 1).set(VariantKey::kShadowLayered, 0);
+      out.push_back({Pass::depth, peel.filtered_for(Pass::depth)});
+      if (frame.shadow_views.size() > 1)
+        out.push_back({Pass::depth,
+                       VariantKey(peel).set(VariantKey::kShadowProjection, 0).filtered_for(Pass::depth)});
+    }
     if (fk.has(VariantKey::kShadow) && d.cast_shadows) {
       out.push_back({Pass::depth, k.filtered_for(Pass::depth)});
       // Views after the first are cascades: the plain depth program, whatever the first's is.
@@ -79,6 +88,8 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
       if (!frame.probes.empty()) out.push_back({Pass::forward, (m | capture_fk).filtered_for(Pass::forward)});
     }
   }
+  if (fk.get(VariantKey::kShadowTechnique) == VariantKey::kTechniqueLom)
+    out.push_back({Pass::lom_occlusion, fk.filtered_for(Pass::lom_occlusion)});
   auto less = [](const ProgramRequest& a, const ProgramRequest& b) {
     return std::pair(a.pass, a.key) < std::pair(b.pass, b.key);
   };

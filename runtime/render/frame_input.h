@@ -116,6 +116,9 @@ struct ShadowView {
   float light_size = 0.0f;
   int pcf_taps = 16;
   float pcf_radius = 2.5f;
+  /// Texels the lookup reaches from the point's texel (filter_reach_texels()): map_bounds
+  /// selection keeps this, plus the normal offset, free at a cascade's edges.
+  float filter_reach = 1.5f;
   /// Depth pass: polygon offset and face culling.
   float slope_bias = 0.0f, constant_bias = 0.0f;
   CullMode cull = CullMode::back;
@@ -129,6 +132,7 @@ struct ShadowMapSettings {
   ShadowFilter filter = ShadowSettings{}.filter;
   ShadowTechnique technique = ShadowSettings{}.technique;
   PcfKernel pcf_kernel = ShadowSettings{}.pcf_kernel;
+  int lom_layers = ShadowSettings{}.lom_layers;  ///< technique lom: depth layers per map layer
   CascadeSelection selection = ShadowSettings{}.selection;
   bool layered = ShadowSettings{}.layered;  ///< all of a view's layers in one instanced pass
   bool debug_cascades = ShadowSettings{}.debug_cascades;

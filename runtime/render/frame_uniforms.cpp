@@ -48,7 +48,7 @@ ShadowViewBlock pack_view(const ShadowView& v) {
   for (int i = 0; i <= v.layer_count; ++i) b.splits[i / 4][i % 4] = v.splits[std::size_t(i)];
   b.info = glm::ivec4(v.light_index, v.first_layer, v.layer_count, 0);
   b.params = glm::vec4(v.normal_offset, v.blend_band, v.paraboloid_margin, 0.0f);
-  b.soft = glm::vec4(v.light_size, v.pcf_radius, float(v.pcf_taps), 0.0f);
+  b.soft = glm::vec4(v.light_size, v.pcf_radius, float(v.pcf_taps), v.filter_reach);
   return b;
 }
 
@@ -60,7 +60,8 @@ FrameBlock pack_frame_block(const FrameInput& frame) {
   fb.view = frame.camera.view;
   fb.camera_pos = glm::vec4(frame.camera.position, 1.0f);
   fb.ambient = glm::vec4(frame.ambient, 0.0f);
-  fb.frame_params = glm::vec4(frame.exposure, float(frame.shadow_map.size), 0.0f, 0.0f);
+  fb.frame_params = glm::vec4(frame.exposure, float(frame.shadow_map.size),
+                              float(frame.shadow_map.lom_layers), 0.0f);
   const int lights = shaded_lights(frame);
   const int views = int(frame.shadow_views.size());
   fb.counts = glm::ivec4(lights, views, views > 0 ? frame.aov_shadow_view : -1, 0);

@@ -18,7 +18,8 @@ struct alignas(16) ShadowViewBlock {
   glm::vec4 texel[2];                 ///< metres per texel per layer (view_texel(k, i))
   glm::ivec4 info;                    ///< x light index, y first layer, z layer count
   glm::vec4 params;                   ///< x normal offset (texels), y blend band, z paraboloid margin
-  /// Soft shadows: x light size (ShadowView::light_size), y Poisson disc radius (texels), z taps.
+  /// Soft shadows: x light size (ShadowView::light_size), y Poisson disc radius (texels), z taps,
+  /// w the lookup's reach in texels (ShadowView::filter_reach).
   glm::vec4 soft;
 };
 
@@ -27,7 +28,7 @@ struct alignas(16) FrameBlock {
   glm::mat4 view;
   glm::vec4 camera_pos;    ///< xyz: world position
   glm::vec4 ambient;       ///< rgb: linear ambient radiance
-  glm::vec4 frame_params;  ///< x exposure, y shadow map size (texels a side)
+  glm::vec4 frame_params;  ///< x exposure, y shadow map size (texels a side), z lom layers
   glm::ivec4 counts;       ///< x lights shaded, y shadow views, z the view the AOV shows
   glm::vec4 light_color[kMaxLights];  ///< rgb: colour * intensity
   glm::ivec4 light_info[kMaxLights];  ///< x LightType, y its shadow view (-1: none)

@@ -9,6 +9,7 @@
 #include <map>
 #include <type_traits>
 
+#include "components/bounds.h"
 #include "runtime/render/renderer.h"
 
 namespace kaskad::render {
@@ -330,20 +331,30 @@ struct CasterRun {
   bool mirrored;  ///< the casters' transforms mirror (negative determinant): reversed winding
 };
 
-// The casters of view `view` in `layers` (bit c: layer c of the view; a caster goes to the layers
-// of its mask in `layers`), in depth order, as runs that share a draw (same mesh and depth
-// program, and the same material where the depth program reads it), their instance records in
-// `records`: one per caster and layer, carrying that layer when `per_layer` (the layered pass).
-std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache,
-                                   const DrawState& state, std::size_t view, std::uint32_t layers,
-                                   bool per_layer, std::vector<InstanceRecord>& records) {
+// Draws of view `view` as instanced runs that share a draw (same mesh and depth program, and
+// the same material where the depth program reads it), in depth order. `mask_of(i)`: the layers
+// of the view (bit c) draw i goes to; `record_of(i, c)`: its instance record in layer c. The
+// records go to `records`, one per draw and layer.
+// The depth program's key of draw i in view `view`; `peel`: a LomPass depth peel (one layer per
+// pass, never the layered program).
+VariantKey depth_program_key(const DrawList& list, std::size_t view, std::uint32_t i, bool peel) {
+  VariantKey k = list.depth_key(view, i);
+  if (peel) k.set(VariantKey::kShadowPeel, 1).set(VariantKey::kShadowLayered, 0);
+  return k;
+}
+
+template <typename MaskOf, typename RecordOf>
+std::vector<CasterRun> depth_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache,
+                                  const DrawState& state, std::size_t view, bool peel,
+                                  MaskOf mask_of, RecordOf record_of,
+                                  std::vector<InstanceRecord>& records) {
   const ShadowView& v = frame.shadow_views[view];
   auto same_batch = [&](std::uint32_t i, std::uint32_t j) {
     const DrawItem& a = frame.draws[i];
     const DrawItem& b = frame.draws[j];
     if (a.mesh != b.mesh || mirrors(a.model) != mirrors(b.model) ||
-        list.depth_key(view, i).filtered_for(Pass::depth) !=
-            list.depth_key(view, j).filtered_for(Pass::depth))
+        depth_program_key(list, view, i, peel).filtered_for(Pass::depth) !=
+            depth_program_key(list, view, j, peel).filtered_for(Pass::depth))
       return false;
     return !state.depth_reads_material(list.keys[i]) ||
            (a.material == b.material && list.keys[i].material() == list.keys[j].material());
@@ -352,17 +363,32 @@ std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list
   std::vector<CasterRun> runs;
   std::uint32_t previous = 0;
   for (std::uint32_t i : list.depth_order) {
-    const std::uint32_t mask = layers & caster_mask(v, frame.draws[i]);
+    const std::uint32_t mask = mask_of(i);
     if (mask == 0 || cache.mesh(frame.draws[i].mesh).index_count == 0) continue;
     if (runs.empty() || !same_batch(previous, i))
       runs.push_back({i, records.size(), 0, mirrors(frame.draws[i].model)});
     previous = i;
     for (int c = 0; c < v.layer_count; ++c)
-      if (mask & (1u << c))
-        records.push_back(depth_instance_of(frame.draws[i].model, per_layer ? std::uint32_t(c) : 0u));
+      if (mask & (1u << c)) records.push_back(record_of(i, c));
     runs.back().count = records.size() - runs.back().first;
   }
   return runs;
+}
+
+// The casters of view `view` in `layers` (bit c: layer c of the view; a caster goes to the layers
+// of its mask in `layers`), their instance records carrying the layer when `per_layer` (the
+// layered pass).
+std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache,
+                                   const DrawState& state, std::size_t view, std::uint32_t layers,
+                                   bool per_layer, std::vector<InstanceRecord>& records) {
+  const ShadowView& v = frame.shadow_views[view];
+  return depth_runs(
+      frame, list, cache, state, view, false,
+      [&](std::uint32_t i) { return layers & caster_mask(v, frame.draws[i]); },
+      [&](std::uint32_t i, int c) {
+        return depth_instance_of(frame.draws[i].model, per_layer ? std::uint32_t(c) : 0u);
+      },
+      records);
 }
 
 // Culling, polygon offset and clipping of view `v`'s depth pass.
@@ -386,13 +412,14 @@ void set_depth_state(const ShadowView& v) {
 // light_vp: the one layer's matrix, null for the layered pass.
 Status draw_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache, DrawState& state,
                  FrameStats& stats, std::size_t view, std::span<const CasterRun> runs,
-                 std::span<const InstanceRecord> records, const glm::mat4* light_vp) {
+                 std::span<const InstanceRecord> records, const glm::mat4* light_vp,
+                 bool peel = false) {
   const std::uint32_t base = cache.upload(records);
   const ShadowView& v = frame.shadow_views[view];
   for (const CasterRun& run : runs) {
     const DrawItem& d = frame.draws[run.draw];
     const GpuMesh& m = cache.mesh(d.mesh);
-    KASKAD_TRY(state.use_program(Pass::depth, list.depth_key(view, run.draw)));
+    KASKAD_TRY(state.use_program(Pass::depth, depth_program_key(list, view, run.draw, peel)));
     const GLuint prog = state.program().id();
     if (state.depth_reads_material(list.keys[run.draw])) state.bind_material(d, list.keys[run.draw]);
     if (light_vp) {  // one layer
@@ -505,6 +532,270 @@ Image ShadowMapPass::read() const {
                   row * sizeof(float));
   return img;
 }
+
+// ---- LomPass -------------------------------------------------------------------------------------
+
+namespace {
+
+// Whether a view gets a layered occlusion map: cascades, spot maps and cube faces (the
+// paraboloid's projection is not a matrix, and its lookup is the plain one).
+bool lom_view(const ShadowView& v) { return v.projection != ShadowProjection::dual_paraboloid; }
+
+// A layer's peel region: its read rectangle grown by the widest reach of the occlusion pass's
+// search (the factors at the rectangle's edge read peels that far out).
+glm::ivec4 peel_rect(const glm::ivec4& r, int size) {
+  if (empty_rect(r)) return r;
+  const int m = kPcssMaxRadiusTexels + 2;
+  return {std::max(r.x - m, 0), std::max(r.y - m, 0), std::min(r.z + m, size),
+          std::min(r.w + m, size)};
+}
+
+}  // namespace
+
+void LomPass::ensure_storage(int size, int slices) {
+  if (depth_ && size == size_ && slices == slices_) return;
+  size_ = size;
+  slices_ = slices;
+  depth_ = gpu::make_texture(GL_TEXTURE_2D_ARRAY);
+  glTextureStorage3D(depth_.id(), 1, GL_R32F, size, size, slices);
+  occlusion_ = gpu::make_texture(GL_TEXTURE_2D_ARRAY);
+  glTextureStorage3D(occlusion_.id(), 1, GL_R8, size, size, slices);
+  test_depth_ = gpu::make_texture(GL_TEXTURE_2D);
+  glTextureStorage2D(test_depth_.id(), 1, GL_DEPTH_COMPONENT32F, size, size);
+  previous_ = gpu::make_texture(GL_TEXTURE_2D);
+  glTextureStorage2D(previous_.id(), 1, GL_R32F, size, size);
+  for (GLuint t : {depth_.id(), occlusion_.id(), previous_.id()}) {
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  }
+  peel_fbo_ = gpu::make_framebuffer();
+  glNamedFramebufferTexture(peel_fbo_.id(), GL_DEPTH_ATTACHMENT, test_depth_.id(), 0);
+  glNamedFramebufferDrawBuffer(peel_fbo_.id(), GL_COLOR_ATTACHMENT0);
+  factor_fbo_ = gpu::make_framebuffer();
+  glNamedFramebufferDrawBuffer(factor_fbo_.id(), GL_COLOR_ATTACHMENT0);
+  if (!nearest_) {
+    nearest_ = gpu::make_sampler();
+    glSamplerParameteri(nearest_.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glSamplerParameteri(nearest_.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glSamplerParameteri(nearest_.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glSamplerParameteri(nearest_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};  // outside the map: nothing stored
+    glSamplerParameterfv(nearest_.id(), GL_TEXTURE_BORDER_COLOR, border);
+    any_samples_ = gpu::make_query(GL_ANY_SAMPLES_PASSED);
+    counter_ = gpu::make_buffer();
+    glNamedBufferStorage(counter_.id(), sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
+    empty_vao_ = gpu::make_vertex_array();
+  }
+  const int layers = slices / std::max(peels_, 1);
+  drawn_from_.assign(std::size_t(layers), 0);
+  drawn_rect_.assign(std::size_t(layers), glm::ivec4(0));
+  layer_overflow_.assign(std::size_t(layers), 0);
+}
+
+Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const ShadowMapPass& shadow,
+                        FrameStats& stats) {
+  stats.lom_layers_computed = 0;
+  stats.lom_overflow_texels = 0;
+  redraw_ = 0;
+  const std::vector<ShadowView>& views = frame.shadow_views;
+  if (views.empty() || frame.shadow_map.technique != ShadowTechnique::lom) return {};
+  const int size = frame.shadow_map.size;
+  const int total = views.back().first_layer + views.back().layer_count;
+  const int peels = frame.shadow_map.lom_layers + 1;
+  const int slices = total * peels;
+  if (!depth_ || size != size_ || slices != slices_ || peels != peels_) {
+    GLint max_layers = 0;
+    glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+    const double mib = double(size) * size * slices * 5.0 / double(1 << 20);
+    const std::string what = std::to_string(slices) + " slices of " + std::to_string(size) +
+                             "^2 (" + std::to_string(int(mib)) + " MiB)";
+    if (slices > max_layers)
+      return Error{"", "shadow.lom_layers", "the layered occlusion map needs " + what +
+                                                ", more than this driver's GL_MAX_ARRAY_TEXTURE_LAYERS " +
+                                                std::to_string(max_layers)};
+    glTexImage3D(GL_PROXY_TEXTURE_2D_ARRAY, 0, GL_R32F, size, size, slices, 0, GL_RED, GL_FLOAT,
+                 nullptr);
+    GLint got = 0;
+    glGetTexLevelParameteriv(GL_PROXY_TEXTURE_2D_ARRAY, 0, GL_TEXTURE_WIDTH, &got);
+    if (got == 0)
+      return Error{"", "shadow.lom_layers",
+                   "the OpenGL driver refuses the layered occlusion map's " + what +
+                       "; use a smaller map_size, fewer lom_layers or fewer cascades"};
+    peels_ = peels;
+    depth_ = {};
+    ensure_storage(size, slices);
+  }
+  // A layer's inputs beyond its casters: the receivers that cast nothing (stored, so that they
+  // are shaded), the light's size and the layer count.
+  inputs_.assign(std::size_t(total), 0);
+  for (const ShadowView& v : views)
+    for (int c = 0; c < v.layer_count; ++c) {
+      const int layer = v.first_layer + c;
+      InputHash h;
+      h.add(shadow.layer_inputs(layer)).add(v.light_size).add(peels).add(v.cull);
+      for (std::uint32_t i : list.depth_order) {
+        const DrawItem& d = frame.draws[i];
+        if (d.receive_shadows && !d.cast_shadows) h.add(d.mesh).add(d.model);
+      }
+      inputs_[std::size_t(layer)] = h.value();
+      if (!lom_view(v) || v.skipped[std::size_t(c)]) continue;
+      const glm::ivec4 rect = stats.layer_rect[std::size_t(layer)];
+      const bool drawn = drawn_from_[std::size_t(layer)] != 0 &&
+                         holds(drawn_rect_[std::size_t(layer)], rect);
+      const bool held = ((v.held >> c) & 1u) != 0;
+      if (!frame.shadow_cache || !drawn || (inputs_[std::size_t(layer)] != drawn_from_[std::size_t(layer)] && !held))
+        redraw_ |= 1u << layer;
+    }
+  stats.lom_layers_computed = redraw_;
+  return {};
+}
+
+Status LomPass::record(const FrameInput& frame, const DrawList& list, GpuCache& cache,
+                       DrawState& state, FrameStats& stats) {
+  if (frame.shadow_views.empty() || frame.shadow_map.technique != ShadowTechnique::lom) return {};
+  const int peels = peels_;
+  Status status;
+  std::vector<InstanceRecord> records;
+  for (std::size_t view = 0; view < frame.shadow_views.size() && status; ++view) {
+    const ShadowView& v = frame.shadow_views[view];
+    for (int c = 0; c < v.layer_count && status; ++c) {
+      const int layer = v.first_layer + c;
+      if (!((redraw_ >> layer) & 1u)) continue;
+      const glm::ivec4 read = stats.layer_rect[std::size_t(layer)];
+      const glm::ivec4 r = peel_rect(read, size_);
+      if (empty_rect(r)) continue;
+      // a. Peels 0 .. lom_layers (the last one only to count what did not fit): casters of
+      //    the layer, and receivers in its frustum (flagged when they cast nothing).
+      const glm::mat4& vp = v.view_proj[std::size_t(c)];
+      const std::uint32_t bit = 1u << c;
+      auto mask_of = [&](std::uint32_t i) -> std::uint32_t {
+        const DrawItem& d = frame.draws[i];
+        if (caster_mask(v, d) & bit) return bit;
+        return d.receive_shadows && !outside_clip_volume(vp, d.bounds) ? bit : 0u;
+      };
+      auto record_of = [&](std::uint32_t i, int) {
+        const DrawItem& d = frame.draws[i];
+        return depth_instance_of(d.model, d.cast_shadows ? 0u : 1u);
+      };
+      const auto runs =
+          depth_runs(frame, list, cache, state, view, true, mask_of, record_of, records);
+      glBindFramebuffer(GL_FRAMEBUFFER, peel_fbo_.id());
+      glViewport(0, 0, size_, size_);
+      glEnable(GL_SCISSOR_TEST);
+      glScissor(r.x, r.y, r.z - r.x, r.w - r.y);
+      set_depth_state(v);
+      glDisable(GL_POLYGON_OFFSET_FILL);  // exact depths: the peels compare them bit for bit
+      glEnable(GL_DEPTH_TEST);
+      glDepthFunc(GL_LESS);
+      glDepthMask(GL_TRUE);
+      glBindTextureUnit(kTexPeelPrevious, previous_.id());
+      glBindSampler(kTexPeelPrevious, 0);
+      // A peel that finds nothing leaves the deeper ones empty: they are only cleared.
+      int found = peels;
+      for (int j = 0; j < peels && status; ++j) {
+        const int slice = layer * peels + j;
+        glNamedFramebufferTextureLayer(peel_fbo_.id(), GL_COLOR_ATTACHMENT0, depth_.id(), 0, slice);
+        const float empty[4] = {1.0f, 0.0f, 0.0f, 0.0f};
+        glClearBufferfv(GL_COLOR, 0, empty);
+        if (j >= found) continue;
+        if (j == 0) {
+          const float none = 0.0f;
+          glClearTexSubImage(previous_.id(), 0, r.x, r.y, 0, r.z - r.x, r.w - r.y, 1, GL_RED,
+                             GL_FLOAT, &none);
+        } else {
+          glCopyImageSubData(depth_.id(), GL_TEXTURE_2D_ARRAY, 0, r.x, r.y, slice - 1,
+                             previous_.id(), GL_TEXTURE_2D, 0, r.x, r.y, 0, r.z - r.x,
+                             r.w - r.y, 1);
+        }
+        glClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
+        glBeginQuery(GL_ANY_SAMPLES_PASSED, any_samples_.id());
+        status = draw_runs(frame, list, cache, state, stats, view, runs, records,
+                           &v.view_proj[std::size_t(c)], true);
+        glEndQuery(GL_ANY_SAMPLES_PASSED);
+        GLuint any = 0;
+        glGetQueryObjectuiv(any_samples_.id(), GL_QUERY_RESULT, &any);
+        if (!any) found = j;
+      }
+      glDisable(GL_CLIP_DISTANCE0);
+      if (!status) break;
+      // b. The occlusion factor of every stored point in the read rectangle (one texel more
+      //    for pass 2's bilinear samples), peel by peel; the last peel's draw counts the
+      //    texels where the overflow peel found a surface.
+      auto program = state.use_program(Pass::lom_occlusion, list.frame_key.filtered_for(Pass::lom_occlusion));
+      if (!program) {
+        status = program.error();
+        break;
+      }
+      const glm::ivec4 f = {std::max(read.x - 1, 0), std::max(read.y - 1, 0),
+                            std::min(read.z + 1, size_), std::min(read.w + 1, size_)};
+      glBindFramebuffer(GL_FRAMEBUFFER, factor_fbo_.id());
+      glScissor(f.x, f.y, f.z - f.x, f.w - f.y);
+      glDisable(GL_DEPTH_TEST);
+      glDisable(GL_CULL_FACE);
+      bind();
+      const GLuint zero = 0;
+      glNamedBufferSubData(counter_.id(), 0, sizeof zero, &zero);
+      glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, counter_.id());
+      glBindVertexArray(empty_vao_.id());
+      // Empty peels get no factors: lookups read a factor only where a depth is stored.
+      for (int j = 0; j + 1 < peels && j < found; ++j) {
+        glNamedFramebufferTextureLayer(factor_fbo_.id(), GL_COLOR_ATTACHMENT0, occlusion_.id(), 0,
+                                       layer * peels + j);
+        glProgramUniform4i(state.program().id(), kLocLomTarget, int(view), c, j,
+                           j + 2 == peels ? 1 : 0);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+      }
+      glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT);
+      GLuint overflow = 0;  // 0 unless the overflow peel found something
+      if (found == peels) glGetNamedBufferSubData(counter_.id(), 0, sizeof overflow, &overflow);
+      layer_overflow_[std::size_t(layer)] = std::int64_t(overflow);
+      drawn_from_[std::size_t(layer)] = inputs_[std::size_t(layer)];
+      drawn_rect_[std::size_t(layer)] = read;
+      glEnable(GL_DEPTH_TEST);
+    }
+  }
+  glDisable(GL_SCISSOR_TEST);
+  glBindVertexArray(0);
+  for (std::int64_t n : layer_overflow_) stats.lom_overflow_texels += n;
+  return status;
+}
+
+void LomPass::bind() {
+  if (!depth_) return;
+  glBindTextureUnit(kTexLomDepth, depth_.id());
+  glBindSampler(kTexLomDepth, nearest_.id());
+  glBindTextureUnit(kTexLomOcclusion, occlusion_.id());
+  glBindSampler(kTexLomOcclusion, nearest_.id());
+}
+
+namespace {
+
+// Every slice of a 2D array texture of one red channel, stacked as ShadowMapPass::read().
+Image read_slices(const gpu::Texture& t, int size, int slices) {
+  Image img;
+  img.width = size;
+  img.height = size * slices;
+  img.channels = 1;
+  img.channel_names = {"Y"};
+  if (!t) return img;
+  const std::size_t row = std::size_t(size), layer = row * row;
+  std::vector<float> stack(layer * std::size_t(slices));
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(t.id(), 0, GL_RED, GL_FLOAT, GLsizei(stack.size() * sizeof(float)),
+                    stack.data());
+  img.pixels.resize(stack.size());
+  for (int l = 0; l < slices; ++l)
+    for (int y = 0; y < size; ++y)
+      std::memcpy(&img.pixels[std::size_t(l) * layer + std::size_t(y) * row],
+                  &stack[std::size_t(l) * layer + std::size_t(size - 1 - y) * row],
+                  row * sizeof(float));
+  return img;
+}
+
+}  // namespace
+
+Image LomPass::read_depths() const { return read_slices(depth_, size_, slices_); }
+Image LomPass::read_factors() const { return read_slices(occlusion_, size_, slices_); }
 
 // ---- Forward drawing (main view and probe faces) ------------------------------------------------
 

@@ -31,6 +31,7 @@ struct Renderer::Impl {
 
   // The passes, in order (passes.h).
   ShadowMapPass shadow;
+  LomPass lom;
   ProbeCapturePass probe_capture;
   ForwardPass forward;
 
@@ -192,9 +193,13 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
                                state.features_by_uniform(), stats_));
   glBeginQuery(GL_TIME_ELAPSED, im.timers[0].id());
   Status st = im.shadow.record(frame, list, *im.cache, state, stats_);
+  // S1's layered occlusion map (technique lom) from those layers, timed with them.
+  if (st) st = im.lom.prepare(frame, list, im.shadow, stats_);
+  if (st) st = im.lom.record(frame, list, *im.cache, state, stats_);
   glEndQuery(GL_TIME_ELAPSED);
   KASKAD_TRY(st);
   im.shadow.bind();
+  im.lom.bind();
 
   // 2. Probe captures. After it: every probe's visible cube (and sphere map) is the one the
   //    frame's reflections read.
@@ -279,6 +284,7 @@ Result<std::vector<glm::vec2>> Renderer::shadow_at_points(std::span<const glm::v
   // case other GL work ran in between.
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
   im.shadow.bind();
+  im.lom.bind();
   glBindFramebuffer(GL_FRAMEBUFFER, im.points_fbo.id());
   glViewport(0, 0, w, h);
   glDisable(GL_DEPTH_TEST);
@@ -395,6 +401,8 @@ std::array<std::size_t, kMaxCascades> Renderer::cascade_pixel_counts() const {
 }
 
 Image Renderer::read_shadow_map() const { return impl_->shadow.read(); }
+Image Renderer::read_lom_depths() const { return impl_->lom.read_depths(); }
+Image Renderer::read_lom_factors() const { return impl_->lom.read_factors(); }
 
 CubeMap Renderer::read_probe_cube(ProbeHandle handle, int buffer) const {
   return impl_->cache->probes().read_cube(handle, buffer);

@@ -62,6 +62,12 @@ struct FrameStats {
   /// cascade_pixel_counts(), which render_frames() calls after its last frame when AOVs are
   /// written; 0 otherwise.
   std::array<std::size_t, kMaxCascades> cascade_receiver_pixels{};
+  /// ShadowTechnique::lom: shadow-map layers whose peels and occlusion factors were recomputed
+  /// this frame (bit l, as shadow_layers_rendered), and texels, over all layers, where the
+  /// depth peels found more light-facing surfaces than lom_layers (a point under all of them
+  /// reads as umbra; shadow.glsl's lom()).
+  std::uint32_t lom_layers_computed = 0;
+  std::int64_t lom_overflow_texels = 0;
   /// GPU times are the previous frame's (queries are read a frame late); 0 until frame 3.
   double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
   double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)
@@ -122,6 +128,10 @@ class Renderer {
   /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom; with
   /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;
+  /// Technique lom: the signed depths of every depth peel and the occlusion factors, stacked as
+  /// read_shadow_map() (lom_layers + 1 slices per shadow-map layer; empty before the first).
+  Image read_lom_depths() const;
+  Image read_lom_factors() const;
 
   /// The visibility of the shadow view the AOV shows (FrameInput::aov_shadow_view) at fixed world
   /// points

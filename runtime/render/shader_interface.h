@@ -31,23 +31,26 @@ static_assert(sizeof(InstanceRecord) == 128);
 
 // Uniform locations (no name look-ups at draw time). Per-program ones may share a number when no
 // program has both: the layered depth pass (13, 14, 16..), the points pass (13), reflections
-// (16..19).
+// (16..19), the LOM occlusion pass (20: ivec4 view, layer of the view, peel, count overflow).
 inline constexpr int kLocBaseColor = 8, kLocMaterial = 9, kLocEmissive = 10,
                      kLocFeatureBits = 11, kLocLightViewProj = 12, kLocTargetSize = 13,
                      kLocLayerBase = 14, kLocLayerViewProj = 16,
                      kLocReflection = 16, kLocReflectionBoxMin = 17, kLocReflectionBoxMax = 18,
-                     kLocReflectionCentre = 19;
+                     kLocReflectionCentre = 19, kLocLomTarget = 20;
 
 // Texture units.
 /// kTexShadowDepth: the shadow map again, through a sampler without depth compare (raw depths for
 /// PCSS's blocker search); kTexShadowLinear: again, compared with linear filtering (each tap of
 /// the disc kernels a hardware 2x2 PCF). ShadowMapPass::bind() binds all three.
+/// kTexLomDepth / kTexLomOcclusion: S1's layered depth map (signed depths, LomPass) and its
+/// occlusion factors; kTexPeelPrevious: the layer before the one a depth peel draws.
 inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
                           kTexReflectionCube = 3, kTexReflectionSphere = 4, kTexShadowDepth = 5,
-                          kTexShadowLinear = 6;
+                          kTexShadowLinear = 6, kTexLomDepth = 7, kTexLomOcclusion = 8,
+                          kTexPeelPrevious = 9;
 
 /// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...).
-inline std::array<std::pair<const char*, int>, 25> shader_interface_defines() {
+inline std::array<std::pair<const char*, int>, 29> shader_interface_defines() {
   return {{{"ATTR_POSITION", kAttrPosition},
            {"ATTR_NORMAL", kAttrNormal},
            {"ATTR_UV", kAttrUv},
@@ -66,11 +69,15 @@ inline std::array<std::pair<const char*, int>, 25> shader_interface_defines() {
            {"LOC_REFLECTION_BOX_MIN", kLocReflectionBoxMin},
            {"LOC_REFLECTION_BOX_MAX", kLocReflectionBoxMax},
            {"LOC_REFLECTION_CENTRE", kLocReflectionCentre},
+           {"LOC_LOM_TARGET", kLocLomTarget},
            {"UNIT_BASE_COLOR", int(kTexBaseColor)},
            {"UNIT_NORMAL", int(kTexNormal)},
            {"UNIT_SHADOW", int(kTexShadow)},
            {"UNIT_SHADOW_DEPTH", int(kTexShadowDepth)},
            {"UNIT_SHADOW_LINEAR", int(kTexShadowLinear)},
+           {"UNIT_LOM_DEPTH", int(kTexLomDepth)},
+           {"UNIT_LOM_OCCLUSION", int(kTexLomOcclusion)},
+           {"UNIT_PEEL_PREVIOUS", int(kTexPeelPrevious)},
            {"UNIT_REFLECTION_CUBE", int(kTexReflectionCube)},
            {"UNIT_REFLECTION_SPHERE", int(kTexReflectionSphere)}}};
 }

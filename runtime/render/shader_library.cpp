@@ -29,6 +29,7 @@ PassFiles files_for(Pass pass) {
   switch (pass) {
     case Pass::depth: return {"shadow_depth.vert", "shadow_depth.frag"};
     case Pass::shadow_points: return {"shadow_points.vert", "shadow_points.frag"};
+    case Pass::lom_occlusion: return {"fullscreen.vert", "lom_occlusion.frag"};
     case Pass::forward: break;
   }
   return {"forward.vert", "forward.frag"};

@@ -21,7 +21,7 @@
 //   shadow_projection != ortho has cascade_count 1 (cascades are directional only)
 //   shadow_layered needs shadow; the depth pass keeps it (its vertex shader picks the layer)
 //   shadow_lights != 1 needs shadow (the lookups of lights that do not exist are not compiled)
-//   shadow_technique != pcf and shadow_kernel != k3x3 need shadow
+//   shadow_technique != pcf, shadow_kernel != k3x3 and shadow_peel need shadow
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask, and the projection
 // when it is dual_paraboloid: its vertex shader differs), so every material shares one or two
 // shadow programs.
@@ -35,14 +35,16 @@
 
 namespace kaskad::render {
 
-/// forward: colour + AOVs; depth: shadow maps; shadow_points: the shadow lookup evaluated at given
-/// world points (Renderer::shadow_at_points(), the stability metrics).
-enum class Pass : std::uint8_t { forward = 0, depth = 1, shadow_points = 2 };
+/// forward: colour + AOVs; depth: shadow maps (and LOM's depth peels); shadow_points: the shadow
+/// lookup evaluated at given world points (Renderer::shadow_at_points(), the stability metrics);
+/// lom_occlusion: the occlusion factors of S1's layered occlusion map (LomPass).
+enum class Pass : std::uint8_t { forward = 0, depth = 1, shadow_points = 2, lom_occlusion = 3 };
 
 constexpr const char* pass_name(Pass pass) {
   switch (pass) {
     case Pass::depth: return "depth";
     case Pass::shadow_points: return "points";
+    case Pass::lom_occlusion: return "lom";
     case Pass::forward: break;
   }
   return "forward";
@@ -136,7 +138,12 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // ShadowSettings::technique). Bits 32-35 leave the field room for the techniques to come
     // (backprojection, lom, vsm, evsm).
     {.name = "shadow_technique", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_TECHNIQUE",
-     .stages = kFragmentStage, .offset = 32, .values = {"pcf", "pcss", "backprojection"}, .requires_ = {"shadow"}},
+     .stages = kFragmentStage, .offset = 32, .values = {"pcf", "pcss", "backprojection", "lom"}, .requires_ = {"shadow"}},
+    // The depth pass peeling layer j > 0 of S1's layered depth map (LomPass): fragments at or in
+    // front of layer j - 1 are discarded, and each writes its depth, signed by whether its draw
+    // casts shadows.
+    {.name = "shadow_peel", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_PEEL",
+     .stages = kVertexStage | kFragmentStage, .offset = 30, .requires_ = {"shadow"}},
     // The PCF footprint of shadow_filter pcf3x3 (ShadowSettings::pcf_kernel): N x N boxes of
     // nearest compares, or a rotated Poisson-like disc of ShadowSettings::pcf_taps taps.
     {.name = "shadow_kernel", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_KERNEL",
@@ -251,8 +258,11 @@ class VariantKey {
   /// A count, not a switch, so loops over shadowed lights have a compile-time bound and a light
   /// that does not exist costs nothing (llvmpipe runs a zero-trip loop's body once, masked).
   static constexpr Field kShadowLightsMinus1 = feature_field("shadow_lights");
-  /// ShadowTechnique: 0 pcf, 1 pcss, 2 backprojection.
+  /// ShadowTechnique: 0 pcf, 1 pcss, 2 backprojection, 3 lom.
   static constexpr Field kShadowTechnique = feature_field("shadow_technique");
+  static constexpr std::uint32_t kTechniqueLom = 3;
+  /// Depth pass: peel a layer of S1's layered depth map.
+  static constexpr Field kShadowPeel = feature_field("shadow_peel");
   /// PcfKernel: 0 3x3, 1 5x5, 2 7x7, 3 9x9, 4 poisson.
   static constexpr Field kShadowKernel = feature_field("shadow_kernel");
   /// ToneMapping: 0 none, 1 khr_pbr_neutral, 2 aces.
@@ -296,9 +306,9 @@ class VariantKey {
   /// The combination rules in the header comment. Unused bits must be zero.
   constexpr bool valid() const { return broken_rule().kind == BrokenRule::none; }
 
-  /// The part of the key a pass's shaders read. The depth pass only needs alpha masking; the
-  /// shadow-points pass only the shadow lookup's frame features (a receiver, without AOVs or the
-  /// debug tint); the forward pass needs everything.
+  /// The part of the key a pass's shaders read. The depth pass only needs alpha masking (and
+  /// peeling); the shadow-points and LOM occlusion passes only the shadow lookup's frame
+  /// features (a receiver, without AOVs or the debug tint); the forward pass needs everything.
   constexpr VariantKey filtered_for(Pass pass) const {
     if (pass == Pass::depth) {
       const std::uint64_t projection = get(kShadowProjection) == kProjectionDualParaboloid
@@ -306,11 +316,12 @@ class VariantKey {
                                            : 0u;
       const std::uint64_t layered =
           has(kShadowLayered) ? kShadowLayered.mask() | kShadow.mask() : 0u;
-      return VariantKey(bits_ & (kAlphaMask.mask() | projection | layered));
+      const std::uint64_t peel = has(kShadowPeel) ? kShadowPeel.mask() | kShadow.mask() : 0u;
+      return VariantKey(bits_ & (kAlphaMask.mask() | projection | layered | peel));
     }
-    if (pass == Pass::shadow_points)
+    if (pass == Pass::shadow_points || pass == Pass::lom_occlusion)
       return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask() &
-                         ~kShadowLayered.mask() & ~kToneMapping.mask()) |
+                         ~kShadowLayered.mask() & ~kToneMapping.mask() & ~kShadowPeel.mask()) |
                         kReceiveShadows.mask());
     return *this;
   }

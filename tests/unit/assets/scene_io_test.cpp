@@ -228,7 +228,8 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
 
   // Saved and read again, with a spot light's radius.
   const fs::path file = temp_dir() / "soft.json";
-  std::ofstream(file) << R"({ "shadow": { "technique": "pcss", "pcf_kernel": "poisson", "pcf_taps": 24 },
+  std::ofstream(file) << R"({ "shadow": { "technique": "pcss", "pcf_kernel": "poisson", "pcf_taps": 24,
+                               "lom_layers": 5 },
     "entities": [
       { "name": "lamp", "transform": { "translation": [0, 4, 0], "direction": [0, -1, 0] },
         "light": { "type": "spot", "cast_shadows": true, "radius": 0.25 },
@@ -245,6 +246,7 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   EXPECT_EQ(again->shadow_defaults.technique, ShadowTechnique::pcss);
   EXPECT_EQ(again->shadow_defaults.pcf_kernel, PcfKernel::poisson);
   EXPECT_EQ(again->shadow_defaults.pcf_taps, 24);
+  EXPECT_EQ(again->shadow_defaults.lom_layers, 5);
   EXPECT_EQ(again->world.get<ShadowSettings>(find(*again, "lamp")).pcf_kernel, PcfKernel::k9x9);
 
   expect_error(read_scene(def, {"shadow.technique=vsm"}), {"/shadow/technique", "vsm", "pcf", "pcss", "backprojection"});
@@ -258,6 +260,9 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   expect_error(read_scene(def, {"shadow.pcf_taps=65"}), {"/shadow/pcf_taps", "65"});
   expect_error(read_scene(def, {"shadow.pcf_radius=0.5"}), {"/shadow/pcf_radius", "0.5"});
   expect_error(read_scene(def, {"shadow.pcf_radius=17"}), {"/shadow/pcf_radius", "17"});
+  expect_error(read_scene(def, {"shadow.lom_layers=1"}), {"/shadow/lom_layers", "[2, 16]", "1"});
+  expect_error(read_scene(def, {"shadow.lom_layers=17"}), {"/shadow/lom_layers", "17"});
+  expect_error(read_scene(def, {"shadow.technique=layered"}), {"/shadow/technique", "lom"});
   expect_error(read_scene(file, {"lamp.light.radius=-0.1"}), {"/light/radius", "-0.1"});
   expect_error(read_scene(file, {"lamp.light.radius=101"}), {"/light/radius", "101"});
   expect_error(read_scene(file, {"lamp.light.angular_size_deg=1"}),
@@ -269,7 +274,11 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   EXPECT_EQ(validate_shadow_settings(bad), "pcf_taps must be in [8, 64], was 100");
   bad = {};
   bad.technique = ShadowTechnique(7);
-  EXPECT_EQ(validate_shadow_settings(bad), "technique must be pcf, pcss or backprojection, was 7");
+  EXPECT_EQ(validate_shadow_settings(bad),
+            "technique must be pcf, pcss, backprojection or lom, was 7");
+  bad = {};
+  bad.lom_layers = 1;
+  EXPECT_EQ(validate_shadow_settings(bad), "lom_layers must be in [2, 16], was 1");
 }
 
 TEST(SceneIo, OverrideErrorsListValidKeys) {

@@ -43,11 +43,11 @@ bool documented_rules_hold(VariantKey k) {
       V::kShadowFilter.mask() | V::kCascadeCountMinus1.mask() | V::kAovs.mask() |
       V::kDebugCascades.mask() | V::kCascadeSelection.mask() | V::kShadowProjection.mask() |
       V::kShadowLayered.mask() | V::kShadowLightsMinus1.mask() | V::kShadowTechnique.mask() |
-      V::kShadowKernel.mask() | V::kToneMapping.mask();
+      V::kShadowKernel.mask() | V::kToneMapping.mask() | V::kShadowPeel.mask();
   if (k.bits() & ~used) return false;
   if (k.get(V::kToneMapping) > 2) return false;      // none, khr_pbr_neutral, aces
   if (k.get(V::kShadowFilter) > 2) return false;     // none, bilinear, pcf3x3
-  if (k.get(V::kShadowTechnique) > 2) return false;  // pcf, pcss, backprojection
+  if (k.get(V::kShadowTechnique) > 3) return false;  // pcf, pcss, backprojection, lom
   if (k.get(V::kShadowKernel) > 4) return false;     // 3x3, 5x5, 7x7, 9x9, poisson
   if (k.has(V::kReflectionCube) && k.has(V::kReflectionSphere)) return false;
   if (k.has(V::kReflectionBox) && !k.has(V::kReflectionCube)) return false;
@@ -55,7 +55,7 @@ bool documented_rules_hold(VariantKey k) {
                             k.has(V::kDebugCascades) || k.has(V::kCascadeSelection) ||
                             k.has(V::kShadowProjection) || k.has(V::kShadowLayered) ||
                             k.has(V::kShadowLightsMinus1) || k.has(V::kShadowTechnique) ||
-                            k.has(V::kShadowKernel);
+                            k.has(V::kShadowKernel) || k.has(V::kShadowPeel);
   if (needs_shadow && !k.has(V::kShadow)) return false;
   if (k.has(V::kShadowProjection) && k.has(V::kCascadeCountMinus1)) return false;
   return true;
@@ -80,6 +80,7 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
     EXPECT_EQ(k.filtered_for(Pass::forward), k);
     EXPECT_TRUE(k.filtered_for(Pass::depth).valid());
     EXPECT_TRUE(k.filtered_for(Pass::shadow_points).valid());
+    EXPECT_TRUE(k.filtered_for(Pass::lom_occlusion).valid());
     return true;
   };
   // No rule links a material feature to a frame feature, so every subset of the frame bits is
@@ -114,9 +115,9 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   // Material keys: 2^5 free bits x 4 of the 8 reflection cube/sphere/box combinations = 128.
   // Frame keys: 2 without shadow (aovs), and with shadow 3 filters x 2 aovs x 2 debug x
   // 2 selection x 2 layered x 4 shadowed-light counts x (8 ortho cascade counts + 3 other
-  // projections) x 3 techniques x 5 kernels = 31680; all of them x 3 tone mappings.
+  // projections) x 4 techniques x 5 kernels x 2 peel = 84480; all of them x 3 tone mappings.
   EXPECT_EQ(valid_materials, 128);
-  EXPECT_EQ(valid_frames, 3 * (2 + 31680));
+  EXPECT_EQ(valid_frames, 3 * (2 + 84480));
 }
 
 // The table is the one source: the manifest's features, their fields and the GLSL bit numbers
