@@ -1,6 +1,9 @@
-// Forward shading: Blinn-Phong driven by glTF metallic-roughness inputs, linear lighting, sRGB
-// output through the sRGB colour target. Features (content/shaders/features.json) are selected by
-// the preprocessor only; see README.md in this folder.
+// Forward shading: the glTF 2.0 metallic-roughness BRDF (brdf.glsl, the specification's Appendix
+// B), linear lighting, sRGB output through the sRGB colour target. A light's colour is the
+// illuminance it delivers (outgoing radiance = f * E * N.L; components/brdf.h); u_ambient is a
+// uniform radiance, which a Lambert surface reflects as ambient * c_diff. Features
+// (content/shaders/features.json) are selected by the preprocessor only; see README.md in this folder.
+#include "brdf.glsl"
 #include "common.glsl"
 #include "features.glsl"
 #include "shadow.glsl"
@@ -84,13 +87,8 @@ void main() {
 #endif
 
   float metallic = clamp(u_material.x, 0.0, 1.0);
-  float roughness = clamp(u_material.y, 0.03, 1.0);
-  vec3 diffuse_color = base.rgb * (1.0 - metallic);
-  vec3 f0 = mix(vec3(0.04), base.rgb, metallic);
-  // Blinn-Phong exponent from roughness (alpha = roughness^2, n = 2 / alpha^2 - 2), energy-normalised.
-  float alpha = roughness * roughness;
-  float shininess = max(2.0 / (alpha * alpha) - 2.0, 1.0);
-  float spec_norm = (shininess + 8.0) / 8.0;
+  float roughness = u_material.y;  // brdf_evaluate() clamps it
+  vec3 diffuse_color = mix(base.rgb, vec3(0.0), metallic);  // Appendix B's c_diff
 
   float view_depth = -(u_view * vec4(v_world_pos, 1.0)).z;
   vec3 color = u_ambient.rgb * diffuse_color;
@@ -150,14 +148,13 @@ void main() {
     }
     float ndl = max(dot(n, l), 0.0);
     if (ndl <= 0.0) continue;
-    vec3 h = normalize(l + v);
-    vec3 spec = f0 * spec_norm * pow(max(dot(n, h), 0.0), shininess);
     float shadow = 1.0;
 #if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
     for (int k = 0; k < SHADOW_VIEWS; ++k)  // constant indices: no dynamic array access
       if (u_light_info[i].y == k) shadow = view_visibility[k];
 #endif
-    color += (diffuse_color + spec) * u_light_color[i].rgb * ndl * attenuation * shadow;
+    color += brdf_evaluate(base.rgb, metallic, roughness, n, v, l) * u_light_color[i].rgb * ndl *
+             attenuation * shadow;
   }
 
   vec3 reflected = vec3(0.0);  // S3's C_t
