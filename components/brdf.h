@@ -6,9 +6,10 @@
 //   alpha  = roughness^2
 //   F = f0 + (1 - f0) (1 - |V.H|)^5                  Schlick
 //   D = alpha^2 / (pi ((N.H)^2 (alpha^2 - 1) + 1)^2)  GGX / Trowbridge-Reitz (0 where N.H <= 0)
-//   V = 0.5 / (N.L sqrt((N.V)^2 (1 - alpha^2) + alpha^2) + N.V sqrt((N.L)^2 (1 - alpha^2) + alpha^2))
-//       Smith height-correlated visibility G2 / (4 N.L N.V) (Heitz 2014, "Understanding the
-//       Masking-Shadowing Function", eq. 99; the Khronos sample viewer's V_GGX)
+//   V = 0.5 / (N.L sqrt((N.V)^2 (1 - a2) + a2) + N.V sqrt((N.L)^2 (1 - a2) + a2)), a2 = alpha^2
+//       Smith height-correlated visibility G2 / (4 N.L N.V), G2 = 1 / (1 + Lambda(V) +
+//       Lambda(L)) (Heitz 2014, "Understanding the Masking-Shadowing Function in
+//       Microfacet-Based BRDFs"; the Khronos sample viewer's V_GGX)
 //   f_diffuse  = (1 - F) (1 / pi) c_diff             Lambert
 //   f_specular = F D V
 //   f = f_diffuse + f_specular                       (per steradian: a BRDF)

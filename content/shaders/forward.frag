@@ -2,7 +2,7 @@
 // B), linear lighting, sRGB output through the sRGB colour target. A light's colour is the
 // illuminance it delivers (outgoing radiance = f * E * N.L; components/brdf.h); u_ambient is a
 // uniform radiance, which a Lambert surface reflects as ambient * c_diff. Features
-// (content/shaders/features.json) are selected by the preprocessor only; see README.md in this folder.
+// (content/shaders/features.json) are selected by the preprocessor only; see README.md here.
 #include "brdf.glsl"
 #include "common.glsl"
 #include "features.glsl"

@@ -1020,14 +1020,16 @@ Result<TextureTransform> read_texture_transform(const Importer& im,
   if (ext == extensions.end()) return t;
   const std::string where = where_in + " KHR_texture_transform";
   if (!ext->second.IsObject()) return Error{im.file, where, "must be an object"};
-  if (const tinygltf::Value* v = member(ext->second, "offset"); v && !finite_numbers(*v, 2, &t.offset[0]))
+  const tinygltf::Value* offset = member(ext->second, "offset");
+  if (offset && !finite_numbers(*offset, 2, &t.offset[0]))
     return Error{im.file, where, "offset must be 2 finite numbers"};
   if (const tinygltf::Value* v = member(ext->second, "rotation")) {
     if (!v->IsNumber() || !std::isfinite(v->GetNumberAsDouble()))
       return Error{im.file, where, "rotation must be a finite number (radians)"};
     t.rotation = float(v->GetNumberAsDouble());
   }
-  if (const tinygltf::Value* v = member(ext->second, "scale"); v && !finite_numbers(*v, 2, &t.scale[0]))
+  const tinygltf::Value* scale = member(ext->second, "scale");
+  if (scale && !finite_numbers(*scale, 2, &t.scale[0]))
     return Error{im.file, where, "scale must be 2 finite numbers"};
   if (const tinygltf::Value* v = member(ext->second, "texCoord")) {
     if (!v->IsInt() || v->GetNumberAsInt() < 0)
@@ -1128,8 +1130,9 @@ Result<Material> read_material(Importer& im, int index) {
   m.normal_texture = normal_slot->texture;
   m.normal_transform = normal_slot->transform;
   // Occlusion: the R channel scales the ambient light, by 1 + strength * (R - 1) (glTF 3.9.3).
-  auto occlusion_slot = read_slot(im, g.occlusionTexture.index, g.occlusionTexture.texCoord,
-                                  g.occlusionTexture.extensions, false, where + " occlusionTexture");
+  auto occlusion_slot =
+      read_slot(im, g.occlusionTexture.index, g.occlusionTexture.texCoord,
+                g.occlusionTexture.extensions, false, where + " occlusionTexture");
   if (!occlusion_slot) return occlusion_slot.error();
   m.occlusion_texture = occlusion_slot->texture;
   m.occlusion_transform = occlusion_slot->transform;

@@ -291,7 +291,9 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
       const VariantKey key = list.depth_key(view, i);
       h.add(d.mesh).add(d.model).add(key.filtered_for(Pass::depth).bits());
       if (key.has(VariantKey::kAlphaMask) || features_by_uniform)
-        h.add(d.material.base_color.a).add(d.material.alpha_cutoff).add(d.material.base_color_texture)
+        h.add(d.material.base_color.a)
+            .add(d.material.alpha_cutoff)
+            .add(d.material.base_color_texture)
             .add(d.material.base_color_transform);
     }
     return h.value();

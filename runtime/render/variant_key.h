@@ -343,7 +343,8 @@ static_assert(!VariantKey().set(VariantKey::kReflectionBox, 1).valid());
 static_assert(VariantKey().set(VariantKey::kReflectionBox, 1).set(VariantKey::kReflectionCube, 1).valid());
 static_assert(VariantKey().set(VariantKey::kNormalMap, 1).filtered_for(Pass::depth) == VariantKey());
 static_assert(!VariantKey().set(VariantKey::kEmissiveTexture, 1).valid());
-static_assert(VariantKey().set(VariantKey::kTextureTransform, 1).filtered_for(Pass::depth) == VariantKey());
+static_assert(VariantKey().set(VariantKey::kTextureTransform, 1).filtered_for(Pass::depth) ==
+              VariantKey());
 static_assert(VariantKey().set(VariantKey::kTextureTransform, 1).set(VariantKey::kAlphaMask, 1)
                   .filtered_for(Pass::depth) ==
               VariantKey().set(VariantKey::kTextureTransform, 1).set(VariantKey::kAlphaMask, 1));

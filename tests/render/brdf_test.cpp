@@ -4,6 +4,8 @@
 // between) and roughness (from the clamp to 1) are uploaded as a texture, a fragment shader
 // evaluates the shipped GLSL function per pixel into an RGBA32F target, and every channel must
 // agree within 1e-3 (relative above 1: GGX peaks reach 1e5 at low roughness).
+#include "components/brdf.h"
+
 #include <gtest/gtest.h>
 
 #include <epoxy/gl.h>
@@ -16,7 +18,6 @@
 #include <string>
 #include <vector>
 
-#include "components/brdf.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/gpu/shader.h"
 #include "tests/render/headless_gl.h"

@@ -48,7 +48,8 @@ class MaterialInputsTest : public PlayerTest {
     auto back = load_image(dir() / name);
     EXPECT_TRUE(back.ok());
     for (std::size_t i = 0; back.ok() && i < texels.size(); ++i)
-      for (int c = 0; c < 3; ++c) texels[i][c] = back->pixels[i * std::size_t(back->channels) + std::size_t(c)];
+      for (int c = 0; c < 3; ++c)
+        texels[i][c] = back->pixels[i * std::size_t(back->channels) + std::size_t(c)];
     return texels;
   }
   /// The card scene with material file `material` (JSON text) and ambient `ambient`.
@@ -56,12 +57,14 @@ class MaterialInputsTest : public PlayerTest {
     std::ofstream(dir() / (name + "_material.json")) << material;
     const fs::path file = dir() / (name + ".json");
     std::ofstream(file) << R"({ "kaskad_scene": 1,
-      "render": { "ambient": [)" << ambient << ", " << ambient << ", " << ambient
+      "render": { "ambient": [)"
+                        << ambient << ", " << ambient << ", " << ambient
                         << R"(], "ground": "none", "clear_color": [0, 0, 0] },
       "entities": [
         { "name": "card", "transform": { "euler_deg": [90, 0, 0] },
           "primitive": { "shape": "plane" },
-          "material": { "file": ")" << name << R"(_material.json" } },
+          "material": { "file": ")"
+                        << name << R"(_material.json" } },
         { "name": "camera", "transform": { "translation": [0, 0, 1.2], "look_at": [0, 0, 0] },
           "camera": { "fov_y_deg": 40, "near": 0.1, "far": 20, "active": true } } ] })";
     return file;
@@ -92,7 +95,9 @@ TEST_F(MaterialInputsTest, EmissiveTextureMultipliesTheEmissiveFactor) {
   const glm::vec3 factor(1.0f, 0.5f, 0.25f);
   const Shot s = shoot(scene("emissive", R"({ "features": ["emissive", "emissive_texture"],
       "parameters": { "base_color": [0, 0, 0, 1], "emissive": [1, 0.5, 0.25] },
-      "textures": { "emissive": "glow.png" } })", 0.0f), {}, 32, 32);
+      "textures": { "emissive": "glow.png" } })",
+                             0.0f),
+                       {}, 32, 32);
   ASSERT_EQ(s.color.width, 32);
   for (int c = 0; c < 3; ++c)  // the texture is sRGB: decoded before it multiplies
     EXPECT_NEAR(s.color.at(16, 16, c), srgb_encode(factor[c] * srgb_decode(t[c])), 1.5f / 255.0f);

@@ -678,12 +678,14 @@ TEST(SceneIo, LiveOverridesChangeALoadedSceneAsAFileWould) {
 
 TEST(SceneIo, ExposureInEv) {
   // exposure_ev is 2^EV; the saved form is the scale; `exposure` alone keeps working.
-  auto s = read_scene(write_file("ev.json", R"({"render": {"exposure_ev": -1.5}, "entities": []})"));
+  auto s =
+      read_scene(write_file("ev.json", R"({"render": {"exposure_ev": -1.5}, "entities": []})"));
   ASSERT_TRUE(s.ok()) << s.error().to_string();
   EXPECT_FLOAT_EQ(s->render.exposure, std::exp2(-1.5f));
   EXPECT_FLOAT_EQ(scene_to_json(*s)["render"]["exposure"].get<float>(), std::exp2(-1.5f));
   EXPECT_FALSE(scene_to_json(*s)["render"].contains("exposure_ev"));
-  auto plain = read_scene(write_file("ev_plain.json", R"({"render": {"exposure": 0.25}, "entities": []})"));
+  auto plain =
+      read_scene(write_file("ev_plain.json", R"({"render": {"exposure": 0.25}, "entities": []})"));
   ASSERT_TRUE(plain.ok()) << plain.error().to_string();
   EXPECT_FLOAT_EQ(plain->render.exposure, 0.25f);
   // Live: an EV replaces the scale, and back.

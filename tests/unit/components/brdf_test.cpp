@@ -74,9 +74,9 @@ TEST(Brdf, ReciprocalMetalsHaveNoDiffuseDielectricDiffuseIsLambert) {
         // Dielectric: f - F D V = (1 - F) c / pi with F of f0 0.04.
         in.metallic = 0.0f;
         const glm::vec3 f = brdf_fresnel_schlick(glm::vec3(0.04f), glm::dot(v, h));
-        const glm::vec3 diffuse = brdf_evaluate(in, n, v, l) -
-                                  f * brdf_distribution_ggx(n, h, alpha) *
-                                      brdf_visibility_smith_correlated(l.z, v.z, alpha);
+        const glm::vec3 diffuse =
+            brdf_evaluate(in, n, v, l) - f * brdf_distribution_ggx(n, h, alpha) *
+                                             brdf_visibility_smith_correlated(l.z, v.z, alpha);
         const glm::vec3 lambert = (glm::vec3(1.0f) - f) * in.base / kPi;
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(diffuse[c], lambert[c], 1e-5f);
       }
