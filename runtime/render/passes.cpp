@@ -127,8 +127,9 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
   if (features_by_uniform_) glProgramUniform1ui(program_.id(), kLocFeatureBits, GLuint(key.material().bits()));
   glBindTextureUnit(kTexBaseColor, cache_.texture(m.base_color_texture, false).id());
   glBindTextureUnit(kTexNormal, cache_.texture(m.normal_texture, true).id());
-  // The optional features' uniforms exist only in programs compiled with them (a location no
-  // uniform has is a GL error; only -1 is ignored): set them where the key has the feature.
+  // The optional features' uniforms exist only in programs compiled with them (elsewhere their
+  // location is an error or another uniform's): set them where `key` (the key the current
+  // program was compiled for, as far as material features go) has the feature.
   const VariantKey features = key.material();
   if (features.has(VariantKey::kOcclusionTexture) || features_by_uniform_) {
     const glm::vec4 extra(m.occlusion_strength, 0.0f, 0.0f, 0.0f);
@@ -422,7 +423,10 @@ Status draw_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache,
     const GpuMesh& m = cache.mesh(d.mesh);
     KASKAD_TRY(state.use_program(Pass::depth, list.depth_key(view, run.draw)));
     const GLuint prog = state.program().id();
-    if (state.depth_reads_material(list.keys[run.draw])) state.bind_material(d, list.keys[run.draw]);
+    // The material as the depth program sees it: uniforms of features it lacks (occlusion, ...)
+    // must not be set, their locations may belong to other uniforms there.
+    const VariantKey depth_material = list.keys[run.draw].filtered_for(Pass::depth);
+    if (state.depth_reads_material(depth_material)) state.bind_material(d, depth_material);
     if (light_vp) {  // one layer
       glProgramUniformMatrix4fv(prog, kLocLightViewProj, 1, GL_FALSE, &(*light_vp)[0][0]);
     } else {  // layered: every layer of the view, the instance says which

@@ -124,5 +124,43 @@ TEST_F(MaterialInputsTest, TextureTransformOffsetsTheLookup) {
   }
 }
 
+// Cut-outs casting shadows with the new inputs: the depth pass draws them with only the
+// features its program has (alpha_mask, and texture_transform when the material has it), so no
+// uniform of the others may be set there (a GL error, which fails the test through the fixture).
+TEST_F(MaterialInputsTest, CutOutsWithTheNewInputsCastShadowsWithoutGlErrors) {
+  Image mask;  // opaque | transparent
+  mask.width = 2;
+  mask.height = 1;
+  mask.channels = 4;
+  mask.pixels = {1, 1, 1, 1, 1, 1, 1, 0};
+  ASSERT_TRUE(save_image(dir() / "mask.png", mask).ok());
+  texture("ao2.png", {glm::vec3(0.5f)});
+  for (const char* transform : {"", R"(, "texture_transform")"}) {
+    const std::string material = std::string(R"({ "features": ["base_color_texture", "alpha_mask",
+        "occlusion_texture", "emissive", "emissive_texture")") + transform + R"(],
+      "parameters": { "base_color": [1, 1, 1, 1], "emissive": [0.1, 0.1, 0.1],
+                      "double_sided": true)" + (*transform ? R"(, "uv_offset": [0.5, 0])" : "") +
+                                 R"( },
+      "textures": { "base_color": "mask.png", "occlusion": "ao2.png", "emissive": "mask.png" } })";
+    std::ofstream(dir() / "cutout_material.json") << material;
+    const fs::path file = dir() / "cutout.json";
+    std::ofstream(file) << R"({ "kaskad_scene": 1,
+      "render": { "ambient": [0.2, 0.2, 0.2], "ground": "none", "clear_color": [0, 0, 0],
+                  "shadow_cache": false },
+      "entities": [
+        { "name": "floor", "transform": { "scale": [6, 1, 6] }, "primitive": { "shape": "plane" },
+          "material": { "base_color": [0.8, 0.8, 0.8, 1] } },
+        { "name": "card", "transform": { "translation": [0, 1, 0], "scale": [2, 1, 2] },
+          "primitive": { "shape": "plane" }, "material": { "file": "cutout_material.json" } },
+        { "name": "sun", "transform": { "direction": [0.3, -1, 0.2] },
+          "light": { "type": "directional", "intensity": 2, "cast_shadows": true } },
+        { "name": "camera", "transform": { "translation": [0, 6, 0.01], "look_at": [0, 0, 0] },
+          "camera": { "fov_y_deg": 60, "near": 0.1, "far": 20, "active": true } } ] })";
+    const Shot s = shoot(file, {}, 64, 64);
+    ASSERT_EQ(s.color.width, 64) << transform;
+    EXPECT_EQ(gpu::debug_error_count(), 0) << "with" << transform;
+  }
+}
+
 }  // namespace
 }  // namespace kaskad
