@@ -2,6 +2,8 @@
 // (see content/shaders/forward.frag for the mapping). Linear colour values.
 #pragma once
 
+#include <array>
+#include <cmath>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -10,6 +12,23 @@
 
 namespace kaskad {
 
+/// KHR_texture_transform of one texture slot: uv' = T(offset) R(rotation) S(scale) uv, i.e.
+/// u' = s.x cos(r) u + s.y sin(r) v + offset.x, v' = -s.x sin(r) u + s.y cos(r) v + offset.y.
+struct TextureTransform {
+  glm::vec2 offset{0.0f};  ///< uv units
+  float rotation = 0.0f;   ///< radians, counter-clockwise in uv space
+  glm::vec2 scale{1.0f};
+
+  bool operator==(const TextureTransform&) const = default;
+};
+
+/// The two rows (a, b) of t's affine map: u' = dot(a, (u, v, 1)), v' = dot(b, (u, v, 1)).
+inline std::array<glm::vec3, 2> uv_transform_rows(const TextureTransform& t) {
+  const float c = std::cos(t.rotation), s = std::sin(t.rotation);
+  return {glm::vec3(c * t.scale.x, s * t.scale.y, t.offset.x),
+          glm::vec3(-s * t.scale.x, c * t.scale.y, t.offset.y)};
+}
+
 struct Material {
   glm::vec4 base_color{1.0f};                  ///< linear RGBA factor (glTF baseColorFactor)
   TextureId base_color_texture = kNoTexture;   ///< sRGB texture, multiplied by base_color
@@ -17,7 +36,12 @@ struct Material {
   float roughness = 0.5f;                      ///< [0,1] (glTF roughnessFactor)
   TextureId normal_texture = kNoTexture;       ///< tangent-space normal map (optional)
   float normal_scale = 1.0f;                   ///< glTF normalTexture.scale
-  glm::vec3 emissive{0.0f};                    ///< linear emitted radiance
+  glm::vec3 emissive{0.0f};                    ///< linear emitted radiance (x emissive strength)
+  TextureId emissive_texture = kNoTexture;     ///< sRGB texture, multiplied by emissive
+  TextureId occlusion_texture = kNoTexture;    ///< linear; R is the ambient occlusion
+  float occlusion_strength = 1.0f;             ///< glTF occlusionTexture.strength, [0,1]
+  /// KHR_texture_transform per texture slot (identity: none).
+  TextureTransform base_color_transform, normal_transform, occlusion_transform, emissive_transform;
   bool double_sided = false;                   ///< glTF doubleSided: light both faces
   bool alpha_mask = false;                     ///< glTF alphaMode MASK: discard below alpha_cutoff
   float alpha_cutoff = 0.5f;                   ///< glTF alphaCutoff

@@ -42,6 +42,14 @@ layout(location = LOC_EMISSIVE) uniform vec3 u_emissive;
 
 layout(binding = UNIT_BASE_COLOR) uniform sampler2D u_base_color_tex;
 layout(binding = UNIT_NORMAL) uniform sampler2D u_normal_tex;
+#if MATERIAL_HAS_OCCLUSION_TEXTURE
+layout(location = LOC_MATERIAL_EXTRA) uniform vec4 u_material_extra;  // x occlusion strength
+layout(binding = UNIT_OCCLUSION) uniform sampler2D u_occlusion_tex;   // linear, R channel
+#endif
+#if MATERIAL_HAS_EMISSIVE_TEXTURE
+layout(binding = UNIT_EMISSIVE) uniform sampler2D u_emissive_tex;  // sRGB, times u_emissive
+#endif
+
 
 #ifdef VERTEX_STAGE_INSTANCED
 // Per instance (InstanceRecord): the model matrix and its normal matrix.

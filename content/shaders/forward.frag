@@ -1,6 +1,9 @@
-// Forward shading: Blinn-Phong driven by glTF metallic-roughness inputs, linear lighting, sRGB
-// output through the sRGB colour target. Features (content/shaders/features.json) are selected by
-// the preprocessor only; see README.md in this folder.
+// Forward shading: the glTF 2.0 metallic-roughness BRDF (brdf.glsl, the specification's Appendix
+// B), linear lighting, sRGB output through the sRGB colour target. A light's colour is the
+// illuminance it delivers (outgoing radiance = f * E * N.L; components/brdf.h); u_ambient is a
+// uniform radiance, which a Lambert surface reflects as ambient * c_diff. Features
+// (content/shaders/features.json) are selected by the preprocessor only; see README.md here.
+#include "brdf.glsl"
 #include "common.glsl"
 #include "features.glsl"
 #include "shadow.glsl"
@@ -61,7 +64,8 @@ vec3 perturb_normal(vec3 n, vec3 p, vec2 uv, vec3 tangent_normal) {
 void main() {
   vec4 base = u_base_color;
 #if MATERIAL_HAS_BASE_COLOR_TEXTURE
-  if (ENABLED(BIT_BASE_COLOR_TEXTURE)) base *= texture(u_base_color_tex, v_uv);
+  if (ENABLED(BIT_BASE_COLOR_TEXTURE))
+    base *= texture(u_base_color_tex, slot_uv(UV_SLOT_BASE_COLOR, v_uv));
 #endif
 #if MATERIAL_HAS_ALPHA_MASK
   if (ENABLED(BIT_ALPHA_MASK) && base.a < u_material.w) discard;
@@ -77,25 +81,38 @@ void main() {
   vec3 n = geometric_n;
 #if MATERIAL_HAS_NORMAL_MAP
   if (ENABLED(BIT_NORMAL_MAP)) {
-    vec3 tn = texture(u_normal_tex, v_uv).xyz * 2.0 - 1.0;
+    // The cotangent frame follows the normal map's own (transformed) uvs.
+    vec2 normal_uv = slot_uv(UV_SLOT_NORMAL, v_uv);
+    vec3 tn = texture(u_normal_tex, normal_uv).xyz * 2.0 - 1.0;
     tn.xy *= u_material.z;
-    n = perturb_normal(n, v_world_pos, v_uv, normalize(tn));
+    n = perturb_normal(n, v_world_pos, normal_uv, normalize(tn));
   }
 #endif
 
   float metallic = clamp(u_material.x, 0.0, 1.0);
-  float roughness = clamp(u_material.y, 0.03, 1.0);
-  vec3 diffuse_color = base.rgb * (1.0 - metallic);
-  vec3 f0 = mix(vec3(0.04), base.rgb, metallic);
-  // Blinn-Phong exponent from roughness (alpha = roughness^2, n = 2 / alpha^2 - 2), energy-normalised.
-  float alpha = roughness * roughness;
-  float shininess = max(2.0 / (alpha * alpha) - 2.0, 1.0);
-  float spec_norm = (shininess + 8.0) / 8.0;
+  float roughness = u_material.y;  // brdf_evaluate() clamps it
+  vec3 diffuse_color = mix(base.rgb, vec3(0.0), metallic);  // Appendix B's c_diff
 
   float view_depth = -(u_view * vec4(v_world_pos, 1.0)).z;
-  vec3 color = u_ambient.rgb * diffuse_color;
+  // Ambient (uniform radiance) reflected by the Lambert lobe; glTF's occlusion texture scales
+  // this indirect light only: 1 + strength * (occlusion - 1) (glTF 2.0, 3.9.3).
+  float occlusion = 1.0;
+#if MATERIAL_HAS_OCCLUSION_TEXTURE
+  if (ENABLED(BIT_OCCLUSION_TEXTURE)) {
+    float ao = texture(u_occlusion_tex, slot_uv(UV_SLOT_OCCLUSION, v_uv)).r;
+    occlusion = 1.0 + u_material_extra.x * (ao - 1.0);
+  }
+#endif
+  vec3 color = u_ambient.rgb * diffuse_color * occlusion;
 #if MATERIAL_HAS_EMISSIVE
-  if (ENABLED(BIT_EMISSIVE)) color += u_emissive;
+  if (ENABLED(BIT_EMISSIVE)) {
+    vec3 emissive = u_emissive;  // the factor, times KHR_materials_emissive_strength
+#if MATERIAL_HAS_EMISSIVE_TEXTURE
+    if (ENABLED(BIT_EMISSIVE_TEXTURE))
+      emissive *= texture(u_emissive_tex, slot_uv(UV_SLOT_EMISSIVE, v_uv)).rgb;
+#endif
+    color += emissive;
+  }
 #endif
   // Shadow visibility per shadow view (as many views as the variant has: none is no code); the
   // AOV shows the view u_counts.z names, the debug tint view 0's cascade.
@@ -150,14 +167,13 @@ void main() {
     }
     float ndl = max(dot(n, l), 0.0);
     if (ndl <= 0.0) continue;
-    vec3 h = normalize(l + v);
-    vec3 spec = f0 * spec_norm * pow(max(dot(n, h), 0.0), shininess);
     float shadow = 1.0;
 #if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
     for (int k = 0; k < SHADOW_VIEWS; ++k)  // constant indices: no dynamic array access
       if (u_light_info[i].y == k) shadow = view_visibility[k];
 #endif
-    color += (diffuse_color + spec) * u_light_color[i].rgb * ndl * attenuation * shadow;
+    color += brdf_evaluate(base.rgb, metallic, roughness, n, v, l) * u_light_color[i].rgb * ndl *
+             attenuation * shadow;
   }
 
   vec3 reflected = vec3(0.0);  // S3's C_t

@@ -22,7 +22,8 @@ layout(location = 0) out float o_depth;
 void main() {
 #if MATERIAL_HAS_ALPHA_MASK
   if (ENABLED(BIT_ALPHA_MASK)) {
-    float alpha = u_base_color.a * texture(u_base_color_tex, v_uv).a;
+    vec2 uv = slot_uv(UV_SLOT_BASE_COLOR, v_uv);
+    float alpha = u_base_color.a * texture(u_base_color_tex, uv).a;
     if (alpha < u_material.w) discard;
   }
 #endif

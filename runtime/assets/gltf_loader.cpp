@@ -76,7 +76,8 @@ constexpr float kInfiniteFarOverNear = 1000.0f;
 /// Extensions we implement; a file that *requires* any other one is refused.
 constexpr std::string_view kSupportedExtensions[] = {"KHR_draco_mesh_compression",
                                                      "KHR_lights_punctual", "KHR_mesh_quantization",
-                                                     "KHR_materials_emissive_strength"};
+                                                     "KHR_materials_emissive_strength",
+                                                     "KHR_texture_transform"};
 
 bool supported_extension(std::string_view name) {
   return std::find(std::begin(kSupportedExtensions), std::end(kSupportedExtensions), name) !=
@@ -998,6 +999,66 @@ float clamp01(double v) {
   return float(std::clamp(v, 0.0, 1.0));
 }
 
+/// `count` finite numbers from a JSON array member of an extension object.
+bool finite_numbers(const tinygltf::Value& array, std::size_t count, float* out) {
+  if (!array.IsArray() || array.ArrayLen() != count) return false;
+  for (std::size_t i = 0; i < count; ++i) {
+    const tinygltf::Value& x = array.Get(int(i));
+    if (!x.IsNumber() || !std::isfinite(x.GetNumberAsDouble())) return false;
+    out[i] = float(x.GetNumberAsDouble());
+  }
+  return true;
+}
+
+/// A texture reference's KHR_texture_transform (offset, rotation, scale; identity without the
+/// extension). Its texCoord, when given, overrides the reference's `tex_coord`.
+Result<TextureTransform> read_texture_transform(const Importer& im,
+                                                const tinygltf::ExtensionMap& extensions,
+                                                int& tex_coord, const std::string& where_in) {
+  TextureTransform t;
+  const auto ext = extensions.find("KHR_texture_transform");
+  if (ext == extensions.end()) return t;
+  const std::string where = where_in + " KHR_texture_transform";
+  if (!ext->second.IsObject()) return Error{im.file, where, "must be an object"};
+  const tinygltf::Value* offset = member(ext->second, "offset");
+  if (offset && !finite_numbers(*offset, 2, &t.offset[0]))
+    return Error{im.file, where, "offset must be 2 finite numbers"};
+  if (const tinygltf::Value* v = member(ext->second, "rotation")) {
+    if (!v->IsNumber() || !std::isfinite(v->GetNumberAsDouble()))
+      return Error{im.file, where, "rotation must be a finite number (radians)"};
+    t.rotation = float(v->GetNumberAsDouble());
+  }
+  const tinygltf::Value* scale = member(ext->second, "scale");
+  if (scale && !finite_numbers(*scale, 2, &t.scale[0]))
+    return Error{im.file, where, "scale must be 2 finite numbers"};
+  if (const tinygltf::Value* v = member(ext->second, "texCoord")) {
+    if (!v->IsInt() || v->GetNumberAsInt() < 0)
+      return Error{im.file, where, "texCoord must be an integer >= 0"};
+    tex_coord = v->GetNumberAsInt();
+  }
+  return t;
+}
+
+/// One texture slot of a material: the texture (kNoTexture when absent or unusable) and its
+/// KHR_texture_transform.
+struct TextureSlot {
+  TextureId texture = kNoTexture;
+  TextureTransform transform;
+};
+Result<TextureSlot> read_slot(Importer& im, int index, int tex_coord,
+                              const tinygltf::ExtensionMap& extensions, bool srgb,
+                              const std::string& where) {
+  TextureSlot slot;
+  if (index < 0) return slot;
+  auto transform = read_texture_transform(im, extensions, tex_coord, where);
+  if (!transform) return transform.error();
+  slot.transform = transform.value();
+  auto texture = texture_for(im, index, tex_coord, srgb, where);
+  if (!texture) return texture.error();
+  slot.texture = texture.value();
+  return slot;
+}
+
 /// glTF metallic-roughness material -> Material. -1 gives glTF's default material (3.9.6).
 Result<Material> read_material(Importer& im, int index) {
   if (auto it = im.materials.find(index); it != im.materials.end()) return it->second;
@@ -1024,6 +1085,11 @@ Result<Material> read_material(Importer& im, int index) {
       !std::isfinite(g.normalTexture.scale)) {
     return Error{im.file, where, "non-finite metallic, roughness or normal scale factor"};
   }
+  if (!(g.occlusionTexture.strength >= 0.0 && g.occlusionTexture.strength <= 1.0)) {
+    return Error{im.file, where + " occlusionTexture",
+                 "strength must be a number in [0, 1], was " +
+                     std::to_string(g.occlusionTexture.strength)};
+  }
 
   Material m;
   if (base.size() == 4) {
@@ -1039,7 +1105,11 @@ Result<Material> read_material(Importer& im, int index) {
   }
   if (auto ext = g.extensions.find("KHR_materials_emissive_strength"); ext != g.extensions.end()) {
     const tinygltf::Value* strength = member(ext->second, "emissiveStrength");
-    if (strength != nullptr && strength->IsNumber()) {
+    if (strength != nullptr && !strength->IsNumber()) {
+      return Error{im.file, where + " KHR_materials_emissive_strength",
+                   "emissiveStrength must be a number"};
+    }
+    if (strength != nullptr) {
       const double s = strength->GetNumberAsDouble();
       if (!std::isfinite(s) || s < 0.0) {
         return Error{im.file, where, "emissiveStrength must be a finite number >= 0"};
@@ -1048,19 +1118,34 @@ Result<Material> read_material(Importer& im, int index) {
     }
   }
 
-  auto base_texture = texture_for(im, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
-                                  true, where + " baseColorTexture");
-  if (!base_texture) return base_texture.error();
-  m.base_color_texture = base_texture.value();
-  auto normal_texture = texture_for(im, g.normalTexture.index, g.normalTexture.texCoord, false,
-                                    where + " normalTexture");
-  if (!normal_texture) return normal_texture.error();
-  m.normal_texture = normal_texture.value();
+  // Each slot: its texture and KHR_texture_transform (sRGB for colours, linear for data).
+  auto base_slot = read_slot(im, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                             pbr.baseColorTexture.extensions, true, where + " baseColorTexture");
+  if (!base_slot) return base_slot.error();
+  m.base_color_texture = base_slot->texture;
+  m.base_color_transform = base_slot->transform;
+  auto normal_slot = read_slot(im, g.normalTexture.index, g.normalTexture.texCoord,
+                               g.normalTexture.extensions, false, where + " normalTexture");
+  if (!normal_slot) return normal_slot.error();
+  m.normal_texture = normal_slot->texture;
+  m.normal_transform = normal_slot->transform;
+  // Occlusion: the R channel scales the ambient light, by 1 + strength * (R - 1) (glTF 3.9.3).
+  auto occlusion_slot =
+      read_slot(im, g.occlusionTexture.index, g.occlusionTexture.texCoord,
+                g.occlusionTexture.extensions, false, where + " occlusionTexture");
+  if (!occlusion_slot) return occlusion_slot.error();
+  m.occlusion_texture = occlusion_slot->texture;
+  m.occlusion_transform = occlusion_slot->transform;
+  m.occlusion_strength = float(g.occlusionTexture.strength);
+  // Emissive: texture * emissiveFactor (* strength); without emission it has no effect.
+  auto emissive_slot = read_slot(im, g.emissiveTexture.index, g.emissiveTexture.texCoord,
+                                 g.emissiveTexture.extensions, true, where + " emissiveTexture");
+  if (!emissive_slot) return emissive_slot.error();
+  m.emissive_texture = emissive_slot->texture;
+  m.emissive_transform = emissive_slot->transform;
 
   std::string ignored;
   if (pbr.metallicRoughnessTexture.index >= 0) ignored += " metallicRoughnessTexture";
-  if (g.occlusionTexture.index >= 0) ignored += " occlusionTexture";
-  if (g.emissiveTexture.index >= 0) ignored += " emissiveTexture";
   if (g.alphaMode == "MASK") {
     m.alpha_mask = true;
     m.alpha_cutoff = float(std::clamp(g.alphaCutoff, 0.0, 1.0));

@@ -101,9 +101,15 @@ Result<Material> load_material_file(const std::filesystem::path& file,
         else if (p.name == "alpha_cutoff") pr.number(key, m.alpha_cutoff, mn, mx);
         else if (p.name == "double_sided") pr.boolean(key, m.double_sided);
         else if (p.name == "k_s") pr.number(key, m.k_s, mn, mx);
+        else if (p.name == "occlusion_strength") pr.number(key, m.occlusion_strength, mn, mx);
+        // A material file has one texture transform, for all its textures (glTF has one per slot).
+        else if (p.name == "uv_offset") pr.vector<2>(key, m.base_color_transform.offset, mn, mx);
+        else if (p.name == "uv_rotation") pr.number(key, m.base_color_transform.rotation, mn, mx);
+        else if (p.name == "uv_scale") pr.vector<2>(key, m.base_color_transform.scale, mn, mx);
         else fail(pr.at(key), "parameter '" + p.name + "' is declared but the engine does not know it");
       }
     }
+    m.normal_transform = m.occlusion_transform = m.emissive_transform = m.base_color_transform;
     m.alpha_mask = std::find(features.begin(), features.end(), "alpha_mask") != features.end();
     // 3. Textures: declared slot, its feature listed; listed texture features need their texture.
     std::vector<std::string> given;
@@ -120,7 +126,11 @@ Result<Material> load_material_file(const std::filesystem::path& file,
         if (!it.value().is_string()) fail(at, "expected a file path, got " + type_name(it.value()));
         auto tex = load_texture(file.parent_path() / it.value().get<std::string>(), slot->srgb, assets);
         if (!tex) fail(at, tex.error().to_string());
-        (slot->name == "normal" ? m.normal_texture : m.base_color_texture) = *tex;
+        if (slot->name == "normal") m.normal_texture = *tex;
+        else if (slot->name == "occlusion") m.occlusion_texture = *tex;
+        else if (slot->name == "emissive") m.emissive_texture = *tex;
+        else if (slot->name == "base_color") m.base_color_texture = *tex;
+        else fail(at, "texture slot '" + slot->name + "' is declared but the engine does not know it");
         given.push_back(slot->name);
       }
     }

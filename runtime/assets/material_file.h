@@ -20,15 +20,29 @@ Result<Material> load_material_file(const std::filesystem::path& file,
                                     const render::FeatureManifest& manifest, AssetStore& assets);
 
 /// VariantKey material bits implied by a material's data (loaders without a material file: glTF,
-/// inline scene materials): textures present, alpha mask, non-zero emission.
+/// inline scene materials): textures present, alpha mask, non-zero emission; the emissive
+/// texture only with emission (it multiplies the factor); the texture transform when a texture
+/// in use has a non-identity one.
 inline std::uint32_t derive_material_features(const Material& m) {
   using render::VariantKey;
   std::uint32_t bits = 0;
-  if (m.base_color_texture != kNoTexture) bits |= VariantKey::kBaseColorTexture.mask();
-  if (m.normal_texture != kNoTexture) bits |= VariantKey::kNormalMap.mask();
+  bool transformed = false;
+  auto uses = [&](TextureId texture, const TextureTransform& t) {
+    if (texture == kNoTexture) return false;
+    transformed = transformed || !(t == TextureTransform{});
+    return true;
+  };
+  if (uses(m.base_color_texture, m.base_color_transform))
+    bits |= VariantKey::kBaseColorTexture.mask();
+  if (uses(m.normal_texture, m.normal_transform)) bits |= VariantKey::kNormalMap.mask();
+  if (uses(m.occlusion_texture, m.occlusion_transform))
+    bits |= VariantKey::kOcclusionTexture.mask();
   if (m.alpha_mask) bits |= VariantKey::kAlphaMask.mask();
-  if (m.emissive.r > 0.0f || m.emissive.g > 0.0f || m.emissive.b > 0.0f)
+  if (m.emissive.r > 0.0f || m.emissive.g > 0.0f || m.emissive.b > 0.0f) {
     bits |= VariantKey::kEmissive.mask();
+    if (uses(m.emissive_texture, m.emissive_transform)) bits |= VariantKey::kEmissiveTexture.mask();
+  }
+  if (transformed) bits |= VariantKey::kTextureTransform.mask();
   return bits;
 }
 

@@ -20,13 +20,18 @@ enum class GroundMode {
   on,
 };
 
+/// render.exposure_ev's range: 2^-20 to 2^13 (exposure's own limit is 1e4).
+inline constexpr float kMinExposureEv = -20.0f, kMaxExposureEv = 13.0f;
+
 /// Frame-wide render settings (scene file section "render").
 struct RenderSettings {
   int width = 1280;                       ///< output image size, pixels
   int height = 720;
   glm::vec3 ambient{0.08f, 0.09f, 0.11f}; ///< linear ambient radiance added to every surface
   glm::vec3 clear_color{0.55f, 0.65f, 0.8f};  ///< linear background colour
-  float exposure = 1.0f;                  ///< multiplies linear colour before sRGB encoding
+  /// Multiplies linear colour before tone mapping and sRGB encoding. Scene files give it as
+  /// `exposure` (this scale) or `exposure_ev` (stops: 2^EV, in [kMinExposureEv, kMaxExposureEv]).
+  float exposure = 1.0f;
   /// The curve applied after the exposure (components/tone_mapping.h); none by default.
   ToneMapping tone_mapping = ToneMapping::none;
   /// Which shadowed light the AOV's visibility and cascade channels show: 0 the first, k the

@@ -235,6 +235,14 @@ void read_render(ObjectReader& r, RenderSettings& s) {
   r.vector<3>("ambient", s.ambient, 0.0f, 1.0e4f);
   r.vector<3>("clear_color", s.clear_color, 0.0f, 1.0e4f);
   r.number("exposure", s.exposure, 0.0f, 1.0e4f);
+  // Exposure in EV (stops): the scale is 2^EV. Either form, not both; saved as `exposure`.
+  if (r.has("exposure_ev")) {
+    if (r.has("exposure"))
+      fail(r.at("exposure_ev"), "give exposure (a scale) or exposure_ev (stops), not both");
+    float ev = 0.0f;
+    r.number("exposure_ev", ev, kMinExposureEv, kMaxExposureEv);
+    s.exposure = std::exp2(ev);
+  }
   r.enumeration("tone_mapping", s.tone_mapping, kToneMappings);
   r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
   r.enumeration("ground", s.ground, kGroundModes);
@@ -568,6 +576,12 @@ Status set_field(json* node, const std::vector<std::string>& parts, const std::s
           std::find(kRotationKeys.begin(), kRotationKeys.end(), p) != kRotationKeys.end();
       if (rotation_form) {
         for (const char* k : kRotationKeys) node->erase(k);
+        (*node)[p] = nullptr;
+      }
+      // Likewise the exposure, as a scale or in EV (the saved form has the scale).
+      if (i == 0 && key.starts_with("render.") && (p == "exposure" || p == "exposure_ev")) {
+        node->erase("exposure");
+        node->erase("exposure_ev");
         (*node)[p] = nullptr;
       }
       if (!node->contains(p))

@@ -14,6 +14,7 @@
 #include <string>
 #include <thread>
 
+#include "components/brdf.h"
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
 #include "runtime/reference/row_workers.h"
@@ -124,18 +125,12 @@ ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment)
 glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
                       const Material& material, const glm::vec3& position, const glm::vec3& normal,
                       const glm::vec3& to_eye, bool receives_shadows, std::uint64_t* rays) {
-  // forward.frag, main(), line by line (change together).
-  const glm::vec3 base = glm::vec3(material.base_color);
+  // forward.frag, main(), line by line (change together); the BRDF is components/brdf.h.
+  const BrdfInputs brdf{glm::vec3(material.base_color), material.metallic, material.roughness};
   const glm::vec3& n = normal;
   const glm::vec3& v = to_eye;
-  const float metallic = std::clamp(material.metallic, 0.0f, 1.0f);
-  const float roughness = std::clamp(material.roughness, 0.03f, 1.0f);
-  const glm::vec3 diffuse_color = base * (1.0f - metallic);
-  const glm::vec3 f0 = glm::mix(glm::vec3(0.04f), base, metallic);
-  // Blinn-Phong exponent from roughness (alpha = roughness^2, n = 2 / alpha^2 - 2), normalised.
-  const float alpha = roughness * roughness;
-  const float shininess = std::max(2.0f / (alpha * alpha) - 2.0f, 1.0f);
-  const float spec_norm = (shininess + 8.0f) / 8.0f;
+  const glm::vec3 diffuse_color =
+      glm::mix(brdf.base, glm::vec3(0.0f), std::clamp(material.metallic, 0.0f, 1.0f));
 
   glm::vec3 color = scene.ambient * diffuse_color + material.emissive;
   for (const ShadingLight& light : scene.lights) {
@@ -158,8 +153,6 @@ glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
     }
     const float ndl = std::max(glm::dot(n, l), 0.0f);
     if (ndl <= 0.0f) continue;
-    const glm::vec3 h = glm::normalize(l + v);
-    const glm::vec3 spec = f0 * spec_norm * std::pow(std::max(glm::dot(n, h), 0.0f), shininess);
     float shadow = 1.0f;
     if (light.shadowed && receives_shadows && attenuation > 0.0f) {
       ReferenceLight ref;
@@ -169,7 +162,7 @@ glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
       shadow = tracer.hard_visibility(position, n, ref);
       if (rays) ++*rays;
     }
-    color += (diffuse_color + spec) * light.color * ndl * attenuation * shadow;
+    color += brdf_evaluate(brdf, n, v, l) * light.color * ndl * attenuation * shadow;
   }
   return color;
 }

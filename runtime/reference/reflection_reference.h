@@ -11,9 +11,10 @@
 // Differences from the rasteriser, by design or not yet done: the hit is shaded with the
 // triangle's geometric normal (flat primitives agree exactly, smooth meshes differ slightly); the
 // base colour texture is sampled bilinearly from its top mip level (GL filters trilinearly over
-// mips); no normal maps or alpha cut-outs; the view vector at the hit points back along the
-// mirror ray (a probe captured at a centre sees it from there instead); every light with
-// cast_shadows gets a hard shadow ray (the engine shadows one light).
+// mips); no normal maps, alpha cut-outs, occlusion or emissive textures or texture transforms;
+// the view vector at the hit points back along the mirror ray (a probe captured at a centre sees
+// it from there instead); every light with cast_shadows gets a hard shadow ray (the engine
+// shadows one light).
 #pragma once
 
 #include <cstdint>
@@ -73,8 +74,8 @@ glm::vec4 hit_base_color(const ReflectionScene& scene, const Material& material,
 /// forward.frag's radiance (before exposure) leaving surface point `position` with unit normal
 /// `normal` (facing the viewer) towards the unit vector `to_eye`, taking material.base_color as
 /// the base colour (multiply a texture sample in first): ambient * diffuse + emissive +
-/// sum over lights of (diffuse + normalised Blinn-Phong specular) * radiance * N.L * attenuation
-/// * visibility, with glTF metallic-roughness mapped as in forward.frag. Shadow rays (shadowed
+/// sum over lights of the glTF BRDF (components/brdf.h) * illuminance * N.L * attenuation *
+/// visibility, as in forward.frag. Shadow rays (shadowed
 /// lights, when `receives_shadows`) start at position + ray_offset() * normal.
 glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
                       const Material& material, const glm::vec3& position, const glm::vec3& normal,

@@ -110,9 +110,12 @@ VariantKey DrawList::depth_key(std::size_t view, std::uint32_t i) const {
 
 namespace {
 
-// The material's fields in the order draws sort by: textures first (the costliest binds).
+// The material's fields in the order draws sort by: textures first (the costliest binds). The
+// texture transforms are left out: draws that differ only there still bind apart (Material's
+// operator== decides), they just need not sort next to each other.
 auto material_fields(const Material& m) {
-  return std::tie(m.base_color_texture, m.normal_texture, m.double_sided, m.alpha_mask,
+  return std::tie(m.base_color_texture, m.normal_texture, m.occlusion_texture,
+                  m.emissive_texture, m.occlusion_strength, m.double_sided, m.alpha_mask,
                   m.metallic, m.roughness, m.base_color.r, m.base_color.g, m.base_color.b,
                   m.base_color.a, m.normal_scale, m.emissive.r, m.emissive.g, m.emissive.b,
                   m.alpha_cutoff, m.k_s, m.features);

@@ -74,10 +74,11 @@ Result<FeatureManifest> FeatureManifest::load(const std::filesystem::path& file)
         r.string("type", type);
         std::size_t n = 1;
         if (type == "float") p.type = ParamType::float_;
+        else if (type == "vec2") p.type = ParamType::vec2, n = 2;
         else if (type == "vec3") p.type = ParamType::vec3, n = 3;
         else if (type == "vec4") p.type = ParamType::vec4, n = 4;
         else if (type == "bool") p.type = ParamType::bool_;
-        else fail(r.at("type"), "unknown type '" + type + "'; expected float, vec3, vec4 or bool");
+        else fail(r.at("type"), "unknown type '" + type + "'; expected float, vec2, vec3, vec4 or bool");
         if (!r.has("default")) fail(r.at("default"), "missing");
         p.default_value = numbers(r.raw("default"), r.at("default"), n);
         if (p.type != ParamType::bool_) {

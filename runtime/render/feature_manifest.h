@@ -30,12 +30,12 @@ struct Feature {
   int key_bias = 0;                      ///< stored = value - key_bias (= min)
 };
 
-enum class ParamType { float_, vec3, vec4, bool_ };
+enum class ParamType { float_, vec2, vec3, vec4, bool_ };
 
 struct MaterialParameter {
   std::string name;
   ParamType type = ParamType::float_;
-  std::vector<double> default_value;  ///< 1, 3 or 4 numbers (bool: 0 or 1)
+  std::vector<double> default_value;  ///< 1, 2, 3 or 4 numbers (bool: 0 or 1)
   double min = 0, max = 1;
   std::string feature;  ///< only allowed when this feature is on (empty: always)
 };

@@ -3,6 +3,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -127,6 +128,31 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
   if (features_by_uniform_) glProgramUniform1ui(program_.id(), kLocFeatureBits, GLuint(key.material().bits()));
   glBindTextureUnit(kTexBaseColor, cache_.texture(m.base_color_texture, false).id());
   glBindTextureUnit(kTexNormal, cache_.texture(m.normal_texture, true).id());
+  // The optional features' uniforms exist only in programs compiled with them (elsewhere their
+  // location is an error or another uniform's): set them where `key` (the key the current
+  // program was compiled for, as far as material features go) has the feature.
+  const VariantKey features = key.material();
+  if (features.has(VariantKey::kOcclusionTexture) || features_by_uniform_) {
+    const glm::vec4 extra(m.occlusion_strength, 0.0f, 0.0f, 0.0f);
+    glProgramUniform4fv(program_.id(), kLocMaterialExtra, 1, &extra[0]);
+    glBindTextureUnit(kTexOcclusion, cache_.texture(m.occlusion_texture, false).id());
+  }
+  if (features.has(VariantKey::kEmissiveTexture) || features_by_uniform_)
+    glBindTextureUnit(kTexEmissive, cache_.texture(m.emissive_texture, false).id());
+  if (features.has(VariantKey::kTextureTransform) || features_by_uniform_) {
+    std::array<glm::vec4, 2 * kUvSlotCount> rows{};
+    const TextureTransform* slots[kUvSlotCount] = {};
+    slots[kUvSlotBaseColor] = &m.base_color_transform;
+    slots[kUvSlotNormal] = &m.normal_transform;
+    slots[kUvSlotOcclusion] = &m.occlusion_transform;
+    slots[kUvSlotEmissive] = &m.emissive_transform;
+    for (int i = 0; i < kUvSlotCount; ++i) {
+      const auto r = uv_transform_rows(*slots[i]);
+      rows[std::size_t(2 * i)] = glm::vec4(r[0], 0.0f);
+      rows[std::size_t(2 * i + 1)] = glm::vec4(r[1], 0.0f);
+    }
+    glProgramUniform4fv(program_.id(), kLocUvTransform, GLsizei(rows.size()), &rows[0][0]);
+  }
 }
 
 bool DrawState::depth_reads_material(VariantKey key) const {
@@ -267,7 +293,10 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
       const VariantKey key = list.depth_key(view, i);
       h.add(d.mesh).add(d.model).add(key.filtered_for(Pass::depth).bits());
       if (key.has(VariantKey::kAlphaMask) || features_by_uniform)
-        h.add(d.material.base_color.a).add(d.material.alpha_cutoff).add(d.material.base_color_texture);
+        h.add(d.material.base_color.a)
+            .add(d.material.alpha_cutoff)
+            .add(d.material.base_color_texture)
+            .add(d.material.base_color_transform);
     }
     return h.value();
   };
@@ -421,7 +450,10 @@ Status draw_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache,
     const GpuMesh& m = cache.mesh(d.mesh);
     KASKAD_TRY(state.use_program(Pass::depth, depth_program_key(list, view, run.draw, peel)));
     const GLuint prog = state.program().id();
-    if (state.depth_reads_material(list.keys[run.draw])) state.bind_material(d, list.keys[run.draw]);
+    // The material as the depth program sees it: uniforms of features it lacks (occlusion, ...)
+    // must not be set, their locations may belong to other uniforms there.
+    const VariantKey depth_material = list.keys[run.draw].filtered_for(Pass::depth);
+    if (state.depth_reads_material(depth_material)) state.bind_material(d, depth_material);
     if (light_vp) {  // one layer
       glProgramUniformMatrix4fv(prog, kLocLightViewProj, 1, GL_FALSE, &(*light_vp)[0][0]);
     } else {  // layered: every layer of the view, the instance says which

@@ -37,7 +37,8 @@ class DrawState {
   Status use_program(Pass pass, VariantKey key);
   /// The program in use.
   gpu::ProgramRef program() const { return program_; }
-  /// The material of draw `d` (drawn with `key`) on the current program.
+  /// The material of draw `d` on the current program; `key`: the key that program was compiled
+  /// for (its material features say which optional uniforms exist).
   void bind_material(const DrawItem& d, VariantKey key);
   /// Whether a draw with `key` reads its material in the depth pass: alpha-masked draws do, and
   /// every draw when the library's programs select material features by uniform (the test

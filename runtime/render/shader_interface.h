@@ -37,6 +37,14 @@ inline constexpr int kLocBaseColor = 8, kLocMaterial = 9, kLocEmissive = 10,
                      kLocLayerBase = 14, kLocLayerViewProj = 16,
                      kLocReflection = 16, kLocReflectionBoxMin = 17, kLocReflectionBoxMax = 18,
                      kLocReflectionCentre = 19, kLocLomTarget = 20;
+/// vec4: x occlusion strength (MATERIAL_HAS_OCCLUSION_TEXTURE).
+inline constexpr int kLocMaterialExtra = 24;
+/// vec4[8]: per texture slot (kUvSlot*) two rows (a, b, c) of its uv transform
+/// u' = a.x u + a.y v + a.z, v' = b.x u + b.y v + b.z (MATERIAL_HAS_TEXTURE_TRANSFORM); 25..32.
+inline constexpr int kLocUvTransform = 25;
+/// Texture slots in kLocUvTransform's array.
+inline constexpr int kUvSlotBaseColor = 0, kUvSlotNormal = 1, kUvSlotOcclusion = 2,
+                     kUvSlotEmissive = 3, kUvSlotCount = 4;
 
 // Texture units.
 /// kTexShadowDepth: the shadow map again, through a sampler without depth compare (raw depths for
@@ -46,11 +54,11 @@ inline constexpr int kLocBaseColor = 8, kLocMaterial = 9, kLocEmissive = 10,
 /// occlusion factors; kTexPeelPrevious: the layer before the one a depth peel draws.
 inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
                           kTexReflectionCube = 3, kTexReflectionSphere = 4, kTexShadowDepth = 5,
-                          kTexShadowLinear = 6, kTexLomDepth = 7, kTexLomOcclusion = 8,
-                          kTexPeelPrevious = 9;
+                          kTexShadowLinear = 6, kTexOcclusion = 7, kTexEmissive = 8,
+                          kTexLomDepth = 9, kTexLomOcclusion = 10, kTexPeelPrevious = 11;
 
 /// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...).
-inline std::array<std::pair<const char*, int>, 29> shader_interface_defines() {
+inline std::array<std::pair<const char*, int>, 38> shader_interface_defines() {
   return {{{"ATTR_POSITION", kAttrPosition},
            {"ATTR_NORMAL", kAttrNormal},
            {"ATTR_UV", kAttrUv},
@@ -70,6 +78,13 @@ inline std::array<std::pair<const char*, int>, 29> shader_interface_defines() {
            {"LOC_REFLECTION_BOX_MAX", kLocReflectionBoxMax},
            {"LOC_REFLECTION_CENTRE", kLocReflectionCentre},
            {"LOC_LOM_TARGET", kLocLomTarget},
+           {"LOC_MATERIAL_EXTRA", kLocMaterialExtra},
+           {"LOC_UV_TRANSFORM", kLocUvTransform},
+           {"UV_SLOT_BASE_COLOR", kUvSlotBaseColor},
+           {"UV_SLOT_NORMAL", kUvSlotNormal},
+           {"UV_SLOT_OCCLUSION", kUvSlotOcclusion},
+           {"UV_SLOT_EMISSIVE", kUvSlotEmissive},
+           {"UV_SLOT_COUNT", kUvSlotCount},
            {"UNIT_BASE_COLOR", int(kTexBaseColor)},
            {"UNIT_NORMAL", int(kTexNormal)},
            {"UNIT_SHADOW", int(kTexShadow)},
@@ -79,7 +94,9 @@ inline std::array<std::pair<const char*, int>, 29> shader_interface_defines() {
            {"UNIT_LOM_OCCLUSION", int(kTexLomOcclusion)},
            {"UNIT_PEEL_PREVIOUS", int(kTexPeelPrevious)},
            {"UNIT_REFLECTION_CUBE", int(kTexReflectionCube)},
-           {"UNIT_REFLECTION_SPHERE", int(kTexReflectionSphere)}}};
+           {"UNIT_REFLECTION_SPHERE", int(kTexReflectionSphere)},
+           {"UNIT_OCCLUSION", int(kTexOcclusion)},
+           {"UNIT_EMISSIVE", int(kTexEmissive)}}};
 }
 
 }  // namespace kaskad::render

@@ -22,9 +22,10 @@
 //   shadow_layered needs shadow; the depth pass keeps it (its vertex shader picks the layer)
 //   shadow_lights != 1 needs shadow (the lookups of lights that do not exist are not compiled)
 //   shadow_technique != pcf, shadow_kernel != k3x3 and shadow_peel need shadow
-// filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask, and the projection
-// when it is dual_paraboloid: its vertex shader differs), so every material shares one or two
-// shadow programs.
+//   emissive_texture needs emissive
+// filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask with its
+// texture_transform, peeling, and the projection when it is dual_paraboloid: its vertex shader
+// differs), so every material shares one or two shadow programs.
 #pragma once
 
 #include <array>
@@ -108,6 +109,16 @@ inline constexpr FeatureSpec kFeatureTable[] = {
      .offset = 7, .requires_ = {"reflection_cube"}},
     {.name = "receive_shadows", .define = "MATERIAL_RECEIVES_SHADOWS", .stages = kFragmentStage,
      .offset = 6},
+    // glTF occlusionTexture (R channel, strength): scales the ambient (indirect) light only.
+    {.name = "occlusion_texture", .define = "MATERIAL_HAS_OCCLUSION_TEXTURE",
+     .stages = kFragmentStage, .offset = 8},
+    // glTF emissiveTexture: multiplies the emissive factor, so it needs `emissive`.
+    {.name = "emissive_texture", .define = "MATERIAL_HAS_EMISSIVE_TEXTURE",
+     .stages = kFragmentStage, .offset = 9, .requires_ = {"emissive"}},
+    // KHR_texture_transform: each texture slot's uvs go through its own offset, rotation and
+    // scale (Material::*_transform). The depth pass keeps it with alpha_mask (cut-outs).
+    {.name = "texture_transform", .define = "MATERIAL_HAS_TEXTURE_TRANSFORM",
+     .stages = kFragmentStage, .offset = 10},
     // Frame features (bits 16-31).
     {.name = "shadow", .kind = FeatureKind::frame, .define = "VARIANT_HAS_SHADOW",
      .stages = kFragmentStage, .offset = 16},
@@ -241,6 +252,9 @@ class VariantKey {
   static constexpr Field kReflectionSphere = feature_field("reflection_sphere");
   static constexpr Field kReceiveShadows = feature_field("receive_shadows");
   static constexpr Field kReflectionBox = feature_field("reflection_box");
+  static constexpr Field kOcclusionTexture = feature_field("occlusion_texture");
+  static constexpr Field kEmissiveTexture = feature_field("emissive_texture");
+  static constexpr Field kTextureTransform = feature_field("texture_transform");
   static constexpr std::uint64_t kMaterialMask = 0x0000ffffu;
   // Frame features.
   static constexpr Field kShadow = feature_field("shadow");
@@ -317,7 +331,9 @@ class VariantKey {
       const std::uint64_t layered =
           has(kShadowLayered) ? kShadowLayered.mask() | kShadow.mask() : 0u;
       const std::uint64_t peel = has(kShadowPeel) ? kShadowPeel.mask() | kShadow.mask() : 0u;
-      return VariantKey(bits_ & (kAlphaMask.mask() | projection | layered | peel));
+      // A cut-out reads the base colour texture through its transform.
+      const std::uint64_t transform = has(kAlphaMask) ? kTextureTransform.mask() : 0u;
+      return VariantKey(bits_ & (kAlphaMask.mask() | projection | layered | peel | transform));
     }
     if (pass == Pass::shadow_points || pass == Pass::lom_occlusion)
       return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask() &
@@ -337,6 +353,12 @@ static_assert(VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowFi
 static_assert(!VariantKey().set(VariantKey::kReflectionBox, 1).valid());
 static_assert(VariantKey().set(VariantKey::kReflectionBox, 1).set(VariantKey::kReflectionCube, 1).valid());
 static_assert(VariantKey().set(VariantKey::kNormalMap, 1).filtered_for(Pass::depth) == VariantKey());
+static_assert(!VariantKey().set(VariantKey::kEmissiveTexture, 1).valid());
+static_assert(VariantKey().set(VariantKey::kTextureTransform, 1).filtered_for(Pass::depth) ==
+              VariantKey());
+static_assert(VariantKey().set(VariantKey::kTextureTransform, 1).set(VariantKey::kAlphaMask, 1)
+                  .filtered_for(Pass::depth) ==
+              VariantKey().set(VariantKey::kTextureTransform, 1).set(VariantKey::kAlphaMask, 1));
 static_assert(!VariantKey().set(VariantKey::kShadowProjection, 1).valid());
 static_assert(!VariantKey().set(VariantKey::kShadowLightsMinus1, 1).valid());
 static_assert(VariantKey()

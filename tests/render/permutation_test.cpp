@@ -123,6 +123,67 @@ TEST_F(PermutationTest, EveryVariantMatchesTheUberShaderOracle) {
   }
 }
 
+// The material inputs of issue 17 (occlusion and emissive textures, texture transforms, also on
+// an alpha-masked caster) render the same through their variants as through the oracle.
+TEST_F(PermutationTest, NewMaterialInputsMatchTheUberShaderOracle) {
+  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "permutation_inputs";
+  fs::create_directories(dir);
+  const std::string textures = (content_dir() / "materials" / "textures").string() + "/";
+  std::ofstream(dir / "orm.json") << R"({ "features": ["base_color_texture", "occlusion_texture",
+      "texture_transform"], "parameters": { "occlusion_strength": 0.7, "uv_scale": [2, 3],
+      "uv_rotation": 0.4, "uv_offset": [0.1, 0.2] },
+    "textures": { "base_color": ")" << textures << R"(checker.png", "occlusion": ")" << textures
+                                  << R"(checker.png" } })";
+  std::ofstream(dir / "glow.json") << R"({ "features": ["emissive", "emissive_texture"],
+    "parameters": { "base_color": [0, 0, 0, 1], "emissive": [0.8, 0.5, 0.3] },
+    "textures": { "emissive": ")" << textures << R"(checker.png" } })";
+  std::ofstream(dir / "leaf.json") << R"({ "features": ["base_color_texture", "alpha_mask",
+      "texture_transform"], "parameters": { "double_sided": true, "uv_scale": [1.5, 1.5],
+      "uv_rotation": 0.8 }, "textures": { "base_color": ")" << textures << R"(cutout.png" } })";
+  std::ofstream(dir / "scene.json") << R"({ "kaskad_scene": 1,
+    "render": { "ambient": [0.3, 0.3, 0.35] }, "shadow": { "filter": "pcf3x3" },
+    "entities": [
+      { "name": "ground", "transform": { "scale": [12, 1, 12] }, "primitive": { "shape": "plane" },
+        "material": { "base_color": [0.6, 0.6, 0.58, 1], "roughness": 0.9 } },
+      { "name": "box", "transform": { "translation": [-1.5, 0.6, 0], "scale": [1.2, 1.2, 1.2] },
+        "primitive": { "shape": "box" }, "material": { "file": "orm.json" } },
+      { "name": "panel", "transform": { "translation": [0.5, 0.8, -0.8], "scale": [1.4, 1.6, 0.1] },
+        "primitive": { "shape": "box" }, "material": { "file": "glow.json" } },
+      { "name": "leaf", "transform": { "translation": [1.8, 1.0, 0.6], "euler_deg": [60, -35, 0],
+          "scale": [1.8, 1.8, 1.8] }, "primitive": { "shape": "plane" },
+        "material": { "file": "leaf.json" } },
+      { "name": "sun", "transform": { "direction": [0.4, -0.7, -0.55] },
+        "light": { "type": "directional", "intensity": 5, "cast_shadows": true } },
+      { "name": "camera", "transform": { "translation": [0, 4, 7], "look_at": [0, 0.6, 0] },
+        "camera": { "fov_y_deg": 45, "near": 0.1, "far": 100, "active": true } } ] })";
+  auto load = [&] {
+    auto s = load_scene(dir / "scene.json", {"render.width=320", "render.height=180"});
+    EXPECT_TRUE(s.ok()) << s.error().to_string();
+    return std::move(s.value());
+  };
+  Scene a = load(), b = load();
+  auto variants = make_renderer();
+  auto oracle = make_renderer({}, true);
+  Image aov_v, aov_o;
+  const Image v = render(*variants, a, 1, false, true, &aov_v);
+  const Image o = render(*oracle, b, 1, false, true, &aov_o);
+  ASSERT_EQ(v.pixels.size(), o.pixels.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < v.pixels.size(); ++i)
+    worst = std::max(worst, double(std::abs(v.pixels[i] - o.pixels[i])));
+  EXPECT_LE(worst, 1.0 / 255.0 + 1e-6);
+  float worst_vis = 0;
+  for (int y = 0; y < aov_v.height; ++y)
+    for (int x = 0; x < aov_v.width; ++x)
+      worst_vis = std::max(worst_vis, std::abs(aov_v.at(x, y, 7) - aov_o.at(x, y, 7)));
+  EXPECT_LE(worst_vis, 1e-6f);  // the transformed cut-out's shadow too
+  // The cut-out's shadow program has its transform (and nothing else of the material).
+  std::set<std::uint64_t> depth;
+  for (VariantKey k : variants->shaders().built_keys(Pass::depth)) depth.insert(k.bits());
+  EXPECT_TRUE(depth.count(
+      VariantKey().set(VariantKey::kAlphaMask, 1).set(VariantKey::kTextureTransform, 1).bits()));
+}
+
 TEST_F(PermutationTest, PrewarmLeavesNothingToCompileAndTheCacheIsHit) {
   const fs::path cache = fs::path(KASKAD_TEST_TMP) / "perm_cache";
   fs::remove_all(cache);

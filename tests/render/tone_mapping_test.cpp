@@ -1,7 +1,7 @@
 // Tone mapping on the GPU (render.tone_mapping): an emissive card of known radiance filling the
 // view comes out as components/tone_mapping.h's curve of that radiance times the exposure (sRGB
-// encoded, within 8-bit rounding) for every mode, the clear colour likewise, and the AOVs are the
-// same whatever the mode.
+// encoded, within 8-bit rounding) for every mode, the clear colour likewise, render.exposure_ev
+// gives the scale 2^EV, and the AOVs are the same whatever the mode.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -66,6 +66,15 @@ TEST_F(ToneMappingTest, ColourFollowsTheCurveOfRadianceTimesExposure) {
             << modes[m] << " clear channel " << c;
       }
     }
+}
+
+TEST_F(ToneMappingTest, ExposureInEvIsTwoToTheEv) {
+  const auto file = card(glm::vec3(0.8f), glm::vec3(0.5f));
+  const Frame ev = render(file, {"render.exposure_ev=-1", "render.tone_mapping=aces"});
+  const Frame scale = render(file, {"render.exposure=0.5", "render.tone_mapping=aces"});
+  ASSERT_EQ(ev.color.width, 32);
+  EXPECT_EQ(ev.color.pixels, scale.color.pixels);
+  EXPECT_NEAR(ev.color.at(16, 16, 0), srgb(tone_map_aces(glm::vec3(0.4f)).r), 1.5f / 255.0f);
 }
 
 TEST_F(ToneMappingTest, AovsStayLinear) {

@@ -22,6 +22,7 @@
 #include "components/shadow_settings.h"
 #include "components/transform.h"
 #include "runtime/assets/image_io.h"
+#include "runtime/render/variant_key.h"
 #include "tests/unit/assets/asset_test_util.h"
 
 namespace kaskad {
@@ -607,6 +608,138 @@ TEST(GltfLoaderErrors, MissingTextureIsAWarning) {
   for (const auto& w : s->report->warnings)
     warned |= w.find("no_such_texture.png") != std::string::npos;
   EXPECT_TRUE(warned);
+}
+
+// ---- Material inputs: occlusion, emission, texture transforms --------------------------------
+
+/// triangle_gltf() with two 2x2 PNG images (written next to the file), one texture each, and
+/// material 0 on the triangle set to `material`.
+json textured_triangle(const json& material) {
+  for (const char* name : {"tex_a.png", "tex_b.png"}) {
+    Image image;
+    image.width = image.height = 2;
+    image.channels = 4;
+    image.pixels.assign(16, 0.5f);
+    EXPECT_TRUE(save_image(temp_dir() / name, image).ok());
+  }
+  json doc = triangle_gltf();
+  doc["images"] = {{{"uri", "tex_a.png"}}, {{"uri", "tex_b.png"}}};
+  doc["textures"] = {{{"source", 0}}, {{"source", 1}}};
+  doc["materials"] = {material};
+  doc["meshes"][0]["primitives"][0]["material"] = 0;
+  return doc;
+}
+
+/// The one Material of an import (the triangle's).
+Material only_material(Imported3d& s) {
+  Material out;
+  int n = 0;
+  s.world.view<Material>().each([&](ecs::Entity, Material& m) { out = m, ++n; });
+  EXPECT_EQ(n, 1);
+  return out;
+}
+
+bool warns(const GltfImportReport& report, const std::string& text) {
+  for (const auto& w : report.warnings)
+    if (w.find(text) != std::string::npos) return true;
+  return false;
+}
+
+TEST(GltfLoader, OcclusionTextureIsReadWithItsStrength) {
+  json doc = textured_triangle({{"occlusionTexture", {{"index", 1}, {"strength", 0.25}}}});
+  auto s = import_file(write_gltf("occlusion.gltf", doc));
+  ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+  const Material m = only_material(*s);
+  ASSERT_NE(m.occlusion_texture, kNoTexture);
+  EXPECT_FALSE(s->assets.textures[index(m.occlusion_texture)].srgb);  // data, not colour
+  EXPECT_FLOAT_EQ(m.occlusion_strength, 0.25f);
+  EXPECT_EQ(m.features, render::VariantKey::kOcclusionTexture.mask());
+  EXPECT_FALSE(warns(*s->report, "occlusionTexture"));  // no longer "not imported"
+  // Strength defaults to 1; outside [0, 1] it is an error naming the material and the field.
+  doc["materials"][0]["occlusionTexture"].erase("strength");
+  auto d = import_file(write_gltf("occlusion_default.gltf", doc));
+  ASSERT_TRUE(d->report.ok()) << d->report.error().to_string();
+  EXPECT_FLOAT_EQ(only_material(*d).occlusion_strength, 1.0f);
+  doc["materials"][0]["occlusionTexture"]["strength"] = 1.5;
+  expect_import_error(write_gltf("occlusion_bad.gltf", doc), "occlusionTexture");
+}
+
+TEST(GltfLoader, EmissiveTextureAndStrength) {
+  json doc = textured_triangle(
+      {{"emissiveFactor", {1.0, 0.5, 0.25}},
+       {"emissiveTexture", {{"index", 0}}},
+       {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4.0}}}}}});
+  doc["extensionsUsed"] = {"KHR_materials_emissive_strength"};
+  auto s = import_file(write_gltf("emissive.gltf", doc));
+  ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+  const Material m = only_material(*s);
+  EXPECT_EQ(m.emissive, glm::vec3(4.0f, 2.0f, 1.0f));
+  ASSERT_NE(m.emissive_texture, kNoTexture);
+  EXPECT_TRUE(s->assets.textures[index(m.emissive_texture)].srgb);
+  EXPECT_EQ(m.features,
+            render::VariantKey::kEmissive.mask() | render::VariantKey::kEmissiveTexture.mask());
+  EXPECT_FALSE(warns(*s->report, "emissiveTexture"));
+  // Without emission the texture multiplies zero: no feature (emissive_texture needs emissive).
+  doc["materials"][0].erase("emissiveFactor");
+  auto dark = import_file(write_gltf("emissive_dark.gltf", doc));
+  ASSERT_TRUE(dark->report.ok()) << dark->report.error().to_string();
+  EXPECT_EQ(only_material(*dark).features, 0u);
+  // A strength that is not a number is an error naming the extension.
+  doc["materials"][0]["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] = "4";
+  expect_import_error(write_gltf("emissive_bad.gltf", doc), "KHR_materials_emissive_strength");
+}
+
+TEST(GltfLoader, TextureTransformsArePerSlotWithTexCoordOverride) {
+  json base = {{"index", 0},
+               {"extensions",
+                {{"KHR_texture_transform",
+                  {{"offset", {0.5, -0.25}}, {"rotation", 1.5707963}, {"scale", {2.0, 3.0}}}}}}};
+  // texCoord 1 overridden by the extension's texCoord 0: imported without a TEXCOORD warning.
+  json normal = {{"index", 1},
+                 {"texCoord", 1},
+                 {"extensions", {{"KHR_texture_transform", {{"texCoord", 0}}}}}};
+  json doc = textured_triangle({{"pbrMetallicRoughness", {{"baseColorTexture", base}}},
+                                {"normalTexture", normal}});
+  doc["extensionsUsed"] = {"KHR_texture_transform"};
+  doc["extensionsRequired"] = {"KHR_texture_transform"};
+  auto s = import_file(write_gltf("transform.gltf", doc));
+  ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+  const Material m = only_material(*s);
+  EXPECT_EQ(m.base_color_transform.offset, glm::vec2(0.5f, -0.25f));
+  EXPECT_FLOAT_EQ(m.base_color_transform.rotation, 1.5707963f);
+  EXPECT_EQ(m.base_color_transform.scale, glm::vec2(2.0f, 3.0f));
+  EXPECT_EQ(m.normal_transform, TextureTransform{});
+  EXPECT_NE(m.normal_texture, kNoTexture);
+  EXPECT_FALSE(warns(*s->report, "TEXCOORD"));
+  EXPECT_TRUE(m.features & render::VariantKey::kTextureTransform.mask());
+  // The rows the shader applies: KHR_texture_transform's T * R * S. The point (1, 0) scales to
+  // (2, 0), rotates by +90 degrees in the extension's convention to (0, -2), moves to
+  // (0.5, -2.25).
+  const auto rows = uv_transform_rows(m.base_color_transform);
+  EXPECT_NEAR(glm::dot(rows[0], glm::vec3(1, 0, 1)), 0.5f, 1e-6f);
+  EXPECT_NEAR(glm::dot(rows[1], glm::vec3(1, 0, 1)), -2.25f, 1e-6f);
+  // An override to a set that is not imported keeps the warning.
+  doc["materials"][0]["normalTexture"]["extensions"]["KHR_texture_transform"]["texCoord"] = 1;
+  auto t1 = import_file(write_gltf("transform_uv1.gltf", doc));
+  ASSERT_TRUE(t1->report.ok()) << t1->report.error().to_string();
+  EXPECT_TRUE(warns(*t1->report, "TEXCOORD_1"));
+  // An identity transform is no feature.
+  doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]
+     ["KHR_texture_transform"] = json::object();
+  auto identity = import_file(write_gltf("transform_identity.gltf", doc));
+  ASSERT_TRUE(identity->report.ok()) << identity->report.error().to_string();
+  EXPECT_FALSE(only_material(*identity).features & render::VariantKey::kTextureTransform.mask());
+  // Bad values are errors naming the slot, the extension and the field.
+  doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]
+     ["KHR_texture_transform"] = {{"scale", {1.0}}};
+  auto bad = import_file(write_gltf("transform_bad.gltf", doc));
+  ASSERT_FALSE(bad->report.ok());
+  const std::string text = bad->report.error().to_string();
+  EXPECT_NE(text.find("baseColorTexture KHR_texture_transform"), std::string::npos) << text;
+  EXPECT_NE(text.find("scale must be 2 finite numbers"), std::string::npos) << text;
+  doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]
+     ["KHR_texture_transform"] = {{"rotation", "fast"}};
+  expect_import_error(write_gltf("transform_bad_rotation.gltf", doc), "rotation");
 }
 
 }  // namespace

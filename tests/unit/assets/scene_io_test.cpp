@@ -685,6 +685,43 @@ TEST(SceneIo, LiveOverridesChangeALoadedSceneAsAFileWould) {
   EXPECT_EQ(s->world.get<ShadowSettings>(find(*s, "a")).cascade_count, 2);
 }
 
+TEST(SceneIo, ExposureInEv) {
+  // exposure_ev is 2^EV; the saved form is the scale; `exposure` alone keeps working.
+  auto s =
+      read_scene(write_file("ev.json", R"({"render": {"exposure_ev": -1.5}, "entities": []})"));
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  EXPECT_FLOAT_EQ(s->render.exposure, std::exp2(-1.5f));
+  EXPECT_FLOAT_EQ(scene_to_json(*s)["render"]["exposure"].get<float>(), std::exp2(-1.5f));
+  EXPECT_FALSE(scene_to_json(*s)["render"].contains("exposure_ev"));
+  auto plain =
+      read_scene(write_file("ev_plain.json", R"({"render": {"exposure": 0.25}, "entities": []})"));
+  ASSERT_TRUE(plain.ok()) << plain.error().to_string();
+  EXPECT_FLOAT_EQ(plain->render.exposure, 0.25f);
+  // Live: an EV replaces the scale, and back.
+  ASSERT_TRUE(apply_live_override(*s, "render.exposure_ev=2").ok());
+  EXPECT_FLOAT_EQ(s->render.exposure, 4.0f);
+  ASSERT_TRUE(apply_live_override(*s, "render.exposure=0.5").ok());
+  EXPECT_FLOAT_EQ(s->render.exposure, 0.5f);
+  // Errors name the file and the field: out of range, not a number, both forms at once.
+  const std::pair<const char*, const char*> bad[] = {
+      {R"({"render": {"exposure_ev": 14}})", "must be in [-20, 13], was 14"},
+      {R"({"render": {"exposure_ev": "bright"}})", "expected a number"},
+      {R"({"render": {"exposure": 2, "exposure_ev": 1}})", "not both"}};
+  for (const auto& [text, message] : bad) {
+    const auto file = write_file("ev_bad.json", text);
+    auto e = read_scene(file);
+    ASSERT_FALSE(e.ok()) << text;
+    const std::string got = e.error().to_string();
+    EXPECT_NE(got.find("/render/exposure_ev"), std::string::npos) << got;
+    EXPECT_NE(got.find(message), std::string::npos) << got;
+    EXPECT_NE(got.find("ev_bad.json"), std::string::npos) << got;
+  }
+  auto live = apply_live_override(*s, "render.exposure_ev=-30");
+  ASSERT_FALSE(live.ok());
+  EXPECT_NE(live.error().to_string().find("exposure_ev"), std::string::npos);
+  EXPECT_FLOAT_EQ(s->render.exposure, 0.5f);  // unchanged
+}
+
 TEST(SceneIo, EntitiesAreAddedAndRemovedBetweenFrames) {
   auto s = read_scene(kContent / "scenes" / "default.json");
   ASSERT_TRUE(s.ok());

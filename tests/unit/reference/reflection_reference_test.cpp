@@ -1,5 +1,5 @@
 // The reflection reference on primitive scenes: a mirror ray that hits a lit diffuse wall gives
-// the Blinn-Phong value computed here by hand; shadowed, unshadowed and non-receiving cases;
+// the glTF BRDF's value (Appendix B) computed here by hand; shadowed, unshadowed and non-receiving cases;
 // a miss gives the environment cube (or the clear colour); the per-pixel image and its metric.
 #include "runtime/reference/reflection_reference.h"
 
@@ -62,7 +62,7 @@ Material wall_material() {
   Material m;
   m.base_color = glm::vec4(0.8f, 0.4f, 0.2f, 1.0f);
   m.metallic = 0.0f;
-  m.roughness = 1.0f;  // Blinn-Phong exponent max(2 / 1 - 2, 1) = 1
+  m.roughness = 1.0f;  // alpha = 1: D = 1 / pi, V = 0.5 / (N.L + N.V)
   return m;
 }
 
@@ -85,14 +85,19 @@ ShadingLight sun_along_x(bool shadowed) {
 }
 
 /// forward.frag's value at the wall point by hand: n = (-1, 0, 0), l = (-1, 0, 0) (N.L = 1),
-/// v = (-1, -1, 0) / sqrt(2) towards the mirror; roughness 1: shininess 1, norm 9 / 8; f0 0.04.
+/// v = (-1, -1, 0) / sqrt(2) towards the mirror (N.V = sqrt(1/2)); roughness 1 (alpha 1):
+/// D = 1 / pi, V = 0.5 / (N.L + N.V); f0 0.04, F = f0 + (1 - f0)(1 - V.H)^5; the diffuse part
+/// (1 - F) c / pi. `radiance` is the light's colour (an illuminance).
 glm::vec3 expected_wall(const glm::vec3& ambient, const glm::vec3& radiance, float light_factor) {
   const glm::vec3 diffuse(0.8f, 0.4f, 0.2f);
+  const float pi = 3.14159265f;
   const float s = std::sqrt(0.5f);
   const glm::vec3 h = glm::normalize(glm::vec3(-1.0f - s, -s, 0.0f));
-  const float n_dot_h = -h.x;
-  const float spec = 0.04f * (9.0f / 8.0f) * n_dot_h;
-  return ambient * diffuse + (diffuse + glm::vec3(spec)) * radiance * light_factor;
+  const float v_dot_h = glm::dot(glm::vec3(-s, -s, 0.0f), h);
+  const float fresnel = 0.04f + 0.96f * std::pow(1.0f - v_dot_h, 5.0f);
+  const float spec = fresnel * (1.0f / pi) * (0.5f / (1.0f + s));
+  const glm::vec3 brdf = (1.0f - fresnel) * diffuse / pi + glm::vec3(spec);
+  return ambient * diffuse + brdf * radiance * light_factor;
 }
 
 void expect_near(const glm::vec3& a, const glm::vec3& b, float tol = 1e-5f) {
@@ -101,7 +106,7 @@ void expect_near(const glm::vec3& a, const glm::vec3& b, float tol = 1e-5f) {
   EXPECT_NEAR(a.z, b.z, tol);
 }
 
-TEST(ReflectionReference, MirrorRayOntoLitWallGivesBlinnPhong) {
+TEST(ReflectionReference, MirrorRayOntoLitWallGivesTheGltfBrdf) {
   WallScene w = wall_scene(false, wall_material());
   const RayTracer tracer = build(w.scene);
   const ReflectionScene rs = lit_by(w.scene, sun_along_x(true));

@@ -2,6 +2,7 @@
 // alone (math_test): the plain data and the maths need GLM, ecs::Entity and result.h, nothing of
 // the GL, asset or render layers. (cmake/check_layers.cmake checks the include lines themselves.)
 #include "components/bounds.h"
+#include "components/brdf.h"
 #include "components/camera.h"
 #include "components/light.h"
 #include "components/material.h"
