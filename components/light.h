@@ -1,15 +1,27 @@
-// A punctual light (KHR_lights_punctual semantics). It shines along the entity's local -Z axis
-// (world direction = rotation * (0,0,-1)); spot and point lights sit at the entity's position.
+// A light (KHR_lights_punctual semantics, plus S1's rectangular area light). It shines along the
+// entity's local -Z axis (world direction = rotation * (0,0,-1)); spot, point and area lights sit
+// at the entity's position.
 // Shadow parameters live in ShadowSettings, a separate component on the same entity.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/glm.hpp>
 
 namespace kaskad {
 
-enum class LightType { directional, spot, point };
+/// The values are the shaders' LIGHT_* numbers (render::shader_interface_defines()).
+enum class LightType {
+  directional,
+  spot,
+  point,
+  /// S1's area light: a rectangle of Light::size (local X by local Y) facing along -Z, a
+  /// Lambertian emitter (intensity falls with the cosine from its axis) lighting the cone of
+  /// outer_cone_deg; shaded from its centre, shadowed with one perspective map from its centre
+  /// whose axes are the rectangle's, soft shadows from its size.
+  area,
+};
 
 struct Light {
   LightType type = LightType::directional;
@@ -30,6 +42,9 @@ struct Light {
   /// ray-traced reference's square emitter, S1's square light; pcss's light width l = 2 radius).
   /// Shading stays punctual.
   float radius = 0.0f;
+  /// Area only: width (local X) and height (local Y) of the rectangle, metres, each in (0, 100].
+  /// 2 x 2: S1's experiments.
+  glm::vec2 size{2.0f, 2.0f};
 };
 
 /// World-space direction a light shines along: its world matrix applied to local (0, 0, -1),
@@ -50,8 +65,25 @@ struct LightShading {
   glm::vec3 position{0.0f};                ///< spot/point: world position, metres
   float range = 0.0f;                      ///< spot/point: KHR window radius; 0 = infinite
   float cos_inner = 1.0f;                  ///< spot: cos(inner cone half-angle)
-  float cos_outer = 0.7f;                  ///< spot: cos(outer cone half-angle)
+  float cos_outer = 0.7f;                  ///< spot, area: cos(outer cone half-angle)
 };
+
+/// How much of a light's intensity leaves towards a point in direction `l` from it (unit, from
+/// the point to the light), before distance attenuation: the spot's smooth cone; an area light's
+/// cone times its Lambertian cosine; 1 for the others. The CPU twin of forward.frag's.
+inline float light_emission(const LightShading& s, const glm::vec3& l) {
+  if (s.type != LightType::spot && s.type != LightType::area) return 1.0f;
+  const float cd = glm::dot(-l, s.direction);
+  // GLSL's smoothstep(cos_outer, cos_inner, cd), with a step where the edges meet (GLSL leaves
+  // e0 >= e1 undefined).
+  const float e0 = s.cos_outer, e1 = s.cos_inner;
+  float cone = cd >= e1 ? 1.0f : 0.0f;
+  if (e1 > e0) {
+    const float t = glm::clamp((cd - e0) / (e1 - e0), 0.0f, 1.0f);
+    cone = t * t * (3.0f - 2.0f * t);
+  }
+  return s.type == LightType::area ? cone * std::max(cd, 0.0f) : cone;
+}
 
 /// The shading parameters of a Light on an entity with this world matrix.
 inline LightShading light_shading(const Light& light, const glm::mat4& world_matrix) {

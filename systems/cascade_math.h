@@ -95,6 +95,9 @@ struct LightFrame {
   glm::vec3 origin{0.0f};  ///< a point on the light axis (the light entity's position). Keep it
                            ///< fixed while the camera moves: the stable fit snaps relative to it.
                            ///< S0's beam cylinder (radius R) is centred on this axis
+  /// The light entity's local +Y: an area light's map is oriented by it (its rectangle's
+  /// height along the map's y). Need not be unit or perpendicular to `direction`.
+  glm::vec3 up{0.0f, 0.0f, 1.0f};
 };
 
 // ---- Near / far (S2 ComputeNearAndFar, S0 step 3) -----------------------------------------------

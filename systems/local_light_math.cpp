@@ -71,12 +71,18 @@ float spot_tan_half_fov(float outer_cone_deg, int map_size, float border_texels)
 }
 
 PerspectiveShadow fit_spot_shadow(const glm::vec3& position, const glm::vec3& direction,
-                                  float tan_half, float near, float far, int map_size) {
+                                  float tan_half, float near, float far, int map_size,
+                                  const glm::vec3& up) {
   KASKAD_CHECK(glm::length(direction) > 0.0f && tan_half > 0.0f && near > 0.0f && far > near,
                "fit_spot_shadow: needs a direction, tan_half > 0 and 0 < near < far, was near " +
                    std::to_string(near) + ", far " + std::to_string(far));
   const glm::vec3 dir = glm::normalize(direction);
-  return perspective_shadow(position, dir, light_up_vector(dir), tan_half, near, far, map_size);
+  // The given up unless it is (nearly) parallel to the direction or not finite.
+  const glm::vec3 side = glm::cross(dir, up);
+  const bool finite_up = std::isfinite(up.x) && std::isfinite(up.y) && std::isfinite(up.z);
+  const bool usable = finite_up && glm::dot(side, side) > 1e-6f * glm::dot(up, up);
+  return perspective_shadow(position, dir, usable ? up : light_up_vector(dir), tan_half, near, far,
+                            map_size);
 }
 
 int cube_face_of(const glm::vec3& d) {

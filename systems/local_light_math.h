@@ -51,10 +51,13 @@ struct PerspectiveShadow {
 /// and the cone's rim is not shadowed beyond it).
 float spot_tan_half_fov(float outer_cone_deg, int map_size, float border_texels);
 
-/// A spot light's map: looking along `direction` from `position` with spot_tan_half_fov().
+/// A spot (or area) light's map: looking along `direction` from `position` with
+/// spot_tan_half_fov(), its y axis towards `up` (an area light's local +Y, so its x axis is the
+/// light's +X) when that is finite and not parallel to the direction, else light_up_vector().
 /// Preconditions: direction non-zero, tan_half > 0, 0 < near < far.
 PerspectiveShadow fit_spot_shadow(const glm::vec3& position, const glm::vec3& direction,
-                                  float tan_half, float near, float far, int map_size);
+                                  float tan_half, float near, float far, int map_size,
+                                  const glm::vec3& up = glm::vec3(0.0f));
 
 /// Cube faces in GL order: +X, -X, +Y, -Y, +Z, -Z.
 inline constexpr int kCubeFaces = 6;

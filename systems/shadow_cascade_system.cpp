@@ -82,7 +82,7 @@ void fit_local_light(const Light& light, const LightFrame& frame, ShadowData& ou
   // offset, 1 spare.
   const float border = filter_reach_texels(s) + 1.0f + s.normal_offset_bias;
   float tan_half = 0.0f;  // paraboloid maps clip by distance
-  if (light.type == LightType::spot)
+  if (light.type == LightType::spot || light.type == LightType::area)
     tan_half = spot_tan_half_fov(light.outer_cone_deg, s.map_size, border);
   else if (s.point_mode == PointShadowMode::cube)
     tan_half = cube_tan_half_fov(s.map_size, border);
@@ -105,11 +105,14 @@ void fit_local_light(const Light& light, const LightFrame& frame, ShadowData& ou
       return !b.empty() && maybe_inside(clip_corners(out.view_proj[std::size_t(i)], b));
     };
   };
-  if (light.type == LightType::spot) {
+  if (light.type == LightType::spot || light.type == LightType::area) {
     out.projection = ShadowProjection::perspective;
     out.cascade_count = 1;
+    // An area light's map has the rectangle's axes (its width along the map's x), which its
+    // soft shadows take the light's extent along.
     const PerspectiveShadow map =
-        fit_spot_shadow(frame.origin, frame.direction, tan_half, near, far, s.map_size);
+        fit_spot_shadow(frame.origin, frame.direction, tan_half, near, far, s.map_size,
+                        light.type == LightType::area ? frame.up : glm::vec3(0.0f));
     out.view_proj[0] = map.view_proj();
     out.texel_size[0] = map.texel_at_unit_distance;
     finish_layer(0, frustum_overlaps(0));
@@ -326,10 +329,11 @@ bool may_shadow(const Aabb& caster, const Aabb& receivers, const glm::vec3& ligh
   return true;
 }
 
-float light_size_for_shadows(const Light& light) {
+glm::vec2 light_size_for_shadows(const Light& light) {
   if (light.type == LightType::directional)
-    return 2.0f * std::tan(0.5f * glm::radians(light.angular_size_deg));
-  return 2.0f * light.radius;
+    return glm::vec2(2.0f * std::tan(0.5f * glm::radians(light.angular_size_deg)));
+  if (light.type == LightType::area) return light.size;
+  return glm::vec2(2.0f * light.radius);
 }
 
 namespace {
@@ -382,6 +386,7 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
   LightFrame light;
   light.direction = light_direction(light_matrix);
   light.origin = glm::vec3(light_matrix[3]);
+  light.up = glm::vec3(light_matrix[1]);
 
   // 2. Casters, receivers and the scene box; entities with non-finite bounds are left out.
   Aabb scene;

@@ -31,8 +31,10 @@ namespace kaskad {
 /// light of angular size theta is a cone of directions: a blocker at distance D above a receiver
 /// (along the light) hides it from directions within theta / 2 of the axis up to D tan(theta / 2)
 /// to each side, so the penumbra is 2 D tan(theta / 2) wide (= D tan(theta) to first order):
-/// 2 tan(theta / 2) per metre of D. A spot or point light is a square of side l = 2 radius.
-float light_size_for_shadows(const Light& light);
+/// 2 tan(theta / 2) per metre of D. A spot or point light is a square of side l = 2 radius, an
+/// area light its rectangle. x: along the map's x axis (an area light's width, local X), y:
+/// along its y axis (height, local Y); x = y for the others.
+glm::vec2 light_size_for_shadows(const Light& light);
 
 struct ShadowData {
   ecs::Entity light = ecs::kNullEntity;  ///< the shadowed light, null when there is none
@@ -62,8 +64,8 @@ struct ShadowData {
   float paraboloid_margin = 0.0f;
   /// The light's size as soft shadows use it (light_size_for_shadows()): directional, the
   /// penumbra width per metre between blocker and receiver, 2 tan(angular size / 2); spot and
-  /// point, the emitter's width l = 2 radius, metres. 0: punctual.
-  float light_size = 0.0f;
+  /// point, the emitter's width l = 2 radius, metres; area, its width and height. 0: punctual.
+  glm::vec2 light_size{0.0f};
   /// Metres per shadow-map texel of each cascade (the larger of x and y). Spot and point lights:
   /// metres per texel at 1 m from the light (the shader scales by the distance).
   std::array<float, kMaxCascades> texel_size{};

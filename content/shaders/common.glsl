@@ -1,9 +1,7 @@
 // Shared declarations. FrameBlock is FrameBlock in runtime/render/frame_uniforms.h (std140; its
 // offsets are tested against this block). MAX_LIGHTS, MAX_CASCADES and MAX_SHADOW_VIEWS are
-// defined in every program from components/limits.h (FeatureManifest::defines).
-#define LIGHT_DIRECTIONAL 0
-#define LIGHT_SPOT 1
-#define LIGHT_POINT 2
+// defined in every program from components/limits.h (FeatureManifest::defines), and LIGHT_*
+// (LightType's values) from runtime/render/shader_interface.h.
 
 // One shadowed light's maps: its layers of the shadow map array (ShadowViewBlock).
 struct ShadowView {
@@ -11,8 +9,10 @@ struct ShadowView {
   vec4 splits[3];                // S0's D[0..8], four per vec4: view_split(k, i)
   vec4 texel[2];                 // metres per texel per layer: view_texel(k, i)
   ivec4 info;                    // x light index, y first layer, z layer count
-  vec4 params;                   // x normal offset (texels), y blend band, z paraboloid margin
-  vec4 soft;                     // x light size (ShadowView::light_size), y disc radius (texels), z taps,
+  vec4 params;                   // x normal offset (texels), y blend band, z paraboloid margin,
+                                 // w the light's size along the map's y (soft.x: along x)
+  vec4 soft;                     // x light size along the map's x (ShadowView::light_size),
+                                 // y disc radius (texels), z taps,
                                  // w the lookup's reach in texels (ShadowView::filter_reach)
 };
 

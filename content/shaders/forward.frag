@@ -160,9 +160,12 @@ void main() {
         float r = d2 / (range * range);
         attenuation *= clamp(1.0 - r * r, 0.0, 1.0);
       }
-      if (type == LIGHT_SPOT) {
+      // light_emission() in components/light.h: the spot's cone; an area light's cone times
+      // its Lambertian cosine.
+      if (type == LIGHT_SPOT || type == LIGHT_AREA) {
         float cd = dot(-l, normalize(u_light_dir[i].xyz));
         attenuation *= smoothstep(u_light_pos[i].w, u_light_cone[i].x, cd);
+        if (type == LIGHT_AREA) attenuation *= max(cd, 0.0);
       }
     }
     float ndl = max(dot(n, l), 0.0);

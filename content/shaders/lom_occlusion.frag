@@ -76,9 +76,9 @@ ivec2 ranks(float lo, float hi, float h) {
   return ivec2(max(k0, 0), min(k1, 63));
 }
 
-// The samples of the light [-h, h]^2 that the rectangle [lo, hi] covers.
-uvec2 light_cells(vec2 lo, vec2 hi, float h) {
-  ivec2 kx = ranks(lo.x, hi.x, h), ky = ranks(lo.y, hi.y, h);
+// The samples of the light [-h.x, h.x] x [-h.y, h.y] that the rectangle [lo, hi] covers.
+uvec2 light_cells(vec2 lo, vec2 hi, vec2 h) {
+  ivec2 kx = ranks(lo.x, hi.x, h.x), ky = ranks(lo.y, hi.y, h.y);
   if (kx.x > kx.y || ky.x > ky.y) return uvec2(0u);
   // y rank 8 b + a is the bit index: a contiguous range of bits.
   uvec2 in_y = bit_range(ky.x, ky.y);
@@ -146,7 +146,7 @@ vec2 surface_slope(ivec2 s, int layer, int m, float z, float size) {
 // cells of one surface meet on the light: no gaps for light to leak through between cells at
 // different depths (backprojection's gaps, which Guennebaud et al. fill with a separate step).
 uvec2 micro_occluder(PcssMap map, ivec2 s, int layer, int m, float z, vec2 offset, float step,
-                     float d_r, float half_light, float size) {
+                     float d_r, vec2 half_light, float size) {
   float d_b = pcss_distance(map, z);
   vec2 dz = surface_slope(s, layer, m, z, size) * (0.5 * step);
   vec2 d_lo = vec2(pcss_distance(map, z - dz.x), pcss_distance(map, z - dz.y));
@@ -163,14 +163,15 @@ uvec2 micro_occluder(PcssMap map, ivec2 s, int layer, int m, float z, vec2 offse
   // Half a sample spacing wider on each side: closes the hairline gaps the slope estimates leave
   // at creases (a box's top meeting its wall: one sample of light, 1/64, leaked into a closed
   // box). Covering a sample twice costs nothing; a silhouette moves by 1/128 of the light.
-  float pad = half_light / 64.0;
+  vec2 pad = half_light / 64.0;
   return light_cells(min(lo, hi) - pad, max(lo, hi) + pad, half_light);
 }
 
 float occlusion_factor(int k, int i, int layer, ivec2 t, float z_p) {
   int layers = lom_layers();
   float size = u_frame.y;
-  float l = u_shadow_views[k].soft.x;
+  vec2 extent = light_extent(k);
+  float l = max(extent.x, extent.y);  // the search, as pcss()
   vec2 c = (vec2(t) + 0.5) / size;
   // The stored surface's plane (d depth / d uv): a point of it in another texel is not in front
   // of P.
@@ -181,7 +182,7 @@ float occlusion_factor(int k, int i, int layer, ivec2 t, float z_p) {
     return z >= 0.0 && z < z_p - margin ? 1.0 : 0.0;
   }
   PcssMap map = pcss_map(k, i);
-  float half_light = map.perspective ? 0.5 * l : 0.5 * l * 0.88622693;  // as backprojection()
+  vec2 half_light = light_half_extent(k, map.perspective);
   float d_r = pcss_distance(map, z_p);
   ivec2 cell = fixed_texel(k, i, t, size);
   uvec3 h = pcg3d(uvec3(uvec2(cell), uint(layer)));

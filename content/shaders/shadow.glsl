@@ -169,6 +169,21 @@ vec2 disc_tap(int i, int n, float angle) {
   return r * vec2(cos(a), sin(a));
 }
 
+// The point of [-1, 1]^2 that Shirley and Chiu's concentric map ("A Low Distortion Map Between
+// Disk and Square", 1997) sends to p of the unit disc: the inverse map, area-preserving, so
+// taps even over the disc stay even over the square.
+vec2 square_from_disc(vec2 p) {
+  float r = length(p);
+  if (r <= 0.0) return vec2(0.0);
+  float phi = atan(p.y, p.x);  // (-pi, pi]
+  if (phi < -0.78539816) phi += 6.28318531;  // [-pi/4, 7 pi/4)
+  const float k = 1.27323954;  // 4 / pi
+  if (phi < 0.78539816) return vec2(r, phi * k * r);
+  if (phi < 2.35619449) return vec2(-(phi - 1.57079633) * k * r, r);
+  if (phi < 3.92699082) return vec2(-r, -(phi - 3.14159265) * k * r);
+  return vec2((phi - 4.71238898) * k * r, -r);
+}
+
 // PCF over a disc of `radius` texels, `taps` linear-filtered compares, each against the receiver
 // plane (slope g).
 float disc_pcf(int layer, vec3 c, vec2 g, float radius, int taps, float angle) {
@@ -211,7 +226,9 @@ float box_pcf(int layer, vec3 c, vec2 g) {
 #ifdef SHADOW_SIZED
 // Percentage-closer soft shadows (Fernando, "Percentage-Closer Soft Shadows", SIGGRAPH 2005
 // sketch) in layer i of view k at map coordinates c (receiver q). Light size l = soft.x
-// (ShadowData::light_size). The blocker search and the filter take `taps` disc taps each.
+// (ShadowData::light_size), params.w along the map's y (an area light's rectangle; the others
+// are square): the search takes the longer side, the round filter the side of the square of
+// the same area. The blocker search and the filter take `taps` disc taps each.
 //
 // Perspective maps (spot light, cube face): a square light of width l at the centre of
 // projection, the receiver at distance d_r along the axis and a blocker at d_b. The ray from
@@ -266,11 +283,22 @@ PcssMap pcss_map(int k, int i) {
   map.texel = view_texel(k, i);
   return map;
 }
+
+// The light's extent along the map's x and y (ShadowData::light_size).
+vec2 light_extent(int k) { return vec2(u_shadow_views[k].soft.x, u_shadow_views[k].params.w); }
+
+// Half the light's extent along the map's axes in the units backprojection works in: metres
+// (perspective), or tangent units for a cone (ortho), taken as the square of the same solid
+// angle, side l sqrt(pi) / 2.
+vec2 light_half_extent(int k, bool perspective) {
+  return 0.5 * light_extent(k) * (perspective ? 1.0 : 0.88622693);  // sqrt(pi) / 2
+}
 #endif
 
 #if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_PCSS
 float pcss(int k, int i, int layer, vec3 c, vec2 g, float angle) {
-  float l = u_shadow_views[k].soft.x;
+  vec2 extent = light_extent(k);
+  float l = max(extent.x, extent.y);  // the search: every blocker that can hide part of it
   int taps = int(u_shadow_views[k].soft.z);
   PcssMap map = pcss_map(k, i);
   float d_r = pcss_distance(map, c.z);
@@ -292,8 +320,22 @@ float pcss(int k, int i, int layer, vec3 c, vec2 g, float angle) {
   // 2. Average blocker depth -> 3. penumbra radius (above) -> 4. PCF over it, at least the
   //    3x3 kernel's reach so contact shadows stay filtered.
   float d_b = pcss_distance(map, sum / blockers);
-  float radius = clamp(pcss_radius(map, l, d_r, d_b), 1.5, PCSS_MAX_RADIUS);
-  return disc_pcf(layer, c, g, radius, taps, angle);
+  if (!map.perspective) {  // a cone of directions: a round filter
+    float radius = clamp(pcss_radius(map, sqrt(extent.x * extent.y), d_r, d_b), 1.5, PCSS_MAX_RADIUS);
+    return disc_pcf(layer, c, g, radius, taps, angle);
+  }
+  // A square or rectangular emitter (spot, point, area): the filter has the light's own shape,
+  // half-widths pcss_radius() per axis; the disc's taps are carried onto the square by an
+  // area-preserving map, so they stay as even (a round filter over a square light's straight
+  // edge gave penumbrae 12% too narrow, 10-90%).
+  vec2 radius = vec2(pcss_radius(map, extent.x, d_r, d_b), pcss_radius(map, extent.y, d_r, d_b));
+  radius = clamp(radius, vec2(1.5), vec2(PCSS_MAX_RADIUS));
+  float sum_lit = 0.0;
+  for (int t = 0; t < taps; ++t) {
+    vec2 o = square_from_disc(disc_tap(t, taps, angle)) * radius / u_frame.y;
+    sum_lit += texture(u_shadow_linear, vec4(c.xy + o, float(layer), c.z + dot(g, o)));
+  }
+  return sum_lit / float(taps);
 }
 #endif
 
@@ -321,17 +363,18 @@ float overlap_1d(float a0, float a1, float h) { return max(0.0, min(a1, h) - max
 //
 // Light plane coordinates of a cell u tangent units (perspective) off the receiver's map point,
 // at depth d_b, seen from the receiver at d_r: the line from the receiver through it reaches the
-// light's plane (distance 0) at u d_r d_b / (d_r - d_b) metres, and the light is the square
-// [-l/2, l/2]^2 (Light::radius). Ortho: a cell x metres off the receiver's map point at height
+// light's plane (distance 0) at u d_r d_b / (d_r - d_b) metres, and the light is the rectangle
+// [-w/2, w/2] x [-h/2, h/2] (light_extent(): 2 Light::radius a side, or an area light's size). Ortho: a cell x metres off the receiver's map point at height
 // D = d_r - d_b above it is seen in direction x / D (tangent units); the light is the cone of
 // half-angle theta / 2, taken as the square of the same solid angle, side
 // l sqrt(pi) / 2 (l = 2 tan(theta / 2)).
 float backprojection(int k, int i, int layer, vec3 c, vec2 g, float angle) {
-  float l = u_shadow_views[k].soft.x;
+  vec2 extent = light_extent(k);
+  float l = max(extent.x, extent.y);  // the search, as pcss()
   if (l <= 0.0) return texture(u_shadow_map, vec4(c.xy, float(layer), c.z));  // punctual
   PcssMap map = pcss_map(k, i);
   float size = u_frame.y;
-  float half_light = map.perspective ? 0.5 * l : 0.5 * l * 0.88622693;  // sqrt(pi) / 2
+  vec2 half_light = light_half_extent(k, map.perspective);
   float d_r = pcss_distance(map, c.z);
   float search = clamp(pcss_radius(map, l, d_r, map.perspective ? map.near : 0.0), 1.0,
                        PCSS_MAX_RADIUS);
@@ -357,10 +400,11 @@ float backprojection(int k, int i, int layer, vec3 c, vec2 g, float angle) {
       // The cell's extent relative to the receiver's map point, in texels, then on the light.
       vec2 lo = (uv - c.xy) * size - 0.5 * step, hi = lo + step;
       float f = map.perspective ? map.texel * d_r * d_b / (d_r - d_b) : map.texel / (d_r - d_b);
-      blocked += overlap_1d(lo.x * f, hi.x * f, half_light) * overlap_1d(lo.y * f, hi.y * f, half_light);
+      blocked += overlap_1d(lo.x * f, hi.x * f, half_light.x) *
+                 overlap_1d(lo.y * f, hi.y * f, half_light.y);
     }
   }
-  return clamp(1.0 - blocked / (4.0 * half_light * half_light), 0.0, 1.0);
+  return clamp(1.0 - blocked / (4.0 * half_light.x * half_light.y), 0.0, 1.0);
 }
 #endif
 

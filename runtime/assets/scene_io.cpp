@@ -49,7 +49,8 @@ using json_reader::vec;
 constexpr int kFormatVersion = 1;
 
 const std::vector<std::pair<const char*, LightType>> kLightTypes = {
-    {"directional", LightType::directional}, {"spot", LightType::spot}, {"point", LightType::point}};
+    {"directional", LightType::directional}, {"spot", LightType::spot}, {"point", LightType::point},
+    {"area", LightType::area}};
 const std::vector<std::pair<const char*, CullMode>> kCullModes = {
     {"back", CullMode::back}, {"front", CullMode::front}, {"none", CullMode::none}};
 const std::vector<std::pair<const char*, ShadowFilter>> kFilters = {
@@ -276,13 +277,24 @@ bool read_light(ObjectReader& lr, Light& l) {
   lr.boolean("cast_shadows", l.cast_shadows);
   lr.number("angular_size_deg", l.angular_size_deg, 0.0f, 45.0f);
   lr.number("radius", l.radius, 0.0f, 100.0f);
+  const bool size_given = lr.has("size");
+  lr.vector("size", l.size, 1e-3f, 100.0f);
   lr.finish();
   if (l.type == LightType::directional && l.radius > 0.0f)
     fail(lr.at("radius"), "is for spot and point lights; a directional light's size is "
                           "angular_size_deg");
+  if (l.type == LightType::area && l.radius > 0.0f)
+    fail(lr.at("radius"), "is for spot and point lights; an area light's size is size [width, "
+                          "height] (metres)");
   if (l.type != LightType::directional && l.angular_size_deg > 0.0f)
     fail(lr.at("angular_size_deg"), "is for directional lights; a spot or point light's size is "
-                                    "radius (metres)");
+                                    "radius (metres), an area light's size [width, height]");
+  if (size_given && l.type != LightType::area)
+    fail(lr.at("size"), "is for area lights (type \"area\"); a spot or point light's size is "
+                        "radius, a directional light's angular_size_deg");
+  if (l.type == LightType::area && l.outer_cone_deg > 80.0f)
+    fail(lr.at("outer_cone_deg"), "of an area light must be at most 80 (its shadow map is one "
+                                  "perspective map over the cone), was " + json(num(l.outer_cone_deg)).dump());
   if (l.inner_cone_deg > l.outer_cone_deg)
     fail(lr.at("inner_cone_deg"), "must not exceed outer_cone_deg");
   return cast_given;
@@ -475,6 +487,7 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
                   {"cast_shadows", l->cast_shadows},
                   {"angular_size_deg", num(l->angular_size_deg)},
                   {"radius", num(l->radius)}};
+    if (l->type == LightType::area) j["light"]["size"] = vec(l->size);
     if (const auto* s = w.try_get<ShadowSettings>(e)) {
       json sj = write_shadow(*s, &scene.shadow_defaults);
       if (!sj.empty()) j["shadow"] = sj;

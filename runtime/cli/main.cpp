@@ -448,6 +448,14 @@ int run_render(Args a) {
     }
     std::printf("%s\n", drawn < st.shadow_layers ? "; the others kept their depth (same matrix "
                                                     "and casters)" : "");
+    if (scene->shadow_defaults.technique == ShadowTechnique::lom ||
+        (!timings->last.shadows.empty() &&
+         timings->last.shadows.front().settings.technique == ShadowTechnique::lom))
+      std::printf("          lom: %d of %d layers peeled and their occlusion recomputed; %lld "
+                  "texels with more light-facing surfaces than lom_layers (read as umbra "
+                  "below them)\n",
+                  std::popcount(st.lom_layers_computed), st.shadow_layers,
+                  static_cast<long long>(st.lom_overflow_texels));
   }
   const std::vector<ShadowData>& views = timings->last.shadows;
   const std::size_t aov_view = std::size_t(aov_shadow_index(*scene, views.size()));
@@ -459,7 +467,7 @@ int run_render(Args a) {
                 sh.first_layer + sh.cascade_count - 1, sh.settings.map_size,
                 views.size() > 1 && k == aov_view ? " (the AOV shows it)" : "");
     if (sh.projection != ShadowProjection::ortho) {
-      const char* kinds[] = {"", "spot: 1 perspective map", "point: 6 cube faces",
+      const char* kinds[] = {"", "spot or area: 1 perspective map", "point: 6 cube faces",
                              "point: 2 paraboloid hemispheres"};
       std::printf("          %s, near %.3g m, far %.3g m from the light\n", kinds[int(sh.projection)],
                   double(sh.splits[0]), double(sh.splits[1]));

@@ -62,6 +62,7 @@ inline double num(float f) {
   std::from_chars(buf, r.ptr, d);
   return d;
 }
+inline json vec(const glm::vec2& v) { return json::array({num(v.x), num(v.y)}); }
 inline json vec(const glm::vec3& v) { return json::array({num(v.x), num(v.y), num(v.z)}); }
 inline json vec(const glm::vec4& v) { return json::array({num(v.x), num(v.y), num(v.z), num(v.w)}); }
 

@@ -339,11 +339,16 @@ ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix
   r.position = glm::vec3(world_matrix[3]);
   r.direction = light_direction(world_matrix);
   r.right = perpendicular(r.direction, glm::vec3(world_matrix[0]));
-  r.outer_cone_deg = light.type == LightType::spot ? light.outer_cone_deg : 180.0f;
+  const bool cone = light.type == LightType::spot || light.type == LightType::area;
+  r.outer_cone_deg = cone ? light.outer_cone_deg : 180.0f;
   r.range = light.type == LightType::directional ? 0.0f : light.range;
   r.angular_size_deg = light.type == LightType::directional ? light.angular_size_deg : 0.0f;
   // Light::radius: a square of side 2 radius (the square the shadow techniques assume).
   r.size = light.type == LightType::directional ? 0.0f : 2.0f * light.radius;
+  if (light.type == LightType::area) {
+    r.size = light.size.x;
+    r.height = light.size.y;
+  }
   return r;
 }
 
@@ -617,8 +622,11 @@ float area_visibility(RTCScene occluders, float offset, const glm::vec3& positio
             glm::normalize(cos_t * -axis + sin_t * (std::cos(phi) * t1 + std::sin(phi) * t2));
         ray.tmax = kInfinity;
       } else {
-        // Point on the square emitter (S1), edges along t1 and t2, centred at the light.
-        const glm::vec3 s = light.position + light.size * ((su - 0.5f) * t1 + (sv - 0.5f) * t2);
+        // Point on the rectangular emitter (S1's square), edges along t1 and t2, centred at the
+        // light.
+        const float height = light.height > 0.0f ? light.height : light.size;
+        const glm::vec3 s =
+            light.position + light.size * (su - 0.5f) * t1 + height * (sv - 0.5f) * t2;
         const glm::vec3 d = s - origin;
         const float dist = glm::length(d);
         if (!(dist > offset)) {  // the sample is at the surface point: nothing in between
@@ -720,7 +728,7 @@ Result<ShadowReference> RayTracer::shadow_reference(const Image& aov,
   const Impl& im = *impl_;
   const bool area = light.is_area();
   const float cos_outer = std::cos(glm::radians(std::min(light.outer_cone_deg, 180.0f)));
-  const bool spot = light.type == LightType::spot;
+  const bool spot = light.type == LightType::spot || light.type == LightType::area;  // a cone
   std::atomic<int> next_row{0};
   std::atomic<std::uint64_t> total_rays{0};
 

@@ -33,10 +33,13 @@ struct ReferenceLight {
   glm::vec3 right{1.0f, 0.0f, 0.0f};       ///< area light: the square's first edge, or the cone's
                                       ///< azimuth origin (the entity's +X); the tracer makes it
                                       ///< unit and perpendicular to `direction`
-  /// Spot/point: side of the square emitter in metres (perpendicular to `direction`, centred at
-  /// `position`, edges along `right` and direction x right; S1's 2 x 2 light has size 2).
-  /// 0 = punctual.
+  /// Spot/point/area: side of the square emitter in metres (perpendicular to `direction`,
+  /// centred at `position`, edges along `right` and direction x right; S1's 2 x 2 light has
+  /// size 2). 0 = punctual.
   float size = 0.0f;
+  /// Area: the rectangle's side along direction x right (its height, the light's local Y);
+  /// 0 = size (a square).
+  float height = 0.0f;
   /// Directional: apex angle of the cone of incoming directions around -direction, degrees
   /// (the sun: about 0.53). 0 = punctual.
   float angular_size_deg = 0.0f;
@@ -53,7 +56,8 @@ struct ReferenceLight {
 /// the matrix's -Z (as systems/shadow_map_system.cpp light_direction(); change together), right
 /// from its +X, position from its translation; a directional light's angular_size_deg from the
 /// component (an area light when > 0); a spot or point light's size = 2 Light::radius (a square
-/// emitter of side 2 radius; punctual when the radius is 0).
+/// emitter of side 2 radius; punctual when the radius is 0); an area light's size and height
+/// its Light::size, and its cone outer_cone_deg.
 ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix);
 
 /// The first surface a ray hits.

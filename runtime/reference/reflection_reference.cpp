@@ -26,13 +26,6 @@ bool finite(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
-/// GLSL smoothstep, with a step where the edges meet (GLSL leaves e0 >= e1 undefined).
-float smoothstep(float e0, float e1, float x) {
-  if (!(e1 > e0)) return x >= e1 ? 1.0f : 0.0f;
-  const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
-  return t * t * (3.0f - 2.0f * t);
-}
-
 Status check_sizes(const Image& image, const char* what) {
   if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
       image.pixels.size() !=
@@ -148,8 +141,7 @@ glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
         const float r = d2 / (light.range * light.range);
         attenuation *= std::clamp(1.0f - r * r, 0.0f, 1.0f);
       }
-      if (light.type == LightType::spot)
-        attenuation *= smoothstep(light.cos_outer, light.cos_inner, glm::dot(-l, dir));
+      attenuation *= light_emission(light, l);  // spot cone, area cone and cosine
     }
     const float ndl = std::max(glm::dot(n, l), 0.0f);
     if (ndl <= 0.0f) continue;

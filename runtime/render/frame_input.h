@@ -111,9 +111,10 @@ struct ShadowView {
   float paraboloid_margin = 0.0f;
   /// Soft shadows (ShadowSettings::technique): the light's size (ShadowData::light_size:
   /// directional, 2 tan(angular size / 2), penumbra metres per metre of blocker-receiver
-  /// distance; spot/point, the emitter width 2 radius in metres), and the Poisson disc's taps
+  /// distance; spot/point, the emitter width 2 radius in metres; area, its width (map x) and
+  /// height (map y)), and the Poisson disc's taps
   /// and radius in texels (ShadowSettings::pcf_taps, pcf_radius).
-  float light_size = 0.0f;
+  glm::vec2 light_size{0.0f};
   int pcf_taps = 16;
   float pcf_radius = 2.5f;
   /// Texels the lookup reaches from the point's texel (filter_reach_texels()): map_bounds

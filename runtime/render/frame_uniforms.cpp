@@ -47,8 +47,8 @@ ShadowViewBlock pack_view(const ShadowView& v) {
   }
   for (int i = 0; i <= v.layer_count; ++i) b.splits[i / 4][i % 4] = v.splits[std::size_t(i)];
   b.info = glm::ivec4(v.light_index, v.first_layer, v.layer_count, 0);
-  b.params = glm::vec4(v.normal_offset, v.blend_band, v.paraboloid_margin, 0.0f);
-  b.soft = glm::vec4(v.light_size, v.pcf_radius, float(v.pcf_taps), v.filter_reach);
+  b.params = glm::vec4(v.normal_offset, v.blend_band, v.paraboloid_margin, v.light_size.y);
+  b.soft = glm::vec4(v.light_size.x, v.pcf_radius, float(v.pcf_taps), v.filter_reach);
   return b;
 }
 

@@ -17,8 +17,10 @@ struct alignas(16) ShadowViewBlock {
   glm::vec4 splits[3];                ///< S0's D[0..8], four per vec4 (view_split(k, i))
   glm::vec4 texel[2];                 ///< metres per texel per layer (view_texel(k, i))
   glm::ivec4 info;                    ///< x light index, y first layer, z layer count
-  glm::vec4 params;                   ///< x normal offset (texels), y blend band, z paraboloid margin
-  /// Soft shadows: x light size (ShadowView::light_size), y Poisson disc radius (texels), z taps,
+  glm::vec4 params;                   ///< x normal offset (texels), y blend band, z paraboloid margin,
+                                      ///< w the light's size along the map's y (light_size.y)
+  /// Soft shadows: x light size along the map's x (ShadowView::light_size.x; params.w holds y),
+  /// y Poisson disc radius (texels), z taps,
   /// w the lookup's reach in texels (ShadowView::filter_reach).
   glm::vec4 soft;
 };

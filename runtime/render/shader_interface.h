@@ -11,6 +11,8 @@
 
 #include <glm/glm.hpp>
 
+#include "components/light.h"
+
 namespace kaskad::render {
 
 // Vertex attributes: per vertex (a mesh's streams), then per instance (InstanceRecord).
@@ -57,9 +59,14 @@ inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
                           kTexShadowLinear = 6, kTexOcclusion = 7, kTexEmissive = 8,
                           kTexLomDepth = 9, kTexLomOcclusion = 10, kTexPeelPrevious = 11;
 
-/// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...).
-inline std::array<std::pair<const char*, int>, 38> shader_interface_defines() {
-  return {{{"ATTR_POSITION", kAttrPosition},
+/// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...), and
+/// the light types (LIGHT_DIRECTIONAL, ...: u_light_info[i].x holds a LightType).
+inline std::array<std::pair<const char*, int>, 42> shader_interface_defines() {
+  return {{{"LIGHT_DIRECTIONAL", int(LightType::directional)},
+           {"LIGHT_SPOT", int(LightType::spot)},
+           {"LIGHT_POINT", int(LightType::point)},
+           {"LIGHT_AREA", int(LightType::area)},
+           {"ATTR_POSITION", kAttrPosition},
            {"ATTR_NORMAL", kAttrNormal},
            {"ATTR_UV", kAttrUv},
            {"ATTR_MODEL", kAttrModel},

@@ -249,6 +249,32 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   EXPECT_EQ(again->shadow_defaults.lom_layers, 5);
   EXPECT_EQ(again->world.get<ShadowSettings>(find(*again, "lamp")).pcf_kernel, PcfKernel::k9x9);
 
+  // An area light: type, size, its cone; size belongs to area lights only, radius not to them.
+  const fs::path panel_file = temp_dir() / "panel.json";
+  std::ofstream(panel_file) << R"({ "entities": [
+      { "name": "panel", "transform": { "translation": [0, 3, 0], "direction": [0, -1, 0] },
+        "light": { "type": "area", "size": [2, 0.5], "outer_cone_deg": 70, "cast_shadows": true } },
+      { "name": "lamp", "transform": { "translation": [0, 4, 0] }, "light": { "type": "point" } } ] })";
+  auto panel = read_scene(panel_file);
+  ASSERT_TRUE(panel.ok()) << panel.error().to_string();
+  const Light& area = panel->world.get<Light>(find(*panel, "panel"));
+  EXPECT_EQ(area.type, LightType::area);
+  EXPECT_EQ(area.size, glm::vec2(2.0f, 0.5f));
+  const fs::path panel_out = temp_dir() / "panel_saved.json";
+  ASSERT_TRUE(save_scene(panel_out, *panel).ok());
+  auto panel_again = read_scene(panel_out);
+  ASSERT_TRUE(panel_again.ok()) << panel_again.error().to_string();
+  EXPECT_EQ(panel_again->world.get<Light>(find(*panel_again, "panel")).size, glm::vec2(2.0f, 0.5f));
+  EXPECT_EQ(panel_again->world.get<Light>(find(*panel_again, "panel")).type, LightType::area);
+  expect_error(read_scene(panel_file, {"panel.light.size.0=0"}), {"/light/size", "0"});
+  expect_error(read_scene(panel_file, {"panel.light.size.1=101"}), {"/light/size", "101"});
+  expect_error(read_scene(panel_file, {"panel.light.radius=0.5"}), {"/light/radius", "area", "size"});
+  expect_error(read_scene(panel_file, {"panel.light.outer_cone_deg=85"}),
+               {"/light/outer_cone_deg", "80", "85"});
+  const fs::path sized_point = temp_dir() / "sized_point.json";
+  std::ofstream(sized_point) << R"({ "entities": [
+      { "name": "lamp", "light": { "type": "point", "size": [1, 1] } } ] })";
+  expect_error(read_scene(sized_point), {"sized_point.json", "/light/size", "area"});
   expect_error(read_scene(def, {"shadow.technique=vsm"}), {"/shadow/technique", "vsm", "pcf", "pcss", "backprojection"});
   expect_error(read_scene(def, {"shadow.pcf_kernel=4"}), {"/shadow/pcf_kernel", "3, 5, 7, 9", "4"});
   expect_error(read_scene(def, {"shadow.pcf_kernel=11"}), {"/shadow/pcf_kernel", "11"});

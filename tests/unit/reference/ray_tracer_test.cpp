@@ -463,6 +463,16 @@ TEST(RayTracer, ReferenceLightFromAComponent) {
   EXPECT_TRUE(reference_light(sun, glm::mat4(1.0f)).is_area());
   spot.angular_size_deg = 2.0f;
   EXPECT_FALSE(reference_light(spot, m).is_area());
+  // An area light: its rectangle (width along +X, height along +Y) and its cone.
+  Light panel;
+  panel.type = LightType::area;
+  panel.size = {2.0f, 0.5f};
+  panel.outer_cone_deg = 60.0f;
+  const ReferenceLight a = reference_light(panel, m);
+  EXPECT_TRUE(a.is_area());
+  EXPECT_EQ(a.size, 2.0f);
+  EXPECT_EQ(a.height, 0.5f);
+  EXPECT_EQ(a.outer_cone_deg, 60.0f);
 }
 
 // Area lights ------------------------------------------------------------------------------------
@@ -518,6 +528,28 @@ TEST(RayTracer, AreaLightHalfBlockedByAnEdgeThroughTheMiddle) {
   EXPECT_NEAR(tracer.area_light_visibility({0, 0, 0}, {0, 1, 0}, sun, 256, 5), 0.5f, 0.03f);
   sun.right = glm::normalize(glm::vec3(1, 0, 1));
   EXPECT_NEAR(tracer.area_light_visibility({0, 0, 0}, {0, 1, 0}, sun, 256, 5), 0.5f, 0.03f);
+}
+
+// A rectangular emitter (an area light's size): a half-plane whose edge runs along the light's
+// width hides the half of its height; turned to run along the height, the half of its width.
+// A thin bar over the middle hides the fraction of the rectangle it covers, which differs with
+// the rectangle's orientation: proves the sampling uses height along direction x right.
+TEST(RayTracer, RectangularAreaLightIsSampledOverItsWidthAndHeight) {
+  Scene scene;
+  // A bar 0.4 wide along x (infinite along z) halfway up: its shadow on the light plane seen
+  // from the origin is 0.8 wide along x.
+  add(scene, PrimitiveShape::plane, trs({0, 2, 0}, {0.4f, 1, 40}));
+  const RayTracer tracer = build(scene);
+  ReferenceLight panel = positional(LightType::area, {0, 4, 0});
+  panel.right = {1, 0, 0};  // width along x
+  panel.size = 2.0f;
+  panel.height = 0.5f;
+  // Width 2 along x: the bar's 0.8 hides 0.8 / 2 of it.
+  EXPECT_NEAR(tracer.area_light_visibility({0, 0, 0}, {0, 1, 0}, panel, 4096, 3), 1.0f - 0.4f,
+              0.01f);
+  // Width along z instead: the height (0.5) lies along x, and the bar's 0.8 covers all of it.
+  panel.right = {0, 0, 1};
+  EXPECT_NEAR(tracer.area_light_visibility({0, 0, 0}, {0, 1, 0}, panel, 4096, 3), 0.0f, 0.01f);
 }
 
 TEST(RayTracer, AreaLightBehindAParallelSquareMatchesTheOverlapArea) {
