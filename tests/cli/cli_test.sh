@@ -46,7 +46,7 @@ check save_roundtrip2 0 "wrote" -- "$KASKAD" save "$tmp/a.json" -o "$tmp/b.json"
 if cmp -s "$tmp/a.json" "$tmp/b.json"; then echo "ok   save_identical"; passed=$((passed + 1)); else echo "FAIL save_identical"; failed=$((failed + 1)); fi
 check help 0 "usage" -- "$KASKAD" --help
 # Spot and point lights, several shadowed lights: the shadow lines and the per-layer table.
-check render_spot 0 "spot: 1 perspective map" -- "$KASKAD" render "$KASKAD_CONTENT/scenes/spot.json" \
+check render_spot 0 "spot or area: 1 perspective map" -- "$KASKAD" render "$KASKAD_CONTENT/scenes/spot.json" \
   --headless --size 96x64 --frames 1 -o "$tmp/spot.png"
 check render_point_dp 0 "point: 2 paraboloid hemispheres" -- "$KASKAD" render "$KASKAD_CONTENT/scenes/point.json" \
   --headless --size 96x64 --frames 1 -o "$tmp/point.png" --set shadow.point_mode=dual_paraboloid
@@ -133,16 +133,18 @@ assert s == 0.0 and c > 0.0, (s, c)
 print("flicker stable %g crop %g" % (s, c))
 ' "$tmp/flicker/bench.csv"
 # Soft shadows (issue 14): `--sweep soft` runs the techniques and kernels on the 5-degree sun;
-# pcss is closer to the area-light reference (rmse) than hard 3x3 pcf.
-check bench_soft 0 "wrote .*bench.csv \(8 rows\)" -- "$KASKAD" bench "$KASKAD_CONTENT/scenes/soft/sun_5deg.json" \
+# pcss and lom are closer to the area-light reference (rmse) than hard 3x3 pcf.
+check bench_soft 0 "wrote .*bench.csv \(10 rows\)" -- "$KASKAD" bench "$KASKAD_CONTENT/scenes/soft/sun_5deg.json" \
   --size 200x112 --frames 1 --no-chart --stability-frames 0 --out "$tmp/soft" --sweep soft 2>/dev/null
 check bench_soft_csv 0 "pcss beats pcf" -- /usr/bin/python3 -c '
 import csv, sys
 rows = {r["settings"]: r for r in csv.DictReader(open(sys.argv[1]))}
-pcss = float(rows["shadow.technique=pcss;shadow.pcf_taps=16"]["rmse"])
-pcf = float(rows["shadow.technique=pcf;shadow.pcf_kernel=3"]["rmse"])
-print("rmse pcss %.4f pcf %.4f" % (pcss, pcf))
-assert pcss < pcf
+nocache = "render.shadow_cache=false;"
+pcss = float(rows[nocache + "shadow.technique=pcss;shadow.pcf_taps=16"]["rmse"])
+pcf = float(rows[nocache + "shadow.technique=pcf;shadow.pcf_kernel=3"]["rmse"])
+lom = float(rows[nocache + "shadow.technique=lom;shadow.map_size=1024;shadow.lom_layers=8"]["rmse"])
+print("rmse pcss %.4f lom %.4f pcf %.4f" % (pcss, lom, pcf))
+assert pcss < pcf and lom < pcf
 print("pcss beats pcf")
 ' "$tmp/soft/bench.csv"
 check bench_bad_sweep nonzero "--sweep.*expected key=value" -- "$KASKAD" bench --sweep "shadow.map_size" --no-chart --out "$tmp/bench2"

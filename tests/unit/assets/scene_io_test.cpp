@@ -326,8 +326,8 @@ TEST(SceneIo, MalformedFilesGiveErrorsNamingFileAndPlace) {
                {"bad2.json", "/entities/0/lihgt", "unknown key", "light"});
   expect_error(read_scene(write_file("bad3.json", R"({"entities": [{"light": {"intensity": "bright"}}]})")),
                {"bad3.json", "/entities/0/light/intensity", "expected a number"});
-  expect_error(read_scene(write_file("bad4.json", R"({"entities": [{"light": {"type": "area"}}]})")),
-               {"/entities/0/light/type", "area", "directional"});
+  expect_error(read_scene(write_file("bad4.json", R"({"entities": [{"light": {"type": "laser"}}]})")),
+               {"/entities/0/light/type", "laser", "directional", "area"});
   expect_error(read_scene(write_file("bad5.json", R"({"entities": [{"camera": {"near": 10, "far": 1}}]})")),
                {"/entities/0/camera/far", "greater than near"});
   expect_error(read_scene(write_file("bad6.json", R"({"entities": [{"transform": {"parent": "ghost"}}]})")),
