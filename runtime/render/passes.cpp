@@ -91,6 +91,30 @@ std::size_t triangles(const AssetStore& assets, MeshId id) {
   return assets.meshes[index(id)].indices.size() / 3;
 }
 
+// Every slice of a 2D array texture of one channel (`format`: GL_DEPTH_COMPONENT or GL_RED) as
+// one image, layer 0 first, rows top to bottom within each (GL's bottom-to-top rows flipped):
+// ShadowMapPass::read(), LomPass::read_depths(). No texture: an empty stack.
+Image read_slices(const gpu::Texture& t, GLenum format, int size, int slices) {
+  Image img;
+  img.width = size;
+  img.height = size * slices;
+  img.channels = 1;
+  img.channel_names = {"Y"};
+  if (!t) return img;
+  const std::size_t row = std::size_t(size), layer = row * row;
+  std::vector<float> stack(layer * std::size_t(slices));
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(t.id(), 0, format, GL_FLOAT, GLsizei(stack.size() * sizeof(float)),
+                    stack.data());
+  img.pixels.resize(stack.size());
+  for (int l = 0; l < slices; ++l)
+    for (int y = 0; y < size; ++y)
+      std::memcpy(&img.pixels[std::size_t(l) * layer + std::size_t(y) * row],
+                  &stack[std::size_t(l) * layer + std::size_t(size - 1 - y) * row],
+                  row * sizeof(float));
+  return img;
+}
+
 }  // namespace
 
 // ---- DrawState ----------------------------------------------------------------------------------
@@ -543,26 +567,7 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
 }
 
 Image ShadowMapPass::read() const {
-  Image img;
-  img.width = size_;
-  img.height = size_ * layers_;
-  img.channels = 1;
-  img.channel_names = {"Y"};
-  if (!fbo_) return img;
-  // All layers in one read (layer 0 first, rows bottom to top within each); rows are flipped
-  // per layer so the stack reads top to bottom with layer 0 first.
-  const std::size_t row = std::size_t(size_), layer = row * row;
-  std::vector<float> stack(layer * std::size_t(layers_));
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(map_.id(), 0, GL_DEPTH_COMPONENT, GL_FLOAT,
-                    GLsizei(stack.size() * sizeof(float)), stack.data());
-  img.pixels.resize(stack.size());
-  for (int l = 0; l < layers_; ++l)
-    for (int y = 0; y < size_; ++y)
-      std::memcpy(&img.pixels[std::size_t(l) * layer + std::size_t(y) * row],
-                  &stack[std::size_t(l) * layer + std::size_t(size_ - 1 - y) * row],
-                  row * sizeof(float));
-  return img;
+  return read_slices(map_, GL_DEPTH_COMPONENT, size_, layers_);  // empty before the first frame
 }
 
 // ---- LomPass -------------------------------------------------------------------------------------
@@ -800,34 +805,8 @@ void LomPass::bind() {
   glBindSampler(kTexLomOcclusion, nearest_.id());
 }
 
-namespace {
-
-// Every slice of a 2D array texture of one red channel, stacked as ShadowMapPass::read().
-Image read_slices(const gpu::Texture& t, int size, int slices) {
-  Image img;
-  img.width = size;
-  img.height = size * slices;
-  img.channels = 1;
-  img.channel_names = {"Y"};
-  if (!t) return img;
-  const std::size_t row = std::size_t(size), layer = row * row;
-  std::vector<float> stack(layer * std::size_t(slices));
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(t.id(), 0, GL_RED, GL_FLOAT, GLsizei(stack.size() * sizeof(float)),
-                    stack.data());
-  img.pixels.resize(stack.size());
-  for (int l = 0; l < slices; ++l)
-    for (int y = 0; y < size; ++y)
-      std::memcpy(&img.pixels[std::size_t(l) * layer + std::size_t(y) * row],
-                  &stack[std::size_t(l) * layer + std::size_t(size - 1 - y) * row],
-                  row * sizeof(float));
-  return img;
-}
-
-}  // namespace
-
-Image LomPass::read_depths() const { return read_slices(depth_, size_, slices_); }
-Image LomPass::read_factors() const { return read_slices(occlusion_, size_, slices_); }
+Image LomPass::read_depths() const { return read_slices(depth_, GL_RED, size_, slices_); }
+Image LomPass::read_factors() const { return read_slices(occlusion_, GL_RED, size_, slices_); }
 
 // ---- Forward drawing (main view and probe faces) ------------------------------------------------
 

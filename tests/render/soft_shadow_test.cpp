@@ -32,15 +32,20 @@ namespace fs = std::filesystem;
 // angular size theta (degrees). Its edge x = 2 casts a straight penumbra along z on the ground.
 constexpr float kSlabBottom = 1.0f, kSlabTop = 1.05f, kEdge = 2.0f;
 
+// A scene file of this test named `stem` and the process: CTest runs the tests that write
+// them in parallel processes.
+fs::path scene_file(const std::string& stem) {
+  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
+  fs::create_directories(dir);
+  return dir / (stem + "_" + std::to_string(::getpid()) + ".json");
+}
+
 // The slab scene under a sun of angular size theta_deg, with `extra` entities (JSON, each
 // followed by a comma) and the shadow technique `technique`; named `name`, the process and the
 // angle, since CTest runs the tests that write it in parallel processes.
 fs::path write_scene(const std::string& name, float theta_deg, const std::string& technique,
                      const std::string& extra) {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
-  fs::create_directories(dir);
-  const fs::path file = dir / (name + "_" + std::to_string(::getpid()) + "_" +
-                               std::to_string(int(theta_deg * 100.0f)) + ".json");
+  const fs::path file = scene_file(name + "_" + std::to_string(int(theta_deg * 100.0f)));
   std::ofstream(file) << R"({ "kaskad_scene": 1,
     "render": { "width": 320, "height": 180 },
     "shadow": { "technique": ")" << technique << R"(", "cascade_count": 4, "fit_mode": "stable" },
@@ -63,9 +68,7 @@ fs::path write_slab_scene(float theta_deg) { return write_scene("slab", theta_de
 constexpr float kPanel = 1.0f, kPanelHeight = 4.0f;
 
 fs::path write_area_slab_scene() {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
-  fs::create_directories(dir);
-  const fs::path file = dir / ("area_slab_" + std::to_string(::getpid()) + ".json");
+  const fs::path file = scene_file("area_slab");
   std::ofstream(file) << R"({ "kaskad_scene": 1,
     "render": { "width": 320, "height": 180 },
     "shadow": { "map_size": 1024 },
@@ -355,9 +358,7 @@ TEST_F(SoftShadowTest, BackprojectionOverDarkensWhereOccludersOverlapAndLomDoesN
 // sunward wall; the paper's gap filling is not implemented): measured 0.0997 at 500 points,
 // bound 0.12.
 TEST_F(SoftShadowTest, NoTechniqueLeaksLightIntoAClosedBox) {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
-  fs::create_directories(dir);
-  const fs::path file = dir / ("closed_box_" + std::to_string(::getpid()) + ".json");
+  const fs::path file = scene_file("closed_box");
   std::ofstream(file) << R"({ "kaskad_scene": 1,
     "render": { "width": 320, "height": 180 },
     "entities": [
@@ -471,9 +472,7 @@ TEST_F(SoftShadowTest, PcssBeatsHardPcfAgainstTheAreaLightReference) {
 // stored negated and hides nothing. Three 2 x 2 m slabs stacked 1, 2 and 3 m over the ground
 // under a 5-degree sun straight down, one basic map; a box that casts no shadow beside them.
 TEST_F(SoftShadowTest, LomPeelsEverySurfaceAndCountsWhereTheLayersRunOut) {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
-  fs::create_directories(dir);
-  const fs::path file = dir / ("stack_" + std::to_string(::getpid()) + ".json");
+  const fs::path file = scene_file("stack");
   std::ofstream(file) << R"({ "kaskad_scene": 1,
     "render": { "width": 160, "height": 90 },
     "shadow": { "technique": "lom", "map_size": 256, "cascade_count": 1, "fit_mode": "scene" },
