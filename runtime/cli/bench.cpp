@@ -133,7 +133,8 @@ std::string default_sweep() {
 std::string soft_sweep() {
   return "shadow.technique=pcf;shadow.pcf_kernel=3,5,9|"
          "shadow.technique=pcf;shadow.pcf_kernel=poisson;shadow.pcf_taps=16,32|"
-         "shadow.technique=pcss;shadow.pcf_taps=16,32|shadow.technique=backprojection";
+         "shadow.technique=pcss;shadow.pcf_taps=16,32|shadow.technique=backprojection|"
+         "shadow.technique=vsm,evsm";
 }
 
 namespace {

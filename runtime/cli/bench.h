@@ -45,7 +45,8 @@ std::string default_sweep();
 
 /// `--sweep soft` (issue 14): the soft-shadow techniques and PCF kernels, for scenes whose lights
 /// have a size (content/scenes/soft/): pcf with kernels 3x3, 5x5, 9x9 and a 16- and 32-tap
-/// disc, pcss with 16 and 32 taps, and backprojection. 8 configurations; chart them by rmse.
+/// disc, pcss with 16 and 32 taps, backprojection, vsm and evsm (default blur and bleeding
+/// reduction). 10 configurations; chart them by rmse.
 std::string soft_sweep();
 
 /// Parses "key=v1,v2;key2=w1,w2" into the cartesian product, in order; products separated by
