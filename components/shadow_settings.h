@@ -50,6 +50,16 @@ enum class ShadowTechnique {
   /// (backprojection, each part of the light counted once); pass 2 interpolates those factors
   /// trilinearly at the shaded point. Needs a light with a size, as pcss.
   lom,
+  /// Variance shadow maps (Donnelly, Lauritzen, "Variance Shadow Maps", I3D 2006; S2 names
+  /// them): the map's moments E[z], E[z^2] of linear depth, blurred (vsm_blur) and mipmapped,
+  /// bound the lit fraction by Chebyshev's inequality, p_max = s^2 / (s^2 + (t - mu)^2); the
+  /// bound lets light bleed where occluders overlap, cut by vsm_bleed_reduction. A filtered hard
+  /// shadow: the penumbra is the blur's, not the light's size.
+  vsm,
+  /// Exponential variance shadow maps (Lauritzen, McCool, "Layered Variance Shadow Maps", GI
+  /// 2008): the moments of a positive and a negative exponential warp of depth, four in all; the
+  /// lower of their two Chebyshev bounds. Bleeds much less than vsm.
+  evsm,
 };
 
 /// The PCF footprint when filter is pcf3x3 and technique pcf.
@@ -94,8 +104,8 @@ enum class CascadeSelection {
   map_bounds,  ///< the first cascade whose map contains the point (uses the stable fit's slack)
 };
 
-/// Per shadowed light, except map_size, depth_format, filter, technique, pcf_kernel, selection,
-/// layered and debug_cascades: every light's layers share one texture array and the shader features are per
+/// Per shadowed light, except map_size, depth_format, filter, technique, pcf_kernel, lom_layers,
+/// vsm_blur, vsm_bleed_reduction, selection, layered and debug_cascades: every light's layers share one texture array and the shader features are per
 /// frame, so the first shadowed light's values of these apply to all (update_shadows() warns
 /// once, naming the fields, when another light's own differ).
 struct ShadowSettings {
@@ -125,6 +135,15 @@ struct ShadowSettings {
   /// technique lom: depth layers peeled per shadow-map layer, in [2, 16]. 8: S1's experiments.
   /// Each costs one more scene render per cascade (or face) and map_size^2 x 5 bytes.
   int lom_layers = 8;
+  /// technique vsm/evsm: side in texels of the separable Gaussian blur of the moments, odd, in
+  /// [1, 15] (1: no blur; sigma = side / 4, so the kernel ends at two sigmas). 5: the reach of
+  /// the 5x5 PCF box and of the default poisson disc (2.5 texels); Lauritzen (GPU Gems 3,
+  /// ch. 8) blurs with small separable kernels and leaves larger footprints to the mipmaps.
+  int vsm_blur = 5;
+  /// technique vsm/evsm: light-bleeding reduction, in [0, 1): Chebyshev bounds below it read as
+  /// shadow and the rest is rescaled to [0, 1] (linstep(amount, 1, p_max), Lauritzen, GPU Gems 3
+  /// ch. 8). 0.2: the low end of the 0.2-0.3 the chapter suggests; more darkens penumbrae.
+  float vsm_bleed_reduction = 0.2f;
 
   /// N, in [1, 8]. 4: S0 recommends 3..5 (fewer is barely better than one map; each more costs
   /// a scene render).
@@ -198,9 +217,12 @@ struct ShadowSettings {
 /// largest radius plus one, and one for lom (its four neighbouring samples; the occlusion factors
 /// already hold the light's reach). Local lights keep this (plus the normal offset and one spare)
 /// free at their maps' edges; map_bounds selection likewise (ShadowView::filter_reach carries it
-/// to shadow.glsl's map_border()).
+/// to shadow.glsl's map_border()). vsm and evsm: the blur's half width plus one (the lookup
+/// filters linearly; its mip levels past 0 reach further, into texels the blur left clear).
 inline float filter_reach_texels(const ShadowSettings& s) {
   if (s.technique == ShadowTechnique::lom) return 1.0f;
+  if (s.technique == ShadowTechnique::vsm || s.technique == ShadowTechnique::evsm)
+    return float(s.vsm_blur / 2) + 1.0f;
   if (s.technique != ShadowTechnique::pcf) return float(kPcssMaxRadiusTexels) + 1.0f;
   if (s.filter != ShadowFilter::pcf3x3) return 1.5f;
   switch (s.pcf_kernel) {
@@ -239,8 +261,13 @@ inline std::string validate_shadow_settings(const ShadowSettings& s) {
   if (filter < 0 || filter > static_cast<int>(ShadowFilter::pcf3x3))
     return "filter must be none, bilinear or pcf3x3, was " + std::to_string(filter);
   const int technique = static_cast<int>(s.technique);
-  if (technique < 0 || technique > static_cast<int>(ShadowTechnique::lom))
-    return "technique must be pcf, pcss, backprojection or lom, was " + std::to_string(technique);
+  if (technique < 0 || technique > static_cast<int>(ShadowTechnique::evsm))
+    return "technique must be pcf, pcss, backprojection, lom, vsm or evsm, was " +
+           std::to_string(technique);
+  if (s.vsm_blur < 1 || s.vsm_blur > 15 || s.vsm_blur % 2 == 0)
+    return "vsm_blur must be an odd number of texels in [1, 15], was " + std::to_string(s.vsm_blur);
+  if (!(s.vsm_bleed_reduction >= 0.0f && s.vsm_bleed_reduction < 1.0f))
+    return "vsm_bleed_reduction must be in [0, 1), was " + str(s.vsm_bleed_reduction);
   if (s.lom_layers < 2 || s.lom_layers > 16)
     return "lom_layers must be in [2, 16], was " + std::to_string(s.lom_layers);
   const int kernel = static_cast<int>(s.pcf_kernel);

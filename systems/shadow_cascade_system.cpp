@@ -341,7 +341,7 @@ namespace {
 // The maps of one shadowed light (entity `e`, null for none). Errors are logged when they differ
 // from `last_error`, which is updated. `previous` is this slot's last result (freeze_cascades).
 /// `shared`: for lights after the first, the first light's settings whose map_size,
-/// depth_format, filter, technique, pcf_kernel, lom_layers, selection, layered and debug_cascades apply to
+/// depth_format, filter, technique, pcf_kernel, lom_layers, vsm_blur, vsm_bleed_reduction, selection, layered and debug_cascades apply to
 /// every light (one shared
 /// texture array, one set of shader features). They are applied before fitting, so texel sizes
 /// and the stable fit's snapping use the real map size.
@@ -368,6 +368,8 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
     out.settings.technique = shared->technique;
     out.settings.pcf_kernel = shared->pcf_kernel;
     out.settings.lom_layers = shared->lom_layers;
+    out.settings.vsm_blur = shared->vsm_blur;
+    out.settings.vsm_bleed_reduction = shared->vsm_bleed_reduction;
     out.settings.selection = shared->selection;
     out.settings.layered = shared->layered;
     out.settings.debug_cascades = shared->debug_cascades;
@@ -669,6 +671,8 @@ std::vector<ShadowData> fit_shadowed_lights(const ecs::World& world, const Camer
       check(own->technique == shared->technique, "technique");
       check(own->pcf_kernel == shared->pcf_kernel, "pcf_kernel");
       check(own->lom_layers == shared->lom_layers, "lom_layers");
+      check(own->vsm_blur == shared->vsm_blur, "vsm_blur");
+      check(own->vsm_bleed_reduction == shared->vsm_bleed_reduction, "vsm_bleed_reduction");
       check(own->selection == shared->selection, "selection");
       check(own->layered == shared->layered, "layered");
       check(own->debug_cascades == shared->debug_cascades, "debug_cascades");

@@ -19,9 +19,10 @@ struct ShadowView {
 layout(std140, binding = 0) uniform FrameBlock {
   mat4 u_view_proj;
   mat4 u_view;
-  vec4 u_camera_pos;                // xyz: world position
+  vec4 u_camera_pos;                // xyz: world position, w: pixel footprint (FrameBlock)
   vec4 u_ambient;                   // rgb: linear ambient radiance
-  vec4 u_frame;                     // x exposure, y shadow map size (texels a side), z lom layers
+  vec4 u_frame;                     // x exposure, y shadow map size (texels a side), z lom layers,
+                                    // w vsm_bleed_reduction
   ivec4 u_counts;                   // x lights, y shadow views, z the view the AOV shows
   vec4 u_light_color[MAX_LIGHTS];   // rgb: colour * intensity
   ivec4 u_light_info[MAX_LIGHTS];   // x type (LIGHT_*), y its shadow view (-1: none)

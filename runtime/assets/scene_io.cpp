@@ -57,7 +57,8 @@ const std::vector<std::pair<const char*, ShadowFilter>> kFilters = {
     {"none", ShadowFilter::none}, {"bilinear", ShadowFilter::bilinear}, {"pcf3x3", ShadowFilter::pcf3x3}};
 const std::vector<std::pair<const char*, ShadowTechnique>> kTechniques = {
     {"pcf", ShadowTechnique::pcf}, {"pcss", ShadowTechnique::pcss},
-    {"backprojection", ShadowTechnique::backprojection}, {"lom", ShadowTechnique::lom}};
+    {"backprojection", ShadowTechnique::backprojection}, {"lom", ShadowTechnique::lom},
+    {"vsm", ShadowTechnique::vsm}, {"evsm", ShadowTechnique::evsm}};
 // pcf_kernel is written as the box side (3, 5, 7, 9) or "poisson".
 const std::vector<std::pair<const char*, PcfKernel>> kKernelNames = {{"poisson", PcfKernel::poisson}};
 const std::vector<std::pair<const char*, Projection>> kProjections = {
@@ -114,6 +115,14 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
   r.integer("pcf_taps", s.pcf_taps, 8, 64);
   r.number("pcf_radius", s.pcf_radius, 1.0f, 16.0f);
   r.integer("lom_layers", s.lom_layers, 2, 16);
+  r.integer("vsm_blur", s.vsm_blur, 1, 15);
+  if (s.vsm_blur % 2 == 0)
+    fail(r.at("vsm_blur"), "must be an odd number of texels in [1, 15], was " +
+                               std::to_string(s.vsm_blur));
+  r.number("vsm_bleed_reduction", s.vsm_bleed_reduction, 0.0f, 1.0f);
+  if (s.vsm_bleed_reduction >= 1.0f)
+    fail(r.at("vsm_bleed_reduction"), "must be in [0, 1) (1 would shadow everything), was " +
+                                          json(num(s.vsm_bleed_reduction)).dump());
   r.integer("cascade_count", s.cascade_count, 1, 8);
   r.enumeration("split_scheme", s.split_scheme, kSplitSchemes);
   r.number("lambda", s.lambda, 0.0f, 1.0f);
@@ -157,6 +166,9 @@ json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
   put("pcf_taps", s.pcf_taps, s.pcf_taps != d.pcf_taps);
   put("pcf_radius", num(s.pcf_radius), s.pcf_radius != d.pcf_radius);
   put("lom_layers", s.lom_layers, s.lom_layers != d.lom_layers);
+  put("vsm_blur", s.vsm_blur, s.vsm_blur != d.vsm_blur);
+  put("vsm_bleed_reduction", num(s.vsm_bleed_reduction),
+      s.vsm_bleed_reduction != d.vsm_bleed_reduction);
   put("cascade_count", s.cascade_count, s.cascade_count != d.cascade_count);
   put("split_scheme", enum_name(s.split_scheme, kSplitSchemes), s.split_scheme != d.split_scheme);
   put("lambda", num(s.lambda), s.lambda != d.lambda);

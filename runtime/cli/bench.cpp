@@ -138,7 +138,8 @@ std::string soft_sweep() {
       "shadow.technique=pcf;shadow.pcf_kernel=poisson;shadow.pcf_taps=16,32",
       "shadow.technique=pcss;shadow.pcf_taps=16,32",
       "shadow.technique=backprojection",
-      "shadow.technique=lom;shadow.map_size=1024;shadow.lom_layers=4,8"};
+      "shadow.technique=lom;shadow.map_size=1024;shadow.lom_layers=4,8",
+      "shadow.technique=vsm,evsm"};
   std::string out;
   for (const char* c : configurations)
     out += (out.empty() ? "" : "|") + std::string("render.shadow_cache=false;") + c;

@@ -45,9 +45,9 @@ std::string default_sweep();
 
 /// `--sweep soft` (issue 14): the soft-shadow techniques and PCF kernels, for scenes whose lights
 /// have a size (content/scenes/soft/): pcf with kernels 3x3, 5x5, 9x9 and a 16- and 32-tap
-/// disc, pcss with 16 and 32 taps, backprojection, and lom (S1's 1024^2 map, 4 and 8 layers),
-/// each with the shadow cache off (maps redrawn every frame). 10 configurations; chart them by
-/// rmse.
+/// disc, pcss with 16 and 32 taps, backprojection, lom (S1's 1024^2 map, 4 and 8 layers), vsm
+/// and evsm (default blur and bleeding reduction), each with the shadow cache off (maps redrawn
+/// every frame). 12 configurations; chart them by rmse.
 std::string soft_sweep();
 
 /// Parses "key=v1,v2;key2=w1,w2" into the cartesian product, in order; products separated by

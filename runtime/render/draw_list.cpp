@@ -90,6 +90,9 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   }
   if (fk.get(VariantKey::kShadowTechnique) == VariantKey::kTechniqueLom)
     out.push_back({Pass::lom_occlusion, fk.filtered_for(Pass::lom_occlusion)});
+  if (fk.get(VariantKey::kShadowTechnique) == VariantKey::kTechniqueVsm ||
+      fk.get(VariantKey::kShadowTechnique) == VariantKey::kTechniqueEvsm)
+    out.push_back({Pass::vsm_moments, fk.filtered_for(Pass::vsm_moments)});
   auto less = [](const ProgramRequest& a, const ProgramRequest& b) {
     return std::pair(a.pass, a.key) < std::pair(b.pass, b.key);
   };

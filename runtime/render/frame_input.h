@@ -134,6 +134,9 @@ struct ShadowMapSettings {
   ShadowTechnique technique = ShadowSettings{}.technique;
   PcfKernel pcf_kernel = ShadowSettings{}.pcf_kernel;
   int lom_layers = ShadowSettings{}.lom_layers;  ///< technique lom: depth layers per map layer
+  int vsm_blur = ShadowSettings{}.vsm_blur;  ///< technique vsm/evsm: blur side, texels (MomentsPass)
+  /// technique vsm/evsm: light-bleeding reduction (shadow.glsl's vsm())
+  float vsm_bleed_reduction = ShadowSettings{}.vsm_bleed_reduction;
   CascadeSelection selection = ShadowSettings{}.selection;
   bool layered = ShadowSettings{}.layered;  ///< all of a view's layers in one instanced pass
   bool debug_cascades = ShadowSettings{}.debug_cascades;

@@ -58,10 +58,15 @@ FrameBlock pack_frame_block(const FrameInput& frame) {
   FrameBlock fb{};
   fb.view_proj = frame.camera.proj * frame.camera.view;
   fb.view = frame.camera.view;
-  fb.camera_pos = glm::vec4(frame.camera.position, 1.0f);
+  // w: metres per pixel at 1 m of view depth, 2 tan(fov_y / 2) / height (proj[1][1] =
+  // 1 / tan(fov_y / 2)); 0 for an orthographic camera (the VSM lookups then read mip 0).
+  const bool ortho = frame.camera.proj[3][3] != 0.0f;
+  const float pixel = ortho ? 0.0f : 2.0f / (frame.camera.proj[1][1] * float(frame.height));
+  fb.camera_pos = glm::vec4(frame.camera.position, pixel);
   fb.ambient = glm::vec4(frame.ambient, 0.0f);
   fb.frame_params = glm::vec4(frame.exposure, float(frame.shadow_map.size),
-                              float(frame.shadow_map.lom_layers), 0.0f);
+                              float(frame.shadow_map.lom_layers),
+                              frame.shadow_map.vsm_bleed_reduction);
   const int lights = shaded_lights(frame);
   const int views = int(frame.shadow_views.size());
   fb.counts = glm::ivec4(lights, views, views > 0 ? frame.aov_shadow_view : -1, 0);
@@ -84,7 +89,10 @@ FrameBlock pack_frame_block(const FrameInput& frame) {
 FrameBlock probe_face_block(const FrameBlock& main, const ProbeJob& job, int face) {
   FrameBlock fb = main;
   fb.view_proj = job.view_proj[std::size_t(face)];
-  fb.camera_pos = glm::vec4(job.center, 1.0f);
+  // A 90-degree face: 2 tan(45 deg) / resolution metres per pixel at 1 m. A face's depth is not
+  // the main view's (u_view stays the main camera's), so negated as for an ortho camera: the
+  // lookup's footprint then uses the distance from u_camera_pos (shadow.glsl's pixel_footprint()).
+  fb.camera_pos = glm::vec4(job.center, -2.0f / float(std::max(job.resolution, 1)));
   fb.frame_params.x = 1.0f;
   return fb;
 }

@@ -28,9 +28,12 @@ struct alignas(16) ShadowViewBlock {
 struct alignas(16) FrameBlock {
   glm::mat4 view_proj;
   glm::mat4 view;
-  glm::vec4 camera_pos;    ///< xyz: world position
+  /// xyz: world position; w: metres per pixel at 1 m of view depth (0: orthographic camera;
+  /// negative, probe faces: -w metres per pixel per metre of distance from xyz)
+  glm::vec4 camera_pos;
   glm::vec4 ambient;       ///< rgb: linear ambient radiance
-  glm::vec4 frame_params;  ///< x exposure, y shadow map size (texels a side), z lom layers
+  /// x exposure, y shadow map size (texels a side), z lom layers, w vsm_bleed_reduction
+  glm::vec4 frame_params;
   glm::ivec4 counts;       ///< x lights shaded, y shadow views, z the view the AOV shows
   glm::vec4 light_color[kMaxLights];  ///< rgb: colour * intensity
   glm::ivec4 light_info[kMaxLights];  ///< x LightType, y its shadow view (-1: none)

@@ -32,6 +32,7 @@ struct Renderer::Impl {
   // The passes, in order (passes.h).
   ShadowMapPass shadow;
   LomPass lom;
+  MomentsPass moments;
   ProbeCapturePass probe_capture;
   ForwardPass forward;
 
@@ -196,10 +197,14 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   // S1's layered occlusion map (technique lom) from those layers, timed with them.
   if (st) st = im.lom.prepare(frame, list, im.shadow, stats_);
   if (st) st = im.lom.record(frame, list, *im.cache, state, stats_);
+  // The moments of vsm/evsm from those layers, timed with them.
+  if (st) st = im.moments.prepare(frame, im.shadow, stats_);
+  if (st) st = im.moments.record(frame, list, im.shadow, state);
   glEndQuery(GL_TIME_ELAPSED);
   KASKAD_TRY(st);
   im.shadow.bind();
   im.lom.bind();
+  im.moments.bind();
 
   // 2. Probe captures. After it: every probe's visible cube (and sphere map) is the one the
   //    frame's reflections read.
@@ -285,6 +290,7 @@ Result<std::vector<glm::vec2>> Renderer::shadow_at_points(std::span<const glm::v
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
   im.shadow.bind();
   im.lom.bind();
+  im.moments.bind();
   glBindFramebuffer(GL_FRAMEBUFFER, im.points_fbo.id());
   glViewport(0, 0, w, h);
   glDisable(GL_DEPTH_TEST);

@@ -68,6 +68,9 @@ struct FrameStats {
   /// reads as umbra; shadow.glsl's lom()).
   std::uint32_t lom_layers_computed = 0;
   std::int64_t lom_overflow_texels = 0;
+  /// ShadowTechnique::vsm/evsm: shadow-map layers whose moments were recomputed this frame (bit
+  /// l, as shadow_layers_rendered; MomentsPass).
+  std::uint32_t vsm_layers_computed = 0;
   /// GPU times are the previous frame's (queries are read a frame late); 0 until frame 3.
   double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
   double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)

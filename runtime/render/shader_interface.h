@@ -33,12 +33,16 @@ static_assert(sizeof(InstanceRecord) == 128);
 
 // Uniform locations (no name look-ups at draw time). Per-program ones may share a number when no
 // program has both: the layered depth pass (13, 14, 16..), the points pass (13), reflections
-// (16..19), the LOM occlusion pass (20: ivec4 view, layer of the view, peel, count overflow).
+// (16..19), the LOM occlusion pass (20: ivec4 view, layer of the view, peel, count overflow),
+// the VSM moments pass (20: ivec4 view, layer of the view, step (0 depth to moments along x,
+// 1 along y), blur side in texels; 21: ivec4 the layer's texels with valid depth, x0 y0 x1 y1,
+// ends exclusive).
 inline constexpr int kLocBaseColor = 8, kLocMaterial = 9, kLocEmissive = 10,
                      kLocFeatureBits = 11, kLocLightViewProj = 12, kLocTargetSize = 13,
                      kLocLayerBase = 14, kLocLayerViewProj = 16,
                      kLocReflection = 16, kLocReflectionBoxMin = 17, kLocReflectionBoxMax = 18,
-                     kLocReflectionCentre = 19, kLocLomTarget = 20;
+                     kLocReflectionCentre = 19, kLocLomTarget = 20,
+                     kLocVsmTarget = 20, kLocVsmRect = 21;
 /// vec4: x occlusion strength (MATERIAL_HAS_OCCLUSION_TEXTURE).
 inline constexpr int kLocMaterialExtra = 24;
 /// vec4[8]: per texture slot (kUvSlot*) two rows (a, b, c) of its uv transform
@@ -54,14 +58,17 @@ inline constexpr int kUvSlotBaseColor = 0, kUvSlotNormal = 1, kUvSlotOcclusion =
 /// the disc kernels a hardware 2x2 PCF). ShadowMapPass::bind() binds all three.
 /// kTexLomDepth / kTexLomOcclusion: S1's layered depth map (signed depths, LomPass) and its
 /// occlusion factors; kTexPeelPrevious: the layer before the one a depth peel draws.
+/// kTexVsmMoments: the blurred, mipmapped moments of vsm/evsm (MomentsPass); kTexVsmSource: the
+/// moments blurred along x, read by the blur along y.
 inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
                           kTexReflectionCube = 3, kTexReflectionSphere = 4, kTexShadowDepth = 5,
                           kTexShadowLinear = 6, kTexOcclusion = 7, kTexEmissive = 8,
-                          kTexLomDepth = 9, kTexLomOcclusion = 10, kTexPeelPrevious = 11;
+                          kTexLomDepth = 9, kTexLomOcclusion = 10, kTexPeelPrevious = 11,
+                          kTexVsmMoments = 12, kTexVsmSource = 13;
 
 /// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...), and
 /// the light types (LIGHT_DIRECTIONAL, ...: u_light_info[i].x holds a LightType).
-inline std::array<std::pair<const char*, int>, 42> shader_interface_defines() {
+inline std::array<std::pair<const char*, int>, 46> shader_interface_defines() {
   return {{{"LIGHT_DIRECTIONAL", int(LightType::directional)},
            {"LIGHT_SPOT", int(LightType::spot)},
            {"LIGHT_POINT", int(LightType::point)},
@@ -85,6 +92,8 @@ inline std::array<std::pair<const char*, int>, 42> shader_interface_defines() {
            {"LOC_REFLECTION_BOX_MAX", kLocReflectionBoxMax},
            {"LOC_REFLECTION_CENTRE", kLocReflectionCentre},
            {"LOC_LOM_TARGET", kLocLomTarget},
+           {"LOC_VSM_TARGET", kLocVsmTarget},
+           {"LOC_VSM_RECT", kLocVsmRect},
            {"LOC_MATERIAL_EXTRA", kLocMaterialExtra},
            {"LOC_UV_TRANSFORM", kLocUvTransform},
            {"UV_SLOT_BASE_COLOR", kUvSlotBaseColor},
@@ -100,6 +109,8 @@ inline std::array<std::pair<const char*, int>, 42> shader_interface_defines() {
            {"UNIT_LOM_DEPTH", int(kTexLomDepth)},
            {"UNIT_LOM_OCCLUSION", int(kTexLomOcclusion)},
            {"UNIT_PEEL_PREVIOUS", int(kTexPeelPrevious)},
+           {"UNIT_VSM_MOMENTS", int(kTexVsmMoments)},
+           {"UNIT_VSM_SOURCE", int(kTexVsmSource)},
            {"UNIT_REFLECTION_CUBE", int(kTexReflectionCube)},
            {"UNIT_REFLECTION_SPHERE", int(kTexReflectionSphere)},
            {"UNIT_OCCLUSION", int(kTexOcclusion)},

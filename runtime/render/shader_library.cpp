@@ -30,6 +30,7 @@ PassFiles files_for(Pass pass) {
     case Pass::depth: return {"shadow_depth.vert", "shadow_depth.frag"};
     case Pass::shadow_points: return {"shadow_points.vert", "shadow_points.frag"};
     case Pass::lom_occlusion: return {"fullscreen.vert", "lom_occlusion.frag"};
+    case Pass::vsm_moments: return {"fullscreen.vert", "vsm_moments.frag"};
     case Pass::forward: break;
   }
   return {"forward.vert", "forward.frag"};

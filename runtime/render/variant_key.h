@@ -38,14 +38,22 @@ namespace kaskad::render {
 
 /// forward: colour + AOVs; depth: shadow maps (and LOM's depth peels); shadow_points: the shadow
 /// lookup evaluated at given world points (Renderer::shadow_at_points(), the stability metrics);
-/// lom_occlusion: the occlusion factors of S1's layered occlusion map (LomPass).
-enum class Pass : std::uint8_t { forward = 0, depth = 1, shadow_points = 2, lom_occlusion = 3 };
+/// lom_occlusion: the occlusion factors of S1's layered occlusion map (LomPass); vsm_moments:
+/// the moments of variance shadow maps and their blur (MomentsPass).
+enum class Pass : std::uint8_t {
+  forward = 0,
+  depth = 1,
+  shadow_points = 2,
+  lom_occlusion = 3,
+  vsm_moments = 4
+};
 
 constexpr const char* pass_name(Pass pass) {
   switch (pass) {
     case Pass::depth: return "depth";
     case Pass::shadow_points: return "points";
     case Pass::lom_occlusion: return "lom";
+    case Pass::vsm_moments: return "moments";
     case Pass::forward: break;
   }
   return "forward";
@@ -146,10 +154,10 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     {.name = "shadow_lights", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_LIGHTS",
      .stages = kFragmentStage, .offset = 28, .min = 1, .max = 4, .requires_ = {"shadow"}},
     // Soft shadows (issue 14), per frame like shadow_filter (the first shadowed light's
-    // ShadowSettings::technique). Bits 32-35 leave the field room for the techniques to come
-    // (backprojection, lom, vsm, evsm).
+    // ShadowSettings::technique). Bits 32-35: room for up to 16 techniques.
     {.name = "shadow_technique", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_TECHNIQUE",
-     .stages = kFragmentStage, .offset = 32, .values = {"pcf", "pcss", "backprojection", "lom"}, .requires_ = {"shadow"}},
+     .stages = kFragmentStage, .offset = 32,
+     .values = {"pcf", "pcss", "backprojection", "lom", "vsm", "evsm"}, .requires_ = {"shadow"}},
     // The depth pass peeling layer j > 0 of S1's layered depth map (LomPass): fragments at or in
     // front of layer j - 1 are discarded, and each writes its depth, signed by whether its draw
     // casts shadows.
@@ -272,9 +280,9 @@ class VariantKey {
   /// A count, not a switch, so loops over shadowed lights have a compile-time bound and a light
   /// that does not exist costs nothing (llvmpipe runs a zero-trip loop's body once, masked).
   static constexpr Field kShadowLightsMinus1 = feature_field("shadow_lights");
-  /// ShadowTechnique: 0 pcf, 1 pcss, 2 backprojection, 3 lom.
+  /// ShadowTechnique: 0 pcf, 1 pcss, 2 backprojection, 3 lom, 4 vsm, 5 evsm.
   static constexpr Field kShadowTechnique = feature_field("shadow_technique");
-  static constexpr std::uint32_t kTechniqueLom = 3;
+  static constexpr std::uint32_t kTechniqueLom = 3, kTechniqueVsm = 4, kTechniqueEvsm = 5;
   /// Depth pass: peel a layer of S1's layered depth map.
   static constexpr Field kShadowPeel = feature_field("shadow_peel");
   /// PcfKernel: 0 3x3, 1 5x5, 2 7x7, 3 9x9, 4 poisson.
@@ -321,8 +329,9 @@ class VariantKey {
   constexpr bool valid() const { return broken_rule().kind == BrokenRule::none; }
 
   /// The part of the key a pass's shaders read. The depth pass only needs alpha masking (and
-  /// peeling); the shadow-points and LOM occlusion passes only the shadow lookup's frame
-  /// features (a receiver, without AOVs or the debug tint); the forward pass needs everything.
+  /// peeling); the shadow-points, LOM occlusion and VSM moments passes only the shadow lookup's
+  /// frame features (a receiver, without AOVs or the debug tint); the forward pass needs
+  /// everything.
   constexpr VariantKey filtered_for(Pass pass) const {
     if (pass == Pass::depth) {
       const std::uint64_t projection = get(kShadowProjection) == kProjectionDualParaboloid
@@ -335,7 +344,7 @@ class VariantKey {
       const std::uint64_t transform = has(kAlphaMask) ? kTextureTransform.mask() : 0u;
       return VariantKey(bits_ & (kAlphaMask.mask() | projection | layered | peel | transform));
     }
-    if (pass == Pass::shadow_points || pass == Pass::lom_occlusion)
+    if (pass == Pass::shadow_points || pass == Pass::lom_occlusion || pass == Pass::vsm_moments)
       return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask() &
                          ~kShadowLayered.mask() & ~kToneMapping.mask() & ~kShadowPeel.mask()) |
                         kReceiveShadows.mask());

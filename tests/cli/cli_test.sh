@@ -133,8 +133,12 @@ assert s == 0.0 and c > 0.0, (s, c)
 print("flicker stable %g crop %g" % (s, c))
 ' "$tmp/flicker/bench.csv"
 # Soft shadows (issue 14): `--sweep soft` runs the techniques and kernels on the 5-degree sun;
-# pcss and lom are closer to the area-light reference (rmse) than hard 3x3 pcf.
-check bench_soft 0 "wrote .*bench.csv \(10 rows\)" -- "$KASKAD" bench "$KASKAD_CONTENT/scenes/soft/sun_5deg.json" \
+# pcss and lom are closer to the area-light reference (rmse) than hard 3x3 pcf. vsm and evsm
+# filter a hard shadow; at this small size they score 1.8 and 1.7 x hard pcf's rmse (the tilted
+# box's contact line reads lit over a whole pixel row, VSM's known weakness where the occluder
+# nearly touches the receiver), so they are held to 2 x pcf here (at 400x225 they match pcf:
+# tests/render/soft_shadow_test.cpp).
+check bench_soft 0 "wrote .*bench.csv \(12 rows\)" -- "$KASKAD" bench "$KASKAD_CONTENT/scenes/soft/sun_5deg.json" \
   --size 200x112 --frames 1 --no-chart --stability-frames 0 --out "$tmp/soft" --sweep soft 2>/dev/null
 check bench_soft_csv 0 "pcss beats pcf" -- /usr/bin/python3 -c '
 import csv, sys
@@ -143,8 +147,11 @@ nocache = "render.shadow_cache=false;"
 pcss = float(rows[nocache + "shadow.technique=pcss;shadow.pcf_taps=16"]["rmse"])
 pcf = float(rows[nocache + "shadow.technique=pcf;shadow.pcf_kernel=3"]["rmse"])
 lom = float(rows[nocache + "shadow.technique=lom;shadow.map_size=1024;shadow.lom_layers=8"]["rmse"])
-print("rmse pcss %.4f lom %.4f pcf %.4f" % (pcss, lom, pcf))
+vsm = float(rows[nocache + "shadow.technique=vsm"]["rmse"])
+evsm = float(rows[nocache + "shadow.technique=evsm"]["rmse"])
+print("rmse pcss %.4f lom %.4f pcf %.4f vsm %.4f evsm %.4f" % (pcss, lom, pcf, vsm, evsm))
 assert pcss < pcf and lom < pcf
+assert vsm < 2.0 * pcf and evsm < 2.0 * pcf
 print("pcss beats pcf")
 ' "$tmp/soft/bench.csv"
 check bench_bad_sweep nonzero "--sweep.*expected key=value" -- "$KASKAD" bench --sweep "shadow.map_size" --no-chart --out "$tmp/bench2"

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <bit>
 #include <string>
 #include <vector>
@@ -129,6 +130,36 @@ TEST_F(ShadowCacheTest, LayersAreRedrawnOnlyWhenTheirInputsChange) {
   const Frame walked_fresh = fresh(scene);
   EXPECT_EQ(walked.map, walked_fresh.map);
   EXPECT_EQ(walked.visibility, walked_fresh.visibility);
+}
+
+// vsm/evsm (MomentsPass): a layer's moments are recomputed exactly when the shadow pass redraws
+// it; a repeated frame recomputes none and shades the same. Fails when the moments pass
+// recomputes every layer every frame, or keeps a layer the shadow pass redrew.
+TEST_F(ShadowCacheTest, MomentsAreRecomputedForTheRedrawnLayersOnly) {
+  for (const char* technique : {"vsm", "evsm"}) {
+    // Far cascades on a 4-frame cadence, so that a moving caster redraws only some layers.
+    auto loaded = load_scene(content_dir() / "scenes" / "default.json",
+                             {std::string("shadow.technique=") + technique,
+                              "shadow.far_cascade_interval=4"});
+    ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+    Scene& scene = *loaded;
+    const Frame first = render(*player_, scene);
+    EXPECT_EQ(first.stats.shadow_layers_rendered, 0xfu) << technique;
+    EXPECT_EQ(first.stats.vsm_layers_computed, 0xfu) << technique;
+    const Frame still = render(*player_, scene);
+    EXPECT_EQ(still.stats.vsm_layers_computed, 0u) << technique;
+    EXPECT_EQ(still.visibility, first.visibility) << technique;
+    scene.world.get<Transform>(named(scene, "box_floating")).translation +=
+        glm::vec3(0.3f, 0.2f, 0.1f);
+    const Frame moved = render(*player_, scene);
+    EXPECT_NE(moved.stats.shadow_layers_rendered, 0u) << technique;
+    EXPECT_NE(moved.stats.shadow_layers_rendered, 0xfu) << technique << ": only some layers";
+    EXPECT_EQ(moved.stats.vsm_layers_computed, moved.stats.shadow_layers_rendered) << technique;
+    std::printf("[ %s ] moments recomputed: first 0x%x, still 0x%x, after a caster moved 0x%x "
+                "(shadow layers redrawn 0x%x)\n",
+                technique, first.stats.vsm_layers_computed, still.stats.vsm_layers_computed,
+                moved.stats.vsm_layers_computed, moved.stats.shadow_layers_rendered);
+  }
 }
 
 // The layered pass draws all of a light's layers in one pass: it redraws all of them or none.

@@ -203,8 +203,8 @@ TEST(SceneIo, ReceiverCullingSwitchesLoadAndSave) {
   expect_error(read_scene(def, {"shadow.far_cascade_interval=17"}), {"/shadow/far_cascade_interval", "17"});
 }
 
-// Issue 14's settings: shadow.technique, pcf_kernel, pcf_taps, pcf_radius and the spot/point
-// light radius load, save, override and are rejected out of range with the key and the value.
+// Issue 14's settings: shadow.technique, pcf_kernel, pcf_taps, pcf_radius, lom_layers, vsm_blur,
+// vsm_bleed_reduction and the spot/point light radius load, save, override and are rejected out of range with the key and the value.
 TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   const fs::path def = kContent / "scenes" / "default.json";
   auto s = read_scene(def, {"shadow.technique=pcss", "shadow.pcf_kernel=7", "shadow.pcf_taps=32",
@@ -229,7 +229,7 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   // Saved and read again, with a spot light's radius.
   const fs::path file = temp_dir() / "soft.json";
   std::ofstream(file) << R"({ "shadow": { "technique": "pcss", "pcf_kernel": "poisson", "pcf_taps": 24,
-                               "lom_layers": 5 },
+                               "lom_layers": 5, "vsm_blur": 9, "vsm_bleed_reduction": 0.35 },
     "entities": [
       { "name": "lamp", "transform": { "translation": [0, 4, 0], "direction": [0, -1, 0] },
         "light": { "type": "spot", "cast_shadows": true, "radius": 0.25 },
@@ -247,6 +247,17 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   EXPECT_EQ(again->shadow_defaults.pcf_kernel, PcfKernel::poisson);
   EXPECT_EQ(again->shadow_defaults.pcf_taps, 24);
   EXPECT_EQ(again->shadow_defaults.lom_layers, 5);
+  EXPECT_EQ(again->shadow_defaults.vsm_blur, 9);
+  EXPECT_FLOAT_EQ(again->shadow_defaults.vsm_bleed_reduction, 0.35f);
+  // vsm and evsm by name, and their defaults.
+  for (const auto& [name, technique] : {std::pair("vsm", ShadowTechnique::vsm),
+                                        std::pair("evsm", ShadowTechnique::evsm)}) {
+    auto v = read_scene(def, {std::string("shadow.technique=") + name});
+    ASSERT_TRUE(v.ok()) << v.error().to_string();
+    EXPECT_EQ(v->shadow_defaults.technique, technique);
+    EXPECT_EQ(v->shadow_defaults.vsm_blur, 5);
+    EXPECT_FLOAT_EQ(v->shadow_defaults.vsm_bleed_reduction, 0.2f);
+  }
   EXPECT_EQ(again->world.get<ShadowSettings>(find(*again, "lamp")).pcf_kernel, PcfKernel::k9x9);
 
   // An area light: type, size, its cone; size belongs to area lights only, radius not to them.
@@ -275,7 +286,15 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   std::ofstream(sized_point) << R"({ "entities": [
       { "name": "lamp", "light": { "type": "point", "size": [1, 1] } } ] })";
   expect_error(read_scene(sized_point), {"sized_point.json", "/light/size", "area"});
-  expect_error(read_scene(def, {"shadow.technique=vsm"}), {"/shadow/technique", "vsm", "pcf", "pcss", "backprojection"});
+  expect_error(read_scene(def, {"shadow.technique=msm"}),
+               {"/shadow/technique", "msm", "pcf", "pcss", "backprojection", "lom", "vsm", "evsm"});
+  expect_error(read_scene(def, {"shadow.vsm_blur=4"}), {"/shadow/vsm_blur", "odd", "[1, 15]", "4"});
+  expect_error(read_scene(def, {"shadow.vsm_blur=0"}), {"/shadow/vsm_blur", "0"});
+  expect_error(read_scene(def, {"shadow.vsm_blur=17"}), {"/shadow/vsm_blur", "17"});
+  expect_error(read_scene(def, {"shadow.vsm_bleed_reduction=1"}),
+               {"/shadow/vsm_bleed_reduction", "[0, 1)", "1"});
+  expect_error(read_scene(def, {"shadow.vsm_bleed_reduction=-0.1"}),
+               {"/shadow/vsm_bleed_reduction", "-0.1"});
   expect_error(read_scene(def, {"shadow.pcf_kernel=4"}), {"/shadow/pcf_kernel", "3, 5, 7, 9", "4"});
   expect_error(read_scene(def, {"shadow.pcf_kernel=11"}), {"/shadow/pcf_kernel", "11"});
   expect_error(read_scene(def, {"shadow.pcf_kernel=1"}), {"/shadow/pcf_kernel", "1"});
@@ -301,7 +320,13 @@ TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   bad = {};
   bad.technique = ShadowTechnique(7);
   EXPECT_EQ(validate_shadow_settings(bad),
-            "technique must be pcf, pcss, backprojection or lom, was 7");
+            "technique must be pcf, pcss, backprojection, lom, vsm or evsm, was 7");
+  bad = {};
+  bad.vsm_blur = 6;
+  EXPECT_EQ(validate_shadow_settings(bad), "vsm_blur must be an odd number of texels in [1, 15], was 6");
+  bad = {};
+  bad.vsm_bleed_reduction = 1.0f;
+  EXPECT_EQ(validate_shadow_settings(bad), "vsm_bleed_reduction must be in [0, 1), was 1");
   bad = {};
   bad.lom_layers = 1;
   EXPECT_EQ(validate_shadow_settings(bad), "lom_layers must be in [2, 16], was 1");

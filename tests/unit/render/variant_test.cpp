@@ -1,6 +1,8 @@
 // Variant keys, the feature manifest and material files: no GL needed.
 #include <gtest/gtest.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <algorithm>
 #include <filesystem>
 #include <cstdlib>
@@ -48,7 +50,8 @@ bool documented_rules_hold(VariantKey k) {
   if (k.bits() & ~used) return false;
   if (k.get(V::kToneMapping) > 2) return false;      // none, khr_pbr_neutral, aces
   if (k.get(V::kShadowFilter) > 2) return false;     // none, bilinear, pcf3x3
-  if (k.get(V::kShadowTechnique) > 3) return false;  // pcf, pcss, backprojection, lom
+  // pcf, pcss, backprojection, lom, vsm, evsm
+  if (k.get(V::kShadowTechnique) > 5) return false;
   if (k.get(V::kShadowKernel) > 4) return false;     // 3x3, 5x5, 7x7, 9x9, poisson
   if (k.has(V::kReflectionCube) && k.has(V::kReflectionSphere)) return false;
   if (k.has(V::kReflectionBox) && !k.has(V::kReflectionCube)) return false;
@@ -83,6 +86,7 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
     EXPECT_TRUE(k.filtered_for(Pass::depth).valid());
     EXPECT_TRUE(k.filtered_for(Pass::shadow_points).valid());
     EXPECT_TRUE(k.filtered_for(Pass::lom_occlusion).valid());
+    EXPECT_TRUE(k.filtered_for(Pass::vsm_moments).valid());
     return true;
   };
   // No rule links a material feature to a frame feature, so every subset of the frame bits is
@@ -118,9 +122,10 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   // 8 reflection cube/sphere/box combinations = 768.
   // Frame keys: 2 without shadow (aovs), and with shadow 3 filters x 2 aovs x 2 debug x
   // 2 selection x 2 layered x 4 shadowed-light counts x (8 ortho cascade counts + 3 other
-  // projections) x 4 techniques x 5 kernels x 2 peel = 84480; all of them x 3 tone mappings.
+  // projections) x 6 techniques (pcf, pcss, backprojection, lom, vsm, evsm) x 5 kernels x
+  // 2 peel = 126720; all of them x 3 tone mappings.
   EXPECT_EQ(valid_materials, 768);
-  EXPECT_EQ(valid_frames, 3 * (2 + 84480));
+  EXPECT_EQ(valid_frames, 3 * (2 + 126720));
 }
 
 // The table is the one source: the manifest's features, their fields and the GLSL bit numbers
@@ -374,6 +379,9 @@ TEST(FrameUniforms, PackPutsEveryViewAndLightInItsPlace) {
   frame.lights.resize(3);
   frame.lights[2].type = LightType::spot;
   frame.exposure = 2.5f;
+  frame.shadow_map.vsm_bleed_reduction = 0.3f;
+  frame.height = 200;
+  frame.camera.proj = glm::perspective(glm::radians(90.0f), 2.0f, 0.1f, 100.0f);
   ShadowView a;
   a.light_index = 2;
   a.layer_count = 1;
@@ -396,6 +404,9 @@ TEST(FrameUniforms, PackPutsEveryViewAndLightInItsPlace) {
   const FrameBlock fb = pack_frame_block(frame);
   EXPECT_EQ(fb.counts, glm::ivec4(3, 2, 1, 0));
   EXPECT_EQ(fb.frame_params.x, 2.5f);
+  EXPECT_EQ(fb.frame_params.w, 0.3f);
+  // Metres per pixel at 1 m of view depth: 2 tan(45 deg) / 200.
+  EXPECT_FLOAT_EQ(fb.camera_pos.w, 0.01f);
   EXPECT_EQ(fb.light_info[0], glm::ivec4(int(LightType::directional), 1, 0, 0));
   EXPECT_EQ(fb.light_info[1].y, -1);
   EXPECT_EQ(fb.light_info[2], glm::ivec4(int(LightType::spot), 0, 0, 0));
@@ -409,10 +420,12 @@ TEST(FrameUniforms, PackPutsEveryViewAndLightInItsPlace) {
   EXPECT_EQ(fb.shadow_views[1].view_proj[7], glm::mat4(8.0f));
   ProbeJob job;
   job.center = {1, 2, 3};
+  job.resolution = 64;
   job.view_proj[4] = glm::mat4(3.0f);
   const FrameBlock face = probe_face_block(fb, job, 4);
   EXPECT_EQ(face.view_proj, glm::mat4(3.0f));
-  EXPECT_EQ(face.camera_pos, glm::vec4(1, 2, 3, 1));
+  // A 90-degree face of 64 texels: 2 / 64 metres per pixel per metre of distance, negated.
+  EXPECT_EQ(face.camera_pos, glm::vec4(1, 2, 3, -2.0f / 64.0f));
   EXPECT_EQ(face.frame_params.x, 1.0f);
   EXPECT_EQ(face.view, fb.view);  // sphere maps are made for the main view
 }
