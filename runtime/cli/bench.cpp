@@ -141,8 +141,10 @@ std::string soft_sweep() {
       "shadow.technique=lom;shadow.map_size=1024;shadow.lom_layers=4,8",
       "shadow.technique=vsm,evsm"};
   std::string out;
-  for (const char* c : configurations)
-    out += (out.empty() ? "" : "|") + std::string("render.shadow_cache=false;") + c;
+  for (const char* c : configurations) {
+    if (!out.empty()) out += '|';
+    out.append("render.shadow_cache=false;").append(c);
+  }
   return out;
 }
 

@@ -63,6 +63,28 @@ class PermutationTest : public HeadlessGlTest {
     if (aov) *aov = r.read_aovs();
     return r.read_color();
   }
+
+  // The largest colour and visibility differences between the variants and the über-shader
+  // oracle rendering copies a and b of one scene (one frame each, with AOVs).
+  struct OracleDifference {
+    double colour = 0.0;
+    float visibility = 0.0f;
+  };
+  static OracleDifference against_oracle(render::Renderer& variants, render::Renderer& oracle,
+                                         Scene& a, Scene& b) {
+    Image aov_v, aov_o;
+    const Image v = render(variants, a, 1, false, true, &aov_v);
+    const Image o = render(oracle, b, 1, false, true, &aov_o);
+    OracleDifference d;
+    EXPECT_EQ(v.pixels.size(), o.pixels.size());
+    if (v.pixels.size() != o.pixels.size()) return {1e9, 1e9f};
+    for (std::size_t i = 0; i < v.pixels.size(); ++i)
+      d.colour = std::max(d.colour, double(std::abs(v.pixels[i] - o.pixels[i])));
+    for (int y = 0; y < aov_v.height; ++y)
+      for (int x = 0; x < aov_v.width; ++x)
+        d.visibility = std::max(d.visibility, std::abs(aov_v.at(x, y, 7) - aov_o.at(x, y, 7)));
+    return d;
+  }
 };
 
 TEST_F(PermutationTest, CompilesExactlyTheCombinationsTheSceneUses) {
@@ -106,17 +128,9 @@ TEST_F(PermutationTest, EveryVariantMatchesTheUberShaderOracle) {
     Scene b = scene("materials.json", {std::string("shadow.filter=") + filter});
     auto variants = make_renderer();
     auto oracle = make_renderer({}, true);
-    Image aov_v, aov_o;
-    const Image v = render(*variants, a, 1, false, true, &aov_v);
-    const Image o = render(*oracle, b, 1, false, true, &aov_o);
-    ASSERT_EQ(v.pixels.size(), o.pixels.size());
-    double worst = 0;
-    for (std::size_t i = 0; i < v.pixels.size(); ++i) worst = std::max(worst, double(std::abs(v.pixels[i] - o.pixels[i])));
-    EXPECT_LE(worst, 1.0 / 255.0 + 1e-6) << filter;
-    float worst_vis = 0;
-    for (int y = 0; y < aov_v.height; ++y)
-      for (int x = 0; x < aov_v.width; ++x) worst_vis = std::max(worst_vis, std::abs(aov_v.at(x, y, 7) - aov_o.at(x, y, 7)));
-    EXPECT_LE(worst_vis, 1e-6f) << filter;
+    const OracleDifference d = against_oracle(*variants, *oracle, a, b);
+    EXPECT_LE(d.colour, 1.0 / 255.0 + 1e-6) << filter;
+    EXPECT_LE(d.visibility, 1e-6f) << filter;
     // The oracle is one program per pass; the variants are many.
     EXPECT_EQ(oracle->shaders().built_keys(Pass::forward).size(), 1u);
     EXPECT_GT(variants->shaders().built_keys(Pass::forward).size(), 5u);
@@ -164,19 +178,9 @@ TEST_F(PermutationTest, NewMaterialInputsMatchTheUberShaderOracle) {
   Scene a = load(), b = load();
   auto variants = make_renderer();
   auto oracle = make_renderer({}, true);
-  Image aov_v, aov_o;
-  const Image v = render(*variants, a, 1, false, true, &aov_v);
-  const Image o = render(*oracle, b, 1, false, true, &aov_o);
-  ASSERT_EQ(v.pixels.size(), o.pixels.size());
-  double worst = 0;
-  for (std::size_t i = 0; i < v.pixels.size(); ++i)
-    worst = std::max(worst, double(std::abs(v.pixels[i] - o.pixels[i])));
-  EXPECT_LE(worst, 1.0 / 255.0 + 1e-6);
-  float worst_vis = 0;
-  for (int y = 0; y < aov_v.height; ++y)
-    for (int x = 0; x < aov_v.width; ++x)
-      worst_vis = std::max(worst_vis, std::abs(aov_v.at(x, y, 7) - aov_o.at(x, y, 7)));
-  EXPECT_LE(worst_vis, 1e-6f);  // the transformed cut-out's shadow too
+  const OracleDifference d = against_oracle(*variants, *oracle, a, b);
+  EXPECT_LE(d.colour, 1.0 / 255.0 + 1e-6);
+  EXPECT_LE(d.visibility, 1e-6f);  // the transformed cut-out's shadow too
   // The cut-out's shadow program has its transform (and nothing else of the material).
   std::set<std::uint64_t> depth;
   for (VariantKey k : variants->shaders().built_keys(Pass::depth)) depth.insert(k.bits());
