@@ -11,6 +11,7 @@
 #include <type_traits>
 
 #include "components/bounds.h"
+#include "runtime/core/log.h"
 #include "runtime/render/renderer.h"
 
 namespace kaskad::render {
@@ -661,6 +662,14 @@ Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const Sha
     peels_ = peels;
     depth_ = {};
     ensure_storage(size, slices);
+    // Pass 1 works per map texel and layer: past S1's one 1024^2 map, a software rasteriser
+    // takes seconds whenever the maps are redrawn (the first frame, a moving camera or light).
+    if (double(size) * size * total > 2.0 * 1024.0 * 1024.0)
+      log::warn_once("shadow.technique lom: %d map layers of %d^2 with %d depth peels each; its "
+                     "pass 1 runs per map texel and layer, so every frame that redraws the maps "
+                     "pays for all of them (S1 uses one 1024^2 map: shadow.map_size=1024, or "
+                     "fewer cascades, cut it)",
+                     total, size, peels - 1);
   }
   // A layer's inputs beyond its casters: the receivers that cast nothing (stored, so that they
   // are shaded), the light's size and the layer count.
