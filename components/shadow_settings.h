@@ -104,10 +104,10 @@ enum class CascadeSelection {
   map_bounds,  ///< the first cascade whose map contains the point (uses the stable fit's slack)
 };
 
-/// Per shadowed light, except map_size, depth_format, filter, technique, pcf_kernel, lom_layers,
-/// vsm_blur, vsm_bleed_reduction, selection, layered and debug_cascades: every light's layers share one texture array and the shader features are per
-/// frame, so the first shadowed light's values of these apply to all (update_shadows() warns
-/// once, naming the fields, when another light's own differ).
+/// Per shadowed light, except the fields for_each_shared_field() lists: every light's layers share
+/// one texture array and the shader features are per frame, so the first shadowed light's values
+/// of these apply to all (update_shadows() warns once, naming the fields, when another light's
+/// own differ).
 struct ShadowSettings {
   /// Texels per side of the map (of each cascade); power of two in [64, 16384]. 2048: engine
   /// choice, the size of the first basic map.
@@ -211,6 +211,23 @@ struct ShadowSettings {
   /// maps instead of 6 (S0's earlier work).
   PointShadowMode point_mode = PointShadowMode::cube;
 };
+
+/// The fields every shadowed light takes from the first (one texture array, one set of shader
+/// features), the one list of them: calls visit(name, a.field, b.field) for each.
+template <typename A, typename B, typename Visit>
+void for_each_shared_field(A& a, B& b, Visit&& visit) {
+  visit("map_size", a.map_size, b.map_size);
+  visit("depth_format", a.depth_format, b.depth_format);
+  visit("filter", a.filter, b.filter);
+  visit("technique", a.technique, b.technique);
+  visit("pcf_kernel", a.pcf_kernel, b.pcf_kernel);
+  visit("lom_layers", a.lom_layers, b.lom_layers);
+  visit("vsm_blur", a.vsm_blur, b.vsm_blur);
+  visit("vsm_bleed_reduction", a.vsm_bleed_reduction, b.vsm_bleed_reduction);
+  visit("selection", a.selection, b.selection);
+  visit("layered", a.layered, b.layered);
+  visit("debug_cascades", a.debug_cascades, b.debug_cascades);
+}
 
 /// Texels a lookup reaches from the point's texel: 1.5 for S4's 3x3 (and the single taps), N / 2
 /// for an N x N box, the disc's radius plus one (its taps filter linearly) for poisson, PCSS's

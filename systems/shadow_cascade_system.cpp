@@ -340,9 +340,8 @@ namespace {
 
 // The maps of one shadowed light (entity `e`, null for none). Errors are logged when they differ
 // from `last_error`, which is updated. `previous` is this slot's last result (freeze_cascades).
-/// `shared`: for lights after the first, the first light's settings whose map_size,
-/// depth_format, filter, technique, pcf_kernel, lom_layers, vsm_blur, vsm_bleed_reduction, selection, layered and debug_cascades apply to
-/// every light (one shared
+/// `shared`: for lights after the first, the first light's settings whose shared fields
+/// (for_each_shared_field()) apply to every light (one shared
 /// texture array, one set of shader features). They are applied before fitting, so texel sizes
 /// and the stable fit's snapping use the real map size.
 ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera, ecs::Entity e,
@@ -361,19 +360,9 @@ ShadowData fit_shadowed_light(const ecs::World& world, const CameraState& camera
   };
   if (!out.light.valid()) return finish();
   if (const auto* s = world.try_get<ShadowSettings>(out.light)) out.settings = *s;
-  if (shared) {
-    out.settings.map_size = shared->map_size;
-    out.settings.depth_format = shared->depth_format;
-    out.settings.filter = shared->filter;
-    out.settings.technique = shared->technique;
-    out.settings.pcf_kernel = shared->pcf_kernel;
-    out.settings.lom_layers = shared->lom_layers;
-    out.settings.vsm_blur = shared->vsm_blur;
-    out.settings.vsm_bleed_reduction = shared->vsm_bleed_reduction;
-    out.settings.selection = shared->selection;
-    out.settings.layered = shared->layered;
-    out.settings.debug_cascades = shared->debug_cascades;
-  }
+  if (shared)
+    for_each_shared_field(out.settings, *shared,
+                          [](const char*, auto& mine, const auto& first) { mine = first; });
   const ShadowSettings& s = out.settings;
   if (std::string bad = validate_shadow_settings(s); !bad.empty()) {
     set_error(out, "light " + std::to_string(out.light.index) + ": " + bad);
@@ -662,20 +651,9 @@ std::vector<ShadowData> fit_shadowed_lights(const ecs::World& world, const Camer
     // Say which of the shared fields the light's own component asks otherwise.
     if (const auto* own = world.try_get<ShadowSettings>(l.entity)) {
       std::string differ;
-      auto check = [&](bool same, const char* field) {
-        if (!same) differ += std::string(differ.empty() ? "" : ", ") + field;
-      };
-      check(own->map_size == shared->map_size, "map_size");
-      check(own->depth_format == shared->depth_format, "depth_format");
-      check(own->filter == shared->filter, "filter");
-      check(own->technique == shared->technique, "technique");
-      check(own->pcf_kernel == shared->pcf_kernel, "pcf_kernel");
-      check(own->lom_layers == shared->lom_layers, "lom_layers");
-      check(own->vsm_blur == shared->vsm_blur, "vsm_blur");
-      check(own->vsm_bleed_reduction == shared->vsm_bleed_reduction, "vsm_bleed_reduction");
-      check(own->selection == shared->selection, "selection");
-      check(own->layered == shared->layered, "layered");
-      check(own->debug_cascades == shared->debug_cascades, "debug_cascades");
+      for_each_shared_field(*own, *shared, [&](const char* field, const auto& mine, const auto& first) {
+        if (!(mine == first)) differ += std::string(differ.empty() ? "" : ", ") + field;
+      });
       if (!differ.empty())
         add_notice(name + ": its " + differ +
                    " differ from the first shadowed light's, whose values apply (one shared "

@@ -39,8 +39,8 @@ glm::vec2 light_size_for_shadows(const Light& light);
 struct ShadowData {
   ecs::Entity light = ecs::kNullEntity;  ///< the shadowed light, null when there is none
   /// The light's own (else defaults), except the fields that belong to the shared texture array
-  /// and the frame's shader features: map_size, depth_format, filter, technique, pcf_kernel,
-  /// selection, layered and debug_cascades are the first view's in every view (update_shadows() warns when they differ).
+  /// and the frame's shader features (for_each_shared_field()) are the first view's in every view
+  /// (update_shadows() warns when they differ).
   ShadowSettings settings;
   /// ortho: a directional light's cascades; perspective: a spot light's map; cube or
   /// dual_paraboloid: a point light's maps (settings.point_mode).
