@@ -222,24 +222,30 @@ void ShadowMapPass::ensure_storage(int size, int layers, DepthFormat format, Sha
   glTextureParameteri(map_.id(), GL_TEXTURE_MAG_FILTER, f);
 }
 
+namespace {
+
+// A sampler of shadow data with border 1, as the map itself (S4): outside it every compare is
+// lit, every raw depth 1 (LOM: nothing stored). `compare`: depth compare LEQUAL, else none.
+gpu::Sampler border_sampler(bool compare, GLint filter) {
+  gpu::Sampler s = gpu::make_sampler();
+  const GLuint id = s.id();
+  glSamplerParameteri(id, GL_TEXTURE_COMPARE_MODE, compare ? GL_COMPARE_REF_TO_TEXTURE : GL_NONE);
+  glSamplerParameteri(id, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  glSamplerParameteri(id, GL_TEXTURE_MIN_FILTER, filter);
+  glSamplerParameteri(id, GL_TEXTURE_MAG_FILTER, filter);
+  glSamplerParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+  glSamplerParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+  const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+  glSamplerParameterfv(id, GL_TEXTURE_BORDER_COLOR, border);
+  return s;
+}
+
+}  // namespace
+
 void ShadowMapPass::bind() {
   const gpu::TextureRef map = texture();
-  auto make = [](bool compare, GLint filter) {
-    gpu::Sampler s = gpu::make_sampler();
-    const GLuint id = s.id();
-    glSamplerParameteri(id, GL_TEXTURE_COMPARE_MODE, compare ? GL_COMPARE_REF_TO_TEXTURE : GL_NONE);
-    glSamplerParameteri(id, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-    glSamplerParameteri(id, GL_TEXTURE_MIN_FILTER, filter);
-    glSamplerParameteri(id, GL_TEXTURE_MAG_FILTER, filter);
-    // As the map itself (S4): outside it every compare is lit, every raw depth 1.
-    glSamplerParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-    glSamplerParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-    const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};
-    glSamplerParameterfv(id, GL_TEXTURE_BORDER_COLOR, border);
-    return s;
-  };
-  if (!raw_depth_) raw_depth_ = make(false, GL_NEAREST);
-  if (!linear_compare_) linear_compare_ = make(true, GL_LINEAR);
+  if (!raw_depth_) raw_depth_ = border_sampler(false, GL_NEAREST);
+  if (!linear_compare_) linear_compare_ = border_sampler(true, GL_LINEAR);
   glBindTextureUnit(kTexShadow, map.id());
   glBindTextureUnit(kTexShadowDepth, map.id());
   glBindSampler(kTexShadowDepth, raw_depth_.id());
@@ -612,13 +618,7 @@ void LomPass::ensure_storage(int size, int slices) {
   factor_fbo_ = gpu::make_framebuffer();
   glNamedFramebufferDrawBuffer(factor_fbo_.id(), GL_COLOR_ATTACHMENT0);
   if (!nearest_) {
-    nearest_ = gpu::make_sampler();
-    glSamplerParameteri(nearest_.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glSamplerParameteri(nearest_.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glSamplerParameteri(nearest_.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-    glSamplerParameteri(nearest_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-    const float border[4] = {1.0f, 1.0f, 1.0f, 1.0f};  // outside the map: nothing stored
-    glSamplerParameterfv(nearest_.id(), GL_TEXTURE_BORDER_COLOR, border);
+    nearest_ = border_sampler(false, GL_NEAREST);  // outside the map: nothing stored
     any_samples_ = gpu::make_query(GL_ANY_SAMPLES_PASSED);
     counter_ = gpu::make_buffer();
     glNamedBufferStorage(counter_.id(), sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -672,17 +672,19 @@ Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const Sha
                      total, size, peels - 1);
   }
   // A layer's inputs beyond its casters: the receivers that cast nothing (stored, so that they
-  // are shaded), the light's size and the layer count.
+  // are shaded; hashed once for every layer), the light's size and the layer count.
+  InputHash receivers;
+  for (std::uint32_t i : list.depth_order) {
+    const DrawItem& d = frame.draws[i];
+    if (d.receive_shadows && !d.cast_shadows) receivers.add(d.mesh).add(d.model);
+  }
   inputs_.assign(std::size_t(total), 0);
   for (const ShadowView& v : views)
     for (int c = 0; c < v.layer_count; ++c) {
       const int layer = v.first_layer + c;
       InputHash h;
       h.add(shadow.layer_inputs(layer)).add(v.light_size).add(peels).add(v.cull);
-      for (std::uint32_t i : list.depth_order) {
-        const DrawItem& d = frame.draws[i];
-        if (d.receive_shadows && !d.cast_shadows) h.add(d.mesh).add(d.model);
-      }
+      h.add(receivers.value());
       inputs_[std::size_t(layer)] = h.value();
       if (!lom_view(v) || v.skipped[std::size_t(c)]) continue;
       const glm::ivec4 rect = stats.layer_rect[std::size_t(layer)];
