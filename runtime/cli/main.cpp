@@ -448,9 +448,9 @@ int run_render(Args a) {
     }
     std::printf("%s\n", drawn < st.shadow_layers ? "; the others kept their depth (same matrix "
                                                     "and casters)" : "");
-    if (scene->shadow_defaults.technique == ShadowTechnique::lom ||
-        (!timings->last.shadows.empty() &&
-         timings->last.shadows.front().settings.technique == ShadowTechnique::lom))
+    // The first shadowed light's technique is every view's (for_each_shared_field()).
+    if (!timings->last.shadows.empty() &&
+        timings->last.shadows.front().settings.technique == ShadowTechnique::lom)
       std::printf("          lom: %d of %d layers peeled and their occlusion recomputed; %lld "
                   "texels with more light-facing surfaces than lom_layers (read as umbra "
                   "below them)\n",
