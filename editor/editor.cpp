@@ -258,6 +258,9 @@ class Editor {
   Status edit(const std::string& assignment, bool merge);
   void record(bool merge);  ///< a snapshot of the scene as it is now, after an edit
   Status restore(std::size_t index);
+  /// The scene becomes canonical document `doc` (read as a file of the scene's path would be),
+  /// its programs compiled before its next frame; the scene is unchanged on an error.
+  Status load_document(const json& doc);
   std::string unused_name(const std::string& stem) const;
   Status create(const std::string& shape);
   Status remove_selected();
@@ -399,10 +402,7 @@ Status Editor::edit(const std::string& assignment, bool merge) {
     // the canonical document and the scene remade from it: the same override and readers.
     json doc = scene_to_json(scene_);
     if (!apply_override(doc, assignment)) return live;
-    auto remade = load_scene_document(doc, opt_.scene);
-    if (!remade) return remade.error();
-    scene_ = std::move(remade.value());
-    prewarm_ = true;
+    KASKAD_TRY(load_document(doc));
   }
   record(merge);
   return {};
@@ -486,10 +486,7 @@ Status Editor::reparent_selected(const std::string& parent) {
       return Error{"", "", "parent: '" + parent + "' is '" + selected_ + "' or below it"};
   if (parent.empty()) (*child)["transform"].erase("parent");
   else (*child)["transform"]["parent"] = parent;
-  auto remade = load_scene_document(doc, opt_.scene);
-  if (!remade) return remade.error();
-  scene_ = std::move(remade.value());
-  prewarm_ = true;
+  KASKAD_TRY(load_document(doc));
   record(false);
   return {};
 }
@@ -509,21 +506,23 @@ Status Editor::rename_selected(const std::string& name) {
       ent["transform"]["parent"] = name;
   }
   if (!found) return Error{"", "", "rename: '" + selected_ + "' is imported from a model"};
-  auto remade = load_scene_document(doc, opt_.scene);
-  if (!remade) return remade.error();
-  scene_ = std::move(remade.value());
-  prewarm_ = true;
+  KASKAD_TRY(load_document(doc));
   selected_ = name;
   record(false);
   return {};
 }
 
-Status Editor::restore(std::size_t index) {
-  auto scene = load_scene_document(history_[index], opt_.scene);
+Status Editor::load_document(const json& doc) {
+  auto scene = load_scene_document(doc, opt_.scene);
   if (!scene) return scene.error();
   scene_ = std::move(scene.value());
-  position_ = index;
   prewarm_ = true;
+  return {};
+}
+
+Status Editor::restore(std::size_t index) {
+  KASKAD_TRY(load_document(history_[index]));
+  position_ = index;
   doc_stale_ = true;
   changed_since_frame_ = true;
   if (camera_.moved) {

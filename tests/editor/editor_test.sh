@@ -22,6 +22,14 @@ scene="$KASKAD_CONTENT/scenes/default.json"
 failed=0
 fail() { echo "FAIL $*"; failed=1; }
 ok() { echo "ok   $*"; }
+# refused PATTERN WHAT: the last edit run exited 1 and its output matches PATTERN.
+refused() {
+  if [ "$rc" -eq 1 ] && grep -q "$1" "$tmp/out"; then
+    ok "$2"
+  else
+    fail "$2: exit $rc"; cat "$tmp/out"
+  fi
+}
 
 # edit SCRIPT_TEXT ARGS...: runs the editor on a small window; output in $tmp/out, exit in $rc.
 edit() {
@@ -240,53 +248,29 @@ input)
   edit "frames 1
 sett shadow.cascade_count=2
 quit!" "$scene"
-  if [ "$rc" -eq 1 ] && grep -q "script.txt: line 2: unknown action 'sett'" "$tmp/out"; then
-    ok "bad script line: exit 1, file and line named"
-  else
-    fail "bad script line: exit $rc"; cat "$tmp/out"
-  fi
+  refused "script.txt: line 2: unknown action 'sett'" "bad script line: exit 1, file and line named"
   [ -z "$(grep '^frame' "$tmp/out")" ] && ok "a bad script fails before the first frame" ||
     fail "frames rendered before the bad line was found"
   edit "set shadow.cascade_count=99
 quit!" "$scene"
-  if [ "$rc" -eq 1 ] && grep -q "line 1: .*cascade_count" "$tmp/out"; then
-    ok "rejected value: exit 1 with the readers' message"
-  else
-    fail "rejected value: exit $rc"; cat "$tmp/out"
-  fi
+  refused "line 1: .*cascade_count" "rejected value: exit 1 with the readers' message"
   edit "select box_resting
 rename sun
 quit!" "$scene"
-  if [ "$rc" -eq 1 ] && grep -q "line 2: .*duplicate entity name 'sun'" "$tmp/out"; then
-    ok "rename to a taken name: exit 1, the readers' message"
-  else
-    fail "rename to a taken name: exit $rc"; cat "$tmp/out"
-  fi
+  refused "line 2: .*duplicate entity name 'sun'" "rename to a taken name: exit 1, the readers' message"
   edit "select pole
 parent box_large
 select box_large
 parent pole
 quit!" "$scene"
-  if [ "$rc" -eq 1 ] && grep -q "line 4: parent: 'pole' is 'box_large' or below it" "$tmp/out"; then
-    ok "a parent cycle is refused: exit 1, line named"
-  else
-    fail "parent cycle: exit $rc"; cat "$tmp/out"
-  fi
+  refused "line 4: parent: 'pole' is 'box_large' or below it" "a parent cycle is refused: exit 1, line named"
   edit "set sun.light.intensity=2
 open $scene
 quit!" "$scene"
-  if [ "$rc" -eq 1 ] && grep -q "line 2: open: .*unsaved changes" "$tmp/out"; then
-    ok "open with unsaved changes is refused"
-  else
-    fail "open with unsaved changes: exit $rc"; cat "$tmp/out"
-  fi
+  refused "line 2: open: .*unsaved changes" "open with unsaved changes is refused"
   edit "set sun.light.intensity=2
 quit" "$scene"
-  if [ "$rc" -eq 1 ] && grep -q "unsaved changes" "$tmp/out"; then
-    ok "quit with unsaved changes fails the script"
-  else
-    fail "unsaved quit: exit $rc"; cat "$tmp/out"
-  fi
+  refused "unsaved changes" "quit with unsaved changes fails the script"
   edit "set sun.light.intensity=2
 undo
 quit" "$scene"
