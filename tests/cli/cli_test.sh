@@ -54,6 +54,17 @@ check render_two_suns 0 "view 1: light 'moon' \(entity [0-9]+\), layers 4\.\.5 o
   --headless --size 96x64 --frames 1 -o "$tmp/two.png"
 check cascade_table 0 "layer +m/texel +casters +triangles +drawn +receiver px" -- "$KASKAD" render --headless \
   --size 96x64 --frames 1 -o "$tmp/t.png" --aov "$tmp/t.exr"
+# The ray-traced shadow reference beside the AOV (issue 14): a file with its four channels and the
+# RMSE printed; refused without a shadowed light. Bench options are refused by render.
+check shadow_reference 0 "shadow reference: reference visibility error receiver; [0-9]+ receiver pixels, RMSE 0\.[0-9]+, MAE" -- \
+  "$KASKAD" render "$KASKAD_CONTENT/scenes/soft/sun_5deg.json" --headless --size 96x64 --frames 1 \
+  -o "$tmp/soft.png" --shadow-reference "$tmp/soft_ref.exr"
+if command -v oiiotool >/dev/null; then
+  check shadow_reference_file 0 "channel list: error, receiver, reference, visibility" -- oiiotool --info -v "$tmp/soft_ref.exr"
+fi
+check shadow_reference_unlit nonzero "--shadow-reference.*no shadowed light" -- "$KASKAD" render --headless \
+  --size 96x64 --frames 1 -o "$tmp/unlit.png" --shadow-reference "$tmp/unlit.exr" --set sun.light.cast_shadows=false
+check render_out_refused nonzero "--out is a bench option" -- "$KASKAD" render --headless --out "$tmp/x"
 
 # Bad input: clear errors, non-zero exits, no crashes.
 check unknown_command nonzero "unknown command" -- "$KASKAD" paint
