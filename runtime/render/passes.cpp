@@ -667,8 +667,8 @@ Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const Sha
     if (double(size) * size * total > 2.0 * 1024.0 * 1024.0)
       log::warn_once("shadow.technique lom: %d map layers of %d^2 with %d depth peels each; its "
                      "pass 1 runs per map texel and layer, so every frame that redraws the maps "
-                     "pays for all of them (S1 uses one 1024^2 map: shadow.map_size=1024, or "
-                     "fewer cascades, cut it)",
+                     "pays for all of them (S1's set-up is one 1024^2 map; a smaller "
+                     "shadow.map_size or a smaller shadow.cascade_count cuts it)",
                      total, size, peels - 1);
   }
   // A layer's inputs beyond its casters: the receivers that cast nothing (stored, so that they
