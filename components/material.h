@@ -5,6 +5,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <utility>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -29,6 +31,19 @@ inline std::array<glm::vec3, 2> uv_transform_rows(const TextureTransform& t) {
           glm::vec3(-s * t.scale.x, c * t.scale.y, t.offset.y)};
 }
 
+/// How a reflector's probe map reaches the surface (README "Shading"). s3: S3 eq. (3), the
+/// surface's own shading plus k_s p_r times the mirror-direction lookup (exact, compared with the
+/// ray-traced reference). pbr: the probe lights the glTF BRDF like an environment map (its SH
+/// irradiance and GGX-prefiltered radiance, components/ibl.h), blended with the scene's
+/// environment by p_r; k_s is not used.
+enum class ReflectionModel : std::uint8_t { s3, pbr };
+/// The names scene and material files use (`reflection_model`).
+inline const std::vector<std::pair<const char*, ReflectionModel>>& reflection_model_names() {
+  static const std::vector<std::pair<const char*, ReflectionModel>> names = {
+      {"s3", ReflectionModel::s3}, {"pbr", ReflectionModel::pbr}};
+  return names;
+}
+
 struct Material {
   glm::vec4 base_color{1.0f};                  ///< linear RGBA factor (glTF baseColorFactor)
   TextureId base_color_texture = kNoTexture;   ///< sRGB texture, multiplied by base_color
@@ -48,6 +63,7 @@ struct Material {
   /// S3's k_s, the specular level that scales a reflection map's colour (eq. (3)), in [0, 1].
   /// Used only on entities with a Reflector. 1: a mirror.
   float k_s = 1.0f;
+  ReflectionModel reflection_model = ReflectionModel::s3;
   /// Shader features this material uses, as VariantKey material bits (runtime/render/
   /// variant_key.h). Material files list them; other loaders call derive_material_features()
   /// (runtime/assets/material_file.h).

@@ -1,5 +1,6 @@
 #include "systems/frame.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -8,6 +9,7 @@
 #include "components/mesh_renderer.h"
 #include "components/model.h"
 #include "components/transform.h"
+#include "runtime/core/log.h"
 #include "systems/transform_system.h"
 
 namespace kaskad {
@@ -78,6 +80,11 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.camera.proj = camera.proj;
   in.camera.position = camera.position;
   in.ambient = scene.render.ambient;
+  if (scene.environment_map < scene.assets.env_maps.size()) {
+    in.environment = &scene.assets.env_maps[scene.environment_map];
+    in.environment_key = scene.environment_serial;
+    in.environment_intensity = scene.render.environment_intensity;
+  }
   in.clear_color = scene.render.clear_color;
   in.exposure = scene.render.exposure;
   in.tone_mapping = scene.render.tone_mapping;
@@ -93,6 +100,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   }
 
   const Material default_material;
+  std::vector<ProbeHandle> pbr_probes;  // probes a draw of the pbr reflection model reflects
   world.view<MeshRenderer, WorldTransform>().each(
       [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
         if (mr.mesh == kNoMesh) return;
@@ -111,7 +119,8 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         // A reflector's own draw reflects its probe's map once one is complete (S3 eq. (3)).
         d.material.features &= ~(render::VariantKey::kReflectionCube.mask() |
                                  render::VariantKey::kReflectionSphere.mask() |
-                                 render::VariantKey::kReflectionBox.mask());
+                                 render::VariantKey::kReflectionBox.mask() |
+                                 render::VariantKey::kReflectionPbr.mask());
         // A mesh imported under a model reflects the model's probe (and stays out of it).
         const ProbeData::Entry* p = probes.find(e);
         if (!p)
@@ -124,10 +133,25 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
             if (p->job.box) d.material.features |= render::VariantKey::kReflectionBox.mask();
             d.reflection_scale = d.material.k_s * p->amount;
           }
+          // The pbr model reads the probe's prefiltered cube: sphere maps keep S3's model.
+          if (d.material.reflection_model == ReflectionModel::pbr && p->sphere)
+            log::warn_once("reflection_model pbr needs a cube-map probe; sphere-map probes keep "
+                           "S3's model");
+          if (d.material.reflection_model == ReflectionModel::pbr && !p->sphere) {
+            pbr_probes.push_back(p->job.handle);
+            if (p->has_map) {
+              d.material.features |= render::VariantKey::kReflectionPbr.mask();
+              d.reflection_scale = p->amount;
+            }
+          }
         }
         in.draws.push_back(d);
       });
-  for (const ProbeData::Entry& p : probes.probes) in.probes.push_back(p.job);
+  for (const ProbeData::Entry& p : probes.probes) {
+    in.probes.push_back(p.job);
+    in.probes.back().prefilter =
+        std::find(pbr_probes.begin(), pbr_probes.end(), p.job.handle) != pbr_probes.end();
+  }
 
   // Lights in entity order; each shadow view learns its light's index.
   in.shadow_views.resize(shadows.size());

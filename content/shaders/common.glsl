@@ -21,6 +21,7 @@ layout(std140, binding = 0) uniform FrameBlock {
   mat4 u_view;
   vec4 u_camera_pos;                // xyz: world position, w: pixel footprint (FrameBlock)
   vec4 u_ambient;                   // rgb: linear ambient radiance
+  vec4 u_environment;               // x environment intensity, y its last prefiltered level
   vec4 u_frame;                     // x exposure, y shadow map size (texels a side), z lom layers,
                                     // w vsm_bleed_reduction
   ivec4 u_counts;                   // x lights, y shadow views, z the view the AOV shows

@@ -1,11 +1,13 @@
 // Forward shading: the glTF 2.0 metallic-roughness BRDF (brdf.glsl, the specification's Appendix
 // B), linear lighting, sRGB output through the sRGB colour target. A light's colour is the
-// illuminance it delivers (outgoing radiance = f * E * N.L; components/brdf.h); u_ambient is a
-// uniform radiance, which a Lambert surface reflects as ambient * c_diff. Features
+// illuminance it delivers (outgoing radiance = f * E * N.L; components/brdf.h). Light from the
+// surroundings (ibl.glsl, components/ibl.h) is the environment map (VARIANT_ENVIRONMENT map),
+// else u_ambient as a uniform radiance, or a pbr reflector's probe. Features
 // (content/shaders/features.json) are selected by the preprocessor only; see README.md here.
 #include "brdf.glsl"
 #include "common.glsl"
 #include "features.glsl"
+#include "ibl.glsl"
 #include "shadow.glsl"
 #include "tone_mapping.glsl"
 
@@ -23,7 +25,14 @@ layout(location = 3) out vec2 o_visibility;  // x shadow visibility of the shado
 layout(location = 4) out vec4 o_reflection;  // rgb reflected colour C_t, a 1 with a map (else 0)
 #endif
 
-// Reflection maps (S3). The probe's map and x = k_s * p_r (eq. (3)) are set per draw.
+#if VARIANT_ENVIRONMENT == VARIANT_ENVIRONMENT_MAP
+// render.environment prefiltered by roughness (IblMaps): level k holds roughness k / u_environment.y.
+layout(binding = UNIT_ENVIRONMENT) uniform samplerCube u_environment_cube;
+#endif
+
+// Reflection maps (S3). The probe's map and x = k_s * p_r (eq. (3)) are set per draw. The pbr
+// model (MATERIAL_HAS_REFLECTION_PBR) gets the probe's prefiltered cube instead, and x = p_r,
+// y its SH row, z its last level.
 #if MATERIAL_HAS_REFLECTION_CUBE || MATERIAL_HAS_REFLECTION_SPHERE
 layout(location = LOC_REFLECTION) uniform vec4 u_reflection;
 #endif
@@ -90,12 +99,11 @@ void main() {
 #endif
 
   float metallic = clamp(u_material.x, 0.0, 1.0);
-  float roughness = u_material.y;  // brdf_evaluate() clamps it
-  vec3 diffuse_color = mix(base.rgb, vec3(0.0), metallic);  // Appendix B's c_diff
+  float roughness = u_material.y;  // brdf_evaluate() and ibl_combine() clamp it
 
   float view_depth = -(u_view * vec4(v_world_pos, 1.0)).z;
-  // Ambient (uniform radiance) reflected by the Lambert lobe; glTF's occlusion texture scales
-  // this indirect light only: 1 + strength * (occlusion - 1) (glTF 2.0, 3.9.3).
+  // glTF's occlusion texture scales the light from the surroundings only:
+  // 1 + strength * (occlusion - 1) (glTF 2.0, 3.9.3).
   float occlusion = 1.0;
 #if MATERIAL_HAS_OCCLUSION_TEXTURE
   if (ENABLED(BIT_OCCLUSION_TEXTURE)) {
@@ -103,7 +111,46 @@ void main() {
     occlusion = 1.0 + u_material_extra.x * (ao - 1.0);
   }
 #endif
-  vec3 color = u_ambient.rgb * diffuse_color * occlusion;
+  vec3 reflected = vec3(0.0);  // S3's C_t, or the pbr probe's prefiltered radiance (AOV)
+  float reflector = 0.0;       // 1 where a reflection map applies (AOV)
+#if MATERIAL_HAS_REFLECTION_CUBE || MATERIAL_HAS_REFLECTION_SPHERE
+  // S3 eq. (1), R = U - 2 (N.U) N with U the unit vector from the eye to the point. Computed in
+  // world space, which is eq. (6)'s (MV)^-1 R_VCS (rotation part): the cube is in world space.
+  vec3 r_world = reflect(-v, n);
+#endif
+#if MATERIAL_HAS_REFLECTION_PBR
+  bool reflection_pbr = ENABLED(BIT_REFLECTION_PBR);
+#else
+  bool reflection_pbr = false;
+#endif
+
+  // Light from the surroundings through the BRDF (ibl.glsl): irradiance over pi and the
+  // radiance prefiltered for this roughness along the reflected view direction.
+  float ibl_roughness = clamp(roughness, BRDF_MIN_ROUGHNESS, 1.0);
+  float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
+#if VARIANT_ENVIRONMENT == VARIANT_ENVIRONMENT_MAP
+  vec3 irradiance = u_environment.x * sh9_irradiance_over_pi(0, n);
+  vec3 specular = u_environment.x *
+                  textureLod(u_environment_cube, reflect(-v, n), ibl_roughness * u_environment.y).rgb;
+#else
+  vec3 irradiance = u_ambient.rgb;
+  vec3 specular = u_ambient.rgb;
+#endif
+#if MATERIAL_HAS_REFLECTION_PBR
+  if (reflection_pbr) {
+    // The probe instead of the environment, by p_r.
+    vec3 lookup = r_world;
+#if MATERIAL_HAS_REFLECTION_BOX
+    if (ENABLED(BIT_REFLECTION_BOX)) lookup = box_project(v_world_pos, r_world);
+#endif
+    reflected = textureLod(u_reflection_cube, lookup, ibl_roughness * u_reflection.z).rgb;
+    reflector = 1.0;
+    irradiance = mix(irradiance, sh9_irradiance_over_pi(int(u_reflection.y), n), u_reflection.x);
+    specular = mix(specular, reflected, u_reflection.x);
+  }
+#endif
+  vec3 color = ibl_combine(base.rgb, metallic, roughness, n_dot_v,
+                           dfg_lookup(n_dot_v, ibl_roughness), irradiance, specular) * occlusion;
 #if MATERIAL_HAS_EMISSIVE
   if (ENABLED(BIT_EMISSIVE)) {
     vec3 emissive = u_emissive;  // the factor, times KHR_materials_emissive_strength
@@ -179,15 +226,8 @@ void main() {
              attenuation * shadow;
   }
 
-  vec3 reflected = vec3(0.0);  // S3's C_t
-  float reflector = 0.0;       // 1 where a reflection map applies (AOV)
-#if MATERIAL_HAS_REFLECTION_CUBE || MATERIAL_HAS_REFLECTION_SPHERE
-  // S3 eq. (1), R = U - 2 (N.U) N with U the unit vector from the eye to the point. Computed in
-  // world space, which is eq. (6)'s (MV)^-1 R_VCS (rotation part): the cube is in world space.
-  vec3 r_world = reflect(-v, n);
-#endif
 #if MATERIAL_HAS_REFLECTION_CUBE
-  if (ENABLED(BIT_REFLECTION_CUBE)) {
+  if (ENABLED(BIT_REFLECTION_CUBE) && !reflection_pbr) {
     vec3 lookup = r_world;
 #if MATERIAL_HAS_REFLECTION_BOX
     if (ENABLED(BIT_REFLECTION_BOX)) lookup = box_project(v_world_pos, r_world);
@@ -207,7 +247,7 @@ void main() {
   }
 #endif
 #if MATERIAL_HAS_REFLECTION_CUBE || MATERIAL_HAS_REFLECTION_SPHERE
-  color += u_reflection.x * reflected;  // S3 eq. (3): I' = I + k_s p_r C_t
+  if (!reflection_pbr) color += u_reflection.x * reflected;  // S3 eq. (3): I' = I + k_s p_r C_t
 #endif
 
 #if VARIANT_HAS_SHADOW && VARIANT_DEBUG_CASCADES

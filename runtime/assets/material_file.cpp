@@ -38,6 +38,7 @@ Result<Material> load_material_file(const std::filesystem::path& file,
     ObjectReader root(*doc, "");
     std::string description;
     root.string("description", description);
+    root.enumeration("reflection_model", m.reflection_model, reflection_model_names());
     // 1. Features: known, of material kind, listed once, consistent with each other.
     std::vector<std::string> features;
     if (root.has("features")) {

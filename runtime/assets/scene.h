@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 
 #include <glm/glm.hpp>
 
@@ -27,8 +28,16 @@ inline constexpr float kMinExposureEv = -20.0f, kMaxExposureEv = 13.0f;
 struct RenderSettings {
   int width = 1280;                       ///< output image size, pixels
   int height = 720;
-  glm::vec3 ambient{0.08f, 0.09f, 0.11f}; ///< linear ambient radiance added to every surface
+  /// Linear radiance arriving from every direction when there is no `environment`: surfaces
+  /// reflect it through the BRDF's diffuse and specular lobes (components/ibl.h).
+  glm::vec3 ambient{0.08f, 0.09f, 0.11f};
   glm::vec3 clear_color{0.55f, 0.65f, 0.8f};  ///< linear background colour
+  /// An environment map lighting every surface instead of `ambient` (image-based lighting:
+  /// its SH irradiance and GGX-prefiltered radiance), any layout load_cube_map() reads, relative
+  /// to the scene file; empty: none. Loaded by load_environment() into Scene::environment_map.
+  std::string environment;
+  /// Multiplies the environment map's radiance.
+  float environment_intensity = 1.0f;
   /// Multiplies linear colour before tone mapping and sRGB encoding. Scene files give it as
   /// `exposure` (this scale) or `exposure_ev` (stops: 2^EV, in [kMinExposureEv, kMaxExposureEv]).
   float exposure = 1.0f;
@@ -53,6 +62,13 @@ struct Scene {
   /// overrides individual fields.
   ShadowSettings shadow_defaults;
   std::filesystem::path file;  ///< where it was loaded from (relative paths resolve against it)
+  /// render.environment as loaded: an index into assets.env_maps (kNoEnvironment: none), the
+  /// path it was loaded from, and a number unique to each load (the renderer prefilters a map
+  /// once per number).
+  static constexpr std::uint32_t kNoEnvironment = ~0u;
+  std::uint32_t environment_map = kNoEnvironment;
+  std::string environment_loaded;
+  std::uint64_t environment_serial = 0;
   /// Frames run since the scene was loaded: the next frame's FrameContext::index. render_frames()
   /// advances it, so a caller that renders one frame per call (the editor) still counts frames
   /// (every_n probes, for one).

@@ -237,6 +237,7 @@ Material read_inline_material(ObjectReader& mr) {
   mr.vector<3>("emissive", m.emissive, 0.0f, 1.0e6f);
   mr.boolean("double_sided", m.double_sided);
   mr.number("k_s", m.k_s, 0.0f, 1.0f);
+  mr.enumeration("reflection_model", m.reflection_model, reflection_model_names());
   mr.finish();
   m.features = derive_material_features(m);
   return m;
@@ -257,6 +258,8 @@ void read_render(ObjectReader& r, RenderSettings& s) {
     s.exposure = std::exp2(ev);
   }
   r.enumeration("tone_mapping", s.tone_mapping, kToneMappings);
+  r.string("environment", s.environment);
+  r.number("environment_intensity", s.environment_intensity, 0.0f, 1.0e4f);
   r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
   r.enumeration("ground", s.ground, kGroundModes);
   r.boolean("shadow_cache", s.shadow_cache);
@@ -451,6 +454,13 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
   r.finish();
 }
 
+// Paths are relative to the scene file: rebased when the scene is written somewhere else.
+std::string rebase_path(const Scene& scene, const fs::path& base, const std::string& path) {
+  if (base.empty() || path.empty() || !fs::path(path).is_relative()) return path;
+  const fs::path abs = fs::absolute(scene.file.parent_path() / path).lexically_normal();
+  return abs.lexically_relative(fs::absolute(base).lexically_normal()).generic_string();
+}
+
 json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
   const ecs::World& w = scene.world;
   json j = json::object();
@@ -468,12 +478,7 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
     j["primitive"] = {{"shape", enum_name(p->shape, kShapes)}, {"segments", p->segments}};
     if (p->shape == PrimitiveShape::terrain) j["primitive"]["tiles"] = p->tiles;
   }
-  // Paths are relative to the scene file: rebase them when writing somewhere else.
-  auto rebase = [&](const std::string& path) {
-    if (base.empty() || !fs::path(path).is_relative()) return path;
-    const fs::path abs = fs::absolute(scene.file.parent_path() / path).lexically_normal();
-    return abs.lexically_relative(fs::absolute(base).lexically_normal()).generic_string();
-  };
+  auto rebase = [&](const std::string& path) { return rebase_path(scene, base, path); };
   if (const auto* m = w.try_get<ModelRef>(e)) j["model"] = {{"path", rebase(m->path)}};
   if (const auto* mr = w.try_get<MeshRenderer>(e))
     j["renderer"] = {{"cast_shadows", mr->cast_shadows},
@@ -487,7 +492,8 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
                      {"roughness", num(m->roughness)},
                      {"emissive", vec(m->emissive)},
                      {"double_sided", m->double_sided},
-                     {"k_s", num(m->k_s)}};
+                     {"k_s", num(m->k_s)},
+                     {"reflection_model", enum_name(m->reflection_model, reflection_model_names())}};
   }
   if (const auto* l = w.try_get<Light>(e)) {
     j["light"] = {{"type", enum_name(l->type, kLightTypes)},
@@ -702,7 +708,11 @@ Status apply_live_override(Scene& scene, const std::string& assignment) {
       RenderSettings r = scene.render;
       ObjectReader rr(doc["render"], "/render");
       read_render(rr, r);
-      scene.render = r;
+      std::swap(scene.render, r);
+      if (Status st = load_environment(scene); !st) {
+        scene.render = r;  // unchanged on error
+        return st;
+      }
       return {};
     }
     // Scene-wide shadow defaults: every light takes the new value unless it overrides that
@@ -951,6 +961,32 @@ Status import_model(Scene& scene, ecs::Entity e, bool activate_first_camera,
 
 }  // namespace
 
+Status load_environment(Scene& scene) {
+  const std::string& file = scene.render.environment;
+  if (file == scene.environment_loaded && (file.empty() || scene.environment_map != Scene::kNoEnvironment))
+    return {};
+  static std::uint64_t serial = 0;
+  if (file.empty()) {
+    scene.environment_map = Scene::kNoEnvironment;
+  } else {
+    EnvLoadOptions options;
+    options.face_size = kEnvironmentFaceSize;
+    auto cube = load_cube_map(scene.file.parent_path() / file, options);
+    if (!cube) return Error{scene.file.string(), "/render/environment", cube.error().to_string()};
+    // A reloaded map reuses its slot (the store keeps earlier ids valid otherwise).
+    if (scene.environment_map != Scene::kNoEnvironment &&
+        scene.environment_map < scene.assets.env_maps.size()) {
+      scene.assets.env_maps[scene.environment_map] = std::move(cube.value());
+    } else {
+      scene.assets.env_maps.push_back(std::move(cube.value()));
+      scene.environment_map = std::uint32_t(scene.assets.env_maps.size() - 1);
+    }
+  }
+  scene.environment_loaded = file;
+  scene.environment_serial = ++serial;
+  return {};
+}
+
 Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) {
   ecs::World& w = scene.world;
   std::vector<std::pair<ecs::Entity, MaterialRef>> material_refs;
@@ -962,6 +998,7 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
     if (!m) return m.error();
     w.emplace<Material>(e, *m);
   }
+  KASKAD_TRY(load_environment(scene));
   // Static reflection maps (S3 (a)): loaded once here; the probe system uploads them once.
   std::vector<std::pair<ecs::Entity, Reflector>> static_probes;
   w.view<Reflector>().each([&](ecs::Entity e, Reflector& r) {
@@ -1142,6 +1179,8 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
                    {"clear_color", vec(r.clear_color)},
                    {"exposure", num(r.exposure)},
                    {"tone_mapping", enum_name(r.tone_mapping, kToneMappings)},
+                   {"environment", rebase_path(scene, base_dir, r.environment)},
+                   {"environment_intensity", num(r.environment_intensity)},
                    {"aov_shadow_light", r.aov_shadow_light},
                    {"ground", enum_name(r.ground, kGroundModes)},
                    {"shadow_cache", r.shadow_cache}};

@@ -54,6 +54,13 @@ Status apply_entity_override(Scene& scene, const std::string& assignment);
 /// auto_frame are framed by the load phase (load_scene in runtime/cli/player.h).
 Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest = nullptr);
 
+/// render.environment's faces, texels a side (any layout is resampled to this).
+inline constexpr int kEnvironmentFaceSize = 256;
+/// Loads render.environment (relative to scene.file) into scene.assets.env_maps when it is not
+/// the map loaded last (instantiate_scene and render overrides call it). Errors name the file
+/// and the problem, at /render/environment; the scene is unchanged on error.
+Status load_environment(Scene& scene);
+
 /// One --set assignment on a loaded scene, between frames (playback timelines, the editor):
 /// "render.FIELD" and "shadow.FIELD" (every light takes a new scene-wide shadow value unless it
 /// overrides that field, as at load) by a round trip through the canonical document, entity

@@ -102,6 +102,11 @@ ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment)
   out.world = &scene.world;
   out.assets = &scene.assets;
   out.ambient = scene.render.ambient;
+  if (scene.environment_map < scene.assets.env_maps.size()) {
+    out.environment_light = &scene.assets.env_maps[scene.environment_map];
+    out.environment_sh = project_sh9(*out.environment_light);
+    out.environment_intensity = scene.render.environment_intensity;
+  }
   out.clear_color = scene.render.clear_color;
   out.environment = environment;
   // The same light_shading() as the renderer's lights (systems/frame.cpp).
@@ -122,10 +127,18 @@ glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
   const BrdfInputs brdf{glm::vec3(material.base_color), material.metallic, material.roughness};
   const glm::vec3& n = normal;
   const glm::vec3& v = to_eye;
-  const glm::vec3 diffuse_color =
-      glm::mix(brdf.base, glm::vec3(0.0f), std::clamp(material.metallic, 0.0f, 1.0f));
 
-  glm::vec3 color = scene.ambient * diffuse_color + material.emissive;
+  // Light from the surroundings (components/ibl.h).
+  glm::vec3 irradiance = scene.ambient, specular = scene.ambient;
+  const float roughness = std::clamp(material.roughness, kMinRoughness, 1.0f);
+  if (scene.environment_light) {
+    irradiance = scene.environment_intensity * sh9_irradiance_over_pi(scene.environment_sh, n);
+    specular = scene.environment_intensity *
+               prefiltered_radiance(*scene.environment_light, glm::reflect(-v, n), roughness, 256);
+  }
+  const float n_dot_v = std::clamp(glm::dot(n, v), 0.0f, 1.0f);
+  glm::vec3 color = ibl_combine(brdf, n_dot_v, dfg_lookup(n_dot_v, roughness), irradiance, specular) +
+                    material.emissive;
   for (const ShadingLight& light : scene.lights) {
     glm::vec3 l;
     float attenuation = 1.0f;

@@ -24,6 +24,7 @@
 
 #include "components/light.h"
 #include "components/material.h"
+#include "runtime/assets/env_lighting.h"
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene.h"
@@ -48,7 +49,13 @@ struct ReflectionScene {
   /// null: the base colour factor alone is used.
   const AssetStore* assets = nullptr;
   std::vector<ShadingLight> lights;
-  glm::vec3 ambient{0.05f};     ///< u_ambient.rgb: added as ambient * diffuse colour
+  /// Light from the surroundings (components/ibl.h): the uniform ambient radiance, or, when
+  /// `environment_light` is set, that map's SH irradiance and GGX-prefiltered radiance (by
+  /// importance sampling the map itself) times `environment_intensity`.
+  glm::vec3 ambient{0.05f};
+  const CubeMap* environment_light = nullptr;
+  Sh9 environment_sh{};
+  float environment_intensity = 1.0f;
   glm::vec3 clear_color{0.0f};  ///< returned on a miss when there is no environment
   /// Misses return sample_cube(*environment, R) (world-space R). Not owned; may be null.
   const CubeMap* environment = nullptr;
@@ -73,7 +80,7 @@ glm::vec4 hit_base_color(const ReflectionScene& scene, const Material& material,
 
 /// forward.frag's radiance (before exposure) leaving surface point `position` with unit normal
 /// `normal` (facing the viewer) towards the unit vector `to_eye`, taking material.base_color as
-/// the base colour (multiply a texture sample in first): ambient * diffuse + emissive +
+/// the base colour (multiply a texture sample in first): the light from the surroundings (ibl_combine) + emissive +
 /// sum over lights of the glTF BRDF (components/brdf.h) * illuminance * N.L * attenuation *
 /// visibility, as in forward.frag. Shadow rays (shadowed
 /// lights, when `receives_shadows`) start at position + ray_offset() * normal.

@@ -33,6 +33,7 @@ VariantKey frame_variant(const FrameInput& frame) {
   }
   if (frame.write_aovs) k.set(VariantKey::kAovs, 1);
   k.set(VariantKey::kToneMapping, std::uint32_t(frame.tone_mapping));
+  if (frame.environment) k.set(VariantKey::kEnvironment, 1);
   return k;
 }
 
@@ -82,7 +83,9 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
         materials.push_back(VariantKey(materials[0])
                                 .set(job.sphere ? VariantKey::kReflectionSphere
                                                 : VariantKey::kReflectionCube, 1)
-                                .set(VariantKey::kReflectionBox, job.box ? 1u : 0u));
+                                .set(VariantKey::kReflectionBox, job.box ? 1u : 0u)
+                                .set(VariantKey::kReflectionPbr,
+                                     !job.sphere && d.material.reflection_model == ReflectionModel::pbr));
     for (const VariantKey m : materials) {
       out.push_back({Pass::forward, (m | fk).filtered_for(Pass::forward)});
       if (!frame.probes.empty()) out.push_back({Pass::forward, (m | capture_fk).filtered_for(Pass::forward)});

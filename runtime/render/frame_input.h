@@ -17,6 +17,10 @@
 #include "components/tone_mapping.h"
 #include "components/shadow_settings.h"
 
+namespace kaskad {
+struct CubeMap;
+}
+
 namespace kaskad::render {
 
 struct CameraView {
@@ -60,6 +64,9 @@ struct ProbeJob {
   int visible = 0;
   bool sphere = false;     ///< shade with a sphere map made from the visible cube (S3 eq. (2))
   bool box = false;        ///< box projection of cube lookups onto [box_min, box_max] (world)
+  /// A draw of the pbr reflection model reflects this probe: its visible cube is prefiltered
+  /// (SH and GGX levels, IblMaps) whenever it has changed.
+  bool prefilter = false;
   glm::vec3 box_min{0.0f}, box_max{0.0f};
   /// World -> clip of the six 90° face cameras (systems/environment_probe_system.h).
   std::array<glm::mat4, 6> view_proj{};
@@ -154,7 +161,13 @@ struct FrameInput {
   /// The view whose visibility and cascade the AOV shows (an index into shadow_views).
   int aov_shadow_view = 0;
   std::vector<ProbeJob> probes;
+  /// Light from the surroundings (components/ibl.h): the environment map when there is one
+  /// (not owned; prefiltered once per `environment_key`), its radiance times
+  /// `environment_intensity`; else the uniform ambient radiance.
   glm::vec3 ambient{0.05f};
+  const CubeMap* environment = nullptr;
+  std::uint64_t environment_key = 0;
+  float environment_intensity = 1.0f;
   glm::vec3 clear_color{0.0f};
   float exposure = 1.0f;
   /// The curve the colour output goes through after the exposure (the AOVs and probe cubes stay

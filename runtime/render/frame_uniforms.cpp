@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <string>
 
+#include "components/ibl.h"
+#include "runtime/assets/env_map.h"
+
 namespace kaskad::render {
 
 int shaded_lights(const FrameInput& frame) {
@@ -64,6 +67,9 @@ FrameBlock pack_frame_block(const FrameInput& frame) {
   const float pixel = ortho ? 0.0f : 2.0f / (frame.camera.proj[1][1] * float(frame.height));
   fb.camera_pos = glm::vec4(frame.camera.position, pixel);
   fb.ambient = glm::vec4(frame.ambient, 0.0f);
+  if (frame.environment)
+    fb.environment = glm::vec4(frame.environment_intensity,
+                               float(ibl_specular_levels(frame.environment->size) - 1), 0.0f, 0.0f);
   fb.frame_params = glm::vec4(frame.exposure, float(frame.shadow_map.size),
                               float(frame.shadow_map.lom_layers),
                               frame.shadow_map.vsm_bleed_reduction);

@@ -32,6 +32,9 @@ struct alignas(16) FrameBlock {
   /// negative, probe faces: -w metres per pixel per metre of distance from xyz)
   glm::vec4 camera_pos;
   glm::vec4 ambient;       ///< rgb: linear ambient radiance
+  /// The environment map (VARIANT_ENVIRONMENT map): x intensity, y its prefiltered cube's
+  /// last level (roughness 1)
+  glm::vec4 environment;
   /// x exposure, y shadow map size (texels a side), z lom layers, w vsm_bleed_reduction
   glm::vec4 frame_params;
   glm::ivec4 counts;       ///< x lights shaded, y shadow views, z the view the AOV shows

@@ -1041,9 +1041,17 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
         if (job.handle != d.probe) continue;
         const bool swapped_now = job.faces != 0 && job.target == job.visible;
         const int buffer = capture && swapped_now ? 1 - job.visible : job.visible;
-        glBindTextureUnit(kTexReflectionCube, cache.probes().existing_cube(job.handle, buffer).id());
+        if (key.has(VariantKey::kReflectionPbr)) {
+          // The pbr model: the probe's prefiltered cube, SH row and last level, and p_r.
+          glBindTextureUnit(kTexReflectionCube, cache.probes().existing_specular(job.handle).id());
+          glProgramUniform4f(prog, kLocReflection, d.reflection_scale,
+                             float(cache.probes().sh_row(job.handle)),
+                             float(cache.probes().specular_last_level(job.handle)), 0.0f);
+        } else {
+          glBindTextureUnit(kTexReflectionCube, cache.probes().existing_cube(job.handle, buffer).id());
+          glProgramUniform4f(prog, kLocReflection, d.reflection_scale, 0.0f, 0.0f, 0.0f);
+        }
         glBindTextureUnit(kTexReflectionSphere, cache.probes().existing_sphere(job.handle).id());
-        glProgramUniform4f(prog, kLocReflection, d.reflection_scale, 0.0f, 0.0f, 0.0f);
         if (key.has(VariantKey::kReflectionBox)) {
           glProgramUniform4f(prog, kLocReflectionBoxMin, job.box_min.x, job.box_min.y, job.box_min.z, 0);
           glProgramUniform4f(prog, kLocReflectionBoxMax, job.box_max.x, job.box_max.y, job.box_max.z, 0);
@@ -1079,6 +1087,11 @@ void ProbeCapturePass::prepare(const FrameInput& frame, const AssetStore& assets
 Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
                                 const FrameBlock& main, const gpu::Buffer& ubo, GpuCache& cache,
                                 DrawState& state, FrameStats& stats) {
+  // The environment map, prefiltered once per map; its SH, the split-sum table and its cube are
+  // bound for every forward draw (captures included).
+  cache.probes().ibl().set_environment(frame.environment, frame.environment_key);
+  cache.probes().ibl().bind();
+  state.forget();  // prefiltering uses its own programs and unit 0
   if (frame.probes.empty()) return {};
   glDisable(GL_FRAMEBUFFER_SRGB);
   glEnable(GL_DEPTH_TEST);
@@ -1111,9 +1124,14 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
   }
   glNamedBufferSubData(ubo.id(), 0, sizeof main, &main);  // the main view's block again
   if (!status) return status;
+  // The pbr model's probes: prefiltered once per new visible cube (captured or uploaded).
+  for (const ProbeJob& job : frame.probes)
+    if (job.prefilter && cache.probes().prefilter(job.handle, job.visible)) ++stats.probe_prefilters;
+  cache.probes().ibl().bind();
   for (const ProbeJob& job : frame.probes)
     if (job.sphere && cache.probes().existing_cube(job.handle, job.visible))
       cache.probes().update_sphere(job.handle, job.visible, glm::mat3(frame.camera.view));
+  state.forget();  // the fullscreen passes above used their own programs and unit 0
   return {};
 }
 

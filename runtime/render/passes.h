@@ -48,6 +48,12 @@ class DrawState {
   bool depth_reads_material(VariantKey key) const;
   /// Programs select material features by a uniform, not by compilation (ShaderLibrary).
   bool features_by_uniform() const { return features_by_uniform_; }
+  /// After GL calls outside this class changed the program or texture units (the probes'
+  /// fullscreen passes): the next use_program() and bind_material() bind again.
+  void forget() {
+    program_ = gpu::ProgramRef();
+    material_ = nullptr;
+  }
 
  private:
   ShaderLibrary& shaders_;

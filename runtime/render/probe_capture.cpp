@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "components/ibl.h"
 #include "runtime/gpu/shader.h"
 
 namespace kaskad::render {
@@ -41,6 +42,9 @@ Result<std::unique_ptr<ProbeMaps>> ProbeMaps::create(const std::filesystem::path
   m->sphere_program_ = std::move(prog.value());
   m->empty_vao_ = gpu::make_vertex_array();
   m->fbo_ = gpu::make_framebuffer();
+  auto ibl = IblMaps::create(shader_dir);
+  if (!ibl) return ibl.error();
+  m->ibl_ = std::move(ibl.value());
   return m;
 }
 
@@ -51,6 +55,7 @@ gpu::TextureRef ProbeMaps::cube(ProbeHandle handle, int buffer, int resolution) 
     p.cubes[0] = make_cube(resolution);
     p.cubes[1] = make_cube(resolution);
     p.sphere = gpu::Texture();
+    p.specular = gpu::Texture();  // made again at the new size by prefilter()
   }
   return p.cubes[buffer & 1];
 }
@@ -82,14 +87,58 @@ void ProbeMaps::begin_face(ProbeHandle handle, int buffer, int face, const glm::
   ++faces_rendered;
 }
 
+void ProbeMaps::drop(Probe& p) {
+  ibl_->release_row(p.sh_row);
+  p.sh_row = -1;
+}
+
+void ProbeMaps::clear() {
+  for (auto& [handle, p] : probes_) drop(p);
+  probes_.clear();
+}
+
 void ProbeMaps::retain(const std::vector<ProbeHandle>& live) {
-  std::erase_if(probes_, [&](const auto& entry) {
-    return !std::binary_search(live.begin(), live.end(), entry.first);
-  });
+  for (auto it = probes_.begin(); it != probes_.end();) {
+    if (std::binary_search(live.begin(), live.end(), it->first)) {
+      ++it;
+      continue;
+    }
+    drop(it->second);
+    it = probes_.erase(it);
+  }
 }
 
 void ProbeMaps::finish_cube(ProbeHandle handle, int buffer) {
-  glGenerateTextureMipmap(probes_.at(handle).cubes[buffer & 1].id());
+  Probe& p = probes_.at(handle);
+  glGenerateTextureMipmap(p.cubes[buffer & 1].id());
+  ++p.changes[buffer & 1];
+}
+
+bool ProbeMaps::prefilter(ProbeHandle handle, int buffer) {
+  auto it = probes_.find(handle);
+  if (it == probes_.end() || !it->second.cubes[buffer & 1]) return false;
+  Probe& p = it->second;
+  const std::pair<int, std::uint64_t> source{buffer & 1, p.changes[buffer & 1]};
+  if (p.specular && p.prefiltered == source) return false;
+  if (p.sh_row < 0) p.sh_row = ibl_->acquire_row();
+  ibl_->prefilter(p.cubes[buffer & 1], p.resolution, p.specular, p.sh_row);
+  p.prefiltered = source;
+  return true;
+}
+
+gpu::TextureRef ProbeMaps::existing_specular(ProbeHandle handle) const {
+  auto it = probes_.find(handle);
+  return it == probes_.end() ? gpu::TextureRef() : gpu::TextureRef(it->second.specular);
+}
+
+int ProbeMaps::sh_row(ProbeHandle handle) const {
+  auto it = probes_.find(handle);
+  return it == probes_.end() ? -1 : it->second.sh_row;
+}
+
+int ProbeMaps::specular_last_level(ProbeHandle handle) const {
+  auto it = probes_.find(handle);
+  return it == probes_.end() ? 0 : ibl_specular_levels(it->second.resolution) - 1;
 }
 
 void ProbeMaps::upload(ProbeHandle handle, int buffer, const CubeMap& cube_map) {
@@ -98,6 +147,7 @@ void ProbeMaps::upload(ProbeHandle handle, int buffer, const CubeMap& cube_map) 
     glTextureSubImage3D(tex, 0, 0, 0, f, cube_map.size, cube_map.size, 1, GL_RGBA, GL_FLOAT,
                         cube_map.faces[std::size_t(f)].data());
   glGenerateTextureMipmap(tex);
+  ++probes_.at(handle).changes[buffer & 1];
 }
 
 gpu::TextureRef ProbeMaps::update_sphere(ProbeHandle handle, int buffer,

@@ -18,6 +18,7 @@
 #include "runtime/assets/env_map.h"
 #include "runtime/core/result.h"
 #include "runtime/gpu/gl_handles.h"
+#include "runtime/render/ibl_maps.h"
 
 namespace kaskad::render {
 
@@ -52,8 +53,19 @@ class ProbeMaps {
   CubeMap read_cube(ProbeHandle handle, int buffer) const;
   SphereMap read_sphere(ProbeHandle handle) const;
 
+  /// The pbr reflection model (IblMaps): prefilters cube `buffer` into the probe's specular
+  /// cube and SH row unless that cube was prefiltered since it last changed. True when it ran.
+  bool prefilter(ProbeHandle handle, int buffer);
+  /// The probe's prefiltered cube (none before prefilter()), its SH row and its last level.
+  gpu::TextureRef existing_specular(ProbeHandle handle) const;
+  int sh_row(ProbeHandle handle) const;
+  int specular_last_level(ProbeHandle handle) const;
+  /// Image-based lighting's tables, environment and passes.
+  IblMaps& ibl() { return *ibl_; }
+  const IblMaps& ibl() const { return *ibl_; }
+
   /// Forgets every probe (another scene: handles name entities of one world).
-  void clear() { probes_.clear(); }
+  void clear();
   /// Drops the maps of every probe not in `live` (sorted): reflectors that were destroyed.
   void retain(const std::vector<ProbeHandle>& live);
 
@@ -64,7 +76,14 @@ class ProbeMaps {
     int resolution = 0;
     gpu::Texture cubes[2];
     gpu::Texture sphere;
+    /// The pbr model's prefiltered cube and SH row (-1: none yet); `changes` counts completed
+    /// captures and uploads per buffer, `prefiltered` what the specular cube was made from.
+    gpu::Texture specular;
+    int sh_row = -1;
+    std::uint64_t changes[2] = {0, 0};
+    std::pair<int, std::uint64_t> prefiltered{-1, 0};
   };
+  void drop(Probe& p);
   ProbeMaps() = default;
   gpu::Program sphere_program_;
   gpu::VertexArray empty_vao_;
@@ -72,6 +91,7 @@ class ProbeMaps {
   gpu::Renderbuffer depth_;
   int depth_size_ = 0;
   std::map<ProbeHandle, Probe> probes_;
+  std::unique_ptr<IblMaps> ibl_;
 };
 
 }  // namespace kaskad::render

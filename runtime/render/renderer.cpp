@@ -175,6 +175,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.frustum_culled = 0;
   stats_.program_switches = stats_.material_switches = 0;
   stats_.probe_faces = stats_.probe_draw_calls = stats_.probe_instances = stats_.probe_culled = 0;
+  stats_.probe_prefilters = 0;
   stats_.cascade_receiver_pixels.fill(0);
 
   // The frame block of the main view is bound at binding 0 (every pass reads it).
@@ -413,6 +414,16 @@ Image Renderer::read_lom_factors() const { return impl_->lom.read_factors(); }
 CubeMap Renderer::read_probe_cube(ProbeHandle handle, int buffer) const {
   return impl_->cache->probes().read_cube(handle, buffer);
 }
+
+CubeMap Renderer::read_environment_level(int level) const {
+  return impl_->cache->probes().ibl().read_environment_level(level);
+}
+
+std::vector<glm::vec3> Renderer::read_sh_row(int row) const {
+  return impl_->cache->probes().ibl().read_sh_row(row);
+}
+
+int Renderer::probe_sh_row(ProbeHandle handle) const { return impl_->cache->probes().sh_row(handle); }
 
 SphereMap Renderer::read_probe_sphere(ProbeHandle handle) const {
   return impl_->cache->probes().read_sphere(handle);

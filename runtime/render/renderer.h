@@ -77,6 +77,7 @@ struct FrameStats {
   double probe_gpu_ms = 0.0;          ///< GL_TIME_ELAPSED of the probe captures (previous frame)
   int probe_faces_timed = 0;          ///< faces that probe_gpu_ms covers (previous frame's)
   int probe_faces = 0;                ///< reflection probe cube faces rendered this frame
+  int probe_prefilters = 0;           ///< probe cubes prefiltered for the pbr model this frame
   int probe_draw_calls = 0;           ///< draw calls into those faces (not in draw_calls)
   int probe_instances = 0;            ///< objects they draw
   int probe_culled = 0;               ///< draws outside a captured face's frustum, not drawn
@@ -128,6 +129,12 @@ class Renderer {
   /// rendered; empty when the probe has none. Tests and `kaskad render --probe-maps`.
   CubeMap read_probe_cube(ProbeHandle handle, int buffer) const;
   SphereMap read_probe_sphere(ProbeHandle handle) const;
+  /// Image-based lighting as last made (tests): level `level` of the environment map's
+  /// prefiltered cube (empty without one), and SH row `row` (9 rgb coefficients; row 0 the
+  /// environment's, a pbr probe's row from probe_sh_row()).
+  CubeMap read_environment_level(int level) const;
+  std::vector<glm::vec3> read_sh_row(int row) const;
+  int probe_sh_row(ProbeHandle handle) const;
   /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom; with
   /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;

@@ -60,15 +60,18 @@ inline constexpr int kUvSlotBaseColor = 0, kUvSlotNormal = 1, kUvSlotOcclusion =
 /// occlusion factors; kTexPeelPrevious: the layer before the one a depth peel draws.
 /// kTexVsmMoments: the blurred, mipmapped moments of vsm/evsm (MomentsPass); kTexVsmSource: the
 /// moments blurred along x, read by the blur along y.
+/// kTexDfg, kTexSh, kTexEnvironment: image-based lighting (IblMaps): the split-sum table, the
+/// rows of SH coefficients, the environment map's prefiltered cube.
 inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
                           kTexReflectionCube = 3, kTexReflectionSphere = 4, kTexShadowDepth = 5,
                           kTexShadowLinear = 6, kTexOcclusion = 7, kTexEmissive = 8,
                           kTexLomDepth = 9, kTexLomOcclusion = 10, kTexPeelPrevious = 11,
-                          kTexVsmMoments = 12, kTexVsmSource = 13;
+                          kTexVsmMoments = 12, kTexVsmSource = 13, kTexDfg = 14, kTexSh = 15,
+                          kTexEnvironment = 16;
 
 /// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...), and
 /// the light types (LIGHT_DIRECTIONAL, ...: u_light_info[i].x holds a LightType).
-inline std::array<std::pair<const char*, int>, 46> shader_interface_defines() {
+inline std::array<std::pair<const char*, int>, 49> shader_interface_defines() {
   return {{{"LIGHT_DIRECTIONAL", int(LightType::directional)},
            {"LIGHT_SPOT", int(LightType::spot)},
            {"LIGHT_POINT", int(LightType::point)},
@@ -114,7 +117,10 @@ inline std::array<std::pair<const char*, int>, 46> shader_interface_defines() {
            {"UNIT_REFLECTION_CUBE", int(kTexReflectionCube)},
            {"UNIT_REFLECTION_SPHERE", int(kTexReflectionSphere)},
            {"UNIT_OCCLUSION", int(kTexOcclusion)},
-           {"UNIT_EMISSIVE", int(kTexEmissive)}}};
+           {"UNIT_EMISSIVE", int(kTexEmissive)},
+           {"UNIT_DFG", int(kTexDfg)},
+           {"UNIT_SH", int(kTexSh)},
+           {"UNIT_ENVIRONMENT", int(kTexEnvironment)}}};
 }
 
 }  // namespace kaskad::render

@@ -23,6 +23,7 @@
 //   shadow_lights != 1 needs shadow (the lookups of lights that do not exist are not compiled)
 //   shadow_technique != pcf, shadow_kernel != k3x3 and shadow_peel need shadow
 //   emissive_texture needs emissive
+//   reflection_pbr needs reflection_cube
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask with its
 // texture_transform, peeling, and the projection when it is dual_paraboloid: its vertex shader
 // differs), so every material shares one or two shadow programs.
@@ -127,6 +128,10 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // scale (Material::*_transform). The depth pass keeps it with alpha_mask (cut-outs).
     {.name = "texture_transform", .define = "MATERIAL_HAS_TEXTURE_TRANSFORM",
      .stages = kFragmentStage, .offset = 10},
+    // Material::reflection_model pbr: the reflector's probe lights the glTF BRDF (its SH and
+    // prefiltered cube, components/ibl.h) instead of S3's I + k_s p_r C_t. Set with the cube.
+    {.name = "reflection_pbr", .define = "MATERIAL_HAS_REFLECTION_PBR", .stages = kFragmentStage,
+     .offset = 12, .requires_ = {"reflection_cube"}},
     // Frame features (bits 16-31).
     {.name = "shadow", .kind = FeatureKind::frame, .define = "VARIANT_HAS_SHADOW",
      .stages = kFragmentStage, .offset = 16},
@@ -171,6 +176,10 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // render.tone_mapping (components/tone_mapping.h): the curve the colour output goes through.
     {.name = "tone_mapping", .kind = FeatureKind::frame, .define = "VARIANT_TONE_MAPPING",
      .stages = kFragmentStage, .offset = 40, .values = {"none", "khr_pbr_neutral", "aces"}},
+    // Where light from the surroundings comes from (components/ibl.h): the uniform ambient
+    // radiance, or render.environment's SH and prefiltered cube.
+    {.name = "environment", .kind = FeatureKind::frame, .define = "VARIANT_ENVIRONMENT",
+     .stages = kFragmentStage, .offset = 43, .values = {"uniform", "map"}},
 };
 inline constexpr int kFeatureCount = int(std::size(kFeatureTable));
 
@@ -263,6 +272,7 @@ class VariantKey {
   static constexpr Field kOcclusionTexture = feature_field("occlusion_texture");
   static constexpr Field kEmissiveTexture = feature_field("emissive_texture");
   static constexpr Field kTextureTransform = feature_field("texture_transform");
+  static constexpr Field kReflectionPbr = feature_field("reflection_pbr");
   static constexpr std::uint64_t kMaterialMask = 0x0000ffffu;
   // Frame features.
   static constexpr Field kShadow = feature_field("shadow");
@@ -289,6 +299,8 @@ class VariantKey {
   static constexpr Field kShadowKernel = feature_field("shadow_kernel");
   /// ToneMapping: 0 none, 1 khr_pbr_neutral, 2 aces.
   static constexpr Field kToneMapping = feature_field("tone_mapping");
+  /// 0 uniform (the ambient radiance), 1 map (render.environment).
+  static constexpr Field kEnvironment = feature_field("environment");
   static constexpr std::uint64_t kFrameMask = 0x0000ffffffff0000u;
 
   constexpr VariantKey() = default;
@@ -346,7 +358,8 @@ class VariantKey {
     }
     if (pass == Pass::shadow_points || pass == Pass::lom_occlusion || pass == Pass::vsm_moments)
       return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask() &
-                         ~kShadowLayered.mask() & ~kToneMapping.mask() & ~kShadowPeel.mask()) |
+                         ~kShadowLayered.mask() & ~kToneMapping.mask() & ~kShadowPeel.mask() &
+                         ~kEnvironment.mask()) |
                         kReceiveShadows.mask());
     return *this;
   }

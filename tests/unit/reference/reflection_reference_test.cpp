@@ -9,6 +9,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "components/ibl.h"
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
 #include "runtime/assets/primitives.h"
@@ -87,7 +88,8 @@ ShadingLight sun_along_x(bool shadowed) {
 /// forward.frag's value at the wall point by hand: n = (-1, 0, 0), l = (-1, 0, 0) (N.L = 1),
 /// v = (-1, -1, 0) / sqrt(2) towards the mirror (N.V = sqrt(1/2)); roughness 1 (alpha 1):
 /// D = 1 / pi, V = 0.5 / (N.L + N.V); f0 0.04, F = f0 + (1 - f0)(1 - V.H)^5; the diffuse part
-/// (1 - F) c / pi. `radiance` is the light's colour (an illuminance).
+/// (1 - F) c / pi. `radiance` is the light's colour (an illuminance). The ambient reaches the
+/// BRDF through the split sum.
 glm::vec3 expected_wall(const glm::vec3& ambient, const glm::vec3& radiance, float light_factor) {
   const glm::vec3 diffuse(0.8f, 0.4f, 0.2f);
   const float pi = 3.14159265f;
@@ -97,7 +99,16 @@ glm::vec3 expected_wall(const glm::vec3& ambient, const glm::vec3& radiance, flo
   const float fresnel = 0.04f + 0.96f * std::pow(1.0f - v_dot_h, 5.0f);
   const float spec = fresnel * (1.0f / pi) * (0.5f / (1.0f + s));
   const glm::vec3 brdf = (1.0f - fresnel) * diffuse / pi + glm::vec3(spec);
-  return ambient * diffuse + brdf * radiance * light_factor;
+  // The uniform ambient through the split sum (components/ibl.h), written out: roughness 1
+  // makes the roughness-dependent Fresnel f0 itself.
+  const glm::vec2 ab = dfg_lookup(s, 1.0f);
+  const float fss_ess = 0.04f * ab.x + ab.y;
+  const float ems = 1.0f - ab.x - ab.y;
+  const float f_avg = 0.04f + 0.96f / 21.0f;
+  const float fms_ems = ems * fss_ess * f_avg / (1.0f - f_avg * ems);
+  const glm::vec3 ambient_reflected =
+      ambient * (glm::vec3(fss_ess + fms_ems) + diffuse * (1.0f - fss_ess - fms_ems));
+  return ambient_reflected + brdf * radiance * light_factor;
 }
 
 void expect_near(const glm::vec3& a, const glm::vec3& b, float tol = 1e-5f) {

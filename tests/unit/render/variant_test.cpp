@@ -46,7 +46,8 @@ bool documented_rules_hold(VariantKey k) {
       V::kDebugCascades.mask() | V::kCascadeSelection.mask() | V::kShadowProjection.mask() |
       V::kShadowLayered.mask() | V::kShadowLightsMinus1.mask() | V::kShadowTechnique.mask() |
       V::kShadowKernel.mask() | V::kToneMapping.mask() | V::kOcclusionTexture.mask() |
-      V::kEmissiveTexture.mask() | V::kTextureTransform.mask() | V::kShadowPeel.mask();
+      V::kEmissiveTexture.mask() | V::kTextureTransform.mask() | V::kShadowPeel.mask() |
+      V::kReflectionPbr.mask() | V::kEnvironment.mask();
   if (k.bits() & ~used) return false;
   if (k.get(V::kToneMapping) > 2) return false;      // none, khr_pbr_neutral, aces
   if (k.get(V::kShadowFilter) > 2) return false;     // none, bilinear, pcf3x3
@@ -55,6 +56,7 @@ bool documented_rules_hold(VariantKey k) {
   if (k.get(V::kShadowKernel) > 4) return false;     // 3x3, 5x5, 7x7, 9x9, poisson
   if (k.has(V::kReflectionCube) && k.has(V::kReflectionSphere)) return false;
   if (k.has(V::kReflectionBox) && !k.has(V::kReflectionCube)) return false;
+  if (k.has(V::kReflectionPbr) && !k.has(V::kReflectionCube)) return false;
   if (k.has(V::kEmissiveTexture) && !k.has(V::kEmissive)) return false;
   const bool needs_shadow = k.has(V::kShadowFilter) || k.has(V::kCascadeCountMinus1) ||
                             k.has(V::kDebugCascades) || k.has(V::kCascadeSelection) ||
@@ -118,14 +120,15 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
     if (bits == material_used) break;
   }
   EXPECT_EQ(disagree, 0);
-  // Material keys: 2^6 free bits x 3 of the 4 emissive/emissive_texture combinations x 4 of the
-  // 8 reflection cube/sphere/box combinations = 768.
+  // Material keys: 2^6 free bits x 3 of the 4 emissive/emissive_texture combinations x 6 of the
+  // 16 reflection cube/sphere/box/pbr combinations (none, sphere, cube with or without box and
+  // pbr) = 1152.
   // Frame keys: 2 without shadow (aovs), and with shadow 3 filters x 2 aovs x 2 debug x
   // 2 selection x 2 layered x 4 shadowed-light counts x (8 ortho cascade counts + 3 other
   // projections) x 6 techniques (pcf, pcss, backprojection, lom, vsm, evsm) x 5 kernels x
-  // 2 peel = 126720; all of them x 3 tone mappings.
-  EXPECT_EQ(valid_materials, 768);
-  EXPECT_EQ(valid_frames, 3 * (2 + 126720));
+  // 2 peel = 126720; all of them x 3 tone mappings x 2 environments.
+  EXPECT_EQ(valid_materials, 1152);
+  EXPECT_EQ(valid_frames, 2 * 3 * (2 + 126720));
 }
 
 // The table is the one source: the manifest's features, their fields and the GLSL bit numbers
@@ -153,7 +156,7 @@ TEST(VariantKey, FeatureTableDrivesTheManifestAndTheGlslBits) {
       EXPECT_EQ(value, std::to_string(VariantKey::kReflectionBox.offset));
     }
   }
-  EXPECT_EQ(bits, 11);  // every material feature, in every stage
+  EXPECT_EQ(bits, 12);  // every material feature, in every stage
 }
 
 TEST(VariantKey, DefinesComeFromOneFunctionForBothKinds) {

@@ -4,6 +4,7 @@
 #include "components/bounds.h"
 #include "components/brdf.h"
 #include "components/camera.h"
+#include "components/ibl.h"
 #include "components/light.h"
 #include "components/material.h"
 #include "components/mesh_renderer.h"

@@ -1,0 +1,70 @@
+// GL resources of image-based lighting (components/ibl.h has the formulas): the split-sum table,
+// the rows of SH coefficients (row 0 the environment map's, one row per prefiltered probe), the
+// environment map's prefiltered cube, and the two fullscreen passes that make them from any cube
+// with a mip chain: GGX prefiltering into a cube's levels (content/shaders/ibl_prefilter.frag)
+// and SH projection into a row (sh_project.frag). ProbeMaps owns one and prefilters the probes
+// of the pbr reflection model through it after each completed capture.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "runtime/assets/env_map.h"
+#include "runtime/core/result.h"
+#include "runtime/gpu/gl_handles.h"
+
+namespace kaskad::render {
+
+class IblMaps {
+ public:
+  /// Builds both programs from `shader_dir` and uploads the split-sum table. Needs a current GL
+  /// 4.5 context.
+  static Result<std::unique_ptr<IblMaps>> create(const std::filesystem::path& shader_dir);
+
+  /// GGX samples per texel of the prefiltered levels above 0 (level 0 is the source's level 0).
+  static constexpr int kPrefilterSamples = 64;
+
+  /// Prefilters cube `source` (`size` texels a side, full mip chain) into `target` (made here
+  /// when empty or of another size; ibl_specular_levels(size) levels) and writes the source's SH
+  /// into row `row` (grown as needed). Leaves the framebuffer and program bindings changed.
+  void prefilter(const gpu::Texture& source, int size, gpu::Texture& target, int row);
+
+  /// The environment map (render.environment): uploaded, mipmapped and prefiltered (SH into
+  /// row 0) when `cube` is another map than last time (by `key`); null: none.
+  void set_environment(const CubeMap* cube, std::uint64_t key);
+  /// The environment's prefiltered cube (none without one) and its ibl_specular_levels().
+  gpu::TextureRef environment() const { return environment_specular_; }
+  int environment_levels() const { return environment_levels_; }
+
+  /// A free SH row for a probe (rows >= 1), and giving one back.
+  int acquire_row();
+  void release_row(int row);
+
+  /// Binds the split-sum table and the SH rows to UNIT_DFG and UNIT_SH, and the environment's
+  /// prefiltered cube (or a black one) to UNIT_ENVIRONMENT.
+  void bind() const;
+
+  /// Read-back for tests: SH row `row` (9 rgb coefficients); level `level` of the
+  /// environment's prefiltered cube.
+  std::vector<glm::vec3> read_sh_row(int row) const;
+  CubeMap read_environment_level(int level) const;
+
+  int prefilters = 0;  ///< cubes prefiltered since creation (stats and tests)
+
+ private:
+  IblMaps() = default;
+  void ensure_rows(int rows);
+  gpu::Program prefilter_program_, sh_program_;
+  gpu::VertexArray empty_vao_;
+  gpu::Framebuffer fbo_;
+  gpu::Texture dfg_, sh_, black_cube_;
+  int sh_rows_ = 0;
+  std::vector<bool> row_used_;
+  gpu::Texture environment_source_, environment_specular_;
+  int environment_levels_ = 0;
+  std::uint64_t environment_key_ = 0;
+};
+
+}  // namespace kaskad::render
