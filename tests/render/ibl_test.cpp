@@ -146,7 +146,7 @@ TEST_F(IblTest, GpuPrefilteringAndShMatchTheCpuTwins) {
       const glm::vec3 d(std::cos(lat) * std::sin(lon), std::sin(lat), -std::cos(lat) * std::cos(lon));
       img.at(x, y, 0) = 0.6f + 0.4f * d.y;
       img.at(x, y, 1) = 0.4f + 0.3f * d.x;
-      img.at(x, y, 2) = 0.3f + 0.25f * d.z * d.z;
+      img.at(x, y, 2) = 0.35f + 0.2f * d.z + 0.1f * d.x * d.z;
     }
   const fs::path sky = dir() / "sky.exr";
   ASSERT_TRUE(save_image(sky, img).ok());
