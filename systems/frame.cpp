@@ -83,6 +83,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   if (scene.environment_map < scene.assets.env_maps.size()) {
     in.environment = &scene.assets.env_maps[scene.environment_map];
     in.environment_key = scene.environment_serial;
+    in.environment_sh = scene.environment_sh;
     in.environment_intensity = scene.render.environment_intensity;
   }
   in.clear_color = scene.render.clear_color;

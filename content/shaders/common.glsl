@@ -22,6 +22,7 @@ layout(std140, binding = 0) uniform FrameBlock {
   vec4 u_camera_pos;                // xyz: world position, w: pixel footprint (FrameBlock)
   vec4 u_ambient;                   // rgb: linear ambient radiance
   vec4 u_environment;               // x environment intensity, y its last prefiltered level
+  vec4 u_environment_sh[9];         // rgb: the environment map's SH coefficients
   vec4 u_frame;                     // x exposure, y shadow map size (texels a side), z lom layers,
                                     // w vsm_bleed_reduction
   ivec4 u_counts;                   // x lights, y shadow views, z the view the AOV shows

@@ -129,7 +129,9 @@ void main() {
   float ibl_roughness = clamp(roughness, BRDF_MIN_ROUGHNESS, 1.0);
   float n_dot_v = clamp(dot(n, v), 0.0, 1.0);
 #if VARIANT_ENVIRONMENT == VARIANT_ENVIRONMENT_MAP
-  vec3 irradiance = u_environment.x * sh9_irradiance_over_pi(0, n);
+  vec3 sh[9];
+  for (int i = 0; i < 9; ++i) sh[i] = u_environment_sh[i].rgb;
+  vec3 irradiance = u_environment.x * sh9_irradiance_over_pi(sh, n);
   vec3 specular = u_environment.x *
                   textureLod(u_environment_cube, reflect(-v, n), ibl_roughness * u_environment.y).rgb;
 #else

@@ -8,21 +8,26 @@
 
 // (A, B) of the split sum at (N.V, roughness): dfg_table() in components/ibl.h, uploaded once.
 layout(binding = UNIT_DFG) uniform sampler2D u_dfg;
-// Rows of 9 SH coefficients (rgb) of radiance: row 0 the environment map, one row per probe
-// prefiltered for the pbr reflection model (IblMaps in runtime/render/ibl_maps.h).
+// Rows of 9 SH coefficients (rgb) of radiance, one per probe prefiltered for the pbr reflection
+// model (IblMaps in runtime/render/ibl_maps.h). The environment map's are in the frame block
+// (u_environment_sh: nine fetches per pixel cost llvmpipe about a quarter of a frame).
 layout(binding = UNIT_SH) uniform sampler2D u_sh;
 
-vec3 sh9_irradiance_over_pi(int row, vec3 n) {
-  vec3 e = texelFetch(u_sh, ivec2(0, row), 0).rgb * 0.282095;
-  e += (2.0 / 3.0) * 0.488603 *
-       (texelFetch(u_sh, ivec2(1, row), 0).rgb * n.y + texelFetch(u_sh, ivec2(2, row), 0).rgb * n.z +
-        texelFetch(u_sh, ivec2(3, row), 0).rgb * n.x);
-  e += 0.25 * (texelFetch(u_sh, ivec2(4, row), 0).rgb * (1.092548 * n.x * n.y) +
-               texelFetch(u_sh, ivec2(5, row), 0).rgb * (1.092548 * n.y * n.z) +
-               texelFetch(u_sh, ivec2(6, row), 0).rgb * (0.315392 * (3.0 * n.z * n.z - 1.0)) +
-               texelFetch(u_sh, ivec2(7, row), 0).rgb * (1.092548 * n.x * n.z) +
-               texelFetch(u_sh, ivec2(8, row), 0).rgb * (0.546274 * (n.x * n.x - n.y * n.y)));
+// sh9_irradiance_over_pi() of components/ibl.h: E(n) / pi from coefficients c[0..8].
+vec3 sh9_irradiance_over_pi(vec3 c[9], vec3 n) {
+  vec3 e = c[0] * 0.282095;
+  e += (2.0 / 3.0) * 0.488603 * (c[1] * n.y + c[2] * n.z + c[3] * n.x);
+  e += 0.25 * (c[4] * (1.092548 * n.x * n.y) + c[5] * (1.092548 * n.y * n.z) +
+               c[6] * (0.315392 * (3.0 * n.z * n.z - 1.0)) + c[7] * (1.092548 * n.x * n.z) +
+               c[8] * (0.546274 * (n.x * n.x - n.y * n.y)));
   return max(e, vec3(0.0));
+}
+
+// The same from SH row `row` (a pbr probe's).
+vec3 sh9_irradiance_over_pi(int row, vec3 n) {
+  vec3 c[9];
+  for (int i = 0; i < 9; ++i) c[i] = texelFetch(u_sh, ivec2(i, row), 0).rgb;
+  return sh9_irradiance_over_pi(c, n);
 }
 
 vec2 dfg_lookup(float n_dot_v, float roughness) {

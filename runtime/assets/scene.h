@@ -7,6 +7,7 @@
 
 #include <glm/glm.hpp>
 
+#include "components/ibl.h"
 #include "components/shadow_settings.h"
 #include "components/tone_mapping.h"
 #include "runtime/assets/asset_store.h"
@@ -69,6 +70,7 @@ struct Scene {
   std::uint32_t environment_map = kNoEnvironment;
   std::string environment_loaded;
   std::uint64_t environment_serial = 0;
+  Sh9 environment_sh{};  ///< its SH coefficients (project_sh9)
   /// Frames run since the scene was loaded: the next frame's FrameContext::index. render_frames()
   /// advances it, so a caller that renders one frame per call (the editor) still counts frames
   /// (every_n probes, for one).

@@ -23,6 +23,7 @@
 #include "components/probe_state.h"
 #include "components/reflector.h"
 #include "components/transform.h"
+#include "runtime/assets/env_lighting.h"
 #include "runtime/assets/gltf_loader.h"
 #include "runtime/assets/material_file.h"
 #include "runtime/assets/primitives.h"
@@ -981,6 +982,7 @@ Status load_environment(Scene& scene) {
       scene.assets.env_maps.push_back(std::move(cube.value()));
       scene.environment_map = std::uint32_t(scene.assets.env_maps.size() - 1);
     }
+    scene.environment_sh = project_sh9(scene.assets.env_maps[scene.environment_map]);
   }
   scene.environment_loaded = file;
   scene.environment_serial = ++serial;

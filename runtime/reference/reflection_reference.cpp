@@ -104,7 +104,7 @@ ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment)
   out.ambient = scene.render.ambient;
   if (scene.environment_map < scene.assets.env_maps.size()) {
     out.environment_light = &scene.assets.env_maps[scene.environment_map];
-    out.environment_sh = project_sh9(*out.environment_light);
+    out.environment_sh = scene.environment_sh;
     out.environment_intensity = scene.render.environment_intensity;
   }
   out.clear_color = scene.render.clear_color;

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "components/bounds.h"
+#include "components/ibl.h"
 #include "components/light.h"
 #include "components/limits.h"
 #include "components/material.h"
@@ -167,6 +168,7 @@ struct FrameInput {
   glm::vec3 ambient{0.05f};
   const CubeMap* environment = nullptr;
   std::uint64_t environment_key = 0;
+  Sh9 environment_sh{};  ///< its SH coefficients (project_sh9, once per load)
   float environment_intensity = 1.0f;
   glm::vec3 clear_color{0.0f};
   float exposure = 1.0f;

@@ -70,6 +70,7 @@ FrameBlock pack_frame_block(const FrameInput& frame) {
   if (frame.environment)
     fb.environment = glm::vec4(frame.environment_intensity,
                                float(ibl_specular_levels(frame.environment->size) - 1), 0.0f, 0.0f);
+  for (std::size_t i = 0; i < 9; ++i) fb.environment_sh[i] = glm::vec4(frame.environment_sh[i], 0.0f);
   fb.frame_params = glm::vec4(frame.exposure, float(frame.shadow_map.size),
                               float(frame.shadow_map.lom_layers),
                               frame.shadow_map.vsm_bleed_reduction);

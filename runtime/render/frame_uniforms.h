@@ -35,6 +35,7 @@ struct alignas(16) FrameBlock {
   /// The environment map (VARIANT_ENVIRONMENT map): x intensity, y its prefiltered cube's
   /// last level (roughness 1)
   glm::vec4 environment;
+  glm::vec4 environment_sh[9];  ///< rgb: the environment map's SH coefficients (project_sh9)
   /// x exposure, y shadow map size (texels a side), z lom layers, w vsm_bleed_reduction
   glm::vec4 frame_params;
   glm::ivec4 counts;       ///< x lights shaded, y shadow views, z the view the AOV shows

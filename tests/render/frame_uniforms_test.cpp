@@ -69,6 +69,7 @@ TEST_F(FrameUniformsTest, CppLayoutMatchesTheCompiledBlock) {
       {"u_camera_pos", offsetof(FrameBlock, camera_pos), 0, 0},
       {"u_ambient", offsetof(FrameBlock, ambient), 0, 0},
       {"u_environment", offsetof(FrameBlock, environment), 0, 0},
+      {"u_environment_sh[0]", offsetof(FrameBlock, environment_sh), sizeof(glm::vec4), 9},
       {"u_frame", offsetof(FrameBlock, frame_params), 0, 0},
       {"u_counts", offsetof(FrameBlock, counts), 0, 0},
       {"u_light_color[0]", offsetof(FrameBlock, light_color), sizeof(glm::vec4), kMaxLights},
