@@ -119,7 +119,7 @@ void IblMaps::prefilter(const gpu::Texture& source, int size, gpu::Texture& targ
     const int s = std::max(1, size >> level);
     glViewport(0, 0, s, s);
     glProgramUniform4f(prefilter_program_.id(), 1, float(level) / float(levels - 1), float(size),
-                       float(kPrefilterSamples), 0.0f);
+                       float(prefilter_samples(level)), 0.0f);
     for (int face = 0; face < 6; ++face) {
       glNamedFramebufferTextureLayer(fbo_.id(), GL_COLOR_ATTACHMENT0, target.id(), level, face);
       glProgramUniform4i(prefilter_program_.id(), 0, face, 0, 0, 0);

@@ -6,6 +6,7 @@
 // of the pbr reflection model through it after each completed capture.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -23,8 +24,10 @@ class IblMaps {
   /// 4.5 context.
   static Result<std::unique_ptr<IblMaps>> create(const std::filesystem::path& shader_dir);
 
-  /// GGX samples per texel of the prefiltered levels above 0 (level 0 is the source's level 0).
-  static constexpr int kPrefilterSamples = 64;
+  /// GGX samples per texel of prefiltered level k >= 1 (level 0 is the source's level 0):
+  /// 16 << (k - 1), at most 64. The narrow lobes of the large levels read fine source mips
+  /// already (filtered importance sampling), and those levels hold most of the texels.
+  static int prefilter_samples(int level) { return std::min(64, 16 << std::max(0, level - 1)); }
 
   /// Prefilters cube `source` (`size` texels a side, full mip chain) into `target` (made here
   /// when empty or of another size; ibl_specular_levels(size) levels) and writes the source's SH

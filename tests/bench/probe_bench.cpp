@@ -3,6 +3,7 @@
 // 1. Capture cost per face: GL_TIME_ELAPSED of the probe pass divided by the faces it rendered
 //    (content/scenes/reflections.json, both probes captured every frame at 128^2), against the
 //    forward pass of the main view rendered at the same 128^2 resolution.
+// 1b. The pbr model's prefiltering per cube: the probe pass with pbr reflectors minus with s3.
 // 2. Frame time (CPU wall, GPU finished) over `frames` frames at 640x360, both probes every_n 10:
 //    all six faces at once against time slicing (one face a frame): median and max per run.
 // 3. Reflection error: RMSE of the `reflection` AOV (C_t) of a mirror sphere against the Embree
@@ -135,6 +136,32 @@ int main(int argc, char** argv) {
     std::printf("capture   GPU per face %.3f ms (128^2, 2 probes x 6 faces a frame); main view "
                 "forward pass at 128x128 %.3f ms; ratio %.2f (medians of %d runs)\n",
                 median(per_face), median(main_view), median(per_face) / median(main_view), runs);
+  }
+
+  // 1b. The pbr reflection model's prefiltering (SH and GGX levels after each capture): the
+  // probe pass's GPU time with both reflectors captured every frame, s3 against pbr.
+  {
+    std::vector<double> s3_ms, pbr_ms;
+    int prefilters = 0;
+    for (int r = 0; r < runs; ++r)
+      for (const char* model : {"s3", "pbr"}) {
+        const std::string m = model;
+        Scene s = load_or_die(scene_file, {"mirror_sphere.reflector.every_n=1",
+                                           "mirror_plane.reflector.every_n=1",
+                                           "mirror_plane.reflector.faces_per_frame=6",
+                                           "mirror_sphere.material.reflection_model=" + m,
+                                           "mirror_plane.material.reflection_model=" + m});
+        RenderRun run;
+        run.frames = 8;
+        run.write_aovs = false;
+        const RenderTimings t = render_or_die(*player, s, run);
+        (m == "s3" ? s3_ms : pbr_ms).push_back(t.last.stats.probe_gpu_ms);
+        if (m == "pbr") prefilters = t.last.stats.probe_prefilters;
+      }
+    std::printf("prefilter probe pass GPU %.3f ms with s3, %.3f ms with pbr (%d cubes of 128^2 "
+                "prefiltered a frame): %.3f ms per cube (medians of %d runs, interleaved)\n",
+                median(s3_ms), median(pbr_ms), prefilters,
+                (median(pbr_ms) - median(s3_ms)) / std::max(1, prefilters), runs);
   }
 
   // 2. every_n 10: six faces at once against one face a frame. Frames are run one by one so each
