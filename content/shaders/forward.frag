@@ -14,6 +14,9 @@
 in vec3 v_world_pos;
 in vec3 v_world_normal;
 in vec2 v_uv;
+#if MATERIAL_HAS_NORMAL_MAP
+in vec4 v_world_tangent;  // xyz tangent, w bitangent sign (zero without uvs)
+#endif
 
 layout(location = 0) out vec4 o_color;
 #if VARIANT_HAS_AOVS
@@ -56,7 +59,7 @@ vec3 box_project(vec3 p, vec3 r) {
 layout(binding = UNIT_REFLECTION_SPHERE) uniform sampler2D u_reflection_sphere;  // made for this camera (probe_sphere.frag)
 #endif
 
-// Cotangent frame from screen-space derivatives: normal mapping without stored tangents.
+// Cotangent frame from screen-space derivatives: normal mapping where the vertex has no tangent.
 vec3 perturb_normal(vec3 n, vec3 p, vec2 uv, vec3 tangent_normal) {
   vec3 dp1 = dFdx(p), dp2 = dFdy(p);
   vec2 duv1 = dFdx(uv), duv2 = dFdy(uv);
@@ -94,7 +97,19 @@ void main() {
     vec2 normal_uv = slot_uv(UV_SLOT_NORMAL, v_uv);
     vec3 tn = texture(u_normal_tex, normal_uv).xyz * 2.0 - 1.0;
     tn.xy *= u_material.z;
-    n = perturb_normal(n, v_world_pos, normal_uv, normalize(tn));
+    if (dot(v_world_tangent.xyz, v_world_tangent.xyz) > 1e-12) {
+      // MikkTSpace's per-pixel rule: the interpolated normal and tangent (unit at the vertices,
+      // not normalised again), the bitangent sign * cross(n, t), and the whole frame turned
+      // with the normal on back faces.
+      vec3 vn = geometric_n;
+      vec3 vt = gl_FrontFacing ? v_world_tangent.xyz : -v_world_tangent.xyz;
+      vec3 vb = v_world_tangent.w * cross(normalize(v_world_normal), v_world_tangent.xyz);
+      if (!gl_FrontFacing) vb = -vb;
+      tn = normalize(tn);
+      n = normalize(tn.x * vt + tn.y * vb + tn.z * vn);
+    } else {
+      n = perturb_normal(n, v_world_pos, normal_uv, normalize(tn));
+    }
   }
 #endif
 

@@ -10,13 +10,16 @@
 
 #include <glm/glm.hpp>
 
+#include "runtime/assets/mesh_tangents.h"
 #include "runtime/core/log.h"
 
 namespace kaskad::render {
 namespace {
 
 // The vertex array's instanced attributes (InstanceRecord, divisor 1) read from binding 3.
+// Vertex buffer bindings: 0-2 positions, normals and uvs, 3 the instance records, 4 tangents.
 constexpr GLuint kInstanceBinding = 3;
+constexpr GLuint kTangentBinding = 4;
 
 void add_instance_attributes(GLuint vao, GLuint buffer) {
   for (GLuint i = 0; i < 4; ++i) {
@@ -78,12 +81,19 @@ const GpuMesh& GpuCache::mesh(MeshId id) {
   if (m.vao) return m;
   const MeshData& src = assets_->meshes[at];
   const std::size_t n = src.positions.size();
-  // One buffer, three streams: positions | normals | uvs (uvs zero when the mesh has none).
-  const std::size_t pos_bytes = n * sizeof(glm::vec3), uv_bytes = n * sizeof(glm::vec2);
-  std::vector<std::uint8_t> data(2 * pos_bytes + uv_bytes, 0);
+  // One buffer, four streams: positions | normals | uvs | tangents (uvs zero when the mesh has
+  // none; tangents the mesh's own, else generated (MikkTSpace's rule), zero without uvs).
+  const std::size_t pos_bytes = n * sizeof(glm::vec3), uv_bytes = n * sizeof(glm::vec2),
+                    tangent_bytes = n * sizeof(glm::vec4);
+  std::vector<std::uint8_t> data(2 * pos_bytes + uv_bytes + tangent_bytes, 0);
   std::memcpy(data.data(), src.positions.data(), pos_bytes);
   if (src.normals.size() == n) std::memcpy(data.data() + pos_bytes, src.normals.data(), pos_bytes);
   if (src.uvs.size() == n) std::memcpy(data.data() + 2 * pos_bytes, src.uvs.data(), uv_bytes);
+  const std::vector<glm::vec4> generated = src.tangents.size() == n ? std::vector<glm::vec4>()
+                                                                      : generate_tangents(src);
+  const std::vector<glm::vec4>& tangents = generated.empty() ? src.tangents : generated;
+  if (tangents.size() == n)
+    std::memcpy(data.data() + 2 * pos_bytes + uv_bytes, tangents.data(), tangent_bytes);
   m.vertices = gpu::make_buffer();
   glNamedBufferStorage(m.vertices.id(), GLsizeiptr(std::max<std::size_t>(data.size(), 1)),
                        data.data(), 0);
@@ -96,12 +106,15 @@ const GpuMesh& GpuCache::mesh(MeshId id) {
   glVertexArrayVertexBuffer(vao, 0, m.vertices.id(), 0, sizeof(glm::vec3));
   glVertexArrayVertexBuffer(vao, 1, m.vertices.id(), GLintptr(pos_bytes), sizeof(glm::vec3));
   glVertexArrayVertexBuffer(vao, 2, m.vertices.id(), GLintptr(2 * pos_bytes), sizeof(glm::vec2));
-  const GLuint attrs[3] = {kAttrPosition, kAttrNormal, kAttrUv};
-  const GLint sizes[3] = {3, 3, 2};
-  for (int i = 0; i < 3; ++i) {
+  glVertexArrayVertexBuffer(vao, kTangentBinding, m.vertices.id(),
+                            GLintptr(2 * pos_bytes + uv_bytes), sizeof(glm::vec4));
+  const GLuint attrs[4] = {kAttrPosition, kAttrNormal, kAttrUv, kAttrTangent};
+  const GLuint bindings[4] = {0, 1, 2, kTangentBinding};
+  const GLint sizes[4] = {3, 3, 2, 4};
+  for (int i = 0; i < 4; ++i) {
     glEnableVertexArrayAttrib(vao, attrs[i]);
     glVertexArrayAttribFormat(vao, attrs[i], sizes[i], GL_FLOAT, GL_FALSE, 0);
-    glVertexArrayAttribBinding(vao, attrs[i], GLuint(i));
+    glVertexArrayAttribBinding(vao, attrs[i], bindings[i]);
   }
   glVertexArrayElementBuffer(vao, m.indices.id());
   add_instance_attributes(vao, instances_ ? instances_.id() : 0);

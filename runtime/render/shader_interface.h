@@ -20,6 +20,8 @@ inline constexpr unsigned kAttrPosition = 0, kAttrNormal = 1, kAttrUv = 2;
 inline constexpr unsigned kAttrModel = 3;         ///< mat4: locations 3..6
 inline constexpr unsigned kAttrNormalMatrix = 7;  ///< mat3: locations 7..9
 inline constexpr unsigned kAttrLayer = 10;        ///< uint: the layered shadow pass's layer
+/// vec4 per vertex: tangent xyz and bitangent sign w (glTF TANGENT, or generate_tangents()).
+inline constexpr unsigned kAttrTangent = 11;
 
 /// One drawn instance, read by the vertex shaders through instanced attributes (divisor 1) from
 /// the frame's instance buffer: the model matrix, its normal matrix (columns, w unused) and,
@@ -71,7 +73,7 @@ inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
 
 /// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...), and
 /// the light types (LIGHT_DIRECTIONAL, ...: u_light_info[i].x holds a LightType).
-inline std::array<std::pair<const char*, int>, 49> shader_interface_defines() {
+inline std::array<std::pair<const char*, int>, 50> shader_interface_defines() {
   return {{{"LIGHT_DIRECTIONAL", int(LightType::directional)},
            {"LIGHT_SPOT", int(LightType::spot)},
            {"LIGHT_POINT", int(LightType::point)},
@@ -82,6 +84,7 @@ inline std::array<std::pair<const char*, int>, 49> shader_interface_defines() {
            {"ATTR_MODEL", kAttrModel},
            {"ATTR_NORMAL_MATRIX", kAttrNormalMatrix},
            {"ATTR_LAYER", kAttrLayer},
+           {"ATTR_TANGENT", kAttrTangent},
            {"LOC_BASE_COLOR", kLocBaseColor},
            {"LOC_MATERIAL", kLocMaterial},
            {"LOC_EMISSIVE", kLocEmissive},

@@ -105,8 +105,9 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // Material features (bits 0-15).
     {.name = "base_color_texture", .define = "MATERIAL_HAS_BASE_COLOR_TEXTURE",
      .stages = kFragmentStage, .offset = 0},
-    {.name = "normal_map", .define = "MATERIAL_HAS_NORMAL_MAP", .stages = kFragmentStage,
-     .offset = 1},
+    // The vertex stage passes the tangent frame on (ATTR_TANGENT).
+    {.name = "normal_map", .define = "MATERIAL_HAS_NORMAL_MAP",
+     .stages = kVertexStage | kFragmentStage, .offset = 1},
     {.name = "alpha_mask", .define = "MATERIAL_HAS_ALPHA_MASK",
      .stages = kVertexStage | kFragmentStage, .offset = 2},
     {.name = "emissive", .define = "MATERIAL_HAS_EMISSIVE", .stages = kFragmentStage, .offset = 3},
