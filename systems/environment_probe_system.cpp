@@ -221,6 +221,7 @@ ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool
     job.resolution = r.resolution;
     job.exclude_layers = r.exclude_layers;
     job.faces = work.faces;
+    job.faces_per_frame = r.faces_per_frame;
     // After a swap s.front is already the buffer just completed; else the back buffer is 1 - front.
     job.target = work.swap ? s.front : 1 - s.front;
     job.visible = s.front;

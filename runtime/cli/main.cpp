@@ -494,10 +494,11 @@ int run_render(Args a) {
   if (const ProbeData& pd = timings->last.probes; !pd.probes.empty()) {
     std::printf("probes    %zu reflectors: %llu captures, %llu faces since load; last frame %d "
                 "faces, %d objects in %d draw calls into them (%d culled by the face frusta), "
-                "%d cubes prefiltered for the pbr model\n",
+                "%d cubes prefiltered for the pbr model (%d faces)\n",
                 pd.probes.size(), static_cast<unsigned long long>(pd.captures_total),
                 static_cast<unsigned long long>(pd.faces_total), st.probe_faces,
-                st.probe_instances, st.probe_draw_calls, st.probe_culled, st.probe_prefilters);
+                st.probe_instances, st.probe_draw_calls, st.probe_culled, st.probe_prefilters,
+                st.probe_prefilter_faces);
   }
   std::printf("shaders   %d compiled, %d from the binary cache, %.1f ms (prewarm %.1f ms); "
               "%d compiled after the first frame\n",

@@ -66,8 +66,10 @@ struct ProbeJob {
   bool sphere = false;     ///< shade with a sphere map made from the visible cube (S3 eq. (2))
   bool box = false;        ///< box projection of cube lookups onto [box_min, box_max] (world)
   /// A draw of the pbr reflection model reflects this probe: its visible cube is prefiltered
-  /// (SH and GGX levels, IblMaps) whenever it has changed.
+  /// (SH and GGX levels, IblMaps) whenever it has changed, `faces_per_frame` faces a frame like
+  /// the captures (all six for the first map).
   bool prefilter = false;
+  int faces_per_frame = 6;
   glm::vec3 box_min{0.0f}, box_max{0.0f};
   /// World -> clip of the six 90° face cameras (systems/environment_probe_system.h).
   std::array<glm::mat4, 6> view_proj{};

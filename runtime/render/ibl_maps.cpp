@@ -91,6 +91,12 @@ void IblMaps::release_row(int row) {
 }
 
 void IblMaps::prefilter(const gpu::Texture& source, int size, gpu::Texture& target, int row) {
+  prefilter_faces(source, size, target, 0, 6);
+  project_sh(source, size, row);
+}
+
+void IblMaps::prefilter_faces(const gpu::Texture& source, int size, gpu::Texture& target,
+                              int first, int count) {
   const int levels = ibl_specular_levels(size);
   GLint have = 0, levels_have = 0;
   if (target) {
@@ -102,9 +108,12 @@ void IblMaps::prefilter(const gpu::Texture& source, int size, gpu::Texture& targ
     glTextureStorage2D(target.id(), levels, GL_RGBA16F, size, size);
     set_cube_sampling(target.id());
   }
+  first = std::clamp(first, 0, 6);
+  count = std::clamp(count, 0, 6 - first);
+  if (count == 0) return;
   // Level 0 is roughness 0: the mirror, the source as it is.
-  glCopyImageSubData(source.id(), GL_TEXTURE_CUBE_MAP, 0, 0, 0, 0, target.id(), GL_TEXTURE_CUBE_MAP,
-                     0, 0, 0, 0, size, size, 6);
+  glCopyImageSubData(source.id(), GL_TEXTURE_CUBE_MAP, 0, 0, 0, first, target.id(),
+                     GL_TEXTURE_CUBE_MAP, 0, 0, 0, first, size, size, count);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
@@ -120,14 +129,28 @@ void IblMaps::prefilter(const gpu::Texture& source, int size, gpu::Texture& targ
     glViewport(0, 0, s, s);
     glProgramUniform4f(prefilter_program_.id(), 1, float(level) / float(levels - 1), float(size),
                        float(prefilter_samples(level)), 0.0f);
-    for (int face = 0; face < 6; ++face) {
+    for (int face = first; face < first + count; ++face) {
       glNamedFramebufferTextureLayer(fbo_.id(), GL_COLOR_ATTACHMENT0, target.id(), level, face);
       glProgramUniform4i(prefilter_program_.id(), 0, face, 0, 0, 0);
       glDrawArrays(GL_TRIANGLES, 0, 3);
     }
   }
+  glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, 0, 0);
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
+}
+
+void IblMaps::project_sh(const gpu::Texture& source, int size, int row) {
   // SH from a level of at most 16 x 16 texels a face (a box-filtered mip: SH are smooth).
   ensure_rows(row + 1);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glDisable(GL_FRAMEBUFFER_SRGB);
+  glBindVertexArray(empty_vao_.id());
+  glBindTextureUnit(0, source.id());
+  glNamedFramebufferDrawBuffer(fbo_.id(), GL_COLOR_ATTACHMENT0);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
   const int sh_level = std::max(0, mip_levels(size) - 5);
   glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, sh_.id(), 0);
   glViewport(0, row, 9, 1);

@@ -33,6 +33,11 @@ class IblMaps {
   /// when empty or of another size; ibl_specular_levels(size) levels) and writes the source's SH
   /// into row `row` (grown as needed). Leaves the framebuffer and program bindings changed.
   void prefilter(const gpu::Texture& source, int size, gpu::Texture& target, int row);
+  /// The two halves of prefilter(), for time slicing: faces [first, first + count) of every
+  /// level, and the SH row.
+  void prefilter_faces(const gpu::Texture& source, int size, gpu::Texture& target, int first,
+                       int count);
+  void project_sh(const gpu::Texture& source, int size, int row);
 
   /// The environment map (render.environment): uploaded, mipmapped and prefiltered (SH into
   /// row 0) when `cube` is another map than last time (by `key`); null: none.

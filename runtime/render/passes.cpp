@@ -1089,10 +1089,23 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
                                 DrawState& state, FrameStats& stats) {
   // The environment map, prefiltered once per map; its SH, the split-sum table and its cube are
   // bound for every forward draw (captures included).
+  const int prefiltered_before = cache.probes().prefilter_faces;
   cache.probes().ibl().set_environment(frame.environment, frame.environment_key);
   cache.probes().ibl().bind();
-  state.forget();  // prefiltering uses its own programs and unit 0
-  if (frame.probes.empty()) return {};
+  if (frame.probes.empty()) {
+    state.forget();  // prefiltering uses its own programs and unit 0
+    return {};
+  }
+  // The pbr model's prefiltering, time-sliced like the captures: faces_per_frame faces a frame
+  // of the cube that was complete before this frame's captures (they may swap buffers), so a
+  // capture completing every 6 / faces_per_frame frames never starves it.
+  for (const ProbeJob& job : frame.probes) {
+    if (!job.prefilter) continue;
+    const bool swapped_now = job.faces != 0 && job.target == job.visible;
+    const int ready = swapped_now ? 1 - job.visible : job.visible;
+    if (cache.probes().prefilter(job.handle, ready, job.faces_per_frame)) ++stats.probe_prefilters;
+  }
+  state.forget();
   glDisable(GL_FRAMEBUFFER_SRGB);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -1124,14 +1137,18 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
   }
   glNamedBufferSubData(ubo.id(), 0, sizeof main, &main);  // the main view's block again
   if (!status) return status;
-  // The pbr model's probes: prefiltered once per new visible cube (captured or uploaded).
+  // A probe's first map (or one uploaded from a file) is prefiltered whole at once, so a pbr
+  // reflector never waits without one.
   for (const ProbeJob& job : frame.probes)
-    if (job.prefilter && cache.probes().prefilter(job.handle, job.visible)) ++stats.probe_prefilters;
+    if (job.prefilter && !cache.probes().has_specular(job.handle) &&
+        cache.probes().prefilter(job.handle, job.visible, 6))
+      ++stats.probe_prefilters;
   cache.probes().ibl().bind();
   for (const ProbeJob& job : frame.probes)
     if (job.sphere && cache.probes().existing_cube(job.handle, job.visible))
       cache.probes().update_sphere(job.handle, job.visible, glm::mat3(frame.camera.view));
   state.forget();  // the fullscreen passes above used their own programs and unit 0
+  stats.probe_prefilter_faces = cache.probes().prefilter_faces - prefiltered_before;
   return {};
 }
 

@@ -55,7 +55,10 @@ gpu::TextureRef ProbeMaps::cube(ProbeHandle handle, int buffer, int resolution) 
     p.cubes[0] = make_cube(resolution);
     p.cubes[1] = make_cube(resolution);
     p.sphere = gpu::Texture();
-    p.specular = gpu::Texture();  // made again at the new size by prefilter()
+    p.specular[0] = gpu::Texture();  // made again at the new size by prefilter()
+    p.specular[1] = gpu::Texture();
+    p.shown = -1;
+    p.pending = {-1, 0};
   }
   return p.cubes[buffer & 1];
 }
@@ -88,8 +91,10 @@ void ProbeMaps::begin_face(ProbeHandle handle, int buffer, int face, const glm::
 }
 
 void ProbeMaps::drop(Probe& p) {
-  ibl_->release_row(p.sh_row);
-  p.sh_row = -1;
+  for (int& row : p.sh_rows) {
+    ibl_->release_row(row);
+    row = -1;
+  }
 }
 
 void ProbeMaps::clear() {
@@ -114,26 +119,44 @@ void ProbeMaps::finish_cube(ProbeHandle handle, int buffer) {
   ++p.changes[buffer & 1];
 }
 
-bool ProbeMaps::prefilter(ProbeHandle handle, int buffer) {
+bool ProbeMaps::prefilter(ProbeHandle handle, int buffer, int faces) {
   auto it = probes_.find(handle);
-  if (it == probes_.end() || !it->second.cubes[buffer & 1]) return false;
+  const int b = buffer & 1;
+  if (it == probes_.end() || !it->second.cubes[b]) return false;
   Probe& p = it->second;
-  const std::pair<int, std::uint64_t> source{buffer & 1, p.changes[buffer & 1]};
-  if (p.specular && p.prefiltered == source) return false;
-  if (p.sh_row < 0) p.sh_row = ibl_->acquire_row();
-  ibl_->prefilter(p.cubes[buffer & 1], p.resolution, p.specular, p.sh_row);
-  p.prefiltered = source;
+  const std::pair<int, std::uint64_t> source{b, p.changes[b]};
+  if (p.shown >= 0 && p.shown_source == source) return false;  // up to date
+  if (p.pending != source) {  // a new cube: start over
+    p.pending = source;
+    p.pending_faces = 0;
+  }
+  const int count = std::clamp(faces, 1, 6 - p.pending_faces);
+  ibl_->prefilter_faces(p.cubes[b], p.resolution, p.specular[b], p.pending_faces, count);
+  p.pending_faces += count;
+  prefilter_faces += count;
+  if (p.pending_faces < 6) return false;
+  if (p.sh_rows[b] < 0) p.sh_rows[b] = ibl_->acquire_row();
+  ibl_->project_sh(p.cubes[b], p.resolution, p.sh_rows[b]);
+  p.shown = b;
+  p.shown_source = source;
+  p.pending = {-1, 0};
   return true;
+}
+
+bool ProbeMaps::has_specular(ProbeHandle handle) const {
+  auto it = probes_.find(handle);
+  return it != probes_.end() && it->second.shown >= 0;
 }
 
 gpu::TextureRef ProbeMaps::existing_specular(ProbeHandle handle) const {
   auto it = probes_.find(handle);
-  return it == probes_.end() ? gpu::TextureRef() : gpu::TextureRef(it->second.specular);
+  if (it == probes_.end() || it->second.shown < 0) return gpu::TextureRef();
+  return gpu::TextureRef(it->second.specular[it->second.shown]);
 }
 
 int ProbeMaps::sh_row(ProbeHandle handle) const {
   auto it = probes_.find(handle);
-  return it == probes_.end() ? -1 : it->second.sh_row;
+  return it == probes_.end() || it->second.shown < 0 ? -1 : it->second.sh_rows[it->second.shown];
 }
 
 int ProbeMaps::specular_last_level(ProbeHandle handle) const {

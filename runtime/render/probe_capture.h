@@ -53,9 +53,15 @@ class ProbeMaps {
   CubeMap read_cube(ProbeHandle handle, int buffer) const;
   SphereMap read_sphere(ProbeHandle handle) const;
 
-  /// The pbr reflection model (IblMaps): prefilters cube `buffer` into the probe's specular
-  /// cube and SH row unless that cube was prefiltered since it last changed. True when it ran.
-  bool prefilter(ProbeHandle handle, int buffer);
+  /// The pbr reflection model (IblMaps): prefilters `faces` more faces of complete cube
+  /// `buffer` into that buffer's specular cube, and after the sixth its SH row, and from then on
+  /// lookups see it (existing_specular(), sh_row()); nothing when that cube's prefiltered
+  /// version is already shown. A cube that changes again before it is done starts over. True
+  /// when the sixth face was done by this call.
+  bool prefilter(ProbeHandle handle, int buffer, int faces);
+  /// Whether the probe has a prefiltered cube to show.
+  bool has_specular(ProbeHandle handle) const;
+  int prefilter_faces = 0;  ///< faces prefiltered since creation (stats and tests)
   /// The probe's prefiltered cube (none before prefilter()), its SH row and its last level.
   gpu::TextureRef existing_specular(ProbeHandle handle) const;
   int sh_row(ProbeHandle handle) const;
@@ -76,12 +82,16 @@ class ProbeMaps {
     int resolution = 0;
     gpu::Texture cubes[2];
     gpu::Texture sphere;
-    /// The pbr model's prefiltered cube and SH row (-1: none yet); `changes` counts completed
-    /// captures and uploads per buffer, `prefiltered` what the specular cube was made from.
-    gpu::Texture specular;
-    int sh_row = -1;
+    /// The pbr model's prefiltered cube and SH row per buffer (-1: none yet), `shown` the one
+    /// lookups see (-1: none). `changes` counts completed captures and uploads per buffer;
+    /// `shown_source` is the (buffer, changes) the shown cube was made from, `pending` the one
+    /// being prefiltered and `pending_faces` its faces done.
+    gpu::Texture specular[2];
+    int sh_rows[2] = {-1, -1};
+    int shown = -1;
     std::uint64_t changes[2] = {0, 0};
-    std::pair<int, std::uint64_t> prefiltered{-1, 0};
+    std::pair<int, std::uint64_t> shown_source{-1, 0}, pending{-1, 0};
+    int pending_faces = 0;
   };
   void drop(Probe& p);
   ProbeMaps() = default;

@@ -175,7 +175,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.frustum_culled = 0;
   stats_.program_switches = stats_.material_switches = 0;
   stats_.probe_faces = stats_.probe_draw_calls = stats_.probe_instances = stats_.probe_culled = 0;
-  stats_.probe_prefilters = 0;
+  stats_.probe_prefilters = stats_.probe_prefilter_faces = 0;
   stats_.cascade_receiver_pixels.fill(0);
 
   // The frame block of the main view is bound at binding 0 (every pass reads it).

@@ -77,7 +77,8 @@ struct FrameStats {
   double probe_gpu_ms = 0.0;          ///< GL_TIME_ELAPSED of the probe captures (previous frame)
   int probe_faces_timed = 0;          ///< faces that probe_gpu_ms covers (previous frame's)
   int probe_faces = 0;                ///< reflection probe cube faces rendered this frame
-  int probe_prefilters = 0;           ///< probe cubes prefiltered for the pbr model this frame
+  int probe_prefilters = 0;           ///< probe cubes whose pbr prefiltering completed this frame
+  int probe_prefilter_faces = 0;      ///< cube faces prefiltered this frame (time-sliced)
   int probe_draw_calls = 0;           ///< draw calls into those faces (not in draw_calls)
   int probe_instances = 0;            ///< objects they draw
   int probe_culled = 0;               ///< draws outside a captured face's frustum, not drawn

@@ -18,6 +18,7 @@
 #include "runtime/assets/env_lighting.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/cli/player.h"
+#include "systems/frame.h"
 #include "tests/render/player_fixture.h"
 
 namespace kaskad {
@@ -188,7 +189,8 @@ TEST_F(IblTest, GpuPrefilteringAndShMatchTheCpuTwins) {
 
 // A reflector sphere facing a red wall (its probe's +Z face), a green one behind the camera
 // side... the probe sees red ahead of the camera's mirror direction.
-fs::path reflector_scene(const std::string& name, const std::string& model, float roughness) {
+fs::path reflector_scene(const std::string& name, const std::string& model, float roughness,
+                         const std::string& update = R"("update": "first_frame")") {
   const fs::path file = fs::path(KASKAD_TEST_TMP) / "ibl" / (name + ".json");
   std::ofstream(file) << R"({ "kaskad_scene": 1,
     "render": { "ground": "none", "clear_color": [0.1, 0.1, 0.1], "ambient": [0.02, 0.02, 0.02] },
@@ -197,7 +199,7 @@ fs::path reflector_scene(const std::string& name, const std::string& model, floa
         "primitive": { "shape": "sphere", "segments": 64 },
         "material": { "base_color": [1, 1, 1, 1], "metallic": 1, "roughness": )" << roughness
                             << R"(, "reflection_model": ")" << model << R"(" },
-        "reflector": { "map": "cube", "update": "first_frame", "resolution": 64 } },
+        "reflector": { "map": "cube", )" << update << R"(, "resolution": 64 } },
       { "name": "wall", "transform": { "translation": [0, 0, 4], "euler_deg": [90, 0, 0], "scale": [6, 1, 6] },
         "primitive": { "shape": "plane" },
         "material": { "base_color": [0, 0, 0, 1], "emissive": [0.8, 0.1, 0.1], "double_sided": true } },
@@ -232,6 +234,44 @@ TEST_F(IblTest, PbrReflectorIsLitByItsProbe) {
   EXPECT_EQ(r.w, 1.0f);
   EXPECT_LT(r.r, b.r - 0.05f);
   EXPECT_GT(r.r, 0.05f);
+}
+
+TEST_F(IblTest, PbrPrefilteringIsTimeSlicedLikeTheCaptures) {
+  // Captures every 8 frames, 2 faces a frame: the first map is prefiltered whole at once, every
+  // later one 2 faces a frame over the 3 frames after its capture completes, and the pbr
+  // reflector shows the new prefiltered cube only once all six are done.
+  auto scene = load_scene(reflector_scene("sliced", "pbr", 0.5f,
+                                          R"("update": "every_n", "every_n": 8, "faces_per_frame": 2)"),
+                          {});
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  FrameContext ctx;
+  ctx.width = ctx.height = 32;
+  ASSERT_TRUE(prewarm_frame(*scene, *player_->renderer, ctx).ok());
+  SystemState systems;
+  FrameReport report;
+  std::vector<int> faces, done, captured;
+  for (int k = 0; k < 24; ++k) {
+    ctx.index = std::uint64_t(k);
+    ASSERT_TRUE(run_frame(*scene, *player_->renderer, ctx, systems, report).ok());
+    faces.push_back(report.stats.probe_prefilter_faces);
+    done.push_back(report.stats.probe_prefilters);
+    captured.push_back(report.stats.probe_faces);
+  }
+  EXPECT_EQ(faces[0], 6);
+  EXPECT_EQ(done[0], 1);
+  int completions = 0;
+  for (int k = 1; k < 24; ++k) {
+    EXPECT_TRUE(faces[std::size_t(k)] == 0 || faces[std::size_t(k)] == 2) << "frame " << k;
+    if (done[std::size_t(k)] == 0) continue;
+    ++completions;
+    // Done in the third frame of 2 faces, which follow the frame the capture completed in.
+    ASSERT_GE(k, 3);
+    EXPECT_EQ(faces[std::size_t(k - 1)], 2);
+    EXPECT_EQ(faces[std::size_t(k - 2)], 2);
+    EXPECT_EQ(faces[std::size_t(k - 3)], 0);
+    EXPECT_GT(captured[std::size_t(k - 3)], 0);
+  }
+  EXPECT_GE(completions, 2);
 }
 
 }  // namespace
