@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <regex>
@@ -257,6 +258,9 @@ void read_render(ObjectReader& r, RenderSettings& s) {
     s.exposure = std::exp2(ev);
   }
   r.enumeration("tone_mapping", s.tone_mapping, kToneMappings);
+  r.integer("msaa", s.msaa, std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+  if (s.msaa != 1 && s.msaa != 2 && s.msaa != 4 && s.msaa != 8)
+    fail(r.at("msaa"), "must be 1, 2, 4 or 8 (samples per pixel), was " + std::to_string(s.msaa));
   r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
   r.enumeration("ground", s.ground, kGroundModes);
   r.boolean("shadow_cache", s.shadow_cache);
@@ -1142,6 +1146,7 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
                    {"clear_color", vec(r.clear_color)},
                    {"exposure", num(r.exposure)},
                    {"tone_mapping", enum_name(r.tone_mapping, kToneMappings)},
+                   {"msaa", r.msaa},
                    {"aov_shadow_light", r.aov_shadow_light},
                    {"ground", enum_name(r.ground, kGroundModes)},
                    {"shadow_cache", r.shadow_cache}};

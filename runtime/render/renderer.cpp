@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <numeric>
 #include <optional>
@@ -47,6 +48,32 @@ struct Renderer::Impl {
   bool timers_pending = false;
   std::uint64_t frames_rendered = 0;
   bool layer_from_vertex = false;  // GL_ARB_shader_viewport_layer_array: gl_Layer in the VS
+  // Sample counts the driver offers for both multisampled forward targets, ascending (GL 4.5
+  // guarantees 4 at least: GL_MAX_SAMPLES >= 4).
+  std::vector<int> sample_counts;
+
+  // The colour samples of a frame asking for `requested` (render.msaa): the request when the
+  // driver offers it, else the nearest offered count above it, else the largest (with one
+  // warning saying so).
+  int samples_for(int requested) const {
+    if (requested <= 1 || sample_counts.empty()) return 1;
+    int chosen = sample_counts.back();
+    for (int c : sample_counts)
+      if (c >= requested) {
+        chosen = c;
+        break;
+      }
+    if (chosen != requested)
+      log::warn_once("render.msaa %d: this OpenGL driver offers %s samples per pixel for the colour "
+                     "and depth targets (GL_SAMPLES); using %d",
+                     requested, sample_list().c_str(), chosen);
+    return chosen;
+  }
+  std::string sample_list() const {
+    std::string out;
+    for (int c : sample_counts) out += (out.empty() ? "" : ", ") + std::to_string(c);
+    return out;
+  }
 
   // The key as this driver can build it: without gl_Layer in vertex shaders the layered shadow
   // pass falls back to one pass per layer (the same maps).
@@ -74,6 +101,31 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
     log::warn(
         "GL_ARB_shader_viewport_layer_array missing: shadow maps are drawn one layer at a "
         "time");
+  // Sample counts offered for the forward pass's colour and depth formats (GL_SAMPLES lists
+  // them in descending order; each is within GL_MAX_COLOR/DEPTH_TEXTURE_SAMPLES).
+  {
+    const auto list = ForwardPass::targets();
+    std::vector<int> both;
+    for (GLenum format : {list.front().internal_format, list.back().internal_format}) {
+      GLint n = 0;
+      glGetInternalformativ(GL_TEXTURE_2D_MULTISAMPLE, format, GL_NUM_SAMPLE_COUNTS, 1, &n);
+      std::vector<GLint> counts(std::size_t(std::max(n, 0)));
+      if (n > 0)
+        glGetInternalformativ(GL_TEXTURE_2D_MULTISAMPLE, format, GL_SAMPLES, n, counts.data());
+      std::vector<int> sorted(counts.begin(), counts.end());
+      std::sort(sorted.begin(), sorted.end());
+      if (format == list.front().internal_format) {
+        both = sorted;
+      } else {
+        std::vector<int> common;
+        std::set_intersection(both.begin(), both.end(), sorted.begin(), sorted.end(),
+                              std::back_inserter(common));
+        both = common;
+      }
+    }
+    std::erase_if(both, [](int c) { return c < 2; });
+    im.sample_counts = both;
+  }
   im.frame_ubo = gpu::make_buffer();
   glNamedBufferStorage(im.frame_ubo.id(), sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   for (gpu::Query& q : im.timers) q = gpu::make_query(GL_TIME_ELAPSED);
@@ -215,7 +267,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   KASKAD_TRY(st);
 
   // 3. Forward. After it: colour (and the AOVs) of the main view.
-  im.forward.prepare(frame);
+  im.forward.prepare(frame, im.samples_for(frame.msaa));
+  stats_.msaa_samples = im.forward.samples();
   glBeginQuery(GL_TIME_ELAPSED, im.timers[1].id());
   st = im.forward.record(frame, list, *im.cache, state, stats_);
   glEndQuery(GL_TIME_ELAPSED);

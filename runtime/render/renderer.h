@@ -80,6 +80,8 @@ struct FrameStats {
   int probe_draw_calls = 0;           ///< draw calls into those faces (not in draw_calls)
   int probe_instances = 0;            ///< objects they draw
   int probe_culled = 0;               ///< draws outside a captured face's frustum, not drawn
+  /// Colour samples per pixel of the main view (render.msaa as the driver offers it; 1: none).
+  int msaa_samples = 1;
   int program_switches = 0;           ///< glUseProgram calls in the frame (draws are sorted)
   int material_switches = 0;          ///< material uniform/texture updates in the frame
   ShaderStats shaders;                ///< compiles, cache hits, compile ms (since creation)

@@ -23,6 +23,7 @@
 //   shadow_lights != 1 needs shadow (the lookups of lights that do not exist are not compiled)
 //   shadow_technique != pcf, shadow_kernel != k3x3 and shadow_peel need shadow
 //   emissive_texture needs emissive
+//   alpha_to_coverage is kept by the forward pass only with alpha_mask (filtered_for())
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask with its
 // texture_transform, peeling, and the projection when it is dual_paraboloid: its vertex shader
 // differs), so every material shares one or two shadow programs.
@@ -171,6 +172,12 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // render.tone_mapping (components/tone_mapping.h): the curve the colour output goes through.
     {.name = "tone_mapping", .kind = FeatureKind::frame, .define = "VARIANT_TONE_MAPPING",
      .stages = kFragmentStage, .offset = 40, .values = {"none", "khr_pbr_neutral", "aces"}},
+    // render.msaa > 1: the multisampled colour pass. An alpha-masked draw writes its coverage
+    // (alpha sharpened around the cutoff) instead of discarding, and GL_SAMPLE_ALPHA_TO_COVERAGE
+    // turns it into samples. Only alpha-masked programs keep it (filtered_for()), so the others
+    // are shared with the single-sample pass.
+    {.name = "alpha_to_coverage", .kind = FeatureKind::frame, .define = "VARIANT_ALPHA_TO_COVERAGE",
+     .stages = kFragmentStage, .offset = 42},
 };
 inline constexpr int kFeatureCount = int(std::size(kFeatureTable));
 
@@ -289,6 +296,8 @@ class VariantKey {
   static constexpr Field kShadowKernel = feature_field("shadow_kernel");
   /// ToneMapping: 0 none, 1 khr_pbr_neutral, 2 aces.
   static constexpr Field kToneMapping = feature_field("tone_mapping");
+  /// The multisampled colour pass's alpha-masked draws: coverage from alpha (render.msaa > 1).
+  static constexpr Field kAlphaToCoverage = feature_field("alpha_to_coverage");
   static constexpr std::uint64_t kFrameMask = 0x0000ffffffff0000u;
 
   constexpr VariantKey() = default;
@@ -331,7 +340,7 @@ class VariantKey {
   /// The part of the key a pass's shaders read. The depth pass only needs alpha masking (and
   /// peeling); the shadow-points, LOM occlusion and VSM moments passes only the shadow lookup's
   /// frame features (a receiver, without AOVs or the debug tint); the forward pass needs
-  /// everything.
+  /// everything but alpha_to_coverage on draws without alpha_mask (it changes nothing there).
   constexpr VariantKey filtered_for(Pass pass) const {
     if (pass == Pass::depth) {
       const std::uint64_t projection = get(kShadowProjection) == kProjectionDualParaboloid
@@ -346,8 +355,10 @@ class VariantKey {
     }
     if (pass == Pass::shadow_points || pass == Pass::lom_occlusion || pass == Pass::vsm_moments)
       return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask() &
-                         ~kShadowLayered.mask() & ~kToneMapping.mask() & ~kShadowPeel.mask()) |
+                         ~kShadowLayered.mask() & ~kToneMapping.mask() & ~kShadowPeel.mask() &
+                         ~kAlphaToCoverage.mask()) |
                         kReceiveShadows.mask());
+    if (!has(kAlphaMask)) return VariantKey(bits_ & ~kAlphaToCoverage.mask());
     return *this;
   }
 
@@ -391,6 +402,14 @@ static_assert(VariantKey()
                   .set(VariantKey::kShadowFilter, 2)
                   .filtered_for(Pass::depth) ==
               VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 3));
+
+static_assert(VariantKey().set(VariantKey::kAlphaToCoverage, 1).filtered_for(Pass::forward) ==
+              VariantKey());
+static_assert(VariantKey().set(VariantKey::kAlphaToCoverage, 1).set(VariantKey::kAlphaMask, 1)
+                  .filtered_for(Pass::forward)
+                  .has(VariantKey::kAlphaToCoverage));
+static_assert(VariantKey().set(VariantKey::kAlphaToCoverage, 1).set(VariantKey::kAlphaMask, 1)
+                  .filtered_for(Pass::depth) == VariantKey().set(VariantKey::kAlphaMask, 1));
 
 /// A program a frame needs: a pass and its key.
 struct ProgramRequest {
