@@ -168,7 +168,7 @@ std::string gib(double bytes) {
 
 }  // namespace
 
-Status Renderer::check_target_size(int width, int height, bool read_aovs) const {
+Status Renderer::check_target_size(int width, int height, bool read_aovs, int msaa) const {
   const std::string size = std::to_string(width) + "x" + std::to_string(height);
   const std::string where = "render size " + size;
   if (width < 1 || height < 1) return Error{"", where, "width and height must be at least 1"};
@@ -197,6 +197,22 @@ Status Renderer::check_target_size(int width, int height, bool read_aovs) const 
                    std::string("the OpenGL driver refuses a ") + t.name + " target of this size (" +
                        gib(pixels * t.bytes_per_pixel) + ")"};
     gpu_bytes += pixels * t.bytes_per_pixel;
+  }
+  // With render.msaa, the multisampled colour and depth targets too, at the count used.
+  if (const int samples = impl_->samples_for(msaa); samples > 1) {
+    const auto list = ForwardPass::targets();
+    for (const ForwardPass::Target* t : {&list.front(), &list.back()}) {
+      glTexImage2DMultisample(GL_PROXY_TEXTURE_2D_MULTISAMPLE, samples, t->internal_format, width,
+                              height, GL_TRUE);
+      GLint got = 0;
+      glGetTexLevelParameteriv(GL_PROXY_TEXTURE_2D_MULTISAMPLE, 0, GL_TEXTURE_WIDTH, &got);
+      const double bytes = pixels * t->bytes_per_pixel * samples;
+      if (got == 0)
+        return Error{"", where,
+                     "the OpenGL driver refuses a " + std::to_string(samples) + "-sample " +
+                         t->name + " target of this size (" + gib(bytes) + "; render.msaa)"};
+      gpu_bytes += bytes;
+    }
   }
   // Read-backs: colour as float RGBA, and with AOVs 14 float channels plus their staging.
   const double host_bytes = pixels * (16.0 + (read_aovs ? 2.0 * 14 * 4 + 64 : 0.0));

@@ -110,8 +110,9 @@ class Renderer {
   /// GL limits (GL_MAX_TEXTURE_SIZE, GL_MAX_RENDERBUFFER_SIZE, GL_MAX_VIEWPORT_DIMS), the driver's
   /// answer for each target format (proxy textures: llvmpipe refuses textures over 1 GiB) and an
   /// estimate of the memory the targets and read-backs take against the memory available.
+  /// With `msaa` > 1 (render.msaa), the multisampled colour and depth targets count too.
   /// The error names the size and what refused it.
-  Status check_target_size(int width, int height, bool read_aovs) const;
+  Status check_target_size(int width, int height, bool read_aovs, int msaa = 1) const;
 
   /// Records and submits the shadow and forward passes. Meshes and textures are uploaded from
   /// `assets` on first use. Errors: shader compile/link failures (content errors).
