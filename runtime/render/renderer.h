@@ -31,10 +31,12 @@ namespace kaskad::render {
 /// Draw calls are GL draw calls: draws that share mesh, program and material are one instanced
 /// draw. Instances are the objects those calls draw.
 struct FrameStats {
-  int draw_calls = 0;                 ///< forward pass of the main view
+  /// Forward pass of the main view; with render.msaa > 1 and AOVs, its multisampled colour
+  /// and single-sample AOV draws together (each object twice).
+  int draw_calls = 0;
   int instances = 0;                  ///< objects drawn by them
   int frustum_culled = 0;             ///< draws outside the main view's frustum, not drawn
-  std::size_t triangles = 0;          ///< submitted in the forward pass
+  std::size_t triangles = 0;          ///< submitted in the forward pass (both, as draw_calls)
   /// Shadow pass draw calls recorded this frame (0 when every layer kept its depth).
   int shadow_draw_calls = 0;
   /// Caster instances in the shadow map's layers (one per caster and layer) and their
