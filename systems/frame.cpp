@@ -90,6 +90,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.exposure = scene.render.exposure;
   in.tone_mapping = scene.render.tone_mapping;
   in.write_aovs = ctx.write_aovs;
+  in.msaa = scene.render.msaa;
   in.shadow_cache = scene.render.shadow_cache;
   if (!shadows.empty()) {
     const ShadowSettings& s = shadows.front().settings;  // shared by every view (ShadowData)

@@ -79,7 +79,14 @@ void main() {
   if (ENABLED(BIT_BASE_COLOR_TEXTURE))
     base *= texture(u_base_color_tex, slot_uv(UV_SLOT_BASE_COLOR, v_uv));
 #endif
-#if MATERIAL_HAS_ALPHA_MASK
+  float coverage = 1.0;  // o_color's alpha: 1, or a cut-out's coverage under alpha to coverage
+#if MATERIAL_HAS_ALPHA_MASK && VARIANT_ALPHA_TO_COVERAGE
+  // The multisampled colour pass (render.msaa > 1): alpha sharpened around the cutoff to about
+  // one pixel's width, which GL_SAMPLE_ALPHA_TO_COVERAGE turns into covered samples, so the
+  // cut-out's edge is anti-aliased like a triangle's (Golus, "Anti-aliased Alpha Test", 2017).
+  if (ENABLED(BIT_ALPHA_MASK))
+    coverage = clamp((base.a - u_material.w) / max(fwidth(base.a), 1e-4) + 0.5, 0.0, 1.0);
+#elif MATERIAL_HAS_ALPHA_MASK
   if (ENABLED(BIT_ALPHA_MASK) && base.a < u_material.w) discard;
 #endif
   vec3 view_vec = u_camera_pos.xyz - v_world_pos;
@@ -270,7 +277,8 @@ void main() {
 #if VARIANT_HAS_SHADOW && VARIANT_DEBUG_CASCADES
   color *= cascade_tint(tint_cascade);
 #endif
-  o_color = vec4(tone_map(color * u_frame.x), 1.0);
+  // Tone mapped here, per sample under MSAA: the resolve averages displayable values.
+  o_color = vec4(tone_map(color * u_frame.x), coverage);
 #if VARIANT_HAS_AOVS
   o_position = vec4(v_world_pos, 1.0);
   o_normal = vec4(geometric_n, view_depth);

@@ -44,6 +44,11 @@ struct RenderSettings {
   float exposure = 1.0f;
   /// The curve applied after the exposure (components/tone_mapping.h); none by default.
   ToneMapping tone_mapping = ToneMapping::none;
+  /// Colour samples per pixel: 1 (no anti-aliasing, the default: every golden image and
+  /// reference comparison was made so), 2, 4 or 8 (MSAA, resolved after tone mapping each
+  /// sample; the AOVs stay single-sample). A count the driver does not offer is replaced by the
+  /// nearest one it does, with a warning.
+  int msaa = 1;
   /// Which shadowed light the AOV's visibility and cascade channels show: 0 the first, k the
   /// k-th further shadowed directional light (a debug path; colour is not affected).
   int aov_shadow_light = 0;

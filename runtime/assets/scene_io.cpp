@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <regex>
@@ -261,6 +262,9 @@ void read_render(ObjectReader& r, RenderSettings& s) {
   r.enumeration("tone_mapping", s.tone_mapping, kToneMappings);
   r.string("environment", s.environment);
   r.number("environment_intensity", s.environment_intensity, 0.0f, 1.0e4f);
+  r.integer("msaa", s.msaa, std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+  if (s.msaa != 1 && s.msaa != 2 && s.msaa != 4 && s.msaa != 8)
+    fail(r.at("msaa"), "must be 1, 2, 4 or 8 (samples per pixel), was " + std::to_string(s.msaa));
   r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
   r.enumeration("ground", s.ground, kGroundModes);
   r.boolean("shadow_cache", s.shadow_cache);
@@ -1183,6 +1187,7 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
                    {"tone_mapping", enum_name(r.tone_mapping, kToneMappings)},
                    {"environment", rebase_path(scene, base_dir, r.environment)},
                    {"environment_intensity", num(r.environment_intensity)},
+                   {"msaa", r.msaa},
                    {"aov_shadow_light", r.aov_shadow_light},
                    {"ground", enum_name(r.ground, kGroundModes)},
                    {"shadow_cache", r.shadow_cache}};

@@ -427,8 +427,10 @@ int run_render(Args a) {
     player->context->swap_buffers();
   }
   const auto& st = timings->last.stats;
-  std::printf("frames    %d at %dx%d: first %.1f ms, median %.2f ms (frames 2..%d)\n", a.frames,
-              scene->render.width, scene->render.height, timings->first_frame_ms,
+  const std::string msaa =
+      st.msaa_samples > 1 ? ", " + std::to_string(st.msaa_samples) + "x MSAA" : std::string();
+  std::printf("frames    %d at %dx%d%s: first %.1f ms, median %.2f ms (frames 2..%d)\n", a.frames,
+              scene->render.width, scene->render.height, msaa.c_str(), timings->first_frame_ms,
               timings->median_ms(), a.frames);
   std::printf("last      %d objects in %d draw calls (%d outside the view, culled), %zu "
               "triangles; shadow pass %d caster instances in %d draw calls, %zu triangles; GPU "

@@ -134,7 +134,8 @@ Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRu
   ctx.width = run.width > 0 ? run.width : scene.render.width;
   ctx.height = run.height > 0 ? run.height : scene.render.height;
   ctx.write_aovs = run.write_aovs;
-  KASKAD_TRY(player.renderer->check_target_size(ctx.width, ctx.height, run.write_aovs));
+  KASKAD_TRY(player.renderer->check_target_size(ctx.width, ctx.height, run.write_aovs,
+                                                scene.render.msaa));
   if (run.prewarm) {
     const auto t0 = std::chrono::steady_clock::now();
     KASKAD_TRY(prewarm_frame(scene, *player.renderer, ctx, player.systems));

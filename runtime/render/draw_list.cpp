@@ -45,6 +45,10 @@ VariantKey capture_frame_variant(VariantKey frame) {
   return k;
 }
 
+VariantKey msaa_frame_variant(VariantKey frame) {
+  return VariantKey(frame.bits() & ~VariantKey::kAovs.mask()).set(VariantKey::kAlphaToCoverage, 1);
+}
+
 VariantKey material_variant(const DrawItem& d) {
   // receive_shadows is a per-object flag, but it selects code like a material feature.
   VariantKey k = VariantKey(d.material.features & VariantKey::kMaterialMask & ~VariantKey::kReceiveShadows.mask());
@@ -57,10 +61,16 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   // Probe captures draw without AOVs; a reflector's draw gets its map feature once its first
   // capture completes (possibly frames later when time-sliced): compile those up front too.
   const VariantKey capture_fk = capture_frame_variant(fk);
+  // The main view's forward programs: single-sample (colour, or the AOVs beside a multisampled
+  // colour pass) and multisampled colour.
+  std::vector<VariantKey> main_fks;
+  if (frame.msaa <= 1 || frame.write_aovs) main_fks.push_back(fk);
+  if (frame.msaa > 1) main_fks.push_back(msaa_frame_variant(fk));
   std::vector<ProgramRequest> out;
   for (const DrawItem& d : frame.draws) {
     const VariantKey k = material_variant(d) | fk;
-    out.push_back({Pass::forward, k.filtered_for(Pass::forward)});
+    for (const VariantKey main : main_fks)
+      out.push_back({Pass::forward, (material_variant(d) | main).filtered_for(Pass::forward)});
     if (fk.get(VariantKey::kShadowTechnique) == VariantKey::kTechniqueLom &&
         (d.cast_shadows || d.receive_shadows)) {  // LomPass's peels
       const VariantKey peel =
@@ -87,7 +97,8 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
                                 .set(VariantKey::kReflectionPbr,
                                      !job.sphere && d.material.reflection_model == ReflectionModel::pbr));
     for (const VariantKey m : materials) {
-      out.push_back({Pass::forward, (m | fk).filtered_for(Pass::forward)});
+      for (const VariantKey main : main_fks)
+        out.push_back({Pass::forward, (m | main).filtered_for(Pass::forward)});
       if (!frame.probes.empty()) out.push_back({Pass::forward, (m | capture_fk).filtered_for(Pass::forward)});
     }
   }
@@ -162,6 +173,12 @@ DrawList build_draw_list(const FrameInput& frame, VariantKey frame_key) {
     list.keys[i] = material_variant(frame.draws[i]) | frame_key;
   if (!frame.shadow_views.empty()) list.depth_order = sorted_by(frame, Pass::depth, list.keys);
   list.forward_order = sorted_by(frame, Pass::forward, list.keys);
+  if (frame.msaa > 1) {
+    const VariantKey msaa = msaa_frame_variant(frame_key);
+    list.msaa_keys.resize(frame.draws.size());
+    for (std::size_t i = 0; i < frame.draws.size(); ++i)
+      list.msaa_keys[i] = (material_variant(frame.draws[i]) | msaa).filtered_for(Pass::forward);
+  }
   if (!frame.probes.empty()) {
     const VariantKey capture = capture_frame_variant(frame_key);
     list.capture_keys.resize(frame.draws.size());

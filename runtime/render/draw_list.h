@@ -21,6 +21,9 @@ VariantKey frame_variant(const FrameInput& frame);
 /// says nothing about a point behind it or beside it that a probe face sees: that point would
 /// fall into cascade 0, whose map does not hold it, and come out lit.
 VariantKey capture_frame_variant(VariantKey frame);
+/// The frame features of the multisampled colour pass (FrameInput::msaa > 1) of a frame with
+/// features `frame`: no AOVs (a single-sample pass draws them), and alpha to coverage.
+VariantKey msaa_frame_variant(VariantKey frame);
 /// The material features of a draw (MATERIAL_* part): from the material's data.
 VariantKey material_variant(const DrawItem& draw);
 
@@ -30,8 +33,11 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame);
 
 struct DrawList {
   VariantKey frame_key;  ///< frame_variant() as the driver can build it
-  /// Per draw: material_variant() | the frame key, and | the capture frame key (probe faces).
-  std::vector<VariantKey> keys, capture_keys;
+  /// Per draw: material_variant() | the frame key, | the capture frame key (probe faces), and |
+  /// msaa_frame_variant() of the frame key (the multisampled colour pass; only when
+  /// FrameInput::msaa > 1). forward_order serves both: two draws have equal keys exactly when
+  /// they have equal msaa_keys, so its runs of one program and material are the same.
+  std::vector<VariantKey> keys, capture_keys, msaa_keys;
   /// Draw indices in submission order: sorted by the pass's program key, then by material, so
   /// program and material state change as rarely as possible (stable: ties keep draw order).
   std::vector<std::uint32_t> depth_order, forward_order, capture_order;

@@ -180,6 +180,10 @@ struct FrameInput {
   /// Write the AOV targets (position, normal + depth, visibility). Off, the forward pass writes
   /// colour only: on llvmpipe the three float targets cost more than the shading itself.
   bool write_aovs = true;
+  /// Colour samples per pixel (render.msaa: 1, 2, 4 or 8; the renderer uses the nearest count
+  /// the driver offers). Above 1 the colour is drawn multisampled and resolved; the AOVs are
+  /// drawn by a single-sample pass of their own, as with 1.
+  int msaa = 1;
   /// Keep shadow-map layers whose inputs did not change (ShadowMapPass); off: draw all.
   bool shadow_cache = true;
 };

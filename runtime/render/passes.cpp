@@ -1167,20 +1167,40 @@ std::span<const ForwardPass::Target> ForwardPass::targets() {
   return list;
 }
 
-void ForwardPass::prepare(const FrameInput& frame) {
-  if (fbo_ && frame.width == width_ && frame.height == height_) return;
-  width_ = frame.width;
-  height_ = frame.height;
-  fbo_ = gpu::make_framebuffer();
+void ForwardPass::prepare(const FrameInput& frame, int samples) {
+  const bool resized = !fbo_ || frame.width != width_ || frame.height != height_;
+  if (resized) {
+    width_ = frame.width;
+    height_ = frame.height;
+    fbo_ = gpu::make_framebuffer();
+    const auto list = targets();
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      gpu::Texture& t = textures_[i];
+      t = gpu::make_texture(GL_TEXTURE_2D);
+      glTextureStorage2D(t.id(), 1, list[i].internal_format, width_, height_);
+      glTextureParameteri(t.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTextureParameteri(t.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      const bool depth = list[i].format == GL_DEPTH_COMPONENT;
+      glNamedFramebufferTexture(fbo_.id(), depth ? GL_DEPTH_ATTACHMENT : GLenum(GL_COLOR_ATTACHMENT0 + i),
+                                t.id(), 0);
+    }
+  }
+  if (!resized && samples == samples_) return;
+  samples_ = samples;
+  msaa_fbo_.reset();
+  for (gpu::Texture& t : msaa_textures_) t.reset();
+  if (samples_ <= 1) return;
+  // The colour and depth formats of targets(), multisampled (fixed sample locations: the
+  // resolve blit does not care, and every driver offers them).
+  msaa_fbo_ = gpu::make_framebuffer();
   const auto list = targets();
-  for (std::size_t i = 0; i < list.size(); ++i) {
-    gpu::Texture& t = textures_[i];
-    t = gpu::make_texture(GL_TEXTURE_2D);
-    glTextureStorage2D(t.id(), 1, list[i].internal_format, width_, height_);
-    glTextureParameteri(t.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(t.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    const bool depth = list[i].format == GL_DEPTH_COMPONENT;
-    glNamedFramebufferTexture(fbo_.id(), depth ? GL_DEPTH_ATTACHMENT : GLenum(GL_COLOR_ATTACHMENT0 + i),
+  const std::size_t which[2] = {0, list.size() - 1};
+  for (std::size_t k = 0; k < 2; ++k) {
+    gpu::Texture& t = msaa_textures_[k];
+    t = gpu::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
+    glTextureStorage2DMultisample(t.id(), samples_, list[which[k]].internal_format, width_, height_,
+                                  GL_TRUE);
+    glNamedFramebufferTexture(msaa_fbo_.id(), k == 0 ? GL_COLOR_ATTACHMENT0 : GL_DEPTH_ATTACHMENT,
                               t.id(), 0);
   }
 }
@@ -1189,24 +1209,57 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list, GpuCac
                            DrawState& state, FrameStats& stats) {
   const GLenum bufs[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
                           GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
-  glNamedFramebufferDrawBuffers(fbo_.id(), frame.write_aovs ? 5 : 1, bufs);
   aovs_written_ = frame.write_aovs;
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
   glViewport(0, 0, frame.width, frame.height);
   glEnable(GL_FRAMEBUFFER_SRGB);
   const glm::vec3 background = tone_map(frame.tone_mapping, frame.clear_color * frame.exposure);
   const float clear_color[4] = {background.r, background.g, background.b, 1.0f};
   const float zero[4] = {0, 0, 0, 0};
   const float one = 1.0f;
-  glClearBufferfv(GL_COLOR, 0, clear_color);
-  if (frame.write_aovs)
-    for (int i = 1; i < 5; ++i) glClearBufferfv(GL_COLOR, i, zero);
+  const glm::mat4 view_proj = frame.camera.proj * frame.camera.view;
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
+  // Whether the single-sample pass below draws colour (no MSAA) or only the AOVs.
+  bool single_colour = true;
+  if (samples_ > 1) {
+    // a. Colour, multisampled. Alpha-masked draws write their coverage as alpha (forward.frag,
+    //    VARIANT_ALPHA_TO_COVERAGE); every stored alpha is 1 (alpha to one).
+    glBindFramebuffer(GL_FRAMEBUFFER, msaa_fbo_.id());
+    glClearBufferfv(GL_COLOR, 0, clear_color);
+    glClearBufferfv(GL_DEPTH, 0, &one);
+    glEnable(GL_SAMPLE_ALPHA_TO_COVERAGE);
+    glEnable(GL_SAMPLE_ALPHA_TO_ONE);
+    const Status st = draw_forward(frame, list.forward_order, list.msaa_keys, nullptr, view_proj,
+                                   cache, state, stats);
+    glDisable(GL_SAMPLE_ALPHA_TO_ONE);
+    glDisable(GL_SAMPLE_ALPHA_TO_COVERAGE);
+    // b. The resolve: the samples' average, taken in linear space (GL_FRAMEBUFFER_SRGB).
+    glNamedFramebufferDrawBuffers(fbo_.id(), 1, bufs);
+    glBlitNamedFramebuffer(msaa_fbo_.id(), fbo_.id(), 0, 0, width_, height_, 0, 0, width_, height_,
+                           GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    if (!st || !frame.write_aovs) {
+      glDisable(GL_FRAMEBUFFER_SRGB);
+      return st;
+    }
+    single_colour = false;
+  }
+  // c. Single sample: colour and the AOVs, or the AOVs alone beside the multisampled colour
+  //    (the same programs as without MSAA; their colour output is dropped).
+  const GLenum aov_bufs[5] = {GL_NONE, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                              GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
+  glNamedFramebufferDrawBuffers(fbo_.id(), frame.write_aovs ? 5 : 1,
+                                single_colour ? bufs : aov_bufs);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
+  if (single_colour) glClearBufferfv(GL_COLOR, 0, clear_color);
+  if (frame.write_aovs)
+    for (int i = 1; i < 5; ++i) glClearBufferfv(GL_COLOR, i, zero);
   glClearBufferfv(GL_DEPTH, 0, &one);
-  const Status st = draw_forward(frame, list.forward_order, list.keys, nullptr,
-                                 frame.camera.proj * frame.camera.view, cache, state, stats);
+  // The AOV pass draws what the colour pass drew: its culling is counted once.
+  const int culled = stats.frustum_culled;
+  const Status st = draw_forward(frame, list.forward_order, list.keys, nullptr, view_proj, cache,
+                                 state, stats);
+  if (!single_colour) stats.frustum_culled = culled;
   glDisable(GL_FRAMEBUFFER_SRGB);
   return st;
 }

@@ -207,12 +207,21 @@ class ProbeCapturePass {
                 const gpu::Buffer& ubo, GpuCache& cache, DrawState& state, FrameStats& stats);
 };
 
+/// The main view. With one sample: one draw of every visible draw into colour and, when asked
+/// for, the AOVs. With `samples` > 1 (render.msaa): the colour is drawn into multisampled colour
+/// and depth targets with DrawList::msaa_keys (alpha-masked draws through alpha to coverage) and
+/// resolved into the single-sample colour target by a blit; the AOVs, when asked for, are drawn
+/// by a second, single-sample pass with DrawList::keys whose colour output goes nowhere, so they
+/// are those of a frame without MSAA, bit for bit. Each sample is tone mapped by forward.frag
+/// before the resolve averages them (in linear space: GL_FRAMEBUFFER_SRGB is on for the blit),
+/// so a bright background does not darken the edges in front of it.
 class ForwardPass {
  public:
-  /// The colour, AOV and depth targets at the frame's size (made when the size changes).
-  void prepare(const FrameInput& frame);
+  /// The colour, AOV and depth targets at the frame's size, and with `samples` > 1 the
+  /// multisampled colour and depth targets (made when the size or sample count changes).
+  void prepare(const FrameInput& frame, int samples);
   /// Draws the main view's visible draws into colour (and the AOVs when asked for). After it:
-  /// colour holds the frame, the AOVs its surfaces when write_aovs.
+  /// colour holds the frame (resolved), the AOVs its surfaces when write_aovs.
   Status record(const FrameInput& frame, const DrawList& list, GpuCache& cache,
                 DrawState& state, FrameStats& stats);
 
@@ -227,16 +236,20 @@ class ForwardPass {
 
   int width() const { return width_; }
   int height() const { return height_; }
+  /// Colour samples of the last prepare() (1: no multisampled targets).
+  int samples() const { return samples_; }
   bool aovs_written() const { return aovs_written_; }
   gpu::FramebufferRef framebuffer() const { return fbo_; }
   /// Attachment i of targets().
   gpu::TextureRef texture(int i) const { return textures_[std::size_t(i)]; }
 
  private:
-  int width_ = 0, height_ = 0;
+  int width_ = 0, height_ = 0, samples_ = 1;
   bool aovs_written_ = false;
   gpu::Framebuffer fbo_;
   std::array<gpu::Texture, 6> textures_;
+  gpu::Framebuffer msaa_fbo_;                 ///< samples_ > 1: colour and depth, multisampled
+  std::array<gpu::Texture, 2> msaa_textures_;  ///< targets() 0 and 5 with samples_ samples
 };
 
 /// The forward path of the main view and of probe faces: draws `order` with `keys` as seen by

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <numeric>
 #include <optional>
@@ -47,6 +48,32 @@ struct Renderer::Impl {
   bool timers_pending = false;
   std::uint64_t frames_rendered = 0;
   bool layer_from_vertex = false;  // GL_ARB_shader_viewport_layer_array: gl_Layer in the VS
+  // Sample counts the driver offers for both multisampled forward targets, ascending (GL 4.5
+  // guarantees 4 at least: GL_MAX_SAMPLES >= 4).
+  std::vector<int> sample_counts;
+
+  // The colour samples of a frame asking for `requested` (render.msaa): the request when the
+  // driver offers it, else the nearest offered count above it, else the largest (with one
+  // warning saying so).
+  int samples_for(int requested) const {
+    if (requested <= 1 || sample_counts.empty()) return 1;
+    int chosen = sample_counts.back();
+    for (int c : sample_counts)
+      if (c >= requested) {
+        chosen = c;
+        break;
+      }
+    if (chosen != requested)
+      log::warn_once("render.msaa %d: this OpenGL driver offers %s samples per pixel for the colour "
+                     "and depth targets (GL_SAMPLES); using %d",
+                     requested, sample_list().c_str(), chosen);
+    return chosen;
+  }
+  std::string sample_list() const {
+    std::string out;
+    for (int c : sample_counts) out += (out.empty() ? "" : ", ") + std::to_string(c);
+    return out;
+  }
 
   // The key as this driver can build it: without gl_Layer in vertex shaders the layered shadow
   // pass falls back to one pass per layer (the same maps).
@@ -74,6 +101,31 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
     log::warn(
         "GL_ARB_shader_viewport_layer_array missing: shadow maps are drawn one layer at a "
         "time");
+  // Sample counts offered for the forward pass's colour and depth formats (GL_SAMPLES lists
+  // them in descending order; each is within GL_MAX_COLOR/DEPTH_TEXTURE_SAMPLES).
+  {
+    const auto list = ForwardPass::targets();
+    std::vector<int> both;
+    for (GLenum format : {list.front().internal_format, list.back().internal_format}) {
+      GLint n = 0;
+      glGetInternalformativ(GL_TEXTURE_2D_MULTISAMPLE, format, GL_NUM_SAMPLE_COUNTS, 1, &n);
+      std::vector<GLint> counts(std::size_t(std::max(n, 0)));
+      if (n > 0)
+        glGetInternalformativ(GL_TEXTURE_2D_MULTISAMPLE, format, GL_SAMPLES, n, counts.data());
+      std::vector<int> sorted(counts.begin(), counts.end());
+      std::sort(sorted.begin(), sorted.end());
+      if (format == list.front().internal_format) {
+        both = sorted;
+      } else {
+        std::vector<int> common;
+        std::set_intersection(both.begin(), both.end(), sorted.begin(), sorted.end(),
+                              std::back_inserter(common));
+        both = common;
+      }
+    }
+    std::erase_if(both, [](int c) { return c < 2; });
+    im.sample_counts = both;
+  }
   im.frame_ubo = gpu::make_buffer();
   glNamedBufferStorage(im.frame_ubo.id(), sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   for (gpu::Query& q : im.timers) q = gpu::make_query(GL_TIME_ELAPSED);
@@ -116,7 +168,7 @@ std::string gib(double bytes) {
 
 }  // namespace
 
-Status Renderer::check_target_size(int width, int height, bool read_aovs) const {
+Status Renderer::check_target_size(int width, int height, bool read_aovs, int msaa) const {
   const std::string size = std::to_string(width) + "x" + std::to_string(height);
   const std::string where = "render size " + size;
   if (width < 1 || height < 1) return Error{"", where, "width and height must be at least 1"};
@@ -145,6 +197,22 @@ Status Renderer::check_target_size(int width, int height, bool read_aovs) const 
                    std::string("the OpenGL driver refuses a ") + t.name + " target of this size (" +
                        gib(pixels * t.bytes_per_pixel) + ")"};
     gpu_bytes += pixels * t.bytes_per_pixel;
+  }
+  // With render.msaa, the multisampled colour and depth targets too, at the count used.
+  if (const int samples = impl_->samples_for(msaa); samples > 1) {
+    const auto list = ForwardPass::targets();
+    for (const ForwardPass::Target* t : {&list.front(), &list.back()}) {
+      glTexImage2DMultisample(GL_PROXY_TEXTURE_2D_MULTISAMPLE, samples, t->internal_format, width,
+                              height, GL_TRUE);
+      GLint got = 0;
+      glGetTexLevelParameteriv(GL_PROXY_TEXTURE_2D_MULTISAMPLE, 0, GL_TEXTURE_WIDTH, &got);
+      const double bytes = pixels * t->bytes_per_pixel * samples;
+      if (got == 0)
+        return Error{"", where,
+                     "the OpenGL driver refuses a " + std::to_string(samples) + "-sample " +
+                         t->name + " target of this size (" + gib(bytes) + "; render.msaa)"};
+      gpu_bytes += bytes;
+    }
   }
   // Read-backs: colour as float RGBA, and with AOVs 14 float channels plus their staging.
   const double host_bytes = pixels * (16.0 + (read_aovs ? 2.0 * 14 * 4 + 64 : 0.0));
@@ -216,7 +284,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   KASKAD_TRY(st);
 
   // 3. Forward. After it: colour (and the AOVs) of the main view.
-  im.forward.prepare(frame);
+  im.forward.prepare(frame, im.samples_for(frame.msaa));
+  stats_.msaa_samples = im.forward.samples();
   glBeginQuery(GL_TIME_ELAPSED, im.timers[1].id());
   st = im.forward.record(frame, list, *im.cache, state, stats_);
   glEndQuery(GL_TIME_ELAPSED);

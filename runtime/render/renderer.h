@@ -31,10 +31,12 @@ namespace kaskad::render {
 /// Draw calls are GL draw calls: draws that share mesh, program and material are one instanced
 /// draw. Instances are the objects those calls draw.
 struct FrameStats {
-  int draw_calls = 0;                 ///< forward pass of the main view
+  /// Forward pass of the main view; with render.msaa > 1 and AOVs, its multisampled colour
+  /// and single-sample AOV draws together (each object twice).
+  int draw_calls = 0;
   int instances = 0;                  ///< objects drawn by them
   int frustum_culled = 0;             ///< draws outside the main view's frustum, not drawn
-  std::size_t triangles = 0;          ///< submitted in the forward pass
+  std::size_t triangles = 0;          ///< submitted in the forward pass (both, as draw_calls)
   /// Shadow pass draw calls recorded this frame (0 when every layer kept its depth).
   int shadow_draw_calls = 0;
   /// Caster instances in the shadow map's layers (one per caster and layer) and their
@@ -82,6 +84,8 @@ struct FrameStats {
   int probe_draw_calls = 0;           ///< draw calls into those faces (not in draw_calls)
   int probe_instances = 0;            ///< objects they draw
   int probe_culled = 0;               ///< draws outside a captured face's frustum, not drawn
+  /// Colour samples per pixel of the main view (render.msaa as the driver offers it; 1: none).
+  int msaa_samples = 1;
   int program_switches = 0;           ///< glUseProgram calls in the frame (draws are sorted)
   int material_switches = 0;          ///< material uniform/texture updates in the frame
   ShaderStats shaders;                ///< compiles, cache hits, compile ms (since creation)
@@ -110,8 +114,9 @@ class Renderer {
   /// GL limits (GL_MAX_TEXTURE_SIZE, GL_MAX_RENDERBUFFER_SIZE, GL_MAX_VIEWPORT_DIMS), the driver's
   /// answer for each target format (proxy textures: llvmpipe refuses textures over 1 GiB) and an
   /// estimate of the memory the targets and read-backs take against the memory available.
+  /// With `msaa` > 1 (render.msaa), the multisampled colour and depth targets count too.
   /// The error names the size and what refused it.
-  Status check_target_size(int width, int height, bool read_aovs) const;
+  Status check_target_size(int width, int height, bool read_aovs, int msaa = 1) const;
 
   /// Records and submits the shadow and forward passes. Meshes and textures are uploaded from
   /// `assets` on first use. Errors: shader compile/link failures (content errors).

@@ -24,6 +24,7 @@
 //   shadow_technique != pcf, shadow_kernel != k3x3 and shadow_peel need shadow
 //   emissive_texture needs emissive
 //   reflection_pbr needs reflection_cube
+//   alpha_to_coverage is kept by the forward pass only with alpha_mask (filtered_for())
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask with its
 // texture_transform, peeling, and the projection when it is dual_paraboloid: its vertex shader
 // differs), so every material shares one or two shadow programs.
@@ -177,6 +178,12 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // render.tone_mapping (components/tone_mapping.h): the curve the colour output goes through.
     {.name = "tone_mapping", .kind = FeatureKind::frame, .define = "VARIANT_TONE_MAPPING",
      .stages = kFragmentStage, .offset = 40, .values = {"none", "khr_pbr_neutral", "aces"}},
+    // render.msaa > 1: the multisampled colour pass. An alpha-masked draw writes its coverage
+    // (alpha sharpened around the cutoff) instead of discarding, and GL_SAMPLE_ALPHA_TO_COVERAGE
+    // turns it into samples. Only alpha-masked programs keep it (filtered_for()), so the others
+    // are shared with the single-sample pass.
+    {.name = "alpha_to_coverage", .kind = FeatureKind::frame, .define = "VARIANT_ALPHA_TO_COVERAGE",
+     .stages = kFragmentStage, .offset = 42},
     // Where light from the surroundings comes from (components/ibl.h): the uniform ambient
     // radiance, or render.environment's SH and prefiltered cube.
     {.name = "environment", .kind = FeatureKind::frame, .define = "VARIANT_ENVIRONMENT",
@@ -302,6 +309,8 @@ class VariantKey {
   static constexpr Field kToneMapping = feature_field("tone_mapping");
   /// 0 uniform (the ambient radiance), 1 map (render.environment).
   static constexpr Field kEnvironment = feature_field("environment");
+  /// The multisampled colour pass's alpha-masked draws: coverage from alpha (render.msaa > 1).
+  static constexpr Field kAlphaToCoverage = feature_field("alpha_to_coverage");
   static constexpr std::uint64_t kFrameMask = 0x0000ffffffff0000u;
 
   constexpr VariantKey() = default;
@@ -344,7 +353,7 @@ class VariantKey {
   /// The part of the key a pass's shaders read. The depth pass only needs alpha masking (and
   /// peeling); the shadow-points, LOM occlusion and VSM moments passes only the shadow lookup's
   /// frame features (a receiver, without AOVs or the debug tint); the forward pass needs
-  /// everything.
+  /// everything but alpha_to_coverage on draws without alpha_mask (it changes nothing there).
   constexpr VariantKey filtered_for(Pass pass) const {
     if (pass == Pass::depth) {
       const std::uint64_t projection = get(kShadowProjection) == kProjectionDualParaboloid
@@ -360,8 +369,9 @@ class VariantKey {
     if (pass == Pass::shadow_points || pass == Pass::lom_occlusion || pass == Pass::vsm_moments)
       return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask() &
                          ~kShadowLayered.mask() & ~kToneMapping.mask() & ~kShadowPeel.mask() &
-                         ~kEnvironment.mask()) |
+                         ~kEnvironment.mask() & ~kAlphaToCoverage.mask()) |
                         kReceiveShadows.mask());
+    if (!has(kAlphaMask)) return VariantKey(bits_ & ~kAlphaToCoverage.mask());
     return *this;
   }
 
@@ -405,6 +415,14 @@ static_assert(VariantKey()
                   .set(VariantKey::kShadowFilter, 2)
                   .filtered_for(Pass::depth) ==
               VariantKey().set(VariantKey::kShadow, 1).set(VariantKey::kShadowProjection, 3));
+
+static_assert(VariantKey().set(VariantKey::kAlphaToCoverage, 1).filtered_for(Pass::forward) ==
+              VariantKey());
+static_assert(VariantKey().set(VariantKey::kAlphaToCoverage, 1).set(VariantKey::kAlphaMask, 1)
+                  .filtered_for(Pass::forward)
+                  .has(VariantKey::kAlphaToCoverage));
+static_assert(VariantKey().set(VariantKey::kAlphaToCoverage, 1).set(VariantKey::kAlphaMask, 1)
+                  .filtered_for(Pass::depth) == VariantKey().set(VariantKey::kAlphaMask, 1));
 
 /// A program a frame needs: a pass and its key.
 struct ProgramRequest {

@@ -248,9 +248,10 @@ TEST_F(PermutationTest, HotReloadKeepsTheLastGoodProgramAndMapsErrors) {
   {
     std::ifstream in(dir / "forward.frag");
     std::string f((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const std::string from = "o_color = vec4(tone_map(color * u_frame.x), 1.0);";
+    const std::string from = "o_color = vec4(tone_map(color * u_frame.x), coverage);";
     ASSERT_NE(f.find(from), std::string::npos);
-    f.replace(f.find(from), from.size(), "o_color = vec4(tone_map(color * u_frame.x) + 0.2, 1.0);");
+    f.replace(f.find(from), from.size(),
+              "o_color = vec4(tone_map(color * u_frame.x) + 0.2, coverage);");
     std::ofstream(dir / "forward.frag", std::ios::trunc) << f;
   }
   for (const char* name : {"common.glsl", "forward.frag"})

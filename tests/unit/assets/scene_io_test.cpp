@@ -773,6 +773,39 @@ TEST(SceneIo, ExposureInEv) {
   EXPECT_FLOAT_EQ(s->render.exposure, 0.5f);  // unchanged
 }
 
+// render.msaa: 1 by default, 2, 4 or 8 from a file, --set and live; saved and read back;
+// anything else is an error naming the key and the value, and changes nothing when live.
+TEST(SceneIo, MsaaLoadsSavesAndRejectsOtherCounts) {
+  const fs::path def = kContent / "scenes" / "default.json";
+  auto d = read_scene(def);
+  ASSERT_TRUE(d.ok()) << d.error().to_string();
+  EXPECT_EQ(d->render.msaa, 1);
+  EXPECT_EQ(scene_to_json(*d)["render"]["msaa"].get<int>(), 1);
+  for (int samples : {1, 2, 4, 8}) {
+    auto s = read_scene(def, {"render.msaa=" + std::to_string(samples)});
+    ASSERT_TRUE(s.ok()) << s.error().to_string();
+    EXPECT_EQ(s->render.msaa, samples);
+    const fs::path out = temp_dir() / "msaa_saved.json";
+    ASSERT_TRUE(save_scene(out, *s).ok());
+    auto again = read_scene(out);
+    ASSERT_TRUE(again.ok()) << again.error().to_string();
+    EXPECT_EQ(again->render.msaa, samples);
+  }
+  auto file = read_scene(write_file("msaa.json", R"({"render": {"msaa": 8}, "entities": []})"));
+  ASSERT_TRUE(file.ok()) << file.error().to_string();
+  EXPECT_EQ(file->render.msaa, 8);
+  for (const char* bad : {"0", "3", "16", "-4"})
+    expect_error(read_scene(def, {std::string("render.msaa=") + bad}),
+                 {"/render/msaa", "must be 1, 2, 4 or 8", std::string("was ") + bad});
+  expect_error(read_scene(def, {"render.msaa=4.5"}), {"/render/msaa", "expected an integer"});
+  ASSERT_TRUE(apply_live_override(*file, "render.msaa=2").ok());
+  EXPECT_EQ(file->render.msaa, 2);
+  auto live = apply_live_override(*file, "render.msaa=6");
+  ASSERT_FALSE(live.ok());
+  EXPECT_NE(live.error().to_string().find("msaa"), std::string::npos);
+  EXPECT_EQ(file->render.msaa, 2);  // unchanged
+}
+
 TEST(SceneIo, EntitiesAreAddedAndRemovedBetweenFrames) {
   auto s = read_scene(kContent / "scenes" / "default.json");
   ASSERT_TRUE(s.ok());
