@@ -497,6 +497,9 @@ int run_render(Args a) {
                 pd.probes.size(), static_cast<unsigned long long>(pd.captures_total),
                 static_cast<unsigned long long>(pd.faces_total), st.probe_faces,
                 st.probe_instances, st.probe_draw_calls, st.probe_culled);
+    if (timings->first_probe_rounds > 1)
+      std::printf("          first frame: %d capture rounds (render.probe_bounces), %d faces\n",
+                  timings->first_probe_rounds, timings->first_probe_faces);
   }
   std::printf("shaders   %d compiled, %d from the binary cache, %.1f ms (prewarm %.1f ms); "
               "%d compiled after the first frame\n",

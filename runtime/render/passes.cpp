@@ -126,6 +126,11 @@ DrawState::DrawState(ShaderLibrary& shaders, GpuCache& cache, FrameStats& stats)
       stats_(stats),
       features_by_uniform_(shaders.features_by_uniform()) {}
 
+void DrawState::forget_program() {
+  program_ = {};
+  material_ = nullptr;
+}
+
 Status DrawState::use_program(Pass pass, VariantKey key) {
   auto prog = shaders_.program(pass, key);
   if (!prog) return prog.error();
@@ -998,7 +1003,7 @@ Image MomentsPass::read() const {
 // ---- Forward drawing (main view and probe faces) ------------------------------------------------
 
 Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> order,
-                    const std::vector<VariantKey>& keys, const ProbeJob* capture,
+                    const std::vector<VariantKey>& keys, const ProbeJob* capture, int round,
                     const glm::mat4& view_proj, GpuCache& cache, DrawState& state,
                     FrameStats& stats) {
   int& culled = capture ? stats.probe_culled : stats.frustum_culled;
@@ -1033,14 +1038,13 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
     }
     glFrontFace(mirrored ? GL_CW : GL_CCW);
     state.bind_material(d, keys[i]);
-    // A draw reflecting a probe gets its map: `visible` as of before this frame's captures (a
-    // probe never sees a cube being captured), and k_s * p_r.
+    // A draw reflecting a probe gets its map (probe_read_buffer(): never a cube being
+    // captured), and k_s * p_r.
     const VariantKey key = keys[i];
     if (reflective(i)) {
       for (const ProbeJob& job : frame.probes) {
         if (job.handle != d.probe) continue;
-        const bool swapped_now = job.faces != 0 && job.target == job.visible;
-        const int buffer = capture && swapped_now ? 1 - job.visible : job.visible;
+        const int buffer = probe_read_buffer(job, capture ? round : 0);
         glBindTextureUnit(kTexReflectionCube, cache.probes().existing_cube(job.handle, buffer).id());
         glBindTextureUnit(kTexReflectionSphere, cache.probes().existing_sphere(job.handle).id());
         glProgramUniform4f(prog, kLocReflection, d.reflection_scale, 0.0f, 0.0f, 0.0f);
@@ -1085,35 +1089,58 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   Status status;
-  for (const ProbeJob& job : frame.probes) {
-    if (job.env_map != kNoProbe || job.faces == 0) continue;  // static maps were uploaded
-    cache.probes().cube(job.handle, job.target, job.resolution);
-    for (int f = 0; f < 6 && status; ++f) {
-      if (!(job.faces & (1u << f))) continue;
-      const FrameBlock face = probe_face_block(main, job, f);
-      glNamedBufferSubData(ubo.id(), 0, sizeof face, &face);
-      cache.probes().begin_face(job.handle, job.target, f, frame.clear_color);
-      const int before = stats.draw_calls, instances_before = stats.instances;
-      const std::size_t triangles_before = stats.triangles;
-      status = draw_forward(frame, list.capture_order, list.capture_keys, &job, face.view_proj,
-                            cache, state, stats);
-      // Draws into faces are counted apart from the main view's.
-      stats.probe_draw_calls += stats.draw_calls - before;
-      stats.probe_instances += stats.instances - instances_before;
-      stats.draw_calls = before;
-      stats.instances = instances_before;
-      stats.triangles = triangles_before;
-      ++stats.probe_faces;
+  // Every cube captured this frame exists before the first face is drawn, so that a probe read
+  // before its first capture is a black cube, not an empty texture unit.
+  int rounds = 1;
+  for (const ProbeJob& job : frame.probes)
+    if (job.env_map == kNoProbe && job.faces != 0) {
+      cache.probes().cube(job.handle, job.target, job.resolution);
+      rounds = std::max(rounds, job.rounds);
     }
-    if (!status) break;
-    // Complete (the target is now the visible buffer): rebuild its mip chain.
-    if (job.target == job.visible) cache.probes().finish_cube(job.handle, job.target);
+  // Round k draws every probe due in it into capture_buffer(job, k), its reflective draws
+  // reading the other probes' maps of round k - 1 (probe_read_buffer()).
+  for (int round = 1; round <= rounds && status; ++round) {
+    for (const ProbeJob& job : frame.probes) {
+      if (job.env_map != kNoProbe || job.faces == 0 || round > job.rounds) continue;
+      const int buffer = capture_buffer(job, round);
+      for (int f = 0; f < 6 && status; ++f) {
+        if (!(job.faces & (1u << f))) continue;
+        const FrameBlock face = probe_face_block(main, job, f);
+        glNamedBufferSubData(ubo.id(), 0, sizeof face, &face);
+        cache.probes().begin_face(job.handle, buffer, f, frame.clear_color);
+        const int before = stats.draw_calls, instances_before = stats.instances;
+        const std::size_t triangles_before = stats.triangles;
+        status = draw_forward(frame, list.capture_order, list.capture_keys, &job, round,
+                              face.view_proj, cache, state, stats);
+        // Draws into faces are counted apart from the main view's.
+        stats.probe_draw_calls += stats.draw_calls - before;
+        stats.probe_instances += stats.instances - instances_before;
+        stats.draw_calls = before;
+        stats.instances = instances_before;
+        stats.triangles = triangles_before;
+        ++stats.probe_faces;
+      }
+      if (!status) break;
+      // Complete (a round's cube, or the target that is now the visible buffer): rebuild its
+      // mip chain before anything samples it.
+      if (job.target == job.visible) cache.probes().finish_cube(job.handle, buffer);
+    }
+    // A sphere-mapped probe is read through its sphere map: the next round's reads need this
+    // round's.
+    if (round < rounds && status) {
+      for (const ProbeJob& job : frame.probes)
+        if (job.sphere && job.rounds > round)
+          cache.probes().update_sphere(job.handle, capture_buffer(job, round),
+                                       glm::mat3(frame.camera.view));
+      state.forget_program();  // update_sphere() used its own program and texture unit 0
+    }
   }
   glNamedBufferSubData(ubo.id(), 0, sizeof main, &main);  // the main view's block again
   if (!status) return status;
   for (const ProbeJob& job : frame.probes)
     if (job.sphere && cache.probes().existing_cube(job.handle, job.visible))
       cache.probes().update_sphere(job.handle, job.visible, glm::mat3(frame.camera.view));
+  state.forget_program();
   return {};
 }
 
@@ -1170,7 +1197,7 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list, GpuCac
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   glClearBufferfv(GL_DEPTH, 0, &one);
-  const Status st = draw_forward(frame, list.forward_order, list.keys, nullptr,
+  const Status st = draw_forward(frame, list.forward_order, list.keys, nullptr, 0,
                                  frame.camera.proj * frame.camera.view, cache, state, stats);
   glDisable(GL_FRAMEBUFFER_SRGB);
   return st;

@@ -39,6 +39,9 @@ class DrawState {
   Status use_program(Pass pass, VariantKey key);
   /// The program in use.
   gpu::ProgramRef program() const { return program_; }
+  /// After GL work outside this class changed the program or texture units: the next
+  /// use_program() and bind_material() bind again.
+  void forget_program();
   /// The material of draw `d` on the current program; `key`: the key that program was compiled
   /// for (its material features say which optional uniforms exist).
   void bind_material(const DrawItem& d, VariantKey key);
@@ -235,10 +238,10 @@ class ForwardPass {
 
 /// The forward path of the main view and of probe faces: draws `order` with `keys` as seen by
 /// `view_proj` (culled per draw), binding reflection maps; `capture` names the probe face being
-/// drawn (its reflector is left out, and reflections read the maps as of before this frame's
-/// captures).
+/// drawn in capture round `round` (its reflector is left out, and reflections read
+/// probe_read_buffer(job, round)); the main view passes none and round 0.
 Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> order,
-                    const std::vector<VariantKey>& keys, const ProbeJob* capture,
+                    const std::vector<VariantKey>& keys, const ProbeJob* capture, int round,
                     const glm::mat4& view_proj, GpuCache& cache, DrawState& state,
                     FrameStats& stats);
 
