@@ -169,6 +169,9 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
   }
   if (features.has(VariantKey::kEmissiveTexture) || features_by_uniform_)
     glBindTextureUnit(kTexEmissive, cache_.texture(m.emissive_texture, false).id());
+  if (features.has(VariantKey::kMetallicRoughnessTexture) || features_by_uniform_)
+    glBindTextureUnit(kTexMetallicRoughness,
+                      cache_.texture(m.metallic_roughness_texture, false).id());
   if (features.has(VariantKey::kTextureTransform) || features_by_uniform_) {
     std::array<glm::vec4, 2 * kUvSlotCount> rows{};
     const TextureTransform* slots[kUvSlotCount] = {};
@@ -176,6 +179,7 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
     slots[kUvSlotNormal] = &m.normal_transform;
     slots[kUvSlotOcclusion] = &m.occlusion_transform;
     slots[kUvSlotEmissive] = &m.emissive_transform;
+    slots[kUvSlotMetallicRoughness] = &m.metallic_roughness_transform;
     for (int i = 0; i < kUvSlotCount; ++i) {
       const auto r = uv_transform_rows(*slots[i]);
       rows[std::size_t(2 * i)] = glm::vec4(r[0], 0.0f);

@@ -127,6 +127,9 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // scale (Material::*_transform). The depth pass keeps it with alpha_mask (cut-outs).
     {.name = "texture_transform", .define = "MATERIAL_HAS_TEXTURE_TRANSFORM",
      .stages = kFragmentStage, .offset = 10},
+    // glTF metallicRoughnessTexture (linear; B metallic, G roughness): multiplies the factors.
+    {.name = "metallic_roughness_texture", .define = "MATERIAL_HAS_METALLIC_ROUGHNESS_TEXTURE",
+     .stages = kFragmentStage, .offset = 11},
     // Frame features (bits 16-31).
     {.name = "shadow", .kind = FeatureKind::frame, .define = "VARIANT_HAS_SHADOW",
      .stages = kFragmentStage, .offset = 16},
@@ -263,6 +266,7 @@ class VariantKey {
   static constexpr Field kOcclusionTexture = feature_field("occlusion_texture");
   static constexpr Field kEmissiveTexture = feature_field("emissive_texture");
   static constexpr Field kTextureTransform = feature_field("texture_transform");
+  static constexpr Field kMetallicRoughnessTexture = feature_field("metallic_roughness_texture");
   static constexpr std::uint64_t kMaterialMask = 0x0000ffffu;
   // Frame features.
   static constexpr Field kShadow = feature_field("shadow");
