@@ -1141,10 +1141,13 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
   }
   glNamedBufferSubData(ubo.id(), 0, sizeof main, &main);  // the main view's block again
   if (!status) return status;
+  bool spheres = false;
   for (const ProbeJob& job : frame.probes)
-    if (job.sphere && cache.probes().existing_cube(job.handle, job.visible))
+    if (job.sphere && cache.probes().existing_cube(job.handle, job.visible)) {
       cache.probes().update_sphere(job.handle, job.visible, glm::mat3(frame.camera.view));
-  state.forget_program();
+      spheres = true;
+    }
+  if (spheres) state.forget_program();  // as between rounds
   return {};
 }
 
