@@ -55,8 +55,11 @@ struct Material {
   TextureId emissive_texture = kNoTexture;     ///< sRGB texture, multiplied by emissive
   TextureId occlusion_texture = kNoTexture;    ///< linear; R is the ambient occlusion
   float occlusion_strength = 1.0f;             ///< glTF occlusionTexture.strength, [0,1]
+  /// glTF metallicRoughnessTexture: linear; B times `metallic`, G times `roughness`.
+  TextureId metallic_roughness_texture = kNoTexture;
   /// KHR_texture_transform per texture slot (identity: none).
-  TextureTransform base_color_transform, normal_transform, occlusion_transform, emissive_transform;
+  TextureTransform base_color_transform, normal_transform, occlusion_transform, emissive_transform,
+      metallic_roughness_transform;
   bool double_sided = false;                   ///< glTF doubleSided: light both faces
   bool alpha_mask = false;                     ///< glTF alphaMode MASK: discard below alpha_cutoff
   float alpha_cutoff = 0.5f;                   ///< glTF alphaCutoff

@@ -12,6 +12,12 @@
 
 namespace kaskad {
 
+/// render.probe_bounces (runtime/assets/scene.h): capture rounds on a frame where probes make
+/// their first capture. S3 has one round (a mirror seen in another's first map is black); 2, the
+/// default, lets every first map show the others' first maps (one inter-reflection), which is
+/// what a viewer notices; each further round costs the first captures once more. Engine choice.
+inline constexpr int kMinProbeBounces = 1, kMaxProbeBounces = 4, kDefaultProbeBounces = 2;
+
 /// The reflection map type (S3): a cube map, or a sphere map generated from the cube.
 enum class ReflectionMap { cube, sphere };
 

@@ -1,7 +1,9 @@
 #include "systems/environment_probe_system.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
+#include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -11,6 +13,7 @@
 #include "components/model.h"
 #include "components/transform.h"
 #include "runtime/core/log.h"
+#include "runtime/core/result.h"
 
 namespace kaskad {
 namespace {
@@ -169,17 +172,34 @@ Aabb reflector_bounds(const ecs::World& world, ecs::Entity e) {
   return box;
 }
 
-ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool commit) {
+int probe_capture_rounds(int full_captures, bool any_first, int bounces) {
+  KASKAD_CHECK(bounces >= kMinProbeBounces && bounces <= kMaxProbeBounces,
+               "probe_capture_rounds: bounces must be in [1, 4], was " + std::to_string(bounces));
+  // One probe alone gains nothing from a second round: it never sees itself, and nothing else
+  // it sees changes between rounds.
+  return any_first && full_captures >= 2 ? bounces : 1;
+}
+
+ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool commit,
+                                    int bounces) {
   ProbeData out;
-  std::vector<std::pair<ecs::Entity, ProbeState>> states;
+  struct Planned {
+    ecs::Entity entity;
+    ProbeState state;
+    ProbeWork work;
+    bool first = false;  // this frame's capture is the probe's first
+  };
+  std::vector<Planned> planned;
   world.view<Reflector>().each([&](ecs::Entity e, const Reflector&) {
     const ProbeState* s = world.try_get<ProbeState>(e);
     ProbeState st = s ? *s : ProbeState{};
     // Index and generation: a reflector in a reused entity slot must not get the old maps.
     st.handle = ProbeHandle::of(e.index, e.generation);
-    states.emplace_back(e, st);
+    planned.push_back({e, st, {}, false});
   });
-  for (auto& [e, s] : states) {
+  for (Planned& p : planned) {
+    const ecs::Entity e = p.entity;
+    ProbeState& s = p.state;
     const Reflector& r = world.get<Reflector>(e);
     // 1. Capture centre: explicit, else the world-bounds centre (S3 wants the pivot there).
     const WorldTransform* wt = world.try_get<WorldTransform>(e);
@@ -206,8 +226,31 @@ ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool
         r.update == ProbeUpdate::on_change
             ? scene_signature(world, e, s.center, r.far, r.exclude_layers)
             : 0;
-    const ProbeWork work = schedule_probe(r, s, frame, signature);
-    // 3. Publish.
+    const bool had_map = s.has_map;
+    p.work = schedule_probe(r, s, frame, signature);
+    p.first = p.work.swap && !had_map;
+  }
+  // 3. Bounce rounds: the probes that capture all six faces this frame take part, when one of
+  // them makes its first capture (probe_capture_rounds()).
+  int full = 0;
+  bool any_first = false;
+  for (const Planned& p : planned) {
+    full += p.work.faces == kAllFaces && p.work.swap;
+    any_first = any_first || p.first;
+  }
+  const int rounds = probe_capture_rounds(full, any_first, bounces);
+  for (Planned& p : planned) {
+    const ecs::Entity e = p.entity;
+    ProbeState& s = p.state;
+    const Reflector& r = world.get<Reflector>(e);
+    const ProbeWork& work = p.work;
+    const int job_rounds = work.faces == kAllFaces && work.swap ? rounds : 1;
+    // Round k writes the buffer round k + 1 reads from, and the last one the new front
+    // (capture_buffer()); round 1 writes the back buffer, so with an even number of rounds the
+    // front ends where it was.
+    if (job_rounds % 2 == 0) s.front = 1 - s.front;
+    s.faces_rendered += std::uint64_t(std::popcount(unsigned(work.faces))) * std::uint64_t(job_rounds - 1);
+    // 4. Publish.
     ProbeData::Entry entry;
     entry.entity = e;
     entry.has_map = s.has_map;
@@ -222,6 +265,7 @@ ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool
     job.exclude_layers = r.exclude_layers;
     job.faces = work.faces;
     job.faces_per_frame = r.faces_per_frame;
+    job.rounds = job_rounds;
     // After a swap s.front is already the buffer just completed; else the back buffer is 1 - front.
     job.target = work.swap ? s.front : 1 - s.front;
     job.visible = s.front;
@@ -233,14 +277,15 @@ ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool
     for (int f = 0; f < 6; ++f) job.view_proj[std::size_t(f)] = proj * cube_face_view(f, s.center);
     if (work.load)
       if (const StaticEnvMap* env = world.try_get<StaticEnvMap>(e)) job.env_map = env->index;
-    out.faces_this_frame += std::popcount(unsigned(work.faces));
+    out.faces_this_frame += std::popcount(unsigned(work.faces)) * job_rounds;
     out.captures_this_frame += (work.swap || work.load) ? 1 : 0;
     out.captures_total += s.captures;
     out.faces_total += s.faces_rendered;
+    out.rounds = std::max(out.rounds, job_rounds);
     out.probes.push_back(entry);
   }
   if (commit)
-    for (auto& [e, s] : states) world.emplace<ProbeState>(e, s);
+    for (const Planned& p : planned) world.emplace<ProbeState>(p.entity, p.state);
   return out;
 }
 

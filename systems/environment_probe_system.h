@@ -29,7 +29,8 @@ struct ProbeData {
     float amount = 1.0f;   ///< S3's p_r
   };
   std::vector<Entry> probes;
-  int faces_this_frame = 0;          ///< cube faces captured this frame, all probes
+  int faces_this_frame = 0;          ///< cube faces captured this frame, all probes and rounds
+  int rounds = 1;                    ///< capture rounds this frame (probe_capture_rounds())
   int captures_this_frame = 0;       ///< captures completed (or files loaded) this frame
   std::uint64_t captures_total = 0;  ///< since load, all probes (ProbeState counters)
   std::uint64_t faces_total = 0;
@@ -40,9 +41,12 @@ struct ProbeData {
 
 /// Phase 4 (Probes). Adds ProbeState to new Reflectors, computes each capture centre (explicit,
 /// else the world-bounds centre, warning once about an off-centre pivot), the on_change
-/// signature, and runs schedule_probe(). With `commit` false (planning: prewarm, `kaskad
-/// variants`) nothing in the world changes. Needs current WorldTransform/WorldBounds.
-ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool commit = true);
+/// signature, runs schedule_probe(), then gives the probes that capture all six faces this frame
+/// probe_capture_rounds() rounds (`bounces`: render.probe_bounces, in [1, 4]); faces counters
+/// count every round. With `commit` false (planning: prewarm, `kaskad variants`) nothing in the
+/// world changes. Needs current WorldTransform/WorldBounds.
+ProbeData update_environment_probes(ecs::World& world, std::uint64_t frame, bool commit = true,
+                                    int bounces = kDefaultProbeBounces);
 
 // ---- Pure parts, exposed for tests -------------------------------------------------------------
 
@@ -70,6 +74,16 @@ struct ProbeWork {
 /// first frame (no map exists yet to show meanwhile).
 ProbeWork schedule_probe(const Reflector& r, ProbeState& s, std::uint64_t frame,
                          std::uint64_t signature);
+
+/// Capture rounds of a frame on which `full_captures` probes capture all six faces, `any_first`
+/// whether one of them captures for the first time, and `bounces` is render.probe_bounces (in
+/// [kMinProbeBounces, kMaxProbeBounces]; a precondition). Those probes are captured `bounces`
+/// times in a row, round k reading the others' maps of round k - 1 (round 1: their maps as of
+/// before the frame, black before a first capture), so with 2 a mirror seen in another mirror's
+/// first map shows its own first map instead of black. Else 1: re-captures read the others'
+/// maps of earlier frames, which already hold their bounces, and time-sliced captures keep their
+/// per-frame cost. A probe never sees itself, so one capturing probe alone gets 1 round too.
+int probe_capture_rounds(int full_captures, bool any_first, int bounces);
 
 /// GL cube-map face f (0..5 = +X, -X, +Y, -Y, +Z, -Z): world -> view of a 90° camera at `center`
 /// (S3: the pivot's translation, the six orientations by rotation) such that NDC (x, y) is the

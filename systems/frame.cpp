@@ -187,7 +187,8 @@ bool run_systems(Scene& scene, const FrameContext& ctx, SystemState& state, bool
   report.shadows_ms = ms_since(t);
 
   t = Clock::now();
-  report.probes = update_environment_probes(scene.world, ctx.index, commit);
+  report.probes = update_environment_probes(scene.world, ctx.index, commit,
+                                            scene.render.probe_bounces);
   report.probes_ms = ms_since(t);
 
   t = Clock::now();

@@ -52,6 +52,10 @@ layout(binding = UNIT_OCCLUSION) uniform sampler2D u_occlusion_tex;   // linear,
 #if MATERIAL_HAS_EMISSIVE_TEXTURE
 layout(binding = UNIT_EMISSIVE) uniform sampler2D u_emissive_tex;  // sRGB, times u_emissive
 #endif
+#if MATERIAL_HAS_METALLIC_ROUGHNESS_TEXTURE
+// Linear: B times the metallic factor, G times the roughness factor (glTF 2.0, 3.9.2).
+layout(binding = UNIT_METALLIC_ROUGHNESS) uniform sampler2D u_metallic_roughness_tex;
+#endif
 
 
 #ifdef VERTEX_STAGE_INSTANCED

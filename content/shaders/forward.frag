@@ -122,6 +122,13 @@ void main() {
 
   float metallic = clamp(u_material.x, 0.0, 1.0);
   float roughness = u_material.y;  // brdf_evaluate() and ibl_combine() clamp it
+#if MATERIAL_HAS_METALLIC_ROUGHNESS_TEXTURE
+  if (ENABLED(BIT_METALLIC_ROUGHNESS_TEXTURE)) {
+    vec4 mr = texture(u_metallic_roughness_tex, slot_uv(UV_SLOT_METALLIC_ROUGHNESS, v_uv));
+    metallic = clamp(u_material.x * mr.b, 0.0, 1.0);
+    roughness = u_material.y * mr.g;
+  }
+#endif
 
   float view_depth = -(u_view * vec4(v_world_pos, 1.0)).z;
   // glTF's occlusion texture scales the light from the surroundings only:

@@ -1143,9 +1143,16 @@ Result<Material> read_material(Importer& im, int index) {
   if (!emissive_slot) return emissive_slot.error();
   m.emissive_texture = emissive_slot->texture;
   m.emissive_transform = emissive_slot->transform;
+  // Metallic-roughness: linear, B times metallicFactor, G times roughnessFactor (glTF 3.9.2).
+  auto mr_slot = read_slot(im, pbr.metallicRoughnessTexture.index,
+                           pbr.metallicRoughnessTexture.texCoord,
+                           pbr.metallicRoughnessTexture.extensions, false,
+                           where + " metallicRoughnessTexture");
+  if (!mr_slot) return mr_slot.error();
+  m.metallic_roughness_texture = mr_slot->texture;
+  m.metallic_roughness_transform = mr_slot->transform;
 
   std::string ignored;
-  if (pbr.metallicRoughnessTexture.index >= 0) ignored += " metallicRoughnessTexture";
   if (g.alphaMode == "MASK") {
     m.alpha_mask = true;
     m.alpha_cutoff = float(std::clamp(g.alphaCutoff, 0.0, 1.0));

@@ -110,7 +110,8 @@ Result<Material> load_material_file(const std::filesystem::path& file,
         else fail(pr.at(key), "parameter '" + p.name + "' is declared but the engine does not know it");
       }
     }
-    m.normal_transform = m.occlusion_transform = m.emissive_transform = m.base_color_transform;
+    m.normal_transform = m.occlusion_transform = m.emissive_transform =
+        m.metallic_roughness_transform = m.base_color_transform;
     m.alpha_mask = std::find(features.begin(), features.end(), "alpha_mask") != features.end();
     // 3. Textures: declared slot, its feature listed; listed texture features need their texture.
     std::vector<std::string> given;
@@ -130,6 +131,7 @@ Result<Material> load_material_file(const std::filesystem::path& file,
         if (slot->name == "normal") m.normal_texture = *tex;
         else if (slot->name == "occlusion") m.occlusion_texture = *tex;
         else if (slot->name == "emissive") m.emissive_texture = *tex;
+        else if (slot->name == "metallic_roughness") m.metallic_roughness_texture = *tex;
         else if (slot->name == "base_color") m.base_color_texture = *tex;
         else fail(at, "texture slot '" + slot->name + "' is declared but the engine does not know it");
         given.push_back(slot->name);

@@ -37,6 +37,8 @@ inline std::uint32_t derive_material_features(const Material& m) {
   if (uses(m.normal_texture, m.normal_transform)) bits |= VariantKey::kNormalMap.mask();
   if (uses(m.occlusion_texture, m.occlusion_transform))
     bits |= VariantKey::kOcclusionTexture.mask();
+  if (uses(m.metallic_roughness_texture, m.metallic_roughness_transform))
+    bits |= VariantKey::kMetallicRoughnessTexture.mask();
   if (m.alpha_mask) bits |= VariantKey::kAlphaMask.mask();
   if (m.emissive.r > 0.0f || m.emissive.g > 0.0f || m.emissive.b > 0.0f) {
     bits |= VariantKey::kEmissive.mask();

@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "components/ibl.h"
+#include "components/reflector.h"
 #include "components/shadow_settings.h"
 #include "components/tone_mapping.h"
 #include "runtime/assets/asset_store.h"
@@ -58,6 +59,10 @@ struct RenderSettings {
   /// Shadow caching: a shadow-map layer whose inputs are those it was last drawn from keeps its
   /// depth. Off, every layer is drawn every frame (for measurements and comparisons).
   bool shadow_cache = true;
+  /// Capture rounds on a frame where reflection probes make their first capture, in
+  /// [kMinProbeBounces, kMaxProbeBounces] (components/reflector.h): each round reads the other
+  /// probes' maps of the round before, so round k shows mirrors seen in mirrors k - 1 deep.
+  int probe_bounces = kDefaultProbeBounces;
 };
 
 struct Scene {

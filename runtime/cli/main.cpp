@@ -501,6 +501,9 @@ int run_render(Args a) {
                 static_cast<unsigned long long>(pd.faces_total), st.probe_faces,
                 st.probe_instances, st.probe_draw_calls, st.probe_culled, st.probe_prefilters,
                 st.probe_prefilter_faces);
+    if (timings->first_probe_rounds > 1)
+      std::printf("          first frame: %d capture rounds (render.probe_bounces), %d faces\n",
+                  timings->first_probe_rounds, timings->first_probe_faces);
   }
   std::printf("shaders   %d compiled, %d from the binary cache, %.1f ms (prewarm %.1f ms); "
               "%d compiled after the first frame\n",

@@ -152,6 +152,8 @@ Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRu
     if (i == 0) {
       player.renderer->shaders().first_frame_done();
       t.first_frame_ms = ms;
+      t.first_probe_rounds = t.last.probes.rounds;
+      t.first_probe_faces = t.last.stats.probe_faces;
     } else {
       t.frame_ms.push_back(ms);
     }

@@ -59,6 +59,9 @@ struct RenderTimings {
   std::vector<double> frame_ms;             ///< every frame after the first (CPU wall, GPU finished)
   double median_ms() const;                 ///< median of frame_ms (first frame if it is empty)
   FrameReport last;                         ///< phase times and counters of the last frame
+  /// The first frame's probe capture rounds and faces (bounce rounds run on it; ProbeData).
+  int first_probe_rounds = 1;
+  int first_probe_faces = 0;
 };
 
 /// Renders `run.frames` frames of `scene`, waiting for the GPU after each so the times are honest.

@@ -11,7 +11,8 @@
 // Differences from the rasteriser, by design or not yet done: the hit is shaded with the
 // triangle's geometric normal (flat primitives agree exactly, smooth meshes differ slightly); the
 // base colour texture is sampled bilinearly from its top mip level (GL filters trilinearly over
-// mips); no normal maps, alpha cut-outs, occlusion or emissive textures or texture transforms;
+// mips); no normal maps, alpha cut-outs, occlusion, emissive or metallic-roughness textures
+// (the factors alone) or texture transforms;
 // the view vector at the hit points back along the mirror ray (a probe captured at a centre sees
 // it from there instead); every light with cast_shadows gets a hard shadow ray (the engine
 // shadows one light).

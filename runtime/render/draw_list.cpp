@@ -132,7 +132,7 @@ namespace {
 // operator== decides), they just need not sort next to each other.
 auto material_fields(const Material& m) {
   return std::tie(m.base_color_texture, m.normal_texture, m.occlusion_texture,
-                  m.emissive_texture, m.occlusion_strength, m.double_sided, m.alpha_mask,
+                  m.emissive_texture, m.metallic_roughness_texture, m.occlusion_strength, m.double_sided, m.alpha_mask,
                   m.metallic, m.roughness, m.base_color.r, m.base_color.g, m.base_color.b,
                   m.base_color.a, m.normal_scale, m.emissive.r, m.emissive.g, m.emissive.b,
                   m.alpha_cutoff, m.k_s, m.features);

@@ -52,8 +52,8 @@ struct DrawItem {
 /// One reflection probe's GPU work this frame (systems/environment_probe_system.h). Each probe
 /// has two cube maps (RGBA16F with mips): `faces` of buffer `target` are captured, then buffer
 /// `visible` is shaded with. Captures draw the frame's draws (shadows included) except the
-/// probe's own and excluded layers; reflective draws in them use their probes' visible maps as
-/// of before this frame's captures (no recursion).
+/// probe's own and excluded layers; reflective draws in them read probe_read_buffer(): the
+/// maps as of before this frame's captures, or in bounce rounds the previous round's.
 struct ProbeJob {
   ProbeHandle handle;
   glm::vec3 center{0.0f};
@@ -76,7 +76,29 @@ struct ProbeJob {
   /// Static file: index into AssetStore::env_maps to upload into buffer `visible` this frame;
   /// kNoProbe: nothing to upload.
   std::uint32_t env_map = kNoProbe;
+  /// Capture rounds this frame (render.probe_bounces; 1: one capture). With more, `faces` (all
+  /// six) are captured `rounds` times, alternating between the two buffers so that the last
+  /// round writes `target` (capture_buffer()), and captures of round r see this probe's map of
+  /// round r - 1 (probe_read_buffer()).
+  int rounds = 1;
 };
+
+/// The buffer that capture round `round` (1..job.rounds) of `job` renders into: `target` in the
+/// last round, the other buffer in the one before, and so on.
+constexpr int capture_buffer(const ProbeJob& job, int round) {
+  return (job.rounds - round) % 2 == 0 ? job.target : 1 - job.target;
+}
+
+/// The buffer of `job` that a reflective draw of it reads while capture round `round` of this
+/// frame renders; 0: the main view, after every capture. Never the buffer `job` is being
+/// captured into, so a round reads the previous round's map (round 1: the map as of before this
+/// frame; a first capture's other buffer is black).
+constexpr int probe_read_buffer(const ProbeJob& job, int round) {
+  if (round == 0) return job.visible;
+  if (job.rounds > 1 && round <= job.rounds) return 1 - capture_buffer(job, round);
+  const bool swapped_now = job.faces != 0 && job.target == job.visible;
+  return swapped_now ? 1 - job.visible : job.visible;  // the map as of before this frame
+}
 
 /// A light as the shaders see it (light_shading() in components/light.h makes one).
 using LightItem = LightShading;

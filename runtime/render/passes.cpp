@@ -164,6 +164,9 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
   }
   if (features.has(VariantKey::kEmissiveTexture) || features_by_uniform_)
     glBindTextureUnit(kTexEmissive, cache_.texture(m.emissive_texture, false).id());
+  if (features.has(VariantKey::kMetallicRoughnessTexture) || features_by_uniform_)
+    glBindTextureUnit(kTexMetallicRoughness,
+                      cache_.texture(m.metallic_roughness_texture, false).id());
   if (features.has(VariantKey::kTextureTransform) || features_by_uniform_) {
     std::array<glm::vec4, 2 * kUvSlotCount> rows{};
     const TextureTransform* slots[kUvSlotCount] = {};
@@ -171,6 +174,7 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
     slots[kUvSlotNormal] = &m.normal_transform;
     slots[kUvSlotOcclusion] = &m.occlusion_transform;
     slots[kUvSlotEmissive] = &m.emissive_transform;
+    slots[kUvSlotMetallicRoughness] = &m.metallic_roughness_transform;
     for (int i = 0; i < kUvSlotCount; ++i) {
       const auto r = uv_transform_rows(*slots[i]);
       rows[std::size_t(2 * i)] = glm::vec4(r[0], 0.0f);
@@ -998,7 +1002,7 @@ Image MomentsPass::read() const {
 // ---- Forward drawing (main view and probe faces) ------------------------------------------------
 
 Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> order,
-                    const std::vector<VariantKey>& keys, const ProbeJob* capture,
+                    const std::vector<VariantKey>& keys, const ProbeJob* capture, int round,
                     const glm::mat4& view_proj, GpuCache& cache, DrawState& state,
                     FrameStats& stats) {
   int& culled = capture ? stats.probe_culled : stats.frustum_culled;
@@ -1033,14 +1037,13 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
     }
     glFrontFace(mirrored ? GL_CW : GL_CCW);
     state.bind_material(d, keys[i]);
-    // A draw reflecting a probe gets its map: `visible` as of before this frame's captures (a
-    // probe never sees a cube being captured), and k_s * p_r.
+    // A draw reflecting a probe gets its map (probe_read_buffer(): never a cube being
+    // captured), and k_s * p_r.
     const VariantKey key = keys[i];
     if (reflective(i)) {
       for (const ProbeJob& job : frame.probes) {
         if (job.handle != d.probe) continue;
-        const bool swapped_now = job.faces != 0 && job.target == job.visible;
-        const int buffer = capture && swapped_now ? 1 - job.visible : job.visible;
+        const int buffer = probe_read_buffer(job, capture ? round : 0);
         if (key.has(VariantKey::kReflectionPbr)) {
           // The pbr model: the probe's prefiltered cube, SH row and last level, and p_r.
           glBindTextureUnit(kTexReflectionCube, cache.probes().existing_specular(job.handle).id());
@@ -1111,36 +1114,62 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   Status status;
-  for (const ProbeJob& job : frame.probes) {
-    if (job.env_map != kNoProbe || job.faces == 0) continue;  // static maps were uploaded
-    cache.probes().cube(job.handle, job.target, job.resolution);
-    for (int f = 0; f < 6 && status; ++f) {
-      if (!(job.faces & (1u << f))) continue;
-      const FrameBlock face = probe_face_block(main, job, f);
-      glNamedBufferSubData(ubo.id(), 0, sizeof face, &face);
-      cache.probes().begin_face(job.handle, job.target, f, frame.clear_color);
-      const int before = stats.draw_calls, instances_before = stats.instances;
-      const std::size_t triangles_before = stats.triangles;
-      status = draw_forward(frame, list.capture_order, list.capture_keys, &job, face.view_proj,
-                            cache, state, stats);
-      // Draws into faces are counted apart from the main view's.
-      stats.probe_draw_calls += stats.draw_calls - before;
-      stats.probe_instances += stats.instances - instances_before;
-      stats.draw_calls = before;
-      stats.instances = instances_before;
-      stats.triangles = triangles_before;
-      ++stats.probe_faces;
+  // Every cube captured this frame exists before the first face is drawn, so that a probe read
+  // before its first capture is a black cube, not an empty texture unit.
+  int rounds = 1;
+  for (const ProbeJob& job : frame.probes)
+    if (job.env_map == kNoProbe && job.faces != 0) {
+      cache.probes().cube(job.handle, job.target, job.resolution);
+      rounds = std::max(rounds, job.rounds);
     }
-    if (!status) break;
-    // Complete (the target is now the visible buffer): rebuild its mip chain.
-    if (job.target == job.visible) cache.probes().finish_cube(job.handle, job.target);
+  // Round k draws every probe due in it into capture_buffer(job, k), its reflective draws
+  // reading the other probes' maps of round k - 1 (probe_read_buffer()).
+  for (int round = 1; round <= rounds && status; ++round) {
+    for (const ProbeJob& job : frame.probes) {
+      if (job.env_map != kNoProbe || job.faces == 0 || round > job.rounds) continue;
+      const int buffer = capture_buffer(job, round);
+      for (int f = 0; f < 6 && status; ++f) {
+        if (!(job.faces & (1u << f))) continue;
+        const FrameBlock face = probe_face_block(main, job, f);
+        glNamedBufferSubData(ubo.id(), 0, sizeof face, &face);
+        cache.probes().begin_face(job.handle, buffer, f, frame.clear_color);
+        const int before = stats.draw_calls, instances_before = stats.instances;
+        const std::size_t triangles_before = stats.triangles;
+        status = draw_forward(frame, list.capture_order, list.capture_keys, &job, round,
+                              face.view_proj, cache, state, stats);
+        // Draws into faces are counted apart from the main view's.
+        stats.probe_draw_calls += stats.draw_calls - before;
+        stats.probe_instances += stats.instances - instances_before;
+        stats.draw_calls = before;
+        stats.instances = instances_before;
+        stats.triangles = triangles_before;
+        ++stats.probe_faces;
+      }
+      if (!status) break;
+      // Complete (a round's cube, or the target that is now the visible buffer): rebuild its
+      // mip chain before anything samples it.
+      if (job.target == job.visible) cache.probes().finish_cube(job.handle, buffer);
+    }
+    // A sphere-mapped probe is read through its sphere map: the next round's reads need this
+    // round's.
+    if (round < rounds && status) {
+      for (const ProbeJob& job : frame.probes)
+        if (job.sphere && job.rounds > round)
+          cache.probes().update_sphere(job.handle, capture_buffer(job, round),
+                                       glm::mat3(frame.camera.view));
+      // A pbr probe's round is prefiltered whole before the next round reads it.
+      for (const ProbeJob& job : frame.probes)
+        if (job.prefilter && job.rounds > round)
+          cache.probes().prefilter(job.handle, capture_buffer(job, round), 6);
+      state.forget();  // update_sphere() and prefiltering used their own programs and unit 0
+    }
   }
   glNamedBufferSubData(ubo.id(), 0, sizeof main, &main);  // the main view's block again
   if (!status) return status;
-  // A probe's first map (or one uploaded from a file) is prefiltered whole at once, so a pbr
-  // reflector never waits without one.
+  // A probe's first map (or one uploaded from a file; after several rounds, the last round's) is
+  // prefiltered whole at once, so a pbr reflector never waits without one.
   for (const ProbeJob& job : frame.probes)
-    if (job.prefilter && !cache.probes().has_specular(job.handle) &&
+    if (job.prefilter && (!cache.probes().has_specular(job.handle) || job.rounds > 1) &&
         cache.probes().prefilter(job.handle, job.visible, 6))
       ++stats.probe_prefilters;
   cache.probes().ibl().bind();
@@ -1257,8 +1286,8 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list, GpuCac
   glClearBufferfv(GL_DEPTH, 0, &one);
   // The AOV pass draws what the colour pass drew: its culling is counted once.
   const int culled = stats.frustum_culled;
-  const Status st = draw_forward(frame, list.forward_order, list.keys, nullptr, view_proj, cache,
-                                 state, stats);
+  const Status st = draw_forward(frame, list.forward_order, list.keys, nullptr, 0, view_proj,
+                                 cache, state, stats);
   if (!single_colour) stats.frustum_culled = culled;
   glDisable(GL_FRAMEBUFFER_SRGB);
   return st;

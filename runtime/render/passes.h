@@ -254,10 +254,10 @@ class ForwardPass {
 
 /// The forward path of the main view and of probe faces: draws `order` with `keys` as seen by
 /// `view_proj` (culled per draw), binding reflection maps; `capture` names the probe face being
-/// drawn (its reflector is left out, and reflections read the maps as of before this frame's
-/// captures).
+/// drawn in capture round `round` (its reflector is left out, and reflections read
+/// probe_read_buffer(job, round)); the main view passes none and round 0.
 Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> order,
-                    const std::vector<VariantKey>& keys, const ProbeJob* capture,
+                    const std::vector<VariantKey>& keys, const ProbeJob* capture, int round,
                     const glm::mat4& view_proj, GpuCache& cache, DrawState& state,
                     FrameStats& stats);
 

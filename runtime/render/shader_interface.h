@@ -47,12 +47,12 @@ inline constexpr int kLocBaseColor = 8, kLocMaterial = 9, kLocEmissive = 10,
                      kLocVsmTarget = 20, kLocVsmRect = 21;
 /// vec4: x occlusion strength (MATERIAL_HAS_OCCLUSION_TEXTURE).
 inline constexpr int kLocMaterialExtra = 24;
-/// vec4[8]: per texture slot (kUvSlot*) two rows (a, b, c) of its uv transform
-/// u' = a.x u + a.y v + a.z, v' = b.x u + b.y v + b.z (MATERIAL_HAS_TEXTURE_TRANSFORM); 25..32.
+/// vec4[10]: per texture slot (kUvSlot*) two rows (a, b, c) of its uv transform
+/// u' = a.x u + a.y v + a.z, v' = b.x u + b.y v + b.z (MATERIAL_HAS_TEXTURE_TRANSFORM); 25..34.
 inline constexpr int kLocUvTransform = 25;
 /// Texture slots in kLocUvTransform's array.
 inline constexpr int kUvSlotBaseColor = 0, kUvSlotNormal = 1, kUvSlotOcclusion = 2,
-                     kUvSlotEmissive = 3, kUvSlotCount = 4;
+                     kUvSlotEmissive = 3, kUvSlotMetallicRoughness = 4, kUvSlotCount = 5;
 
 // Texture units.
 /// kTexShadowDepth: the shadow map again, through a sampler without depth compare (raw depths for
@@ -69,11 +69,11 @@ inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
                           kTexShadowLinear = 6, kTexOcclusion = 7, kTexEmissive = 8,
                           kTexLomDepth = 9, kTexLomOcclusion = 10, kTexPeelPrevious = 11,
                           kTexVsmMoments = 12, kTexVsmSource = 13, kTexDfg = 14, kTexSh = 15,
-                          kTexEnvironment = 16;
+                          kTexEnvironment = 16, kTexMetallicRoughness = 17;
 
 /// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...), and
 /// the light types (LIGHT_DIRECTIONAL, ...: u_light_info[i].x holds a LightType).
-inline std::array<std::pair<const char*, int>, 50> shader_interface_defines() {
+inline std::array<std::pair<const char*, int>, 52> shader_interface_defines() {
   return {{{"LIGHT_DIRECTIONAL", int(LightType::directional)},
            {"LIGHT_SPOT", int(LightType::spot)},
            {"LIGHT_POINT", int(LightType::point)},
@@ -106,6 +106,7 @@ inline std::array<std::pair<const char*, int>, 50> shader_interface_defines() {
            {"UV_SLOT_NORMAL", kUvSlotNormal},
            {"UV_SLOT_OCCLUSION", kUvSlotOcclusion},
            {"UV_SLOT_EMISSIVE", kUvSlotEmissive},
+           {"UV_SLOT_METALLIC_ROUGHNESS", kUvSlotMetallicRoughness},
            {"UV_SLOT_COUNT", kUvSlotCount},
            {"UNIT_BASE_COLOR", int(kTexBaseColor)},
            {"UNIT_NORMAL", int(kTexNormal)},
@@ -123,7 +124,8 @@ inline std::array<std::pair<const char*, int>, 50> shader_interface_defines() {
            {"UNIT_EMISSIVE", int(kTexEmissive)},
            {"UNIT_DFG", int(kTexDfg)},
            {"UNIT_SH", int(kTexSh)},
-           {"UNIT_ENVIRONMENT", int(kTexEnvironment)}}};
+           {"UNIT_ENVIRONMENT", int(kTexEnvironment)},
+           {"UNIT_METALLIC_ROUGHNESS", int(kTexMetallicRoughness)}}};
 }
 
 }  // namespace kaskad::render

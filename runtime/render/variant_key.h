@@ -130,6 +130,9 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // scale (Material::*_transform). The depth pass keeps it with alpha_mask (cut-outs).
     {.name = "texture_transform", .define = "MATERIAL_HAS_TEXTURE_TRANSFORM",
      .stages = kFragmentStage, .offset = 10},
+    // glTF metallicRoughnessTexture (linear; B metallic, G roughness): multiplies the factors.
+    {.name = "metallic_roughness_texture", .define = "MATERIAL_HAS_METALLIC_ROUGHNESS_TEXTURE",
+     .stages = kFragmentStage, .offset = 11},
     // Material::reflection_model pbr: the reflector's probe lights the glTF BRDF (its SH and
     // prefiltered cube, components/ibl.h) instead of S3's I + k_s p_r C_t. Set with the cube.
     {.name = "reflection_pbr", .define = "MATERIAL_HAS_REFLECTION_PBR", .stages = kFragmentStage,
@@ -280,6 +283,7 @@ class VariantKey {
   static constexpr Field kOcclusionTexture = feature_field("occlusion_texture");
   static constexpr Field kEmissiveTexture = feature_field("emissive_texture");
   static constexpr Field kTextureTransform = feature_field("texture_transform");
+  static constexpr Field kMetallicRoughnessTexture = feature_field("metallic_roughness_texture");
   static constexpr Field kReflectionPbr = feature_field("reflection_pbr");
   static constexpr std::uint64_t kMaterialMask = 0x0000ffffu;
   // Frame features.

@@ -198,15 +198,22 @@ assert caught >= 6, caught
 print("acne caught on %d scenes" % caught)
 ' "$tmp/stab/bench.csv"
 
-# Reflection probes: counters printed (13 frames: the sphere captures on 0 and 10, the plane
-# two faces a frame on 0-2 and 10-12), faces dumped, bad settings named.
-check probes_render 0 "probes +2 reflectors: 4 captures, 24 faces since load" -- "$KASKAD" render \
+# Reflection probes: counters printed (13 frames: both first captures on frame 0 in two bounce
+# rounds, 24 faces; then the sphere on 10 and the plane two faces a frame on 10-12), faces
+# dumped, bad settings named.
+check probes_render 0 "probes +2 reflectors: 4 captures, 36 faces since load" -- "$KASKAD" render \
   "$KASKAD_CONTENT/scenes/reflections.json" --headless --size 160x90 --frames 13 -o "$tmp/refl.png" \
   --set mirror_sphere.reflector.resolution=32 --set mirror_plane.reflector.resolution=32 \
   --set mirror_plane.reflector.map=sphere --probe-maps "$tmp/probes"
 for f in mirror_sphere_px mirror_sphere_nz mirror_plane_py mirror_plane_sphere; do
   [ -s "$tmp/probes/$f.png" ] || { echo "FAIL probes_dump: no $f.png"; failed=$((failed + 1)); }
 done
+check probes_bounce_rounds 0 "first frame: 3 capture rounds \(render.probe_bounces\), 36 faces" -- \
+  "$KASKAD" render "$KASKAD_CONTENT/scenes/reflections.json" --headless --size 96x64 --frames 1 \
+  -o "$tmp/refl3.png" --set mirror_sphere.reflector.resolution=16 \
+  --set mirror_plane.reflector.resolution=16 --set render.probe_bounces=3
+check bad_probe_bounces nonzero "reflections.json: /render/probe_bounces: must be in \[1, 4\], was 5" -- "$KASKAD" render \
+  "$KASKAD_CONTENT/scenes/reflections.json" --headless --set render.probe_bounces=5
 check bad_reflector nonzero "reflections.json.*/entities/1/reflector/faces_per_frame.*\[1, 6\]" -- \
   "$KASKAD" render "$KASKAD_CONTENT/scenes/reflections.json" --headless --set mirror_sphere.reflector.faces_per_frame=9
 

@@ -1,8 +1,9 @@
 // The glTF material inputs on the GPU, through material files (the same features glTF imports
 // get): a card filling the view, no lights, so its colour is ambient * base * occlusion +
 // emissive, compared with that value computed here (sRGB encoded, within 8-bit rounding):
-// the occlusion texture at two strengths, the emissive texture times the emissive factor, and a
-// texture transform (uv_offset 0.5 swaps the halves of a two-texel texture).
+// the occlusion texture at two strengths, the emissive texture times the emissive factor, a
+// texture transform (uv_offset 0.5 swaps the halves of a two-texel texture), and under a light
+// the metallic-roughness texture against the CPU BRDF.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "components/brdf.h"
 #include "runtime/assets/image_io.h"
 #include "tests/render/player_fixture.h"
 
@@ -121,6 +123,56 @@ TEST_F(MaterialInputsTest, TextureTransformOffsetsTheLookup) {
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(pixel(moved, 8, 16)[c], right[c], 2.0f / 255.0f);
     EXPECT_NEAR(pixel(moved, 23, 16)[c], left[c], 2.0f / 255.0f);
+  }
+}
+
+// glTF's metallicRoughnessTexture (linear; B metallic, G roughness, times the factors) under a
+// directional light: the card's two halves hold a smooth dielectric and a rough metal, and each
+// half's pixel is the CPU evaluation of Appendix B's BRDF (components/brdf.h) with the texel's
+// values, plus the ambient light on the diffuse colour.
+TEST_F(MaterialInputsTest, MetallicRoughnessTextureSetsMetallicFromBAndRoughnessFromG) {
+  // Four texels of each half, so the bilinear footprint at each pixel below stays in one half.
+  std::vector<glm::vec3> texels(4, glm::vec3(0.0f, 0.3f, 0.0f));  // a smooth dielectric
+  texels.insert(texels.end(), 4, glm::vec3(0.0f, 0.9f, 1.0f));    // a rough metal
+  texels = texture("metal_rough.png", texels);
+  const float metallic_factor = 0.8f, roughness_factor = 0.9f, ambient = 0.1f, intensity = 3.0f;
+  const glm::vec3 base(0.7f, 0.5f, 0.3f), to_light = glm::normalize(glm::vec3(-0.3f, 0.4f, 1.0f));
+  std::ofstream(dir() / "metal_rough_material.json") << R"({
+      "features": ["metallic_roughness_texture"],
+      "parameters": { "base_color": [0.7, 0.5, 0.3, 1], "metallic": 0.8, "roughness": 0.9 },
+      "textures": { "metallic_roughness": "metal_rough.png" } })";
+  const fs::path file = dir() / "metal_rough.json";
+  std::ofstream(file) << R"({ "kaskad_scene": 1,
+      "render": { "ambient": [0.1, 0.1, 0.1], "ground": "none", "clear_color": [0, 0, 0] },
+      "entities": [
+        { "name": "card", "transform": { "euler_deg": [90, 0, 0] }, "primitive": { "shape": "plane" },
+          "material": { "file": "metal_rough_material.json" } },
+        { "name": "sun", "transform": { "direction": [0.3, -0.4, -1] },
+          "light": { "type": "directional", "intensity": 3, "cast_shadows": false } },
+        { "name": "camera", "transform": { "translation": [0, 0, 1.2], "look_at": [0, 0, 0] },
+          "camera": { "fov_y_deg": 40, "near": 0.1, "far": 20, "active": true } } ] })";
+  const Shot s = shoot(file, {}, 32, 32);
+  ASSERT_EQ(s.color.width, 32);
+  const glm::vec3 eye(0.0f, 0.0f, 1.2f), n(0.0f, 0.0f, 1.0f);
+  // The pixel's colour from the texel's values: ambient on the diffuse colour (Appendix B's
+  // c_diff) plus the BRDF times the light, sRGB encoded.
+  auto expected = [&](int x, int y, const glm::vec3& texel) {
+    const glm::vec3 p(s.aovs.at(x, y, 0), s.aovs.at(x, y, 1), s.aovs.at(x, y, 2));
+    BrdfInputs in;
+    in.base = base;
+    in.metallic = metallic_factor * texel.b;
+    in.roughness = roughness_factor * texel.g;
+    const glm::vec3 v = glm::normalize(eye - p);
+    const glm::vec3 linear = ambient * base * (1.0f - in.metallic) +
+                             brdf_evaluate(in, n, v, to_light) * intensity * glm::dot(n, to_light);
+    return glm::vec3(srgb_encode(linear.r), srgb_encode(linear.g), srgb_encode(linear.b));
+  };
+  // Pixels 8 and 23 of row 16 lie in the texture's first and second halves (u = 0.3 and 0.7).
+  const glm::vec3 first = pixel(s, 8, 16), second = pixel(s, 23, 16);
+  EXPECT_GT(glm::length(first - second), 0.1f) << "the halves are shaded alike";
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(first[c], expected(8, 16, texels[0])[c], 1.5f / 255.0f) << "channel " << c;
+    EXPECT_NEAR(second[c], expected(23, 16, texels[7])[c], 1.5f / 255.0f) << "channel " << c;
   }
 }
 

@@ -137,16 +137,18 @@ TEST_F(PermutationTest, EveryVariantMatchesTheUberShaderOracle) {
   }
 }
 
-// The material inputs of issue 17 (occlusion and emissive textures, texture transforms, also on
-// an alpha-masked caster) render the same through their variants as through the oracle.
+// The material inputs of issue 17 (occlusion, metallic-roughness and emissive textures, texture
+// transforms, also on an alpha-masked caster) render the same through their variants as through
+// the oracle.
 TEST_F(PermutationTest, NewMaterialInputsMatchTheUberShaderOracle) {
   const fs::path dir = fs::path(KASKAD_TEST_TMP) / "permutation_inputs";
   fs::create_directories(dir);
   const std::string textures = (content_dir() / "materials" / "textures").string() + "/";
   std::ofstream(dir / "orm.json") << R"({ "features": ["base_color_texture", "occlusion_texture",
-      "texture_transform"], "parameters": { "occlusion_strength": 0.7, "uv_scale": [2, 3],
-      "uv_rotation": 0.4, "uv_offset": [0.1, 0.2] },
+      "metallic_roughness_texture", "texture_transform"], "parameters": { "occlusion_strength": 0.7,
+      "metallic": 1, "roughness": 1, "uv_scale": [2, 3], "uv_rotation": 0.4, "uv_offset": [0.1, 0.2] },
     "textures": { "base_color": ")" << textures << R"(checker.png", "occlusion": ")" << textures
+                                  << R"(checker.png", "metallic_roughness": ")" << textures
                                   << R"(checker.png" } })";
   std::ofstream(dir / "glow.json") << R"({ "features": ["emissive", "emissive_texture"],
     "parameters": { "base_color": [0, 0, 0, 1], "emissive": [0.8, 0.5, 0.3] },

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <set>
 
+#include "components/bounds.h"
 #include "components/material.h"
 #include "components/name.h"
 #include "components/probe_state.h"
@@ -522,6 +523,156 @@ TEST_F(ProbeTest, BoxProjectionCorrectsParallaxInARoom) {
       EXPECT_GT(double(wrong), 0.05 * compared) << wrong << " of " << compared;
     }
   }
+}
+
+// Issue 17: mirrors that see mirrors on the first frame. In content/scenes/reflections.json the
+// mirror ball and the mirror plane both capture on frame 0. With one capture round each sees the
+// other before the other has a map: a mirror reflecting nothing, near black (the ball's base
+// colour is 0.05, the plane's 0.02, both metallic). With render.probe_bounces = 2 the second
+// round reads the first round's maps, so where one probe sees the other reflector it sees that
+// reflector's surroundings. What stays dark is a reflection of the first probe itself inside the
+// other (ball -> plane -> ball: a third bounce), a small patch that each further round shrinks.
+class MirrorsSeeMirrors : public ProbeTest {
+ protected:
+  // The texels of `cube`, captured from `from`, whose direction meets `hit` well inside the
+  // other reflector (not within a texel or two of its silhouette, where filtering mixes in the
+  // background), as counts of dark and clear-colour ones.
+  struct Seen {
+    int texels = 0, dark = 0, clear = 0;
+    float dark_fraction() const { return texels ? float(dark) / float(texels) : 1.0f; }
+  };
+  template <class Hit>
+  static Seen seen(const CubeMap& cube, const glm::vec3& from, Hit hit, const glm::vec3& clear) {
+    Seen out;
+    for (int f = 0; f < 6; ++f)
+      for (int y = 0; y < cube.size; ++y)
+        for (int x = 0; x < cube.size; ++x) {
+          const glm::vec3 d = cube_direction(CubeFace(f), (float(x) + 0.5f) / float(cube.size),
+                                             (float(y) + 0.5f) / float(cube.size));
+          if (!hit(from, glm::normalize(d))) continue;
+          const glm::vec3 c(cube.at(CubeFace(f), x, y));
+          ++out.texels;
+          out.dark += std::max({c.r, c.g, c.b}) < kDark;
+          out.clear += glm::length(c - clear) < 0.02f;
+        }
+    return out;
+  }
+  // Linear radiance below this on every channel reads as black: the ball's own shading without
+  // a map (ambient 0.08-0.11 times a base colour of 0.05, no diffuse for a metal) stays under it
+  // away from the sun's highlight.
+  static constexpr float kDark = 0.05f;
+};
+
+TEST_F(MirrorsSeeMirrors, OnTheFirstFrameOfTheReflectionsDemo) {
+  const fs::path file = content_dir() / "scenes" / "reflections.json";
+  struct Result {
+    Seen ball_in_plane, plane_in_ball, plane_aov;
+    int faces = 0, rounds = 0;
+  };
+  auto first_frame = [&](int bounces, bool sphere_ball) {
+    Result res;
+    std::vector<std::string> sets = {"render.probe_bounces=" + std::to_string(bounces)};
+    if (sphere_ball) sets.push_back("mirror_sphere.reflector.map=sphere");
+    Scene scene = load(file.string(), sets);
+    RenderRun run;
+    run.frames = 1;
+    run.width = 320;
+    run.height = 180;
+    auto t = render_frames(*player_, scene, run);
+    EXPECT_TRUE(t.ok()) << t.error().to_string();
+    if (!t.ok()) return res;
+    res.faces = t->last.stats.probe_faces;
+    res.rounds = t->last.probes.rounds;
+    const ecs::Entity ball = named(scene, "mirror_sphere"), plane = named(scene, "mirror_plane");
+    const ProbeState& bs = scene.world.get<ProbeState>(ball);
+    const ProbeState& ps = scene.world.get<ProbeState>(plane);
+    EXPECT_TRUE(bs.has_map && ps.has_map);
+    // The ball: a sphere (its world bounds' centre and half extent); the plane: the rectangle
+    // of its flat world bounds at z = const. Both shrunk by a margin (2 texels of a 128 face
+    // seen from 4.5 m away is about 0.14 m).
+    const Aabb bb = scene.world.get<WorldBounds>(ball).box, pb = scene.world.get<WorldBounds>(plane).box;
+    const glm::vec3 ball_centre = bb.center();
+    const float ball_radius = 0.5f * (bb.max.x - bb.min.x) - 0.15f;
+    auto hits_ball = [&](const glm::vec3& o, const glm::vec3& d) {
+      const glm::vec3 oc = o - ball_centre;
+      const float b = glm::dot(oc, d), c = glm::dot(oc, oc) - ball_radius * ball_radius;
+      return b < 0.0f && b * b - c > 0.0f;
+    };
+    EXPECT_LT(pb.max.z - pb.min.z, 1e-3f);  // the plane stands in z = const
+    auto hits_plane = [&](const glm::vec3& o, const glm::vec3& d) {
+      if (std::abs(d.z) < 1e-4f) return false;
+      const float s = (pb.min.z - o.z) / d.z;
+      const glm::vec3 p = o + s * d;
+      return s > 0.0f && p.x > pb.min.x + 0.15f && p.x < pb.max.x - 0.15f &&
+             p.y > pb.min.y + 0.15f && p.y < pb.max.y - 0.15f;
+    };
+    const glm::vec3 clear = scene.render.clear_color;
+    res.ball_in_plane = seen(player_->renderer->read_probe_cube(ps.handle, ps.front), ps.center,
+                             hits_ball, clear);
+    res.plane_in_ball = seen(player_->renderer->read_probe_cube(bs.handle, bs.front), bs.center,
+                             hits_plane, clear);
+    // The main view: plane pixels whose lookup direction R (S3 eq. (1)) shows the ball in the
+    // plane's cube, with the reflected colour C_t from the reflection AOV.
+    const Image aov = player_->renderer->read_aovs();
+    const glm::vec3 eye = t->last.camera.position;
+    for (int y = 0; y < aov.height; ++y)
+      for (int x = 0; x < aov.width; ++x) {
+        if (aov.at(x, y, 13) < 0.5f || std::abs(aov.at(x, y, 2) - pb.min.z) > 0.01f) continue;
+        const glm::vec3 p(aov.at(x, y, 0), aov.at(x, y, 1), aov.at(x, y, 2));
+        const glm::vec3 n = glm::normalize(glm::vec3(aov.at(x, y, 3), aov.at(x, y, 4), aov.at(x, y, 5)));
+        const glm::vec3 u = glm::normalize(p - eye);
+        const glm::vec3 r = u - 2.0f * glm::dot(n, u) * n;
+        if (!hits_ball(ps.center, r)) continue;
+        const glm::vec3 ct(aov.at(x, y, 10), aov.at(x, y, 11), aov.at(x, y, 12));
+        ++res.plane_aov.texels;
+        res.plane_aov.dark += std::max({ct.r, ct.g, ct.b}) < kDark;
+        res.plane_aov.clear += glm::length(ct - clear) < 0.02f;
+      }
+    return res;
+  };
+  const Result one = first_frame(1, false), two = first_frame(2, false), three = first_frame(3, false);
+  for (const auto& [name, r] : {std::pair<const char*, const Result&>{"1", one}, {"2", two}, {"3", three}})
+    std::printf("probe_bounces %s: %d rounds, %d faces; ball in plane's cube %d/%d dark, %d clear; "
+                "plane in ball's cube %d/%d dark, %d clear; ball in the main view's plane %d/%d "
+                "dark, %d clear\n",
+                name, r.rounds, r.faces, r.ball_in_plane.dark, r.ball_in_plane.texels,
+                r.ball_in_plane.clear, r.plane_in_ball.dark, r.plane_in_ball.texels,
+                r.plane_in_ball.clear, r.plane_aov.dark, r.plane_aov.texels, r.plane_aov.clear);
+  // One round per probe, or 2 and 3: 12 faces per round.
+  EXPECT_EQ(one.rounds, 1);
+  EXPECT_EQ(one.faces, 12);
+  EXPECT_EQ(two.rounds, 2);
+  EXPECT_EQ(two.faces, 24);
+  EXPECT_EQ(three.faces, 36);
+  for (const Result* r : {&one, &two, &three}) {
+    EXPECT_GT(r->ball_in_plane.texels, 300);
+    EXPECT_GT(r->plane_in_ball.texels, 1000);
+    EXPECT_GT(r->plane_aov.texels, 500);
+    // The other reflector is drawn in each probe (never a hole showing the clear colour).
+    EXPECT_EQ(r->ball_in_plane.clear + r->plane_in_ball.clear + r->plane_aov.clear, 0);
+  }
+  // One round: each mirror is black in the other's map (the sun's highlight aside), and so is
+  // the ball in the plane as the camera sees it. Seen: 99%, 85%, 100%.
+  EXPECT_GT(one.ball_in_plane.dark_fraction(), 0.8f);
+  EXPECT_GT(one.plane_in_ball.dark_fraction(), 0.7f);
+  EXPECT_GT(one.plane_aov.dark_fraction(), 0.8f);
+  // Two rounds: the ball in the plane's map and in the main view shows its surroundings; the
+  // plane in the ball's map still shows the ball black where it reflects it (ball -> plane ->
+  // ball, a third bounce). Seen: 4%, 21%, 2%.
+  EXPECT_LT(two.ball_in_plane.dark_fraction(), 0.1f);
+  EXPECT_LT(two.plane_in_ball.dark_fraction(), 0.3f);
+  EXPECT_LT(two.plane_aov.dark_fraction(), 0.1f);
+  // Three rounds fill that in too. Seen: under 2% each.
+  EXPECT_LT(three.ball_in_plane.dark_fraction(), 0.05f);
+  EXPECT_LT(three.plane_in_ball.dark_fraction(), 0.05f);
+  EXPECT_LT(three.plane_aov.dark_fraction(), 0.05f);
+  // A sphere-mapped ball is read through its sphere map, which each round remakes from its cube.
+  const Result sphere_one = first_frame(1, true), sphere_two = first_frame(2, true);
+  std::printf("sphere-mapped ball: in the plane's cube %d/%d dark with 1 round, %d/%d with 2\n",
+              sphere_one.ball_in_plane.dark, sphere_one.ball_in_plane.texels,
+              sphere_two.ball_in_plane.dark, sphere_two.ball_in_plane.texels);
+  EXPECT_GT(sphere_one.ball_in_plane.dark_fraction(), 0.8f);
+  EXPECT_LT(sphere_two.ball_in_plane.dark_fraction(), 0.1f);
 }
 
 }  // namespace

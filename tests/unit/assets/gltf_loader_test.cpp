@@ -664,6 +664,32 @@ TEST(GltfLoader, OcclusionTextureIsReadWithItsStrength) {
   expect_import_error(write_gltf("occlusion_bad.gltf", doc), "occlusionTexture");
 }
 
+TEST(GltfLoader, MetallicRoughnessTextureIsReadAsLinearDataWithItsTransform) {
+  json mr = {{"index", 1},
+             {"extensions", {{"KHR_texture_transform", {{"offset", {0.25, 0.0}}}}}}};
+  json doc = textured_triangle({{"pbrMetallicRoughness",
+                                 {{"metallicFactor", 0.5},
+                                  {"roughnessFactor", 0.75},
+                                  {"metallicRoughnessTexture", mr}}}});
+  doc["extensionsUsed"] = {"KHR_texture_transform"};
+  auto s = import_file(write_gltf("metallic_roughness.gltf", doc));
+  ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+  const Material m = only_material(*s);
+  ASSERT_NE(m.metallic_roughness_texture, kNoTexture);
+  EXPECT_FALSE(s->assets.textures[index(m.metallic_roughness_texture)].srgb);  // data, not colour
+  EXPECT_FLOAT_EQ(m.metallic, 0.5f);  // the factors stay; the texture multiplies them
+  EXPECT_FLOAT_EQ(m.roughness, 0.75f);
+  EXPECT_EQ(m.metallic_roughness_transform.offset, glm::vec2(0.25f, 0.0f));
+  EXPECT_EQ(m.features, render::VariantKey::kMetallicRoughnessTexture.mask() |
+                            render::VariantKey::kTextureTransform.mask());
+  EXPECT_FALSE(warns(*s->report, "metallicRoughnessTexture"));  // no longer "not imported"
+  // A bad transform is an error naming this slot.
+  doc["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"]["extensions"]
+     ["KHR_texture_transform"] = {{"scale", {1.0}}};
+  expect_import_error(write_gltf("metallic_roughness_bad.gltf", doc),
+                      "metallicRoughnessTexture KHR_texture_transform");
+}
+
 TEST(GltfLoader, EmissiveTextureAndStrength) {
   json doc = textured_triangle(
       {{"emissiveFactor", {1.0, 0.5, 0.25}},

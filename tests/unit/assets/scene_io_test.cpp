@@ -806,6 +806,47 @@ TEST(SceneIo, MsaaLoadsSavesAndRejectsOtherCounts) {
   EXPECT_EQ(file->render.msaa, 2);  // unchanged
 }
 
+TEST(SceneIo, ProbeBouncesLoadSaveOverrideAndRejectBadValues) {
+  // Absent: the default; given: kept through a save and a reload; --set and live overrides.
+  auto d = read_scene(kContent / "scenes" / "reflections.json");
+  ASSERT_TRUE(d.ok()) << d.error().to_string();
+  EXPECT_EQ(d->render.probe_bounces, kDefaultProbeBounces);
+  auto s = read_scene(write_file("bounces.json", R"({"render": {"probe_bounces": 3}, "entities": []})"));
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  EXPECT_EQ(s->render.probe_bounces, 3);
+  EXPECT_EQ(scene_to_json(*s)["render"]["probe_bounces"].get<int>(), 3);
+  const fs::path saved = temp_dir() / "bounces_saved.json";
+  ASSERT_TRUE(save_scene(saved, *s).ok());
+  auto again = read_scene(saved);
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_EQ(again->render.probe_bounces, 3);
+  auto set = read_scene(saved, {"render.probe_bounces=1"});
+  ASSERT_TRUE(set.ok()) << set.error().to_string();
+  EXPECT_EQ(set->render.probe_bounces, 1);
+  ASSERT_TRUE(apply_live_override(*s, "render.probe_bounces=4").ok());
+  EXPECT_EQ(s->render.probe_bounces, 4);
+  // Errors name the file, the field and the range.
+  const std::pair<const char*, const char*> bad[] = {
+      {R"({"render": {"probe_bounces": 0}})", "must be in [1, 4], was 0"},
+      {R"({"render": {"probe_bounces": 5}})", "must be in [1, 4], was 5"},
+      {R"({"render": {"probe_bounces": 1.5}})", "expected an integer"},
+      {R"({"render": {"probe_bounces": "two"}})", "expected an integer"}};
+  for (const auto& [text, message] : bad) {
+    const auto file = write_file("bounces_bad.json", text);
+    auto e = read_scene(file);
+    ASSERT_FALSE(e.ok()) << text;
+    const std::string got = e.error().to_string();
+    EXPECT_NE(got.find("/render/probe_bounces"), std::string::npos) << got;
+    EXPECT_NE(got.find(message), std::string::npos) << got;
+    EXPECT_NE(got.find("bounces_bad.json"), std::string::npos) << got;
+  }
+  expect_error(read_scene(saved, {"render.probe_bounces=9"}), {"probe_bounces", "must be in [1, 4], was 9"});
+  auto live = apply_live_override(*s, "render.probe_bounces=0");
+  ASSERT_FALSE(live.ok());
+  EXPECT_NE(live.error().to_string().find("probe_bounces"), std::string::npos);
+  EXPECT_EQ(s->render.probe_bounces, 4);  // unchanged
+}
+
 TEST(SceneIo, EntitiesAreAddedAndRemovedBetweenFrames) {
   auto s = read_scene(kContent / "scenes" / "default.json");
   ASSERT_TRUE(s.ok());

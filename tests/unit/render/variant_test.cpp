@@ -48,7 +48,7 @@ bool documented_rules_hold(VariantKey k) {
       V::kShadowKernel.mask() | V::kToneMapping.mask() | V::kOcclusionTexture.mask() |
       V::kEmissiveTexture.mask() | V::kTextureTransform.mask() | V::kShadowPeel.mask() |
       V::kReflectionPbr.mask() | V::kEnvironment.mask() |
-      V::kAlphaToCoverage.mask();
+      V::kAlphaToCoverage.mask() | V::kMetallicRoughnessTexture.mask();
   if (k.bits() & ~used) return false;
   if (k.get(V::kToneMapping) > 2) return false;      // none, khr_pbr_neutral, aces
   if (k.get(V::kShadowFilter) > 2) return false;     // none, bilinear, pcf3x3
@@ -125,14 +125,14 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
     if (bits == material_used) break;
   }
   EXPECT_EQ(disagree, 0);
-  // Material keys: 2^6 free bits x 3 of the 4 emissive/emissive_texture combinations x 6 of the
+  // Material keys: 2^7 free bits x 3 of the 4 emissive/emissive_texture combinations x 6 of the
   // 16 reflection cube/sphere/box/pbr combinations (none, sphere, cube with or without box and
-  // pbr) = 1152.
+  // pbr) = 2304.
   // Frame keys: 2 without shadow (aovs), and with shadow 3 filters x 2 aovs x 2 debug x
   // 2 selection x 2 layered x 4 shadowed-light counts x (8 ortho cascade counts + 3 other
   // projections) x 6 techniques (pcf, pcss, backprojection, lom, vsm, evsm) x 5 kernels x
   // 2 peel = 126720; all of them x 3 tone mappings x 2 environments x 2 alpha_to_coverage.
-  EXPECT_EQ(valid_materials, 1152);
+  EXPECT_EQ(valid_materials, 2304);
   EXPECT_EQ(valid_frames, 2 * 2 * 3 * (2 + 126720));
 }
 
@@ -161,7 +161,7 @@ TEST(VariantKey, FeatureTableDrivesTheManifestAndTheGlslBits) {
       EXPECT_EQ(value, std::to_string(VariantKey::kReflectionBox.offset));
     }
   }
-  EXPECT_EQ(bits, 12);  // every material feature, in every stage
+  EXPECT_EQ(bits, 13);  // every material feature, in every stage
 }
 
 TEST(VariantKey, DefinesComeFromOneFunctionForBothKinds) {

@@ -197,6 +197,10 @@ struct ProbeWorld {
     update_transforms(w, assets);
     return update_environment_probes(w, k);
   }
+  ProbeData frame_with(std::uint64_t k, int bounces) {
+    update_transforms(w, assets);
+    return update_environment_probes(w, k, /*commit=*/true, bounces);
+  }
 };
 
 TEST(EnvironmentProbeSystem, StaticSceneNeverRecapturesOnChange) {
@@ -293,6 +297,102 @@ TEST(EnvironmentProbeSystem, CentreIsTheBoundsCentreUnlessGiven) {
   pw.w.get<Reflector>(pw.mirror).has_center = true;
   pw.w.get<Reflector>(pw.mirror).center = {7, 8, 9};
   EXPECT_EQ(pw.frame(1).probes[0].job.center, glm::vec3(7, 8, 9));
+}
+
+// render.probe_bounces: bounce rounds run only where they change something, a first capture
+// with at least one other probe capturing all six faces beside it.
+TEST(ProbeRounds, OnlyFirstCapturesInCompanyGetBounceRounds) {
+  EXPECT_EQ(probe_capture_rounds(2, true, 2), 2);
+  EXPECT_EQ(probe_capture_rounds(5, true, 4), 4);
+  EXPECT_EQ(probe_capture_rounds(1, true, 3), 1);   // alone: it never sees itself
+  EXPECT_EQ(probe_capture_rounds(3, false, 3), 1);  // re-captures read maps that have bounced
+  EXPECT_EQ(probe_capture_rounds(0, false, 2), 1);
+}
+
+// The buffers of a job's rounds, for every round count and target: the last round writes the
+// target (the map then shown), each round writes the other buffer than the one before, and a
+// capture in round r reads the buffer the probe wrote in round r - 1, never the one it writes in
+// round r. A job of one round keeps today's rule: while it swaps, captures see the old front.
+TEST(ProbeRounds, EachRoundReadsThePreviousRoundsBuffer) {
+  for (int rounds = 1; rounds <= kMaxProbeBounces; ++rounds)
+    for (int target = 0; target < 2; ++target) {
+      SCOPED_TRACE(std::to_string(rounds) + " rounds, target " + std::to_string(target));
+      render::ProbeJob job;
+      job.faces = kAllFaces;
+      job.rounds = rounds;
+      job.target = job.visible = target;
+      EXPECT_EQ(render::capture_buffer(job, rounds), target);
+      EXPECT_EQ(render::probe_read_buffer(job, 0), target);  // the main view: the new map
+      for (int r = 1; r <= rounds; ++r) {
+        EXPECT_NE(render::probe_read_buffer(job, r), render::capture_buffer(job, r));
+        if (r > 1) {
+          EXPECT_EQ(render::probe_read_buffer(job, r), render::capture_buffer(job, r - 1));
+        }
+      }
+    }
+  render::ProbeJob sliced;  // a time-sliced capture that has not finished: reads see the front
+  sliced.faces = 0x3;
+  sliced.target = 1;
+  sliced.visible = 0;
+  for (int r = 0; r <= 3; ++r) EXPECT_EQ(render::probe_read_buffer(sliced, r), 0);
+}
+
+// Two mirrors (the reflections demo's every_n 10, one of them time-sliced): their first captures
+// run in `bounces` rounds, counted in the face counters; round 1 writes each probe's back buffer
+// and the last one the buffer shown from then on. Later captures are single rounds again.
+TEST(EnvironmentProbeSystem, FirstCapturesOfTwoMirrorsRunInBounceRounds) {
+  for (int bounces = 1; bounces <= kMaxProbeBounces; ++bounces) {
+    SCOPED_TRACE("probe_bounces " + std::to_string(bounces));
+    ProbeWorld pw(ProbeUpdate::every_n);
+    Reflector sliced;
+    sliced.update = ProbeUpdate::every_n;
+    sliced.faces_per_frame = 2;
+    pw.w.emplace<Reflector>(pw.near_box, sliced);
+    const ProbeData first = pw.frame_with(0, bounces);
+    ASSERT_EQ(first.probes.size(), 2u);
+    EXPECT_EQ(first.rounds, bounces);
+    EXPECT_EQ(first.faces_this_frame, 12 * bounces);
+    EXPECT_EQ(first.captures_this_frame, 2);
+    EXPECT_EQ(first.faces_total, 12u * std::uint64_t(bounces));
+    for (const ProbeData::Entry& p : first.probes) {
+      const ProbeState& s = pw.w.get<ProbeState>(p.entity);
+      EXPECT_EQ(p.job.rounds, bounces);
+      EXPECT_EQ(p.job.faces, kAllFaces);
+      EXPECT_EQ(s.faces_rendered, 6u * std::uint64_t(bounces));
+      EXPECT_EQ(s.captures, 1u);
+      EXPECT_EQ(p.job.visible, s.front);
+      EXPECT_EQ(render::capture_buffer(p.job, bounces), s.front);
+      EXPECT_EQ(render::capture_buffer(p.job, 1), 1 - ProbeState{}.front);  // the back buffer
+    }
+    // Frame 10: the whole re-capture and the sliced one's first two faces, one round each.
+    for (std::uint64_t k = 1; k < 10; ++k) EXPECT_EQ(pw.frame_with(k, bounces).faces_this_frame, 0);
+    const ProbeData again = pw.frame_with(10, bounces);
+    EXPECT_EQ(again.rounds, 1);
+    EXPECT_EQ(again.faces_this_frame, 6 + 2);
+  }
+}
+
+// A reflector added later captures for the first time while an older one re-captures: both
+// take part in the rounds; the older one's round 1 reads and leaves alone the map it showed.
+TEST(EnvironmentProbeSystem, ARecaptureBesideAFirstCaptureKeepsItsShownMapForRoundOne) {
+  for (int bounces = 2; bounces <= kMaxProbeBounces; ++bounces) {
+    SCOPED_TRACE("probe_bounces " + std::to_string(bounces));
+    ProbeWorld pw(ProbeUpdate::every_n);
+    pw.w.get<Reflector>(pw.mirror).every_n = 1;
+    EXPECT_EQ(pw.frame_with(0, bounces).rounds, 1);  // alone
+    const int shown = pw.w.get<ProbeState>(pw.mirror).front;
+    Reflector added;
+    added.update = ProbeUpdate::first_frame;
+    pw.w.emplace<Reflector>(pw.near_box, added);
+    const ProbeData d = pw.frame_with(1, bounces);
+    EXPECT_EQ(d.rounds, bounces);
+    const ProbeData::Entry* old = d.find(pw.mirror);
+    ASSERT_NE(old, nullptr);
+    EXPECT_EQ(old->job.rounds, bounces);
+    EXPECT_NE(render::capture_buffer(old->job, 1), shown);
+    EXPECT_EQ(render::probe_read_buffer(old->job, 1), shown);
+    EXPECT_EQ(pw.w.get<ProbeState>(pw.mirror).front, render::capture_buffer(old->job, bounces));
+  }
 }
 
 }  // namespace
