@@ -90,6 +90,24 @@ void IblMaps::release_row(int row) {
   if (row > 0 && std::size_t(row) < row_used_.size()) row_used_[std::size_t(row)] = false;
 }
 
+void IblMaps::begin_fullscreen(const gpu::Texture& source) {
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glDisable(GL_FRAMEBUFFER_SRGB);
+  glBindVertexArray(empty_vao_.id());
+  glBindTextureUnit(0, source.id());
+  glNamedFramebufferRenderbuffer(fbo_.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, 0);
+  glNamedFramebufferDrawBuffer(fbo_.id(), GL_COLOR_ATTACHMENT0);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
+}
+
+void IblMaps::end_fullscreen() {
+  glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, 0, 0);
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
+}
+
 void IblMaps::prefilter(const gpu::Texture& source, int size, gpu::Texture& target, int row) {
   prefilter_faces(source, size, target, 0, 6);
   project_sh(source, size, row);
@@ -114,15 +132,7 @@ void IblMaps::prefilter_faces(const gpu::Texture& source, int size, gpu::Texture
   // Level 0 is roughness 0: the mirror, the source as it is.
   glCopyImageSubData(source.id(), GL_TEXTURE_CUBE_MAP, 0, 0, 0, first, target.id(),
                      GL_TEXTURE_CUBE_MAP, 0, 0, 0, first, size, size, count);
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_BLEND);
-  glDisable(GL_FRAMEBUFFER_SRGB);
-  glBindVertexArray(empty_vao_.id());
-  glBindTextureUnit(0, source.id());
-  glNamedFramebufferRenderbuffer(fbo_.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, 0);
-  glNamedFramebufferDrawBuffer(fbo_.id(), GL_COLOR_ATTACHMENT0);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
+  begin_fullscreen(source);
   glUseProgram(prefilter_program_.id());
   for (int level = 1; level < levels; ++level) {
     const int s = std::max(1, size >> level);
@@ -135,31 +145,20 @@ void IblMaps::prefilter_faces(const gpu::Texture& source, int size, gpu::Texture
       glDrawArrays(GL_TRIANGLES, 0, 3);
     }
   }
-  glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, 0, 0);
-  glBindVertexArray(0);
-  glEnable(GL_DEPTH_TEST);
+  end_fullscreen();
 }
 
 void IblMaps::project_sh(const gpu::Texture& source, int size, int row) {
   // SH from a level of at most 16 x 16 texels a face (a box-filtered mip: SH are smooth).
   ensure_rows(row + 1);
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_BLEND);
-  glDisable(GL_FRAMEBUFFER_SRGB);
-  glBindVertexArray(empty_vao_.id());
-  glBindTextureUnit(0, source.id());
-  glNamedFramebufferDrawBuffer(fbo_.id(), GL_COLOR_ATTACHMENT0);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
+  begin_fullscreen(source);
   const int sh_level = std::max(0, mip_levels(size) - 5);
   glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, sh_.id(), 0);
   glViewport(0, row, 9, 1);
   glUseProgram(sh_program_.id());
   glProgramUniform4f(sh_program_.id(), 1, float(sh_level), float(std::max(1, size >> sh_level)), 0, 0);
   glDrawArrays(GL_TRIANGLES, 0, 3);
-  glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, 0, 0);
-  glBindVertexArray(0);
-  glEnable(GL_DEPTH_TEST);
+  end_fullscreen();
   ++prefilters;
 }
 

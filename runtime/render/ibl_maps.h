@@ -64,6 +64,10 @@ class IblMaps {
  private:
   IblMaps() = default;
   void ensure_rows(int rows);
+  /// The state of both fullscreen passes: no depth, culling, blending or sRGB writes, `source`
+  /// on unit 0, the pass framebuffer bound; and undoing what the rest of the frame relies on.
+  void begin_fullscreen(const gpu::Texture& source);
+  void end_fullscreen();
   gpu::Program prefilter_program_, sh_program_;
   gpu::VertexArray empty_vao_;
   gpu::Framebuffer fbo_;

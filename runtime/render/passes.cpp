@@ -1259,8 +1259,8 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list, GpuCac
     glClearBufferfv(GL_DEPTH, 0, &one);
     glEnable(GL_SAMPLE_ALPHA_TO_COVERAGE);
     glEnable(GL_SAMPLE_ALPHA_TO_ONE);
-    const Status st = draw_forward(frame, list.forward_order, list.msaa_keys, nullptr, view_proj,
-                                   cache, state, stats);
+    const Status st = draw_forward(frame, list.forward_order, list.msaa_keys, nullptr, 0,
+                                   view_proj, cache, state, stats);
     glDisable(GL_SAMPLE_ALPHA_TO_ONE);
     glDisable(GL_SAMPLE_ALPHA_TO_COVERAGE);
     // b. The resolve: the samples' average, taken in linear space (GL_FRAMEBUFFER_SRGB).

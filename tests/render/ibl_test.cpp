@@ -26,17 +26,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-float srgb_decode(float c) {
-  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
-
 class IblTest : public PlayerTest {
  protected:
-  static fs::path dir() {
-    const fs::path d = fs::path(KASKAD_TEST_TMP) / "ibl";
-    fs::create_directories(d);
-    return d;
-  }
+  static fs::path dir() { return test_dir("ibl"); }
   // An equirectangular environment image: `top` above the horizon, `bottom` below.
   static fs::path room(const std::string& name, glm::vec3 top, glm::vec3 bottom) {
     Image img;

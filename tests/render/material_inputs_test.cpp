@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "components/brdf.h"
+#include "components/ibl.h"
 #include "runtime/assets/image_io.h"
 #include "tests/render/player_fixture.h"
 
@@ -22,21 +23,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-float srgb_encode(float linear) {
-  const float c = std::clamp(linear, 0.0f, 1.0f);
-  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-}
-float srgb_decode(float c) {
-  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
 
 class MaterialInputsTest : public PlayerTest {
  protected:
-  static fs::path dir() {
-    const fs::path d = fs::path(KASKAD_TEST_TMP) / "material_inputs";
-    fs::create_directories(d);
-    return d;
-  }
+  static fs::path dir() { return test_dir("material_inputs"); }
   /// A texture of `width` x 1 texels of the given RGB values (as stored, 8-bit), written as PNG;
   /// returns the values as read back (what the renderer gets).
   static std::vector<glm::vec3> texture(const std::string& name, std::vector<glm::vec3> texels) {
@@ -129,7 +119,7 @@ TEST_F(MaterialInputsTest, TextureTransformOffsetsTheLookup) {
 // glTF's metallicRoughnessTexture (linear; B metallic, G roughness, times the factors) under a
 // directional light: the card's two halves hold a smooth dielectric and a rough metal, and each
 // half's pixel is the CPU evaluation of Appendix B's BRDF (components/brdf.h) with the texel's
-// values, plus the ambient light on the diffuse colour.
+// values, plus the ambient light through the split sum (components/ibl.h's ibl_combine()).
 TEST_F(MaterialInputsTest, MetallicRoughnessTextureSetsMetallicFromBAndRoughnessFromG) {
   // Four texels of each half, so the bilinear footprint at each pixel below stays in one half.
   std::vector<glm::vec3> texels(4, glm::vec3(0.0f, 0.3f, 0.0f));  // a smooth dielectric
@@ -154,8 +144,8 @@ TEST_F(MaterialInputsTest, MetallicRoughnessTextureSetsMetallicFromBAndRoughness
   const Shot s = shoot(file, {}, 32, 32);
   ASSERT_EQ(s.color.width, 32);
   const glm::vec3 eye(0.0f, 0.0f, 1.2f), n(0.0f, 0.0f, 1.0f);
-  // The pixel's colour from the texel's values: ambient on the diffuse colour (Appendix B's
-  // c_diff) plus the BRDF times the light, sRGB encoded.
+  // The pixel's colour from the texel's values: the uniform ambient through both lobes plus the
+  // BRDF times the light, sRGB encoded.
   auto expected = [&](int x, int y, const glm::vec3& texel) {
     const glm::vec3 p(s.aovs.at(x, y, 0), s.aovs.at(x, y, 1), s.aovs.at(x, y, 2));
     BrdfInputs in;
@@ -163,8 +153,12 @@ TEST_F(MaterialInputsTest, MetallicRoughnessTextureSetsMetallicFromBAndRoughness
     in.metallic = metallic_factor * texel.b;
     in.roughness = roughness_factor * texel.g;
     const glm::vec3 v = glm::normalize(eye - p);
-    const glm::vec3 linear = ambient * base * (1.0f - in.metallic) +
-                             brdf_evaluate(in, n, v, to_light) * intensity * glm::dot(n, to_light);
+    const float n_dot_v = glm::dot(n, v);
+    const glm::vec3 ambient_light(ambient);
+    const glm::vec3 linear =
+        ibl_combine(in, n_dot_v, dfg_lookup(n_dot_v, std::max(in.roughness, kMinRoughness)),
+                    ambient_light, ambient_light) +
+        brdf_evaluate(in, n, v, to_light) * intensity * glm::dot(n, to_light);
     return glm::vec3(srgb_encode(linear.r), srgb_encode(linear.g), srgb_encode(linear.b));
   };
   // Pixels 8 and 23 of row 16 lie in the texture's first and second halves (u = 0.3 and 0.7).

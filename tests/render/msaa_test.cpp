@@ -24,11 +24,7 @@ constexpr int kSize = 64;  // square test frames
 
 class MsaaTest : public PlayerTest {
  protected:
-  static fs::path dir() {
-    const fs::path d = fs::path(KASKAD_TEST_TMP) / "msaa";
-    fs::create_directories(d);
-    return d;
-  }
+  static fs::path dir() { return test_dir("msaa"); }
   // The camera of both test scenes: 4 m in front of the origin looking at it, 40° high, so a
   // pixel of a kSize^2 frame is 2 * 4 * tan(20°) / kSize metres wide at the origin.
   static constexpr const char* kCamera =

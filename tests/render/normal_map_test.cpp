@@ -26,8 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-float srgb_decode(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
-
 class NormalMapTest : public PlayerTest {
  protected:
   // The tangent-space normal every texel holds (8-bit encoded as a normal map stores it).
@@ -37,10 +35,11 @@ class NormalMapTest : public PlayerTest {
     return glm::normalize(enc * 2.0f - 1.0f);
   }
   // A 2 x 2 m card facing up (the plane primitive: +u along +x, +v along +z), seen from above,
-  // lit by a sun travelling along `sun_dir`; the card's x scale is `sx` (-1 mirrors it).
+  // lit by a sun travelling along `sun_dir`; the card's x scale is `sx` (-1 mirrors it). Each
+  // test writes its own files (ctest runs tests in parallel).
   static fs::path scene(glm::vec3 sun_dir, float sx) {
-    const fs::path dir = fs::path(KASKAD_TEST_TMP) / "normal_map";
-    fs::create_directories(dir);
+    const fs::path dir =
+        test_dir(std::string("normal_map/") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     Image tex;
     tex.width = tex.height = 4;
     tex.channels = 3;

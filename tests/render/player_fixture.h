@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -17,6 +19,15 @@
 #include "runtime/gpu/context.h"
 
 namespace kaskad {
+
+/// The sRGB transfer functions (IEC 61966-2-1): read_color() returns encoded values.
+inline float srgb_encode(float linear) {
+  const float c = std::clamp(linear, 0.0f, 1.0f);
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+inline float srgb_decode(float encoded) {
+  return encoded <= 0.04045f ? encoded / 12.92f : std::pow((encoded + 0.055f) / 1.055f, 2.4f);
+}
 
 class PlayerTest : public ::testing::Test {
  protected:
@@ -37,6 +48,13 @@ class PlayerTest : public ::testing::Test {
   void TearDown() override { EXPECT_EQ(gpu::debug_error_count(), 0) << "GL errors were logged"; }
 
   static inline Player* player_ = nullptr;  ///< the suite's player (suites run one at a time)
+
+  /// A folder of the test tmp tree for a test's files, created.
+  static std::filesystem::path test_dir(const std::string& name) {
+    const std::filesystem::path d = std::filesystem::path(KASKAD_TEST_TMP) / name;
+    std::filesystem::create_directories(d);
+    return d;
+  }
 
   /// One frame of the scene file `file` (with `sets` overrides) at width x height: its colour
   /// and AOVs (empty images, with a test failure, when it does not load or render).

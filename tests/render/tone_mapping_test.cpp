@@ -20,10 +20,6 @@ namespace {
 
 class ToneMappingTest : public PlayerTest {
  protected:
-  static float srgb(float linear) {
-    const float c = std::clamp(linear, 0.0f, 1.0f);
-    return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-  }
   // An emissive card of radiance `e` filling the middle of the view, black clear colour
   // `clear` around it, no lights, no ambient.
   static std::filesystem::path card(glm::vec3 e, glm::vec3 clear) {
@@ -60,9 +56,9 @@ TEST_F(ToneMappingTest, ColourFollowsTheCurveOfRadianceTimesExposure) {
       const glm::vec3 want = tone_map(ToneMapping(m), e * exposure);
       const glm::vec3 want_clear = tone_map(ToneMapping(m), clear * exposure);
       for (int c = 0; c < 3; ++c) {
-        EXPECT_NEAR(f.color.at(16, 16, c), srgb(want[c]), 1.5f / 255.0f)
+        EXPECT_NEAR(f.color.at(16, 16, c), srgb_encode(want[c]), 1.5f / 255.0f)
             << modes[m] << " e " << e[c] << " channel " << c;
-        EXPECT_NEAR(f.color.at(0, 0, c), srgb(want_clear[c]), 1.5f / 255.0f)
+        EXPECT_NEAR(f.color.at(0, 0, c), srgb_encode(want_clear[c]), 1.5f / 255.0f)
             << modes[m] << " clear channel " << c;
       }
     }
@@ -74,7 +70,7 @@ TEST_F(ToneMappingTest, ExposureInEvIsTwoToTheEv) {
   const Frame scale = render(file, {"render.exposure=0.5", "render.tone_mapping=aces"});
   ASSERT_EQ(ev.color.width, 32);
   EXPECT_EQ(ev.color.pixels, scale.color.pixels);
-  EXPECT_NEAR(ev.color.at(16, 16, 0), srgb(tone_map_aces(glm::vec3(0.4f)).r), 1.5f / 255.0f);
+  EXPECT_NEAR(ev.color.at(16, 16, 0), srgb_encode(tone_map_aces(glm::vec3(0.4f)).r), 1.5f / 255.0f);
 }
 
 TEST_F(ToneMappingTest, AovsStayLinear) {
