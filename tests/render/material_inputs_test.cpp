@@ -23,7 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
 class MaterialInputsTest : public PlayerTest {
  protected:
   static fs::path dir() { return test_dir("material_inputs"); }
