@@ -3,7 +3,8 @@
 #   toggles   each toggle changes the viewport's image; with nothing changed, frames are identical;
 #             the fly camera (key w) and F (frame the selection) move the view; the debug views
 #             (visibility, cascade, shadow map) differ and leave the colour as it was
-#   saving    save -> reload -> save gives the same bytes; edits then undo give the canonical bytes
+#   saving    save -> reload -> save gives the same bytes; edits then undo give the canonical bytes;
+#             an editor killed (SIGKILL) while it saves over and over leaves a whole file
 #   entities  duplicate, create, delete and rename show and are saved; five undos give the original
 #   every_n   a reflector with update every_n = 3 captures on editor frames 0, 3, 6, 9 only; a
 #             probe's map type changed live changes the image
@@ -148,6 +149,46 @@ quit" "$scene"
   [ "$rc" -eq 0 ] || { fail "save_as/open script exit $rc"; tail -5 "$tmp/out"; }
   grep -q '"intensity": 4' "$tmp/as.json" && ok "after save_as, ctrl+s writes the new file" ||
     fail "as.json lacks the edit saved with ctrl+s"
+  # Killed during a save: the editor saves two versions (intensity 3 and 4) in turn, thousands
+  # of times; it is killed with SIGKILL a random moment after its first save, five times. The
+  # file must be one of the two versions, whole, every time (saves write a temporary file and
+  # rename it over the old one).
+  edit "set sun.light.intensity=3
+save $tmp/v3.json
+set sun.light.intensity=4
+save $tmp/v4.json
+quit!" "$scene"
+  [ "$rc" -eq 0 ] || { fail "version script exit $rc"; tail -5 "$tmp/out"; }
+  for i in $(seq 1 3000); do
+    printf 'set sun.light.intensity=3\nsave %s\nset sun.light.intensity=4\nsave %s\n' \
+      "$tmp/killed.json" "$tmp/killed.json"
+  done >"$tmp/kill_script.txt"
+  echo "quit!" >>"$tmp/kill_script.txt"
+  whole=0
+  for k in 1 2 3 4 5; do
+    cp "$tmp/v3.json" "$tmp/killed.json"
+    xvfb-run -a -f "$tmp/xauthority" -s "-screen 0 1024x600x24" "$KASKAD" edit --size 320x180 \
+      --script "$tmp/kill_script.txt" "$scene" >"$tmp/kill_out" 2>&1 &
+    runner=$!
+    for _ in $(seq 1 600); do  # up to 60 s for the first save
+      grep -q "wrote $tmp/killed.json" "$tmp/kill_out" 2>/dev/null && break
+      sleep 0.1
+    done
+    sleep "0.$((RANDOM % 10))$((RANDOM % 10))"
+    # The editor itself (its command line starts with the binary), not xvfb-run, which then
+    # stops its X server as usual.
+    pkill -KILL -f -- "^$KASKAD edit --size 320x180 --script $tmp/kill_script.txt" || true
+    wait "$runner" 2>/dev/null
+    writes=$(grep -c "wrote $tmp/killed.json" "$tmp/kill_out")
+    if cmp -s "$tmp/killed.json" "$tmp/v3.json" || cmp -s "$tmp/killed.json" "$tmp/v4.json"; then
+      whole=$((whole + 1))
+      echo "     kill $k after $writes saves: the file is whole"
+    else
+      fail "kill $k after $writes saves: killed.json is neither version"
+    fi
+    if [ "$writes" -ge 6000 ]; then fail "kill $k came after the last save: the test proves nothing"; fi
+  done
+  [ "$whole" -eq 5 ] && ok "killed mid-save five times: the file was a whole version each time"
   same "open another scene, save it: its canonical bytes" a.json opened.json
   ls "$tmp" | grep -q '\.tmp' && fail "a temporary file was left behind"
   ;;
