@@ -686,10 +686,10 @@ Status Editor::render_viewport(int w, int h) {
     // GPU times from timer queries; on llvmpipe a pass's work can land in the next pass's timer
     // (DESIGN.md, "Facts about these machines"), so they are indications only.
     std::snprintf(line, sizeof line,
-                  "%.1f ms (GPU shadow %.2f, forward %.2f), %d draws, %zu shadow tris, "
-                  "%d probe faces, %d programs",
-                  t->first_frame_ms, st.shadow_gpu_ms, st.forward_gpu_ms, st.draw_calls,
-                  st.shadow_triangles, st.probe_faces,
+                  "%.1f ms (GPU shadow %.2f, probes %.2f, forward %.2f), %d draws, %zu shadow "
+                  "tris, %d probe faces, %d programs",
+                  t->first_frame_ms, st.shadow_gpu_ms, st.probe_gpu_ms, st.forward_gpu_ms,
+                  st.draw_calls, st.shadow_triangles, st.probe_faces,
                   int(player_.renderer->shaders().program_count()));
     stats_ = line;
   }
