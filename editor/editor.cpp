@@ -263,6 +263,7 @@ class Editor {
   Status load_document(const json& doc);
   std::string unused_name(const std::string& stem) const;
   Status create(const std::string& shape);
+  Status import_model(const std::string& path);
   Status remove_selected();
   Status duplicate_selected();
   Status rename_selected(const std::string& name);
@@ -327,6 +328,7 @@ class Editor {
   std::vector<std::function<Status()>> operations_;  ///< UI entity operations, after the frame
   std::string file_line_;         ///< the inspector's path field for open and save as
   int create_shape_ = 0;
+  char import_path_[512] = "";
   json doc_;
   bool doc_stale_ = true;
   FlyCamera camera_;
@@ -438,6 +440,28 @@ Status Editor::create(const std::string& shape) {
                 {"transform", {{"translation", {at.x, at.y, at.z}}}},
                 {"primitive", {{"shape", shape}}}};
   auto e = add_entity(scene_, block, "/create");
+  if (!e) return e.error();
+  selected_ = name;
+  record(false);
+  return {};
+}
+
+Status Editor::import_model(const std::string& path) {
+  // A glTF model entity in front of the camera, like create(); its meshes are imported under it.
+  // The path as given (absolute, or relative to the working folder) is saved relative to the
+  // scene file, as scene files hold it.
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path file = fs::absolute(path, ec);
+  if (!fs::is_regular_file(file, ec)) return Error{path, "", "import: no such model file"};
+  const fs::path base = fs::absolute(scene_.file.parent_path(), ec);
+  const fs::path relative = file.lexically_normal().lexically_relative(base.lexically_normal());
+  const glm::vec3 at = camera_.position + camera_.forward() * std::max(0.5f * speed_, 0.5f);
+  const std::string name = unused_name(file.stem().string());
+  json block = {{"name", name},
+                {"transform", {{"translation", {at.x, at.y, at.z}}}},
+                {"model", {{"path", relative.empty() ? file.generic_string() : relative.generic_string()}}}};
+  auto e = add_entity(scene_, block, "/import");
   if (!e) return e.error();
   selected_ = name;
   record(false);
@@ -946,6 +970,16 @@ void Editor::draw_ui(int w, int h) {
     const std::string shape = kShapes[create_shape_];
     operations_.push_back([this, shape] { return create(shape); });
   }
+  // A glTF file (path as typed, Enter or the button): imported in front of the camera.
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.65f);
+  const bool entered = ImGui::InputTextWithHint("##model", "model.gltf", import_path_,
+                                                sizeof import_path_,
+                                                ImGuiInputTextFlags_EnterReturnsTrue);
+  ImGui::SameLine();
+  if ((ImGui::Button("import") || entered) && import_path_[0] != '\0') {
+    const std::string path = import_path_;
+    operations_.push_back([this, path] { return import_model(path); });
+  }
   ImGui::Separator();
   entity_list();
   left_w_ = ImGui::GetWindowWidth();
@@ -1069,6 +1103,8 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       return {};
     case ActionKind::create:
       return create(a.args[0]);
+    case ActionKind::import:
+      return import_model(a.args[0]);
     case ActionKind::remove:
       return remove_selected();
     case ActionKind::duplicate:

@@ -26,6 +26,7 @@ constexpr Verb kVerbs[] = {
     {"set", ActionKind::set, 1, 1, "set KEY=VALUE"},
     {"select", ActionKind::select, 1, 1, "select NAME"},
     {"create", ActionKind::create, 1, 1, "create SHAPE (box, sphere, cylinder, cone, plane)"},
+    {"import", ActionKind::import, 1, 1, "import MODEL.gltf|.glb"},
     {"delete", ActionKind::remove, 0, 0, "delete"},
     {"duplicate", ActionKind::duplicate, 0, 0, "duplicate"},
     {"rename", ActionKind::rename, 1, 1, "rename NAME"},
@@ -68,11 +69,11 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
     const Verb* v = nullptr;
     for (const Verb& candidate : kVerbs)
       if (verb == candidate.name) v = &candidate;
-    if (!v)
-      return Error{file.string(), where,
-                   "unknown action '" + verb + "' (set, select, create, delete, duplicate, rename, parent, "
-                   "camera, orbit, key, view, frames, screenshot, "
-                   "window_screenshot, open, save, save_as, undo, redo, quit, quit!)"};
+    if (!v) {
+      std::string known;  // the verbs, from the one table
+      for (const Verb& candidate : kVerbs) known += (known.empty() ? "" : ", ") + std::string(candidate.name);
+      return Error{file.string(), where, "unknown action '" + verb + "' (" + known + ")"};
+    }
     ScriptAction a;
     a.kind = v->kind;
     a.line = n;

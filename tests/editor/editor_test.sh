@@ -5,7 +5,8 @@
 #             (visibility, cascade, shadow map) differ and leave the colour as it was
 #   saving    save -> reload -> save gives the same bytes; edits then undo give the canonical bytes;
 #             an editor killed (SIGKILL) while it saves over and over leaves a whole file
-#   entities  duplicate, create, delete and rename show and are saved; five undos give the original
+#   entities  duplicate, create, delete and rename show and are saved; five undos give the original;
+#             a glTF model imported shows, is saved, and undo removes it
 #   every_n   a reflector with update every_n = 3 captures on editor frames 0, 3, 6, 9 only; a
 #             probe's map type changed live changes the image
 #   input     unknown flags, bad script lines, rejected values and unsaved quits fail clearly
@@ -252,6 +253,35 @@ PY
     fail "ops.json does not hold the entity operations"
   fi
   same "seven operations, seven undos: the original bytes" canonical.json undone.json
+  # A glTF model imported in front of the camera: it shows, it is saved with its path relative
+  # to the saved file, and undo takes it away; a file that is not there is refused, named.
+  edit "frames 1
+screenshot $tmp/no_model.png
+import $KASKAD_CONTENT/models/Box/glTF-Binary/Box.glb
+frames 1
+screenshot $tmp/model.png
+save $tmp/model.json
+undo
+save $tmp/model_undone.json
+quit" "$scene"
+  [ "$rc" -eq 0 ] || { fail "import script exit $rc"; tail -5 "$tmp/out"; }
+  differ "an imported model shows" no_model.png model.png
+  if /usr/bin/env python3 - "$tmp/model.json" <<'PY'
+import json, os, sys
+ents = {e["name"]: e for e in json.load(open(sys.argv[1]))["entities"]}
+path = ents["Box_1"]["model"]["path"]
+assert not os.path.isabs(path), path
+assert os.path.isfile(os.path.join(os.path.dirname(sys.argv[1]), path)), path
+PY
+  then
+    ok "the imported model is saved, its path relative to the saved file"
+  else
+    fail "model.json does not hold the imported model"
+  fi
+  same "import, then undo: the original bytes" canonical.json model_undone.json
+  edit "import $tmp/nope.glb
+quit!" "$scene"
+  refused "line 1: .*nope.glb.*no such model file" "importing a missing file: exit 1, the file named"
   ;;
 every_n)
   edit "frames 10

@@ -38,7 +38,7 @@ TEST(EditorScript, EveryActionParses) {
 
 TEST(EditorScript, BadLinesNameTheFileAndLine) {
   EXPECT_EQ(error_of("frames 1\nsett a=1\n"),
-            "s.txt: line 2: unknown action 'sett' (set, select, create, delete, duplicate, rename, "
+            "s.txt: line 2: unknown action 'sett' (set, select, create, import, delete, duplicate, rename, "
             "parent, camera, orbit, key, view, frames, screenshot, window_screenshot, open, save, "
             "save_as, undo, redo, quit, quit!)");
   EXPECT_NE(error_of("orbit 10\n").find("line 1: expected 'orbit YAW_DEG PITCH_DEG'"),
