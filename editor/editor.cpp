@@ -230,6 +230,18 @@ Image cube_strip(const CubeMap& cube) {
   return out;
 }
 
+// A sphere map (row 0 at the top) as an image, gamma-encoded like cube_strip().
+Image sphere_image(const SphereMap& map) {
+  Image out;
+  out.width = out.height = map.size;
+  out.channels = 3;
+  out.pixels.resize(std::size_t(map.size) * std::size_t(map.size) * 3);
+  for (std::size_t i = 0; i < map.texels.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      out.pixels[3 * i + std::size_t(k)] = std::pow(std::clamp(map.texels[i][k], 0.0f, 1.0f), 1.0f / 2.2f);
+  return out;
+}
+
 // A one-channel image as grey RGB.
 Image grey(const Image& one) {
   Image out;
@@ -687,15 +699,21 @@ Status Editor::render_viewport(int w, int h) {
   changed_since_frame_ = false;
   if (view_ == View::colour) {
     last_frame_ = player_.renderer->read_color();
-  } else if (view_ == View::probe_faces) {
+  } else if (view_ == View::probe_faces || view_ == View::sphere_map) {
     const auto& probes = t->last.probes.probes;
     const auto sel = find(selected_);
     const ProbeData::Entry* shown = probes.empty() ? nullptr : &probes.front();
     for (const auto& p : probes)
       if (sel && p.entity == *sel) shown = &p;
-    CubeMap cube;
-    if (shown) cube = player_.renderer->read_probe_cube(shown->job.handle, shown->job.visible);
-    last_frame_ = cube.size > 0 ? cube_strip(cube) : player_.renderer->read_color();
+    if (view_ == View::probe_faces) {
+      CubeMap cube;
+      if (shown) cube = player_.renderer->read_probe_cube(shown->job.handle, shown->job.visible);
+      last_frame_ = cube.size > 0 ? cube_strip(cube) : player_.renderer->read_color();
+    } else {
+      SphereMap sphere;
+      if (shown) sphere = player_.renderer->read_probe_sphere(shown->job.handle);
+      last_frame_ = sphere.size > 0 ? sphere_image(sphere) : player_.renderer->read_color();
+    }
   } else if (view_ == View::shadow_map) {
     last_frame_ = grey(player_.renderer->read_shadow_map());
     if (last_frame_.width == 0) last_frame_ = player_.renderer->read_color();  // no shadowed light

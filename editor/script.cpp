@@ -34,7 +34,7 @@ constexpr Verb kVerbs[] = {
     {"camera", ActionKind::camera, 3, 6, "camera X Y Z [LOOK_X LOOK_Y LOOK_Z]"},
     {"orbit", ActionKind::orbit, 2, 2, "orbit YAW_DEG PITCH_DEG"},
     {"key", ActionKind::key, 1, 1, "key K (w a s d q e f ctrl+z ctrl+y ctrl+s)"},
-    {"view", ActionKind::view, 1, 1, "view colour|visibility|cascade|normal|depth|shadow_map|probe_faces"},
+    {"view", ActionKind::view, 1, 1, "view colour|visibility|cascade|normal|depth|shadow_map|probe_faces|sphere_map"},
     {"frames", ActionKind::frames, 1, 1, "frames N (1..100000)"},
     {"screenshot", ActionKind::screenshot, 1, 1, "screenshot PATH.png"},
     {"window_screenshot", ActionKind::window_screenshot, 1, 1, "window_screenshot PATH.png"},

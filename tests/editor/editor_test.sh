@@ -294,6 +294,8 @@ view probe_faces
 screenshot $tmp/plane_faces.png
 select mirror_sphere
 screenshot $tmp/sphere_faces.png
+view sphere_map
+screenshot $tmp/sphere_map.png
 quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
     --set mirror_sphere.reflector.every_n=3 --set mirror_plane.reflector.every_n=3 \
     --set mirror_plane.reflector.faces_per_frame=6
@@ -308,6 +310,14 @@ quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
   differ "probe map cube -> sphere changes the reflection" cube.png sphere.png
   differ "the probe faces view shows the probe's faces" sphere.png plane_faces.png
   differ "the selected entity's probe is the one shown" plane_faces.png sphere_faces.png
+  # The views differ by shape, whatever the probes' maps hold: the faces view is a 6:1 strip,
+  # the sphere map square (a PNG's width and height are bytes 16-23).
+  png_size() { od -An -tu1 -j16 -N8 "$tmp/$1" | awk '{ printf "%dx%d", $3 * 256 + $4, $7 * 256 + $8 }'; }
+  if [ "$(png_size sphere_faces.png)" = "768x128" ] && [ "$(png_size sphere_map.png)" = "128x128" ]; then
+    ok "the sphere map view shows the probe's 128^2 sphere map, the faces view its six faces"
+  else
+    fail "views: faces $(png_size sphere_faces.png), sphere map $(png_size sphere_map.png)"
+  fi
   ;;
 input)
   out=$("$KASKAD" edit --screenshot x.png 2>&1); code=$?
