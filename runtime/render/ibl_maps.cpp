@@ -159,12 +159,10 @@ void IblMaps::project_sh(const gpu::Texture& source, int size, int row) {
   glProgramUniform4f(sh_program_.id(), 1, float(sh_level), float(std::max(1, size >> sh_level)), 0, 0);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   end_fullscreen();
-  ++prefilters;
 }
 
 void IblMaps::set_environment(const CubeMap* cube, std::uint64_t key) {
   if (!cube || cube->size <= 0) {
-    environment_source_ = gpu::Texture();
     environment_specular_ = gpu::Texture();
     environment_levels_ = 0;
     environment_key_ = 0;
@@ -173,14 +171,15 @@ void IblMaps::set_environment(const CubeMap* cube, std::uint64_t key) {
   if (key == environment_key_ && environment_specular_) return;
   environment_key_ = key;
   const int n = cube->size;
-  environment_source_ = gpu::make_texture(GL_TEXTURE_CUBE_MAP);
-  glTextureStorage2D(environment_source_.id(), mip_levels(n), GL_RGBA16F, n, n);
-  set_cube_sampling(environment_source_.id());
+  // The map itself is needed only to prefilter it (level 0 of the result is a copy of it).
+  const gpu::Texture source = gpu::make_texture(GL_TEXTURE_CUBE_MAP);
+  glTextureStorage2D(source.id(), mip_levels(n), GL_RGBA16F, n, n);
+  set_cube_sampling(source.id());
   for (int f = 0; f < 6; ++f)
-    glTextureSubImage3D(environment_source_.id(), 0, 0, 0, f, n, n, 1, GL_RGBA, GL_FLOAT,
+    glTextureSubImage3D(source.id(), 0, 0, 0, f, n, n, 1, GL_RGBA, GL_FLOAT,
                         cube->faces[std::size_t(f)].data());
-  glGenerateTextureMipmap(environment_source_.id());
-  prefilter(environment_source_, n, environment_specular_, 0);
+  glGenerateTextureMipmap(source.id());
+  prefilter(source, n, environment_specular_, 0);
   environment_levels_ = ibl_specular_levels(n);
 }
 

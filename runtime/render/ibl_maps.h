@@ -59,7 +59,6 @@ class IblMaps {
   std::vector<glm::vec3> read_sh_row(int row) const;
   CubeMap read_environment_level(int level) const;
 
-  int prefilters = 0;  ///< cubes prefiltered since creation (stats and tests)
 
  private:
   IblMaps() = default;
@@ -74,7 +73,7 @@ class IblMaps {
   gpu::Texture dfg_, sh_, black_cube_;
   int sh_rows_ = 0;
   std::vector<bool> row_used_;
-  gpu::Texture environment_source_, environment_specular_;
+  gpu::Texture environment_specular_;
   int environment_levels_ = 0;
   std::uint64_t environment_key_ = 0;
 };

@@ -92,17 +92,20 @@ std::size_t triangles(const AssetStore& assets, MeshId id) {
   return assets.meshes[index(id)].indices.size() / 3;
 }
 
-// Every slice of a 2D array texture of one channel (`format`: GL_DEPTH_COMPONENT or GL_RED) as
-// one image, layer 0 first, rows top to bottom within each (GL's bottom-to-top rows flipped):
-// ShadowMapPass::read(), LomPass::read_depths(). No texture: an empty stack.
-Image read_slices(const gpu::Texture& t, GLenum format, int size, int slices) {
+// Every slice of a 2D array texture as one image, layer 0 first, rows top to bottom within each
+// (GL's bottom-to-top rows flipped), in the channels `format` reads (GL_DEPTH_COMPONENT, GL_RED,
+// GL_RG, GL_RGBA), named `names`: ShadowMapPass::read(), LomPass's and MomentsPass::read(). No
+// texture: an empty stack.
+Image read_slices(const gpu::Texture& t, GLenum format, std::vector<std::string> names, int size,
+                  int slices) {
   Image img;
   img.width = size;
   img.height = size * slices;
-  img.channels = 1;
-  img.channel_names = {"Y"};
+  img.channels = int(names.size());
+  img.channel_names = std::move(names);
   if (!t) return img;
-  const std::size_t row = std::size_t(size), layer = row * row;
+  const std::size_t row = std::size_t(size) * std::size_t(img.channels);
+  const std::size_t layer = row * std::size_t(size);
   std::vector<float> stack(layer * std::size_t(slices));
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glGetTextureImage(t.id(), 0, format, GL_FLOAT, GLsizei(stack.size() * sizeof(float)),
@@ -578,7 +581,7 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
 }
 
 Image ShadowMapPass::read() const {
-  return read_slices(map_, GL_DEPTH_COMPONENT, size_, layers_);  // empty before the first frame
+  return read_slices(map_, GL_DEPTH_COMPONENT, {"Y"}, size_, layers_);  // empty before the first frame
 }
 
 // ---- LomPass -------------------------------------------------------------------------------------
@@ -820,8 +823,8 @@ void LomPass::bind() {
   glBindSampler(kTexLomOcclusion, nearest_.id());
 }
 
-Image LomPass::read_depths() const { return read_slices(depth_, GL_RED, size_, slices_); }
-Image LomPass::read_factors() const { return read_slices(occlusion_, GL_RED, size_, slices_); }
+Image LomPass::read_depths() const { return read_slices(depth_, GL_RED, {"Y"}, size_, slices_); }
+Image LomPass::read_factors() const { return read_slices(occlusion_, GL_RED, {"Y"}, size_, slices_); }
 
 // ---- MomentsPass ---------------------------------------------------------------------------------
 
@@ -977,26 +980,8 @@ void MomentsPass::bind() {
 }
 
 Image MomentsPass::read() const {
-  Image img;
-  const int channels = four_ ? 4 : 2;
-  img.width = size_;
-  img.height = size_ * layers_;
-  img.channels = channels;
-  img.channel_names = four_ ? std::vector<std::string>{"R", "G", "B", "A"}
-                            : std::vector<std::string>{"R", "G"};
-  if (!moments_) return img;
-  const std::size_t row = std::size_t(size_) * std::size_t(channels), layer = row * std::size_t(size_);
-  std::vector<float> stack(layer * std::size_t(layers_));
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(moments_.id(), 0, four_ ? GL_RGBA : GL_RG, GL_FLOAT,
-                    GLsizei(stack.size() * sizeof(float)), stack.data());
-  img.pixels.resize(stack.size());
-  for (int l = 0; l < layers_; ++l)
-    for (int y = 0; y < size_; ++y)
-      std::memcpy(&img.pixels[std::size_t(l) * layer + std::size_t(y) * row],
-                  &stack[std::size_t(l) * layer + std::size_t(size_ - 1 - y) * row],
-                  row * sizeof(float));
-  return img;
+  return four_ ? read_slices(moments_, GL_RGBA, {"R", "G", "B", "A"}, size_, layers_)
+               : read_slices(moments_, GL_RG, {"R", "G"}, size_, layers_);
 }
 
 // ---- Forward drawing (main view and probe faces) ------------------------------------------------
@@ -1100,14 +1085,12 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
     return {};
   }
   // The pbr model's prefiltering, time-sliced like the captures: faces_per_frame faces a frame
-  // of the cube that was complete before this frame's captures (they may swap buffers), so a
-  // capture completing every 6 / faces_per_frame frames never starves it.
-  for (const ProbeJob& job : frame.probes) {
-    if (!job.prefilter) continue;
-    const bool swapped_now = job.faces != 0 && job.target == job.visible;
-    const int ready = swapped_now ? 1 - job.visible : job.visible;
-    if (cache.probes().prefilter(job.handle, ready, job.faces_per_frame)) ++stats.probe_prefilters;
-  }
+  // of the cube that was complete before this frame's captures (what their round 1 reads; they
+  // may swap buffers), so a capture completing every 6 / faces_per_frame frames never starves it.
+  for (const ProbeJob& job : frame.probes)
+    if (job.prefilter &&
+        cache.probes().prefilter(job.handle, probe_read_buffer(job, 1), job.faces_per_frame))
+      ++stats.probe_prefilters;
   state.forget();
   glDisable(GL_FRAMEBUFFER_SRGB);
   glEnable(GL_DEPTH_TEST);
