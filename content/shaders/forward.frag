@@ -142,10 +142,16 @@ void main() {
 #endif
   vec3 reflected = vec3(0.0);  // S3's C_t, or the pbr probe's prefiltered radiance (AOV)
   float reflector = 0.0;       // 1 where a reflection map applies (AOV)
-#if MATERIAL_HAS_REFLECTION_CUBE || MATERIAL_HAS_REFLECTION_SPHERE
   // S3 eq. (1), R = U - 2 (N.U) N with U the unit vector from the eye to the point. Computed in
   // world space, which is eq. (6)'s (MV)^-1 R_VCS (rotation part): the cube is in world space.
+  // Also the direction the surroundings' specular light is looked up along.
   vec3 r_world = reflect(-v, n);
+#if MATERIAL_HAS_REFLECTION_CUBE
+  // Where a probe's cube is read along R, for S3's model and the pbr one alike.
+  vec3 cube_lookup = r_world;
+#if MATERIAL_HAS_REFLECTION_BOX
+  if (ENABLED(BIT_REFLECTION_BOX)) cube_lookup = box_project(v_world_pos, r_world);
+#endif
 #endif
 #if MATERIAL_HAS_REFLECTION_PBR
   bool reflection_pbr = ENABLED(BIT_REFLECTION_PBR);
@@ -162,7 +168,7 @@ void main() {
   for (int i = 0; i < 9; ++i) sh[i] = u_environment_sh[i].rgb;
   vec3 irradiance = u_environment.x * sh9_irradiance_over_pi(sh, n);
   vec3 specular = u_environment.x *
-                  textureLod(u_environment_cube, reflect(-v, n), ibl_roughness * u_environment.y).rgb;
+                  textureLod(u_environment_cube, r_world, ibl_roughness * u_environment.y).rgb;
 #else
   vec3 irradiance = u_ambient.rgb;
   vec3 specular = u_ambient.rgb;
@@ -170,11 +176,7 @@ void main() {
 #if MATERIAL_HAS_REFLECTION_PBR
   if (reflection_pbr) {
     // The probe instead of the environment, by p_r.
-    vec3 lookup = r_world;
-#if MATERIAL_HAS_REFLECTION_BOX
-    if (ENABLED(BIT_REFLECTION_BOX)) lookup = box_project(v_world_pos, r_world);
-#endif
-    reflected = textureLod(u_reflection_cube, lookup, ibl_roughness * u_reflection.z).rgb;
+    reflected = textureLod(u_reflection_cube, cube_lookup, ibl_roughness * u_reflection.z).rgb;
     reflector = 1.0;
     irradiance = mix(irradiance, sh9_irradiance_over_pi(int(u_reflection.y), n), u_reflection.x);
     specular = mix(specular, reflected, u_reflection.x);
@@ -259,11 +261,7 @@ void main() {
 
 #if MATERIAL_HAS_REFLECTION_CUBE
   if (ENABLED(BIT_REFLECTION_CUBE) && !reflection_pbr) {
-    vec3 lookup = r_world;
-#if MATERIAL_HAS_REFLECTION_BOX
-    if (ENABLED(BIT_REFLECTION_BOX)) lookup = box_project(v_world_pos, r_world);
-#endif
-    reflected = texture(u_reflection_cube, lookup).rgb;
+    reflected = texture(u_reflection_cube, cube_lookup).rgb;
     reflector = 1.0;
   }
 #endif
