@@ -28,6 +28,17 @@ layout(location = 3) out vec2 o_visibility;  // x shadow visibility of the shado
 layout(location = 4) out vec4 o_reflection;  // rgb reflected colour C_t, a 1 with a map (else 0)
 #endif
 
+// render.visibility_cache (Renderer::render()): a frame that stores writes each pixel's shadow
+// visibility per shadow view; a frame that sees what the frame before saw reads it back, so the
+// pixel that ends up in front reads its own value and the image is the same, bit for bit.
+#define SHADOW_REUSE (VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS && !VARIANT_HAS_AOVS)
+#if SHADOW_REUSE && VARIANT_SHADOW_REUSE == VARIANT_SHADOW_REUSE_STORE
+layout(location = 1) out vec4 o_cached_visibility;  // x, y, z, w: shadow views 0..3
+#endif
+#if SHADOW_REUSE && VARIANT_SHADOW_REUSE == VARIANT_SHADOW_REUSE_LOAD
+layout(binding = UNIT_CACHED_VISIBILITY) uniform sampler2D u_cached_visibility;
+#endif
+
 #if VARIANT_ENVIRONMENT == VARIANT_ENVIRONMENT_MAP
 // render.environment prefiltered by roughness (IblMaps): level k holds roughness k / u_environment.y.
 layout(binding = UNIT_ENVIRONMENT) uniform samplerCube u_environment_cube;
@@ -200,12 +211,17 @@ void main() {
   int aov_cascade = -1, tint_cascade = -1;
 #if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
   float view_visibility[SHADOW_VIEWS];
+#if SHADOW_REUSE && VARIANT_SHADOW_REUSE == VARIANT_SHADOW_REUSE_LOAD
+  const vec4 cached_visibility = texelFetch(u_cached_visibility, ivec2(gl_FragCoord.xy), 0);
+#endif
   for (int k = 0; k < SHADOW_VIEWS; ++k) {
     float visibility = 1.0;
     int cascade = -1;
     if (ENABLED(BIT_RECEIVE_SHADOWS)) {
 #if VARIANT_HAS_AOVS
       visibility = shadow_visibility(k, v_world_pos, geometric_n, view_depth, cascade);
+#elif SHADOW_REUSE && VARIANT_SHADOW_REUSE == VARIANT_SHADOW_REUSE_LOAD
+      visibility = cached_visibility[k];
 #else
       // No AOV shows it: where the geometric surface faces away from the light it shadows
       // itself, so the lookup is skipped (visibility 0; only a normal-mapped normal can still
@@ -223,6 +239,10 @@ void main() {
     }
     if (k == 0) tint_cascade = cascade;
   }
+#if SHADOW_REUSE && VARIANT_SHADOW_REUSE == VARIANT_SHADOW_REUSE_STORE
+  o_cached_visibility = vec4(1.0);
+  for (int k = 0; k < SHADOW_VIEWS; ++k) o_cached_visibility[k] = view_visibility[k];
+#endif
 #endif
   for (int i = 0; i < u_counts.x; ++i) {
     int type = u_light_info[i].x;

@@ -59,6 +59,10 @@ struct RenderSettings {
   /// Shadow caching: a shadow-map layer whose inputs are those it was last drawn from keeps its
   /// depth. Off, every layer is drawn every frame (for measurements and comparisons).
   bool shadow_cache = true;
+  /// Visibility caching: a frame that sees what the frame before saw (camera, draws, lights,
+  /// shadow maps) reads each pixel's shadow visibility back instead of looking the maps up.
+  /// Images are identical either way; off, every frame looks up (for measurements).
+  bool visibility_cache = true;
   /// Capture rounds on a frame where reflection probes make their first capture, in
   /// [kMinProbeBounces, kMaxProbeBounces] (components/reflector.h): each round reads the other
   /// probes' maps of the round before, so round k shows mirrors seen in mirrors k - 1 deep.

@@ -438,6 +438,10 @@ int run_render(Args a) {
               st.instances, st.draw_calls, st.frustum_culled, st.triangles, st.shadow_instances,
               st.shadow_draw_calls, st.shadow_triangles, st.shadow_gpu_ms, st.forward_gpu_ms,
               st.program_switches, st.material_switches);
+  if (st.probe_gpu_ms > 0 || st.lom_gpu_ms > 0 || st.moments_gpu_ms > 0)
+    std::printf("          GPU parts: probe captures %.2f ms (prefiltering %.2f ms of it), lom "
+                "%.2f ms and moments %.2f ms (of the shadow pass's)\n",
+                st.probe_gpu_ms, st.prefilter_gpu_ms, st.lom_gpu_ms, st.moments_gpu_ms);
   if (st.shadow_layers > 0) {
     const int drawn = std::popcount(st.shadow_layers_rendered);
     std::printf("          shadow layers re-rendered in the last frame: %d of %d", drawn,
@@ -450,6 +454,9 @@ int run_render(Args a) {
     }
     std::printf("%s\n", drawn < st.shadow_layers ? "; the others kept their depth (same matrix "
                                                     "and casters)" : "");
+    if (st.visibility_reused)
+      std::printf("          shadow visibility read back from the frame before (nothing it "
+                  "depends on changed; render.visibility_cache)\n");
     // The first shadowed light's technique is every view's (for_each_shared_field()).
     if (!timings->last.shadows.empty() &&
         timings->last.shadows.front().settings.technique == ShadowTechnique::lom)

@@ -30,6 +30,10 @@ VariantKey frame_variant(const FrameInput& frame) {
             std::uint32_t(std::clamp(first.layer_count, 1, kMaxCascades) - 1));
     k.set(VariantKey::kCascadeSelection, s.selection == CascadeSelection::map_bounds ? 1u : 0u);
     k.set(VariantKey::kDebugCascades, s.debug_cascades ? 1u : 0u);
+    // The cache holds visibility only: not the cascade the tint and the AOVs show, and one
+    // value per pixel, not per sample.
+    if (frame.visibility_cache && !frame.write_aovs && frame.msaa <= 1 && !s.debug_cascades)
+      k.set(VariantKey::kShadowReuse, VariantKey::kReuseStore);
   }
   if (frame.write_aovs) k.set(VariantKey::kAovs, 1);
   k.set(VariantKey::kToneMapping, std::uint32_t(frame.tone_mapping));
@@ -39,7 +43,8 @@ VariantKey frame_variant(const FrameInput& frame) {
 
 VariantKey capture_frame_variant(VariantKey frame) {
   // Cubes hold linear radiance: no AOVs, no tone mapping.
-  VariantKey k = VariantKey(frame.bits() & ~VariantKey::kAovs.mask() & ~VariantKey::kToneMapping.mask());
+  VariantKey k = VariantKey(frame.bits() & ~VariantKey::kAovs.mask() & ~VariantKey::kToneMapping.mask() &
+                            ~VariantKey::kShadowReuse.mask());
   if (k.has(VariantKey::kShadow) && k.get(VariantKey::kShadowProjection) == 0)  // ortho cascades
     k.set(VariantKey::kCascadeSelection, 1);
   return k;
@@ -66,6 +71,9 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   std::vector<VariantKey> main_fks;
   if (frame.msaa <= 1 || frame.write_aovs) main_fks.push_back(fk);
   if (frame.msaa > 1) main_fks.push_back(msaa_frame_variant(fk));
+  // With the visibility cache, a still frame's programs (the shadow-receiving ones) load it.
+  if (fk.get(VariantKey::kShadowReuse) == VariantKey::kReuseStore)
+    main_fks.push_back(VariantKey(fk).set(VariantKey::kShadowReuse, VariantKey::kReuseLoad));
   std::vector<ProgramRequest> out;
   for (const DrawItem& d : frame.draws) {
     const VariantKey k = material_variant(d) | fk;

@@ -8,6 +8,7 @@
 
 #include "components/ibl.h"
 #include "runtime/gpu/shader.h"
+#include "runtime/render/gpu_timers.h"
 #include "runtime/render/shader_interface.h"
 
 namespace kaskad::render {
@@ -91,6 +92,7 @@ void IblMaps::release_row(int row) {
 }
 
 void IblMaps::begin_fullscreen(const gpu::Texture& source) {
+  if (timers_) timers_->begin(TimedPart::probe_prefilter);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
@@ -106,6 +108,7 @@ void IblMaps::end_fullscreen() {
   glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, 0, 0);
   glBindVertexArray(0);
   glEnable(GL_DEPTH_TEST);
+  if (timers_) timers_->end(TimedPart::probe_prefilter);
 }
 
 void IblMaps::prefilter(const gpu::Texture& source, int size, gpu::Texture& target, int row) {

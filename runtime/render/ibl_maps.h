@@ -18,6 +18,8 @@
 
 namespace kaskad::render {
 
+class GpuTimers;
+
 class IblMaps {
  public:
   /// Builds both programs from `shader_dir` and uploads the split-sum table. Needs a current GL
@@ -54,6 +56,9 @@ class IblMaps {
   /// prefiltered cube (or a black one) to UNIT_ENVIRONMENT.
   void bind() const;
 
+  /// Where prefiltering and SH projection are timed (TimedPart::probe_prefilter); none: not.
+  void set_timers(GpuTimers* timers) { timers_ = timers; }
+
   /// Read-back for tests: SH row `row` (9 rgb coefficients); level `level` of the
   /// environment's prefiltered cube.
   std::vector<glm::vec3> read_sh_row(int row) const;
@@ -67,6 +72,7 @@ class IblMaps {
   /// on unit 0, the pass framebuffer bound; and undoing what the rest of the frame relies on.
   void begin_fullscreen(const gpu::Texture& source);
   void end_fullscreen();
+  GpuTimers* timers_ = nullptr;
   gpu::Program prefilter_program_, sh_program_;
   gpu::VertexArray empty_vao_;
   gpu::Framebuffer fbo_;

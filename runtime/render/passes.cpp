@@ -12,6 +12,7 @@
 
 #include "components/bounds.h"
 #include "runtime/core/log.h"
+#include "runtime/render/input_hash.h"
 #include "runtime/render/renderer.h"
 
 namespace kaskad::render {
@@ -43,20 +44,6 @@ GLenum depth_internal_format(DepthFormat f) {
   }
   return GL_DEPTH_COMPONENT24;
 }
-
-// FNV-1a over the bytes of plain values: the inputs of a shadow layer (shadow caching).
-struct InputHash {
-  std::uint64_t h = 14695981039346656037ull;
-  template <typename T>
-  InputHash& add(const T& v) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    unsigned char bytes[sizeof(T)];
-    std::memcpy(bytes, &v, sizeof(T));
-    for (unsigned char b : bytes) h = (h ^ b) * 1099511628211ull;
-    return *this;
-  }
-  std::uint64_t value() const { return h | 1u; }  // never 0, which means "nothing drawn"
-};
 
 /// Whether the driver can make the shadow map array (GL limits, then a proxy texture).
 Status check_shadow_map_size(int size, int layers, DepthFormat format) {
@@ -1179,9 +1166,16 @@ std::span<const ForwardPass::Target> ForwardPass::targets() {
   return list;
 }
 
+ForwardPass::Target ForwardPass::visibility_target(int views) {
+  if (views <= 1) return {"stored visibility (GL_R32F)", GL_R32F, GL_RED, GL_FLOAT, 4};
+  if (views == 2) return {"stored visibility (GL_RG32F)", GL_RG32F, GL_RG, GL_FLOAT, 8};
+  return {"stored visibility (GL_RGBA32F)", GL_RGBA32F, GL_RGBA, GL_FLOAT, 16};
+}
+
 void ForwardPass::prepare(const FrameInput& frame, int samples) {
   const bool resized = !fbo_ || frame.width != width_ || frame.height != height_;
   if (resized) {
+    visibility_.reset();
     width_ = frame.width;
     height_ = frame.height;
     fbo_ = gpu::make_framebuffer();
@@ -1217,8 +1211,8 @@ void ForwardPass::prepare(const FrameInput& frame, int samples) {
   }
 }
 
-Status ForwardPass::record(const FrameInput& frame, const DrawList& list, GpuCache& cache,
-                           DrawState& state, FrameStats& stats) {
+Status ForwardPass::record(const FrameInput& frame, const DrawList& list, std::uint32_t reuse,
+                           GpuCache& cache, DrawState& state, FrameStats& stats) {
   const GLenum bufs[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
                           GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
   aovs_written_ = frame.write_aovs;
@@ -1262,6 +1256,33 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list, GpuCac
                               GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
   glNamedFramebufferDrawBuffers(fbo_.id(), frame.write_aovs ? 5 : 1,
                                 single_colour ? bufs : aov_bufs);
+  // The stored visibility (render.visibility_cache, never with AOVs): a storing frame writes it
+  // through output 1 into attachment 5, attached for this pass only (a loading frame samples
+  // it, which an attached texture must not be).
+  const std::vector<VariantKey>* keys = &list.keys;
+  std::vector<VariantKey> load_keys;
+  const GLenum visibility_attachment = GL_COLOR_ATTACHMENT5;
+  if (reuse == VariantKey::kReuseStore) {
+    const int views = std::min<int>(int(frame.shadow_views.size()), kMaxShadowedLights);
+    if (!visibility_ || views != visibility_views_) {
+      const Target t = visibility_target(views);
+      visibility_ = gpu::make_texture(GL_TEXTURE_2D);
+      glTextureStorage2D(visibility_.id(), 1, t.internal_format, width_, height_);
+      visibility_views_ = views;
+    }
+    glNamedFramebufferTexture(fbo_.id(), visibility_attachment, visibility_.id(), 0);
+    const GLenum store_bufs[2] = {GL_COLOR_ATTACHMENT0, visibility_attachment};
+    glNamedFramebufferDrawBuffers(fbo_.id(), 2, store_bufs);
+  } else if (reuse == VariantKey::kReuseLoad) {
+    KASKAD_CHECK(visibility_, "a frame loads shadow visibility that no frame stored");
+    glBindTextureUnit(kTexCachedVisibility, visibility_.id());
+    glBindSampler(kTexCachedVisibility, 0);
+    load_keys = list.keys;
+    for (VariantKey& k : load_keys)
+      if (k.get(VariantKey::kShadowReuse) == VariantKey::kReuseStore)
+        k.set(VariantKey::kShadowReuse, VariantKey::kReuseLoad);
+    keys = &load_keys;
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
   if (single_colour) glClearBufferfv(GL_COLOR, 0, clear_color);
   if (frame.write_aovs)
@@ -1269,9 +1290,10 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list, GpuCac
   glClearBufferfv(GL_DEPTH, 0, &one);
   // The AOV pass draws what the colour pass drew: its culling is counted once.
   const int culled = stats.frustum_culled;
-  const Status st = draw_forward(frame, list.forward_order, list.keys, nullptr, 0, view_proj,
+  const Status st = draw_forward(frame, list.forward_order, *keys, nullptr, 0, view_proj,
                                  cache, state, stats);
   if (!single_colour) stats.frustum_culled = culled;
+  if (reuse == VariantKey::kReuseStore) glNamedFramebufferTexture(fbo_.id(), visibility_attachment, 0, 0);
   glDisable(GL_FRAMEBUFFER_SRGB);
   return st;
 }

@@ -221,9 +221,12 @@ class ForwardPass {
   /// multisampled colour and depth targets (made when the size or sample count changes).
   void prepare(const FrameInput& frame, int samples);
   /// Draws the main view's visible draws into colour (and the AOVs when asked for). After it:
-  /// colour holds the frame (resolved), the AOVs its surfaces when write_aovs.
-  Status record(const FrameInput& frame, const DrawList& list, GpuCache& cache,
-                DrawState& state, FrameStats& stats);
+  /// colour holds the frame (resolved), the AOVs its surfaces when write_aovs. `reuse` is the
+  /// frame's VariantKey::kShadowReuse: with kReuseStore (the list's keys) the pass also stores
+  /// each pixel's shadow visibility per view; with kReuseLoad its programs read the stored
+  /// values back (the caller's promise: nothing they depend on changed since they were stored).
+  Status record(const FrameInput& frame, const DrawList& list, std::uint32_t reuse,
+                GpuCache& cache, DrawState& state, FrameStats& stats);
 
   struct Target {
     const char* name;
@@ -233,12 +236,16 @@ class ForwardPass {
   /// The targets, in attachment order (colour 0..4, then depth): what prepare() makes and what
   /// Renderer::check_target_size() asks the driver about.
   static std::span<const Target> targets();
+  /// The stored-visibility target for `views` shadow views: one 32-bit float channel each.
+  static Target visibility_target(int views);
 
   int width() const { return width_; }
   int height() const { return height_; }
   /// Colour samples of the last prepare() (1: no multisampled targets).
   int samples() const { return samples_; }
   bool aovs_written() const { return aovs_written_; }
+  /// Whether a storing frame left stored visibility at the current size.
+  bool holds_visibility() const { return bool(visibility_); }
   gpu::FramebufferRef framebuffer() const { return fbo_; }
   /// Attachment i of targets().
   gpu::TextureRef texture(int i) const { return textures_[std::size_t(i)]; }
@@ -250,6 +257,8 @@ class ForwardPass {
   std::array<gpu::Texture, 6> textures_;
   gpu::Framebuffer msaa_fbo_;                 ///< samples_ > 1: colour and depth, multisampled
   std::array<gpu::Texture, 2> msaa_textures_;  ///< targets() 0 and 5 with samples_ samples
+  gpu::Texture visibility_;  ///< visibility_target(visibility_views_), made by a storing frame
+  int visibility_views_ = 0;
 };
 
 /// The forward path of the main view and of probe faces: draws `order` with `keys` as seen by

@@ -15,11 +15,14 @@
 #include <optional>
 #include <tuple>
 #include <type_traits>
+#include <utility>
 
 #include "runtime/core/log.h"
 #include "runtime/gpu/shader.h"
 #include "runtime/render/frame_uniforms.h"
 #include "runtime/render/gpu_cache.h"
+#include "runtime/render/gpu_timers.h"
+#include "runtime/render/input_hash.h"
 #include "runtime/render/passes.h"
 #include "runtime/render/probe_capture.h"
 #include "runtime/render/shader_interface.h"
@@ -43,10 +46,11 @@ struct Renderer::Impl {
   gpu::Texture points_target;
 
   std::optional<VariantKey> frame_key;  // frame features of the last render()
+  /// render.visibility_cache: visibility_inputs() of the visibility the forward pass holds
+  /// (0: none stored).
+  std::uint64_t stored_visibility = 0;
 
-  std::array<gpu::Query, 3> timers;  // shadow, forward, probe captures
-  bool timers_pending = false;
-  std::uint64_t frames_rendered = 0;
+  GpuTimers timers;  // GPU time per part of the frame (read a frame late)
   bool layer_from_vertex = false;  // GL_ARB_shader_viewport_layer_array: gl_Layer in the VS
   // Sample counts the driver offers for both multisampled forward targets, ascending (GL 4.5
   // guarantees 4 at least: GL_MAX_SAMPLES >= 4).
@@ -128,7 +132,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::filesystem::path& 
   }
   im.frame_ubo = gpu::make_buffer();
   glNamedBufferStorage(im.frame_ubo.id(), sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
-  for (gpu::Query& q : im.timers) q = gpu::make_query(GL_TIME_ELAPSED);
+  im.cache->probes().ibl().set_timers(&im.timers);
   return r;
 }
 
@@ -164,6 +168,24 @@ std::string gib(double bytes) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.1f GiB", bytes / double(1ull << 30));
   return buf;
+}
+
+/// What the main view's shadow visibility at each pixel depends on, besides the shadow maps'
+/// depths: the frame block (camera, lights, shadow views' matrices, splits and parameters), the
+/// frame's features, the target size, and every draw of the forward pass with what decides
+/// which of its fragments end up in front (mesh, matrix, program, sidedness, alpha mask).
+std::uint64_t visibility_inputs(const FrameInput& frame, const DrawList& list,
+                                const AssetStore& assets, const FrameBlock& block) {
+  InputHash h;
+  h.add(assets.uid).add(frame.width).add(frame.height).add(list.frame_key.bits()).add(block);
+  for (std::uint32_t i : list.forward_order) {
+    const DrawItem& d = frame.draws[i];
+    const Material& m = d.material;
+    h.add(d.mesh).add(d.model).add(d.receive_shadows).add(list.keys[i].bits());
+    h.add(m.double_sided).add(m.alpha_mask).add(m.alpha_cutoff).add(m.base_color.a);
+    h.add(m.base_color_texture).add(m.base_color_transform);
+  }
+  return h.value();
 }
 
 }  // namespace
@@ -214,6 +236,10 @@ Status Renderer::check_target_size(int width, int height, bool read_aovs, int ms
       gpu_bytes += bytes;
     }
   }
+  // The stored shadow visibility (render.visibility_cache, single-sample frames without AOVs):
+  // at most one float for each of four shadow views.
+  if (!read_aovs && impl_->samples_for(msaa) <= 1)
+    gpu_bytes += pixels * ForwardPass::visibility_target(kMaxShadowedLights).bytes_per_pixel;
   // Read-backs: colour as float RGBA, and with AOVs 14 float channels plus their staging.
   const double host_bytes = pixels * (16.0 + (read_aovs ? 2.0 * 14 * 4 + 64 : 0.0));
   const std::uint64_t available = available_memory();
@@ -261,15 +287,22 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   // 1. Shadow maps. After it: every layer of every shadow view holds its casters' depth.
   KASKAD_TRY(im.shadow.prepare(frame, list, assets, list.frame_key.has(VariantKey::kShadowLayered),
                                state.features_by_uniform(), stats_));
-  glBeginQuery(GL_TIME_ELAPSED, im.timers[0].id());
+  im.timers.begin(TimedPart::shadow_depth);
   Status st = im.shadow.record(frame, list, *im.cache, state, stats_);
-  // S1's layered occlusion map (technique lom) from those layers, timed with them.
+  im.timers.end(TimedPart::shadow_depth);
+  // S1's layered occlusion map (technique lom) from those layers.
+  const std::uint32_t technique = list.frame_key.get(VariantKey::kShadowTechnique);
+  const bool lom = technique == VariantKey::kTechniqueLom;
+  const bool moments = technique == VariantKey::kTechniqueVsm || technique == VariantKey::kTechniqueEvsm;
+  if (lom) im.timers.begin(TimedPart::lom);
   if (st) st = im.lom.prepare(frame, list, im.shadow, stats_);
   if (st) st = im.lom.record(frame, list, *im.cache, state, stats_);
-  // The moments of vsm/evsm from those layers, timed with them.
+  if (lom) im.timers.end(TimedPart::lom);
+  // The moments of vsm/evsm from those layers.
+  if (moments) im.timers.begin(TimedPart::moments);
   if (st) st = im.moments.prepare(frame, im.shadow, stats_);
   if (st) st = im.moments.record(frame, list, im.shadow, state);
-  glEndQuery(GL_TIME_ELAPSED);
+  if (moments) im.timers.end(TimedPart::moments);
   KASKAD_TRY(st);
   im.shadow.bind();
   im.lom.bind();
@@ -278,23 +311,48 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   // 2. Probe captures. After it: every probe's visible cube (and sphere map) is the one the
   //    frame's reflections read.
   im.probe_capture.prepare(frame, assets, *im.cache);
-  glBeginQuery(GL_TIME_ELAPSED, im.timers[2].id());
+  im.timers.begin(TimedPart::probe_captures);
   st = im.probe_capture.record(frame, list, block, im.frame_ubo, *im.cache, state, stats_);
-  glEndQuery(GL_TIME_ELAPSED);
+  im.timers.end(TimedPart::probe_captures);
   KASKAD_TRY(st);
 
-  // 3. Forward. After it: colour (and the AOVs) of the main view.
+  // 3. Forward. After it: colour (and the AOVs) of the main view. With render.visibility_cache
+  //    a frame whose visibility inputs are those of the visibility stored and whose shadow
+  //    maps were all kept reads it back instead of looking the maps up.
   im.forward.prepare(frame, im.samples_for(frame.msaa));
   stats_.msaa_samples = im.forward.samples();
-  glBeginQuery(GL_TIME_ELAPSED, im.timers[1].id());
-  st = im.forward.record(frame, list, *im.cache, state, stats_);
-  glEndQuery(GL_TIME_ELAPSED);
+  std::uint32_t reuse = list.frame_key.get(VariantKey::kShadowReuse);
+  const std::uint64_t stored = std::exchange(im.stored_visibility, 0);
+  if (reuse != 0) {
+    const std::uint64_t inputs = visibility_inputs(frame, list, assets, block);
+    const bool maps_kept = stats_.shadow_layers_rendered == 0 && stats_.lom_layers_computed == 0 &&
+                           stats_.vsm_layers_computed == 0;
+    if (maps_kept && inputs == stored && im.forward.holds_visibility()) reuse = VariantKey::kReuseLoad;
+    im.stored_visibility = inputs;
+  }
+  // Loading programs not built yet are built now (prewarm() builds them up front). One that
+  // does not build (a shader edited into an error since the storing programs were built)
+  // leaves the frame to look up with the programs it has.
+  if (reuse == VariantKey::kReuseLoad)
+    for (std::uint32_t i : list.forward_order) {
+      if (list.keys[i].get(VariantKey::kShadowReuse) != VariantKey::kReuseStore) continue;
+      const VariantKey load = VariantKey(list.keys[i]).set(VariantKey::kShadowReuse, VariantKey::kReuseLoad);
+      if (auto program = im.shaders->program(Pass::forward, load); !program) {
+        log::warn_once("render.visibility_cache: a program that reads the stored visibility does "
+                       "not build (%s); frames look the shadow maps up instead",
+                       program.error().to_string().c_str());
+        reuse = VariantKey::kReuseStore;
+        break;
+      }
+    }
+  stats_.visibility_reused = reuse == VariantKey::kReuseLoad;
+  im.timers.begin(TimedPart::forward);
+  st = im.forward.record(frame, list, reuse, *im.cache, state, stats_);
+  im.timers.end(TimedPart::forward);
+  if (!st) im.stored_visibility = 0;
   KASKAD_TRY(st);
 
   stats_.shaders = im.shaders->stats();
-  // llvmpipe returns garbage for the very first GL_TIME_ELAPSED queries of a context (seen:
-  // 3.4e6 ms), and frame 0 times uploads anyway: results are read from frame 1's queries on.
-  im.timers_pending = im.frames_rendered++ > 0;
   glBindVertexArray(0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return {};
@@ -302,12 +360,15 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
 
 void Renderer::read_timers() {
   Impl& im = *impl_;
-  if (!im.timers_pending) return;  // results of the previous frame (available after finish())
-  GLuint64 ns[3] = {0, 0, 0};
-  for (int i = 0; i < 3; ++i) glGetQueryObjectui64v(im.timers[i].id(), GL_QUERY_RESULT, &ns[i]);
-  stats_.shadow_gpu_ms = double(ns[0]) * 1e-6;
-  stats_.forward_gpu_ms = double(ns[1]) * 1e-6;
-  stats_.probe_gpu_ms = double(ns[2]) * 1e-6;
+  im.timers.begin_frame();  // the previous frame's results (available after its finish())
+  const auto& ms = im.timers.last();
+  auto part = [&](TimedPart p) { return ms[std::size_t(p)]; };
+  stats_.shadow_gpu_ms = part(TimedPart::shadow_depth) + part(TimedPart::lom) + part(TimedPart::moments);
+  stats_.lom_gpu_ms = part(TimedPart::lom);
+  stats_.moments_gpu_ms = part(TimedPart::moments);
+  stats_.forward_gpu_ms = part(TimedPart::forward);
+  stats_.probe_gpu_ms = part(TimedPart::probe_captures) + part(TimedPart::probe_prefilter);
+  stats_.prefilter_gpu_ms = part(TimedPart::probe_prefilter);
   stats_.probe_faces_timed = stats_.probe_faces;  // still the previous frame's count here
 }
 

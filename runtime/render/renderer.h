@@ -73,10 +73,18 @@ struct FrameStats {
   /// ShadowTechnique::vsm/evsm: shadow-map layers whose moments were recomputed this frame (bit
   /// l, as shadow_layers_rendered; MomentsPass).
   std::uint32_t vsm_layers_computed = 0;
+  /// render.visibility_cache: the forward pass read each pixel's shadow visibility back from
+  /// the frame before instead of looking the shadow maps up (nothing it depends on changed).
+  bool visibility_reused = false;
   /// GPU times are the previous frame's (queries are read a frame late); 0 until frame 3.
-  double shadow_gpu_ms = 0.0;         ///< GL_TIME_ELAPSED of the shadow pass (previous frame)
-  double forward_gpu_ms = 0.0;        ///< GL_TIME_ELAPSED of the forward pass (previous frame)
-  double probe_gpu_ms = 0.0;          ///< GL_TIME_ELAPSED of the probe captures (previous frame)
+  /// GPU time (GL_TIMESTAMP pairs, GpuTimers) of the shadow pass with LOM and moments, the
+  /// forward pass and the probe captures (previous frame).
+  double shadow_gpu_ms = 0.0;
+  double forward_gpu_ms = 0.0;
+  double probe_gpu_ms = 0.0;
+  /// Parts of the above (previous frame): LomPass and MomentsPass (in shadow_gpu_ms), and pbr
+  /// prefiltering with SH projection of probes and the environment map (in probe_gpu_ms).
+  double lom_gpu_ms = 0.0, moments_gpu_ms = 0.0, prefilter_gpu_ms = 0.0;
   int probe_faces_timed = 0;          ///< faces that probe_gpu_ms covers (previous frame's)
   int probe_faces = 0;                ///< reflection probe cube faces rendered this frame
   int probe_prefilters = 0;           ///< probe cubes whose pbr prefiltering completed this frame

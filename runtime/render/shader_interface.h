@@ -64,16 +64,18 @@ inline constexpr int kUvSlotBaseColor = 0, kUvSlotNormal = 1, kUvSlotOcclusion =
 /// moments blurred along x, read by the blur along y.
 /// kTexDfg, kTexSh, kTexEnvironment: image-based lighting (IblMaps): the split-sum table, the
 /// rows of SH coefficients, the environment map's prefiltered cube.
+/// kTexCachedVisibility: the main view's stored shadow visibility (VARIANT_SHADOW_REUSE load).
 inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
                           kTexReflectionCube = 3, kTexReflectionSphere = 4, kTexShadowDepth = 5,
                           kTexShadowLinear = 6, kTexOcclusion = 7, kTexEmissive = 8,
                           kTexLomDepth = 9, kTexLomOcclusion = 10, kTexPeelPrevious = 11,
                           kTexVsmMoments = 12, kTexVsmSource = 13, kTexDfg = 14, kTexSh = 15,
-                          kTexEnvironment = 16, kTexMetallicRoughness = 17;
+                          kTexEnvironment = 16, kTexMetallicRoughness = 17,
+                          kTexCachedVisibility = 18;
 
 /// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...), and
 /// the light types (LIGHT_DIRECTIONAL, ...: u_light_info[i].x holds a LightType).
-inline std::array<std::pair<const char*, int>, 52> shader_interface_defines() {
+inline std::array<std::pair<const char*, int>, 53> shader_interface_defines() {
   return {{{"LIGHT_DIRECTIONAL", int(LightType::directional)},
            {"LIGHT_SPOT", int(LightType::spot)},
            {"LIGHT_POINT", int(LightType::point)},
@@ -125,7 +127,8 @@ inline std::array<std::pair<const char*, int>, 52> shader_interface_defines() {
            {"UNIT_DFG", int(kTexDfg)},
            {"UNIT_SH", int(kTexSh)},
            {"UNIT_ENVIRONMENT", int(kTexEnvironment)},
-           {"UNIT_METALLIC_ROUGHNESS", int(kTexMetallicRoughness)}}};
+           {"UNIT_METALLIC_ROUGHNESS", int(kTexMetallicRoughness)},
+           {"UNIT_CACHED_VISIBILITY", int(kTexCachedVisibility)}}};
 }
 
 }  // namespace kaskad::render

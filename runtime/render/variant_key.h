@@ -25,6 +25,7 @@
 //   emissive_texture needs emissive
 //   reflection_pbr needs reflection_cube
 //   alpha_to_coverage is kept by the forward pass only with alpha_mask (filtered_for())
+//   shadow_reuse needs shadow; the forward pass keeps it only with receive_shadows
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask with its
 // texture_transform, peeling, and the projection when it is dual_paraboloid: its vertex shader
 // differs), so every material shares one or two shadow programs.
@@ -191,6 +192,13 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // radiance, or render.environment's SH and prefiltered cube.
     {.name = "environment", .kind = FeatureKind::frame, .define = "VARIANT_ENVIRONMENT",
      .stages = kFragmentStage, .offset = 43, .values = {"uniform", "map"}},
+    // render.visibility_cache: the main view's single-sample colour pass stores each pixel's
+    // shadow visibility (one float per shadow view), and a frame whose visibility inputs are
+    // those of the frame before loads it instead of looking the shadow maps up (Renderer).
+    // Only shadow-receiving programs keep it (filtered_for()).
+    {.name = "shadow_reuse", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_REUSE",
+     .stages = kFragmentStage, .offset = 44, .values = {"off", "store", "load"},
+     .requires_ = {"shadow"}},
 };
 inline constexpr int kFeatureCount = int(std::size(kFeatureTable));
 
@@ -315,6 +323,9 @@ class VariantKey {
   static constexpr Field kEnvironment = feature_field("environment");
   /// The multisampled colour pass's alpha-masked draws: coverage from alpha (render.msaa > 1).
   static constexpr Field kAlphaToCoverage = feature_field("alpha_to_coverage");
+  /// The main view's cached shadow visibility: 0 off, 1 store (look up and store), 2 load.
+  static constexpr Field kShadowReuse = feature_field("shadow_reuse");
+  static constexpr std::uint32_t kReuseStore = 1, kReuseLoad = 2;
   static constexpr std::uint64_t kFrameMask = 0x0000ffffffff0000u;
 
   constexpr VariantKey() = default;
@@ -373,10 +384,13 @@ class VariantKey {
     if (pass == Pass::shadow_points || pass == Pass::lom_occlusion || pass == Pass::vsm_moments)
       return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask() &
                          ~kShadowLayered.mask() & ~kToneMapping.mask() & ~kShadowPeel.mask() &
-                         ~kEnvironment.mask() & ~kAlphaToCoverage.mask()) |
+                         ~kEnvironment.mask() & ~kAlphaToCoverage.mask() &
+                         ~kShadowReuse.mask()) |
                         kReceiveShadows.mask());
-    if (!has(kAlphaMask)) return VariantKey(bits_ & ~kAlphaToCoverage.mask());
-    return *this;
+    // Programs without a shadow lookup have no visibility to store or load.
+    const std::uint64_t reuse = has(kReceiveShadows) ? 0u : kShadowReuse.mask();
+    if (!has(kAlphaMask)) return VariantKey(bits_ & ~kAlphaToCoverage.mask() & ~reuse);
+    return VariantKey(bits_ & ~reuse);
   }
 
  private:

@@ -94,12 +94,14 @@ TEST_F(PermutationTest, CompilesExactlyTheCombinationsTheSceneUses) {
   std::set<std::uint64_t> forward, depth;
   for (const auto& r : requests) (r.pass == Pass::forward ? forward : depth).insert(r.key.bits());
   // materials.json: ground (none), checker, bumpy metal, glow, foliage (alpha), textured+bumpy,
-  // plain cone (no shadow receiving): 7 distinct forward keys; depth: opaque + alpha mask.
-  EXPECT_EQ(forward.size(), 7u);
+  // plain cone (no shadow receiving): 7 distinct forward keys, and the 6 that receive shadows
+  // again reading the stored visibility (render.visibility_cache: still frames); depth:
+  // opaque + alpha mask.
+  EXPECT_EQ(forward.size(), 7u + 6u);
   EXPECT_EQ(depth.size(), 2u);
 
   auto r = make_renderer();
-  render(*r, s);
+  render(*r, s, 2);  // the second frame is still: it reads the visibility back
   EXPECT_EQ(r->shaders().built_keys(Pass::forward).size(), forward.size());
   EXPECT_EQ(r->shaders().built_keys(Pass::depth).size(), depth.size());
   EXPECT_EQ(r->stats().shaders.programs_compiled, int(forward.size() + depth.size()));
@@ -119,7 +121,9 @@ TEST_F(PermutationTest, UnusedFeaturesAreNeverCompiled) {
       EXPECT_FALSE(k.has(VariantKey::kReflectionCube));
       EXPECT_FALSE(k.has(VariantKey::kAovs));  // not asked for
     }
-  EXPECT_EQ(r->stats().shaders.programs_compiled, 2);  // one forward, one depth
+  // One forward program that looks the shadow maps up (and stores the visibility), one that
+  // reads it back (still frames), one depth program.
+  EXPECT_EQ(r->stats().shaders.programs_compiled, 3);
 }
 
 TEST_F(PermutationTest, EveryVariantMatchesTheUberShaderOracle) {

@@ -48,13 +48,14 @@ bool documented_rules_hold(VariantKey k) {
       V::kShadowKernel.mask() | V::kToneMapping.mask() | V::kOcclusionTexture.mask() |
       V::kEmissiveTexture.mask() | V::kTextureTransform.mask() | V::kShadowPeel.mask() |
       V::kReflectionPbr.mask() | V::kEnvironment.mask() |
-      V::kAlphaToCoverage.mask() | V::kMetallicRoughnessTexture.mask();
+      V::kAlphaToCoverage.mask() | V::kMetallicRoughnessTexture.mask() | V::kShadowReuse.mask();
   if (k.bits() & ~used) return false;
   if (k.get(V::kToneMapping) > 2) return false;      // none, khr_pbr_neutral, aces
   if (k.get(V::kShadowFilter) > 2) return false;     // none, bilinear, pcf3x3
   // pcf, pcss, backprojection, lom, vsm, evsm
   if (k.get(V::kShadowTechnique) > 5) return false;
   if (k.get(V::kShadowKernel) > 4) return false;     // 3x3, 5x5, 7x7, 9x9, poisson
+  if (k.get(V::kShadowReuse) > 2) return false;      // off, store, load
   if (k.has(V::kReflectionCube) && k.has(V::kReflectionSphere)) return false;
   if (k.has(V::kReflectionBox) && !k.has(V::kReflectionCube)) return false;
   if (k.has(V::kReflectionPbr) && !k.has(V::kReflectionCube)) return false;
@@ -63,7 +64,8 @@ bool documented_rules_hold(VariantKey k) {
                             k.has(V::kDebugCascades) || k.has(V::kCascadeSelection) ||
                             k.has(V::kShadowProjection) || k.has(V::kShadowLayered) ||
                             k.has(V::kShadowLightsMinus1) || k.has(V::kShadowTechnique) ||
-                            k.has(V::kShadowKernel) || k.has(V::kShadowPeel);
+                            k.has(V::kShadowKernel) || k.has(V::kShadowPeel) ||
+                            k.has(V::kShadowReuse);
   if (needs_shadow && !k.has(V::kShadow)) return false;
   if (k.has(V::kShadowProjection) && k.has(V::kCascadeCountMinus1)) return false;
   return true;
@@ -77,8 +79,8 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   int disagree = 0;
   // valid() (kFeatureTable's rules) agrees with the rules written out above, the manifest names
   // a broken rule exactly when valid() is false, and a valid key filters to itself for the
-  // forward pass (it reads everything, but alpha_to_coverage only with alpha_mask) and to valid
-  // keys for the others.
+  // forward pass (it reads everything, but alpha_to_coverage only with alpha_mask and
+  // shadow_reuse only with receive_shadows) and to valid keys for the others.
   auto check = [&](VariantKey k) {
     if ((k.valid() != documented_rules_hold(k) || k.valid() != m.check(k).empty()) &&
         disagree++ < 5)
@@ -86,10 +88,10 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
                     << ", documented rules " << documented_rules_hold(k) << ", manifest: '"
                     << m.check(k) << "' (" << m.describe(k) << ")";
     if (!k.valid()) return false;
-    EXPECT_EQ(k.filtered_for(Pass::forward),
-              k.has(VariantKey::kAlphaMask)
-                  ? k
-                  : VariantKey(k.bits() & ~VariantKey::kAlphaToCoverage.mask()));
+    std::uint64_t forward = k.bits();
+    if (!k.has(VariantKey::kAlphaMask)) forward &= ~VariantKey::kAlphaToCoverage.mask();
+    if (!k.has(VariantKey::kReceiveShadows)) forward &= ~VariantKey::kShadowReuse.mask();
+    EXPECT_EQ(k.filtered_for(Pass::forward), VariantKey(forward));
     EXPECT_TRUE(k.filtered_for(Pass::depth).valid());
     EXPECT_TRUE(k.filtered_for(Pass::shadow_points).valid());
     EXPECT_TRUE(k.filtered_for(Pass::lom_occlusion).valid());
@@ -109,13 +111,21 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
           .set(VariantKey::kShadowProjection, 3)
           .set(VariantKey::kShadowTechnique, 1)
           .set(VariantKey::kShadowKernel, 4)};
-  int valid_frames = 0, valid_materials = 0;
-  for (std::uint64_t bits = 0;; bits = ((bits | ~frame_used) + 1) & frame_used) {
+  // shadow_reuse's two bits are left out of the subsets (4x the time otherwise) and tried in
+  // each of their values on every valid frame key: its only rule is that it needs shadow.
+  const std::uint64_t reuse = VariantKey::kShadowReuse.mask();
+  const std::uint64_t enumerated = frame_used & ~reuse;
+  int valid_frames = 0, valid_materials = 0, valid_reuse = 0;
+  for (std::uint64_t bits = 0;; bits = ((bits | ~enumerated) + 1) & enumerated) {
     int n = 0;
     for (VariantKey mat : some_materials) n += check(VariantKey(bits | mat.bits())) ? 1 : 0;
     EXPECT_TRUE(n == 0 || n == 3) << std::hex << bits;
     valid_frames += n > 0 ? 1 : 0;
-    if (bits == frame_used) break;
+    if (n > 0)
+      for (std::uint32_t value = 1; value < 4; ++value)
+        valid_reuse += check(VariantKey(bits | some_materials[1].bits())
+                                 .set(VariantKey::kShadowReuse, value)) ? 1 : 0;
+    if (bits == enumerated) break;
   }
   for (std::uint64_t bits = 0;; bits = ((bits | ~material_used) + 1) & material_used) {
     int n = 0;
@@ -134,6 +144,8 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   // 2 peel = 126720; all of them x 3 tone mappings x 2 environments x 2 alpha_to_coverage.
   EXPECT_EQ(valid_materials, 2304);
   EXPECT_EQ(valid_frames, 2 * 2 * 3 * (2 + 126720));
+  // shadow_reuse store and load on every frame key with shadow; "3" is past its values.
+  EXPECT_EQ(valid_reuse, 2 * 2 * 2 * 3 * 126720);
 }
 
 // The table is the one source: the manifest's features, their fields and the GLSL bit numbers
