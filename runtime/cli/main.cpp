@@ -454,6 +454,10 @@ int run_render(Args a) {
     }
     std::printf("%s\n", drawn < st.shadow_layers ? "; the others kept their depth (same matrix "
                                                     "and casters)" : "");
+    if (st.shadow_rect_culled > 0)
+      std::printf("          %d caster instances left out of layers drawn in part: their boxes "
+                  "miss the texels drawn (shadow.scissor_to_receivers)\n",
+                  st.shadow_rect_culled);
     if (st.visibility_reused)
       std::printf("          shadow visibility read back from the frame before (nothing it "
                   "depends on changed; render.visibility_cache)\n");

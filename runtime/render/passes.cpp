@@ -287,6 +287,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   stats.layer_rect.fill(glm::ivec4(0));
   stats.shadow_layers = total;
   stats.shadow_layers_rendered = 0;
+  stats.shadow_rect_culled = 0;
   stats.shadow_draw_calls = 0;
   stats.shadow_instances = 0;
   stats.shadow_triangles = 0;
@@ -432,13 +433,35 @@ std::vector<CasterRun> depth_runs(const FrameInput& frame, const DrawList& list,
 // The casters of view `view` in `layers` (bit c: layer c of the view; a caster goes to the layers
 // of its mask in `layers`), their instance records carrying the layer when `per_layer` (the
 // layered pass).
+// With `rect` (one layer drawn over part of it, ortho: x0, y0, x1, y1 in NDC through `light_vp`),
+// casters whose box lies outside it are left out (counted in `rect_culled`): they would write only
+// texels no lookup reads, and on a software rasteriser each costs its vertices and set-up.
 std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache,
                                    const DrawState& state, std::size_t view, std::uint32_t layers,
-                                   bool per_layer, std::vector<InstanceRecord>& records) {
+                                   bool per_layer, std::vector<InstanceRecord>& records,
+                                   const glm::mat4* light_vp = nullptr,
+                                   const glm::vec4* rect = nullptr, int* rect_culled = nullptr) {
   const ShadowView& v = frame.shadow_views[view];
+  auto outside_rect = [&](const DrawItem& d) {
+    if (!rect || d.bounds.empty()) return false;
+    // The box's NDC bounds through the affine light matrix (Arvo's box transform).
+    const glm::vec3 centre = 0.5f * (d.bounds.min + d.bounds.max);
+    const glm::vec3 half = 0.5f * (d.bounds.max - d.bounds.min);
+    const glm::vec4 c = *light_vp * glm::vec4(centre, 1.0f);
+    glm::vec2 e(0.0f);
+    for (int col = 0; col < 3; ++col)
+      for (int row = 0; row < 2; ++row) e[row] += std::abs((*light_vp)[col][row]) * half[col];
+    const bool out = c.x + e.x < rect->x || c.x - e.x > rect->z || c.y + e.y < rect->y ||
+                     c.y - e.y > rect->w;
+    if (out && rect_culled) ++*rect_culled;
+    return out;
+  };
   return depth_runs(
       frame, list, cache, state, view, false,
-      [&](std::uint32_t i) { return layers & caster_mask(v, frame.draws[i]); },
+      [&](std::uint32_t i) {
+        const std::uint32_t mask = layers & caster_mask(v, frame.draws[i]);
+        return mask != 0 && outside_rect(frame.draws[i]) ? 0u : mask;
+      },
       [&](std::uint32_t i, int c) {
         return depth_instance_of(frame.draws[i].model, per_layer ? std::uint32_t(c) : 0u);
       },
@@ -550,9 +573,15 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
         glScissor(r.x, r.y, r.z - r.x, r.w - r.y);
       }
       if (v.skipped[std::size_t(c)]) continue;
-      const auto runs = caster_runs(frame, list, cache, state, view, 1u << c, false, records);
-      status = draw_runs(frame, list, cache, state, stats, view, runs, records,
-                         &v.view_proj[std::size_t(c)]);
+      // Part of a cascade: casters outside the drawn texels (two texels wider, as the
+      // rectangle is whole texels and the rasteriser's coverage rules are its own) are left out.
+      const glm::mat4& vp = v.view_proj[std::size_t(c)];
+      const bool part = r != glm::ivec4(0, 0, size_, size_) && v.projection == ShadowProjection::ortho;
+      const float texel = 2.0f / float(size_);
+      const glm::vec4 ndc = glm::vec4(r) * texel - 1.0f + glm::vec4(-2, -2, 2, 2) * texel;
+      const auto runs = caster_runs(frame, list, cache, state, view, 1u << c, false, records,
+                                    &vp, part ? &ndc : nullptr, &stats.shadow_rect_culled);
+      status = draw_runs(frame, list, cache, state, stats, view, runs, records, &vp);
     }
   }
   glDisable(GL_POLYGON_OFFSET_FILL);

@@ -48,6 +48,9 @@ struct FrameStats {
   /// Bit l: texture-array layer l was cleared and re-rendered this frame. The others kept their
   /// depth: same matrix, casters, caster matrices, bias and pass mode as when last drawn.
   std::uint32_t shadow_layers_rendered = 0;
+  /// Caster instances left out of layers drawn this frame over part of their texels
+  /// (shadow.scissor_to_receivers) because their boxes miss those texels.
+  int shadow_rect_culled = 0;
   /// Per layer of the shadow map array (all shadow views; view k's layers start at its
   /// first_layer): the casters it holds, their triangles, and metres per texel (spot and point
   /// layers: at 1 m from the light).
