@@ -35,6 +35,7 @@
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
 #include "runtime/cli/player.h"
+#include "runtime/core/json_reader.h"
 #include "runtime/gpu/context.h"
 #include "runtime/gpu/gl_handles.h"
 #include "systems/transform_system.h"
@@ -254,11 +255,26 @@ Image grey(const Image& one) {
   return out;
 }
 
+// The last two parts of a field's path, "/" or "." separated ("/entities/2/light/type" and
+// "sun.light.type" give "light.type"; "/shadow/filter" and "shadow.filter" give "shadow.filter"):
+// the object and the field, which name one table of the readers whichever entity holds them.
+std::string enumeration_key(const std::string& path, char separator) {
+  const auto last = path.rfind(separator);
+  if (last == std::string::npos || last == 0) return path.substr(last == 0 ? 1 : 0);
+  const auto before = path.rfind(separator, last - 1);
+  std::string key = path.substr(before == std::string::npos ? 0 : before + 1);
+  std::replace(key.begin(), key.end(), separator, '.');
+  return key;
+}
+
 class Editor {
  public:
   Editor(Options options, Scene scene, Player& player, std::vector<ScriptAction> script)
       : opt_(std::move(options)), scene_(std::move(scene)), player_(player), script_(std::move(script)) {
     history_.push_back(scene_to_json(scene_));
+    // The scene's enumerations as its reader sees them, whether the file gave them or not (scenes
+    // read later, created entities and edits are recorded as they are read).
+    (void)parse_scene(history_.front(), opt_.scene);
     take_camera_from_scene();
     update_bounds_speed();
   }
@@ -307,6 +323,11 @@ class Editor {
   void inspector();
   void field(const std::string& key, const std::string& label, const json& value);
   void request(const std::string& assignment);
+  /// The names the readers accept for the enumerated field KEY (an inspector key such as
+  /// "shadow.filter" or "sun.light.type"); nullptr when KEY is not enumerated.
+  const std::vector<std::string>* choices(const std::string& key);
+  /// What picking NAME in KEY's combo does: the edit KEY="NAME", for a name of choices(KEY) only.
+  Status choose(const std::string& key, const std::string& name);
   void direction_helpers();
   void interactive_input(float dt);
   Status run_action(const ScriptAction& a, bool& quit);
@@ -325,6 +346,11 @@ class Editor {
   }
 
   Options opt_;
+  /// Every enumeration the scene readers are asked for while the editor runs: the combo boxes'
+  /// items are the readers' own tables.
+  json_reader::EnumerationRecorder enumerations_;
+  std::map<std::string, std::vector<std::string>> choices_;  ///< by enumeration_key()
+  std::size_t choices_from_ = 0;  ///< how many recorded fields choices_ was made from
   Scene scene_;
   Player& player_;  ///< outlives the editor: its context outlives the UI's GL objects
   std::vector<ScriptAction> script_;  ///< --script, parsed before the window opened
@@ -767,8 +793,26 @@ void Editor::request(const std::string& assignment) {
   requests_.emplace_back(assignment, merge);
 }
 
+const std::vector<std::string>* Editor::choices(const std::string& key) {
+  if (choices_from_ != enumerations_.fields().size()) {
+    for (const auto& [path, names] : enumerations_.fields()) choices_[enumeration_key(path, '/')] = names;
+    choices_from_ = enumerations_.fields().size();
+  }
+  const auto it = choices_.find(enumeration_key(key, '.'));
+  return it == choices_.end() ? nullptr : &it->second;
+}
+
+Status Editor::choose(const std::string& key, const std::string& name) {
+  const std::vector<std::string>* names = choices(key);
+  if (!names) return Error{"", "", "'" + key + "' is not an enumerated field"};
+  if (std::find(names->begin(), names->end(), name) == names->end())
+    return Error{"", "", "'" + name + "' is not one of " + key + "'s choices (" + json_reader::join(*names) + ")"};
+  return edit(key + "=" + json(name).dump(), false);
+}
+
 void Editor::field(const std::string& key, const std::string& label, const json& v) {
   ImGui::PushID(key.c_str());
+  const std::vector<std::string>* names = v.is_string() ? choices(key) : nullptr;
   if (v.is_boolean()) {
     bool b = v.get<bool>();
     if (ImGui::Checkbox(label.c_str(), &b)) request(key + "=" + (b ? "true" : "false"));
@@ -782,8 +826,20 @@ void Editor::field(const std::string& key, const std::string& label, const json&
     const float speed = std::max(std::abs(f) * 0.01f, 0.001f);
     if (ImGui::DragFloat(label.c_str(), &f, speed, 0.0f, 0.0f, "%.5g"))
       request(key + "=" + json(double(f)).dump());
+  } else if (names) {
+    // The reader's names; a value outside them (none is read, but a file may be edited while
+    // open) is shown as it is. A choice is the same KEY=VALUE edit as a typed one.
+    const std::string current = v.get<std::string>();
+    if (ImGui::BeginCombo(label.c_str(), current.c_str())) {
+      for (const std::string& n : *names) {
+        const bool is_current = n == current;
+        if (ImGui::Selectable(n.c_str(), is_current) && !is_current)
+          operations_.push_back([this, key, n] { return choose(key, n); });
+        if (is_current) ImGui::SetItemDefaultFocus();
+      }
+      ImGui::EndCombo();
+    }
   } else if (v.is_string()) {
-    // Enumerations are shown as the file spells them, a value outside the list included.
     char buf[512];
     std::snprintf(buf, sizeof buf, "%s", v.get<std::string>().c_str());
     if (ImGui::InputText(label.c_str(), buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue))
@@ -1096,6 +1152,15 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
   switch (a.kind) {
     case ActionKind::set:
       return edit(a.args[0], false);
+    case ActionKind::choices: {
+      // What the inspector's combo for KEY lists (the script cannot click it).
+      const std::vector<std::string>* names = choices(a.args[0]);
+      if (!names) return Error{"", "", "choices: '" + a.args[0] + "' is not an enumerated field"};
+      std::printf("kaskad edit: choices %s: %s\n", a.args[0].c_str(), json_reader::join(*names).c_str());
+      return {};
+    }
+    case ActionKind::choose:
+      return choose(a.args[0], a.args[1]);
     case ActionKind::select:
       if (!find(a.args[0])) return Error{"", "", "select: no entity named '" + a.args[0] + "'"};
       selected_ = a.args[0];

@@ -24,6 +24,8 @@ struct Verb {
 
 constexpr Verb kVerbs[] = {
     {"set", ActionKind::set, 1, 1, "set KEY=VALUE"},
+    {"choices", ActionKind::choices, 1, 1, "choices KEY"},
+    {"choose", ActionKind::choose, 2, 2, "choose KEY NAME"},
     {"select", ActionKind::select, 1, 1, "select NAME"},
     {"create", ActionKind::create, 1, 1, "create SHAPE (box, sphere, cylinder, cone, plane)"},
     {"import", ActionKind::import, 1, 1, "import MODEL.gltf|.glb"},

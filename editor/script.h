@@ -13,7 +13,7 @@
 namespace kaskad::editor {
 
 enum class ActionKind {
-  set, select, create, import, remove, duplicate, rename, parent, camera, orbit, key, view, frames,
+  set, choices, choose, select, create, import, remove, duplicate, rename, parent, camera, orbit, key, view, frames,
   screenshot,
   window_screenshot, open, save, save_as, undo, redo, quit, force_quit
 };

@@ -9,8 +9,11 @@
 #             a glTF model imported shows, is saved, and undo removes it
 #   every_n   a reflector with update every_n = 3 captures on editor frames 0, 3, 6, 9 only; a
 #             probe's map type changed live changes the image
+#   combos    an enumerated field's combo lists exactly the names the scene reader accepts (the
+#             reader's own error lists them), for sections, entities, and an entity made in the
+#             editor; choosing one (what a click does; the script cannot click) edits and saves it
 #   input     unknown flags, bad script lines, rejected values and unsaved quits fail clearly
-# usage: editor_test.sh toggles|saving|entities|every_n|input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
+# usage: editor_test.sh toggles|saving|entities|every_n|combos|input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
 set -u
 : "${KASKAD:?path to the kaskad binary}" "${KASKAD_CONTENT:?content dir}"
 if ! command -v xvfb-run >/dev/null 2>&1; then
@@ -319,6 +322,54 @@ quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
     fail "views: faces $(png_size sphere_faces.png), sphere map $(png_size sphere_map.png)"
   fi
   ;;
+combos)
+  edit "choices shadow.filter
+choices sun.light.type
+choices box_resting.material.reflection_model
+choices render.tone_mapping
+create cone
+choices cone_1.primitive.shape
+choose shadow.filter bilinear
+choose box_resting.material.reflection_model s3
+choose sun.light.type spot
+save $tmp/chosen.json
+quit!" "$scene"
+  [ "$rc" -eq 0 ] || { fail "combos script exit $rc"; tail -5 "$tmp/out"; }
+  # The reader's list for KEY at JSON path PATH: what `kaskad info` says of a value it rejects.
+  reader_names() {
+    "$KASKAD" info "$scene" --set "$1=not_a_name" 2>&1 | sed -n "s|.*$2: unknown value 'not_a_name'; expected one of \(.*\) (after.*|\1|p"
+  }
+  for k in "shadow.filter /shadow/filter" "sun.light.type /entities/8/light/type" \
+           "box_resting.material.reflection_model /entities/1/material/reflection_model" \
+           "render.tone_mapping /render/tone_mapping" "box_resting.primitive.shape /entities/1/primitive/shape"; do
+    set -- $k
+    want=$(reader_names "$1" "$2")
+    key=$1
+    [ "$key" = box_resting.primitive.shape ] && key=cone_1.primitive.shape  # made in the editor
+    got=$(sed -n "s/^kaskad edit: choices $key: //p" "$tmp/out")
+    if [ -n "$want" ] && [ "$got" = "$want" ]; then ok "$key's combo lists the reader's names: $got"
+    else fail "$key's combo lists '$got', the reader accepts '$want'"; fi
+  done
+  if /usr/bin/env python3 - "$tmp/chosen.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+ents = {e["name"]: e for e in d["entities"]}
+assert d["shadow"]["filter"] == "bilinear", d["shadow"]
+assert ents["box_resting"]["material"]["reflection_model"] == "s3", ents["box_resting"]["material"]
+assert ents["sun"]["light"]["type"] == "spot", ents["sun"]["light"]
+PY
+  then
+    ok "choices made (a section, a reloaded section, a live one) are saved"
+  else
+    fail "chosen.json does not hold the choices"
+  fi
+  edit "choices render.exposure
+quit!" "$scene"
+  refused "line 1: choices: 'render.exposure' is not an enumerated field" "a number field has no combo"
+  edit "choose shadow.filter pcss
+quit!" "$scene"
+  refused "line 1: 'pcss' is not one of shadow.filter's choices (none, bilinear, pcf3x3)" "a name outside the list is not a choice"
+  ;;
 input)
   out=$("$KASKAD" edit --screenshot x.png 2>&1); code=$?
   if [ "$code" -eq 2 ] && grep -q "unknown option '--screenshot'" <<<"$out"; then
@@ -358,6 +409,6 @@ quit" "$scene"
   [ "$rc" -eq 0 ] && ok "an edit undone leaves nothing unsaved" || { fail "undone quit: exit $rc"; cat "$tmp/out"; }
   ;;
 *)
-  echo "usage: editor_test.sh toggles|saving|entities|every_n|input"; exit 2 ;;
+  echo "usage: editor_test.sh toggles|saving|entities|every_n|combos|input"; exit 2 ;;
 esac
 exit $failed

@@ -20,10 +20,10 @@ TEST(EditorScript, EveryActionParses) {
   auto r = parse_script_text(
       "# a comment\n\nset sun.transform.direction=[0.2, -0.8, -0.3]\nselect box resting\n"
       "camera 1 2 3\ncamera 1 2 3 0 0 0\nkey ctrl+z\nview cascade\nframes 12\nscreenshot a.png\n"
-      "window_screenshot w.png\nsave\nsave b.json\nundo\nredo\nquit\nquit!\r\n",
+      "window_screenshot w.png\nsave\nsave b.json\nundo\nredo\nquit\nquit!\r\nchoices shadow.filter\nchoose sun.light.type point\n",
       "s.txt");
   ASSERT_TRUE(r.ok()) << r.error().to_string();
-  ASSERT_EQ(r->size(), 15u);
+  ASSERT_EQ(r->size(), 17u);
   EXPECT_EQ((*r)[0].kind, ActionKind::set);
   EXPECT_EQ((*r)[0].args.at(0), "sun.transform.direction=[0.2, -0.8, -0.3]");  // spaces kept
   EXPECT_EQ((*r)[0].line, 3);
@@ -34,11 +34,15 @@ TEST(EditorScript, EveryActionParses) {
   EXPECT_TRUE((*r)[9].args.empty());
   EXPECT_EQ((*r)[13].kind, ActionKind::quit);
   EXPECT_EQ((*r)[14].kind, ActionKind::force_quit);
+  EXPECT_EQ((*r)[15].kind, ActionKind::choices);
+  EXPECT_EQ((*r)[15].args.at(0), "shadow.filter");
+  EXPECT_EQ((*r)[16].kind, ActionKind::choose);
+  EXPECT_EQ((*r)[16].args.size(), 2u);
 }
 
 TEST(EditorScript, BadLinesNameTheFileAndLine) {
   EXPECT_EQ(error_of("frames 1\nsett a=1\n"),
-            "s.txt: line 2: unknown action 'sett' (set, select, create, import, delete, duplicate, rename, "
+            "s.txt: line 2: unknown action 'sett' (set, choices, choose, select, create, import, delete, duplicate, rename, "
             "parent, camera, orbit, key, view, frames, screenshot, window_screenshot, open, save, "
             "save_as, undo, redo, quit, quit!)");
   EXPECT_NE(error_of("orbit 10\n").find("line 1: expected 'orbit YAW_DEG PITCH_DEG'"),
