@@ -30,6 +30,7 @@
 #include "components/light.h"
 #include "components/name.h"
 #include "components/transform.h"
+#include "editor/file_dialog.h"
 #include "editor/script.h"
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
@@ -267,6 +268,39 @@ std::string enumeration_key(const std::string& path, char separator) {
   return key;
 }
 
+// The file dialog's state: what it is for, the folder shown and the name typed.
+struct FileDialog {
+  enum class Purpose { open, save_as, import };
+  Purpose purpose = Purpose::open;
+  bool visible = false;        ///< shown; the operation's success or Cancel ends it
+  bool appearing = false;      ///< open the popup on the next frame
+  fs::path folder;             ///< absolute
+  FolderListing listing;       ///< of `folder`, read when it changes (and on refresh)
+  char name[1024] = "";        ///< typed, or the label of the entry clicked
+  fs::path picked;             ///< the entry clicked (its bytes, whatever its label)
+  fs::path replace;            ///< save as: the existing file the user was asked about
+  std::string error;           ///< the last refusal (an operation's error), shown in the dialog
+
+  const char* title() const {
+    return purpose == Purpose::open ? "Open scene###file_dialog"
+           : purpose == Purpose::save_as ? "Save scene as###file_dialog"
+                                         : "Import model###file_dialog";
+  }
+  std::vector<std::string> extensions() const {
+    if (purpose == Purpose::import) return {".gltf", ".glb"};
+    return {".json"};
+  }
+  void enter(const fs::path& dir) {
+    std::error_code ec;
+    const fs::path abs = fs::absolute(dir, ec);
+    folder = (ec ? dir : abs).lexically_normal();
+    if (folder.has_filename() == false && folder != folder.root_path()) folder = folder.parent_path();
+    listing = list_folder(folder, extensions());
+    picked.clear();
+    error.clear();
+  }
+};
+
 class Editor {
  public:
   Editor(Options options, Scene scene, Player& player, std::vector<ScriptAction> script)
@@ -329,6 +363,13 @@ class Editor {
   /// What picking NAME in KEY's combo does: the edit KEY="NAME", for a name of choices(KEY) only.
   Status choose(const std::string& key, const std::string& name);
   void direction_helpers();
+  /// Shows the file dialog for `purpose`, in the folder of `typed` (a path typed in a panel) and
+  /// with its name, else in the scene's folder.
+  void show_file_dialog(FileDialog::Purpose purpose, const std::string& typed);
+  void file_dialog(int w, int h);
+  /// The dialog's OK: a folder is entered; a file is opened, saved to or imported after the frame,
+  /// the dialog staying with the error when that is refused.
+  void accept_file_dialog();
   void interactive_input(float dt);
   Status run_action(const ScriptAction& a, bool& quit);
 
@@ -365,6 +406,7 @@ class Editor {
   std::string set_line_;          ///< the inspector's free "key=value" field
   std::vector<std::function<Status()>> operations_;  ///< UI entity operations, after the frame
   std::string file_line_;         ///< the inspector's path field for open and save as
+  FileDialog dialog_;
   int create_shape_ = 0;
   char import_path_[512] = "";
   json doc_;
@@ -976,6 +1018,9 @@ void Editor::inspector() {
       const fs::path f = file_line_;
       operations_.push_back([this, f] { return save_as(f); });
     }
+    if (ImGui::Button("open...")) show_file_dialog(FileDialog::Purpose::open, file_line_);
+    ImGui::SameLine();
+    if (ImGui::Button("save as...")) show_file_dialog(FileDialog::Purpose::save_as, file_line_);
   }
   char buf[512];
   std::snprintf(buf, sizeof buf, "%s", set_line_.c_str());
@@ -1054,6 +1099,8 @@ void Editor::draw_ui(int w, int h) {
     const std::string path = import_path_;
     operations_.push_back([this, path] { return import_model(path); });
   }
+  ImGui::SameLine();
+  if (ImGui::Button("...")) show_file_dialog(FileDialog::Purpose::import, import_path_);
   ImGui::Separator();
   entity_list();
   left_w_ = ImGui::GetWindowWidth();
@@ -1086,6 +1133,8 @@ void Editor::draw_ui(int w, int h) {
   ImGui::PopItemWidth();
   ImGui::End();
 
+  file_dialog(w, h);
+
   if (ask_quit_) ImGui::OpenPopup("Unsaved changes");
   if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
     ImGui::Text("%s has unsaved changes.", opt_.scene.filename().string().c_str());
@@ -1112,20 +1161,144 @@ void Editor::draw_ui(int w, int h) {
   }
 }
 
+void Editor::show_file_dialog(FileDialog::Purpose purpose, const std::string& typed) {
+  dialog_.purpose = purpose;
+  std::error_code ec;
+  const fs::path t = typed;
+  if (!typed.empty() && fs::is_directory(t, ec)) {
+    dialog_.enter(t);
+    dialog_.name[0] = '\0';
+  } else if (!typed.empty() && fs::is_directory(fs::absolute(t, ec).parent_path(), ec)) {
+    dialog_.enter(fs::absolute(t, ec).parent_path());
+    std::snprintf(dialog_.name, sizeof dialog_.name, "%s", t.filename().string().c_str());
+  } else {
+    dialog_.enter(opt_.scene.parent_path().empty() ? fs::path(".") : opt_.scene.parent_path());
+    const std::string own = purpose == FileDialog::Purpose::save_as ? opt_.scene.filename().string() : "";
+    std::snprintf(dialog_.name, sizeof dialog_.name, "%s", own.c_str());
+  }
+  dialog_.replace.clear();
+  dialog_.visible = dialog_.appearing = true;
+}
+
+void Editor::accept_file_dialog() {
+  FileDialog& d = dialog_;
+  const std::string typed = d.name;
+  fs::path file = !d.picked.empty() && typed == display_name(d.picked.filename().string())
+                      ? d.picked
+                      : resolve_typed(d.folder, typed);
+  if (file.empty()) {
+    d.error = "type a file name, or pick one";
+    return;
+  }
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) {
+    d.enter(file);
+    d.name[0] = '\0';
+    return;
+  }
+  if (d.purpose == FileDialog::Purpose::save_as) {
+    if (!file.has_extension()) file += ".json";
+    // A file that is there is replaced only when asked twice.
+    if (fs::exists(file, ec) && file != d.replace) {
+      d.replace = file;
+      d.error = display_name(file.filename().string()) + " exists: save again to replace it";
+      return;
+    }
+  }
+  const FileDialog::Purpose purpose = d.purpose;
+  operations_.push_back([this, file, purpose] {
+    const Status st = purpose == FileDialog::Purpose::open      ? open(file)
+                      : purpose == FileDialog::Purpose::save_as ? save_as(file)
+                                                                : import_model(file.string());
+    if (st) dialog_.visible = false;
+    else dialog_.error = st.error().to_string();
+    return st;
+  });
+}
+
+void Editor::file_dialog(int w, int h) {
+  FileDialog& d = dialog_;
+  if (d.appearing) {
+    ImGui::OpenPopup("###file_dialog");
+    d.appearing = false;
+  }
+  ImGui::SetNextWindowSize(ImVec2(std::min(640.0f, 0.8f * float(w)), std::min(460.0f, 0.85f * float(h))),
+                           ImGuiCond_Appearing);
+  ImGui::SetNextWindowPos(ImVec2(0.5f * float(w), 0.5f * float(h)), ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
+  bool keep = true;
+  if (!ImGui::BeginPopupModal(d.title(), &keep, ImGuiWindowFlags_NoSavedSettings)) {
+    d.visible = false;  // closed by Escape or its close button
+    return;
+  }
+  if (!keep || !d.visible) {
+    d.visible = false;
+    ImGui::CloseCurrentPopup();
+    ImGui::EndPopup();
+    return;
+  }
+  if (ImGui::Button("up") && d.folder.has_parent_path() && d.folder.parent_path() != d.folder)
+    d.enter(d.folder.parent_path());
+  ImGui::SameLine();
+  if (ImGui::Button("refresh")) d.enter(d.folder);
+  ImGui::SameLine();
+  ImGui::TextUnformatted(display_name(d.folder.string()).c_str());
+  const ImVec4 red(1.0f, 0.45f, 0.35f, 1.0f);
+  if (!d.listing.error.empty()) ImGui::TextColored(red, "%s", d.listing.error.c_str());
+  // The rows: a folder is entered with one click; a file is picked with one, accepted with two.
+  const float footer = ImGui::GetFrameHeightWithSpacing() * 2.0f +
+                       (d.error.empty() ? 0.0f : ImGui::GetTextLineHeightWithSpacing() * 2.0f);
+  ImGui::BeginChild("entries", ImVec2(0, -footer), true);
+  std::optional<fs::path> enter;
+  bool accept = false;
+  for (const FolderEntry& e : d.listing.entries) {
+    const std::string label = e.folder ? e.label + "/" : e.label;
+    const bool picked = !e.folder && e.path == d.picked;
+    if (ImGui::Selectable(label.c_str(), picked, ImGuiSelectableFlags_AllowDoubleClick)) {
+      if (e.folder) {
+        enter = e.path;
+      } else {
+        d.picked = e.path;
+        std::snprintf(d.name, sizeof d.name, "%s", e.label.c_str());
+        d.error.clear();
+        accept = ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left);
+      }
+    }
+  }
+  if (d.listing.entries.empty() && d.listing.error.empty())
+    ImGui::TextDisabled("no folders or %s files here", json_reader::join(d.extensions()).c_str());
+  ImGui::EndChild();
+  if (enter) d.enter(*enter);
+  if (ImGui::IsWindowAppearing()) ImGui::SetKeyboardFocusHere();
+  ImGui::SetNextItemWidth(-160.0f);
+  if (ImGui::InputText("##name", d.name, sizeof d.name, ImGuiInputTextFlags_EnterReturnsTrue)) accept = true;
+  ImGui::SameLine();
+  const char* verb = d.purpose == FileDialog::Purpose::open      ? "open"
+                     : d.purpose == FileDialog::Purpose::save_as ? "save"
+                                                                 : "import";
+  if (ImGui::Button(verb)) accept = true;
+  ImGui::SameLine();
+  if (ImGui::Button("cancel")) {
+    d.visible = false;
+    ImGui::CloseCurrentPopup();
+  }
+  if (!d.error.empty()) ImGui::TextColored(red, "%s", d.error.c_str());
+  if (accept && d.visible) accept_file_dialog();
+  ImGui::EndPopup();
+}
+
 void Editor::interactive_input(float dt) {
   ImGuiIO& io = ImGui::GetIO();
   if (!ImGui::IsAnyItemActive()) last_drag_key_.clear();
-  // The Dear ImGui 1.86 GLFW backend indexes keys by GLFW key code.
-  if (!io.WantTextInput) {
+  // The Dear ImGui 1.86 GLFW backend indexes keys by GLFW key code. While the file dialog is up,
+  // keys are its own.
+  if (!io.WantTextInput && !dialog_.visible) {
     const char* shortcut = nullptr;
     if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Z, false)) shortcut = "ctrl+z";
     if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Y, false)) shortcut = "ctrl+y";
     if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_S, false)) shortcut = "ctrl+s";
     if (!io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_F, false)) shortcut = "f";
-    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_O, false) && !file_line_.empty()) {
-      const fs::path f = file_line_;
-      operations_.push_back([this, f] { return open(f); });
-    }
+    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_O, false) && !dialog_.visible)
+      show_file_dialog(FileDialog::Purpose::open, file_line_);
     if (shortcut)
       if (Status st = press(shortcut, 0.0f); !st) report(st.error().to_string());
   }
