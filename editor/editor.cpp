@@ -1356,6 +1356,7 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       // refused) fails the script.
       return press(a.args[0], 1.0f / 30.0f);
     case ActionKind::frames:
+    case ActionKind::input:  // the run loop counts both
       return {};
     case ActionKind::create:
       return create(a.args[0]);
@@ -1411,6 +1412,9 @@ int Editor::run() {
   const std::vector<ScriptAction>& script = script_;
   std::size_t next = 0;
   int frames_left = 0;
+  // `input SECONDS`: until then the window takes real input and no script action runs.
+  std::optional<std::chrono::steady_clock::time_point> input_until;
+  int input_phases = 0;
   auto last = std::chrono::steady_clock::now();
   auto last_reload_check = last;
   for (;;) {
@@ -1427,7 +1431,12 @@ int Editor::run() {
     if (!opt_.script.empty()) {
       // Script actions run between frames; `frames N` lets N frames render, and a screenshot
       // after a change first renders the frame that shows it.
-      while (frames_left == 0 && next < script.size()) {
+      if (input_until && std::chrono::steady_clock::now() >= *input_until) {
+        input_until.reset();
+        std::printf("kaskad edit: input %d ended\n", input_phases);
+        std::fflush(stdout);
+      }
+      while (!input_until && frames_left == 0 && next < script.size()) {
         const ScriptAction& a = script[next];
         if (a.kind == ActionKind::screenshot && changed_since_frame_) {
           frames_left = 1;
@@ -1443,9 +1452,15 @@ int Editor::run() {
         ++next;
         if (a.kind == ActionKind::frames) frames_left = std::stoi(a.args[0]);
         if (a.kind == ActionKind::window_screenshot) frames_left = 1;
+        if (a.kind == ActionKind::input) {
+          input_until = std::chrono::steady_clock::now() + std::chrono::seconds(std::stoi(a.args[0]));
+          // Flushed: a test driving the window with real events waits for this line.
+          std::printf("kaskad edit: input %d for %s s\n", ++input_phases, a.args[0].c_str());
+          std::fflush(stdout);
+        }
         if (quit) break;
       }
-      if (!quit && frames_left == 0 && next == script.size()) {
+      if (!quit && !input_until && frames_left == 0 && next == script.size()) {
         std::fprintf(stderr, "kaskad edit: error: %s: the script ended without quit or quit!\n",
                      opt_.script.string().c_str());
         return 1;
@@ -1482,7 +1497,7 @@ int Editor::run() {
     const auto now = std::chrono::steady_clock::now();
     const float dt = std::min(std::chrono::duration<float>(now - last).count(), 0.1f);
     last = now;
-    if (opt_.script.empty()) interactive_input(dt);
+    if (opt_.script.empty() || input_until) interactive_input(dt);
     draw_ui(w, h);
     ImGui::Render();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -13,7 +13,10 @@
 #             reader's own error lists them), for sections, entities, and an entity made in the
 #             editor; choosing one (what a click does; the script cannot click) edits and saves it
 #   input     unknown flags, bad script lines, rejected values and unsaved quits fail clearly
-# usage: editor_test.sh toggles|saving|entities|every_n|combos|input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
+#   real_input  real X events (xdotool) during the script's `input` phases: right mouse + W flies
+#             forward, F frames the selection, Ctrl+Z undoes an edit, Ctrl+O's file dialog opens
+#             a typed scene (skipped, saying so, without xdotool)
+# usage: editor_test.sh toggles|saving|entities|every_n|combos|input|real_input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
 set -u
 : "${KASKAD:?path to the kaskad binary}" "${KASKAD_CONTENT:?content dir}"
 if ! command -v xvfb-run >/dev/null 2>&1; then
@@ -408,7 +411,111 @@ undo
 quit" "$scene"
   [ "$rc" -eq 0 ] && ok "an edit undone leaves nothing unsaved" || { fail "undone quit: exit $rc"; cat "$tmp/out"; }
   ;;
+real_input)
+  if ! command -v xdotool >/dev/null 2>&1 || ! command -v Xvfb >/dev/null 2>&1; then
+    echo "SKIPPED: no xdotool (install the xdotool package: scripts/setup.sh)"
+    exit 77
+  fi
+  "$KASKAD" save "$scene" -o "$tmp/canonical.json" >/dev/null || fail "kaskad save"
+  "$KASKAD" save "$scene" -o "$tmp/other.json" --set sun.light.intensity=2.5 >/dev/null || fail "kaskad save other"
+  # Our own X server (xdotool needs its display): -displayfd writes the number it took.
+  Xvfb -displayfd 3 -screen 0 1024x600x24 -nolisten tcp 3>"$tmp/display" 2>"$tmp/xvfb.log" &
+  xvfb=$!
+  editor=""
+  trap '[ -n "$editor" ] && kill "$editor" 2>/dev/null; kill "$xvfb" 2>/dev/null; wait 2>/dev/null;
+        [ -n "${KEEP:-}" ] || rm -rf "$tmp"' EXIT
+  for _ in $(seq 1 100); do [ -s "$tmp/display" ] && break; sleep 0.1; done
+  [ -s "$tmp/display" ] || { fail "Xvfb did not start"; cat "$tmp/xvfb.log"; exit 1; }
+  export DISPLAY=":$(cat "$tmp/display")"
+  # Each `input N` lets the window take real events for N seconds (generous: frames on llvmpipe
+  # are slow); the saves after them record what the events did.
+  printf '%s\n' "select sphere" "frames 1" "input 6" "save $tmp/flown.json" "input 5" \
+    "save $tmp/framed.json" "set sun.light.intensity=3" "input 5" "save $tmp/undone.json" "input 8" \
+    "save $tmp/opened.json" "quit!" >"$tmp/script.txt"
+  timeout 180 "$KASKAD" edit --size 800x360 --script "$tmp/script.txt" "$scene" >"$tmp/out" 2>&1 &
+  editor=$!
+  # phase K: waits (at most 90 s) for the editor's "input K for" line, then for its window.
+  window=""
+  phase() {
+    for _ in $(seq 1 900); do
+      grep -q "^kaskad edit: input $1 for" "$tmp/out" && break
+      kill -0 "$editor" 2>/dev/null || return 1
+      sleep 0.1
+    done
+    grep -q "^kaskad edit: input $1 for" "$tmp/out" || return 1
+    [ -n "$window" ] || window=$(timeout 20 xdotool search --sync --name "^Kaskad editor" | head -1)
+    [ -n "$window" ] && timeout 10 xdotool windowfocus --sync "$window"
+  }
+  # A key held long enough for a frame to see it: Dear ImGui 1.86 reads key states once a frame,
+  # so a press and release between two frames would be lost.
+  hold() { timeout 10 xdotool keydown "$1"; sleep "${2:-0.5}"; timeout 10 xdotool keyup "$1"; }
+  # The viewport is the middle of the 800x360 window (panels 160 and 260 wide).
+  if phase 1; then
+    timeout 10 xdotool mousemove --window "$window" 350 180
+    sleep 0.5
+    timeout 10 xdotool mousedown 3
+    hold w 0.8
+    timeout 10 xdotool mouseup 3
+  else fail "no input phase 1"; fi
+  if phase 2; then hold f; else fail "no input phase 2"; fi
+  if phase 3; then hold ctrl+z; else fail "no input phase 3"; fi
+  if phase 4; then
+    hold ctrl+o
+    sleep 1
+    timeout 20 xdotool type --delay 40 "$tmp/other.json"
+    sleep 0.5
+    hold Return
+    sleep 2
+    title=$(timeout 10 xdotool getwindowname "$window")
+  else fail "no input phase 4"; fi
+  wait "$editor"
+  rc=$?
+  editor=""
+  [ "$rc" -eq 0 ] || { fail "real_input script exit $rc"; grep -v '^frame' "$tmp/out" | tail -5; }
+  if /usr/bin/env python3 - "$tmp" <<'PY'
+import json, math, sys
+tmp = sys.argv[1]
+def ents(name):
+    return {e["name"]: e for e in json.load(open(f"{tmp}/{name}.json"))["entities"]}
+def forward(q):  # (0, 0, -1) turned by the quaternion [x, y, z, w]: v + w t + q.xyz x t, t = 2 q.xyz x v
+    x, y, z, w = q
+    tx, ty, tz = 2 * y * -1.0, -2 * x * -1.0, 0.0
+    return (w * tx + (y * tz - z * ty), w * ty + (z * tx - x * tz), -1.0 + w * tz + (x * ty - y * tx))
+def sub(a, b): return [p - q for p, q in zip(a, b)]
+def dot(a, b): return sum(p * q for p, q in zip(a, b))
+def norm(a): return math.sqrt(dot(a, a))
+ok = True
+def check(cond, what):
+    global ok
+    print(("ok   " if cond else "FAIL ") + what)
+    ok = ok and cond
+before = ents("canonical")["camera"]["transform"]
+flown = ents("flown")["camera"]["transform"]
+f0 = forward(before["rotation"])
+move = sub(flown["translation"], before["translation"])
+along = dot(move, f0)
+check(along > 0.5 and norm(move) - along < 0.05 * along,
+      f"right mouse + W flew the camera forward: {along:.2f} m along its heading, {norm(move):.2f} m in all")
+framed = ents("framed")["camera"]["transform"]
+to_sphere = sub([2.4, 0.6, 1.6], framed["translation"])
+f1 = forward(framed["rotation"])
+# Framed: the sphere's centre on the view axis, at 1.2 r / sin(fov / 2) with r the half diagonal of
+# its bounds (radius 0.5 scaled by 1.2) and fov 45 degrees (editor.cpp, frame_selection).
+expected = 1.2 * (0.5 * 1.2 * math.sqrt(3.0)) / math.sin(math.radians(22.5))
+axis = dot(to_sphere, f1) / norm(to_sphere)
+check(axis > 0.999 and abs(norm(to_sphere) - expected) < 0.05 * expected,
+      f"F framed the selected sphere: {norm(to_sphere):.2f} m away (expected {expected:.2f}), axis cosine {axis:.4f}")
+check(ents("undone")["sun"]["light"]["intensity"] == 5.34, "Ctrl+Z undid the edit (intensity 3 -> 5.34)")
+check(ents("opened")["sun"]["light"]["intensity"] == 2.5, "Ctrl+O, a typed path and Enter opened other.json")
+sys.exit(0 if ok else 1)
+PY
+  then :; else failed=1; grep -v '^frame' "$tmp/out" | tail -8; fi
+  case "${title:-}" in
+    *other.json) ok "the window's title names the opened scene" ;;
+    *) fail "window title '${title:-}' after opening other.json" ;;
+  esac
+  ;;
 *)
-  echo "usage: editor_test.sh toggles|saving|entities|every_n|combos|input"; exit 2 ;;
+  echo "usage: editor_test.sh toggles|saving|entities|every_n|combos|input|real_input"; exit 2 ;;
 esac
 exit $failed
