@@ -294,7 +294,8 @@ struct FileDialog {
     std::error_code ec;
     const fs::path abs = fs::absolute(dir, ec);
     folder = (ec ? dir : abs).lexically_normal();
-    if (folder.has_filename() == false && folder != folder.root_path()) folder = folder.parent_path();
+    // "a/b/.." normalises to "a/": shown, and gone up from, as "a".
+    if (!folder.has_filename() && folder != folder.root_path()) folder = folder.parent_path();
     listing = list_folder(folder, extensions());
     picked.clear();
     error.clear();
@@ -1270,7 +1271,13 @@ void Editor::file_dialog(int w, int h) {
   if (enter) d.enter(*enter);
   if (ImGui::IsWindowAppearing()) ImGui::SetKeyboardFocusHere();
   ImGui::SetNextItemWidth(-160.0f);
-  if (ImGui::InputText("##name", d.name, sizeof d.name, ImGuiInputTextFlags_EnterReturnsTrue)) accept = true;
+  ImGui::InputText("##name", d.name, sizeof d.name);
+  // Enter anywhere in the dialog (the name field gives up the keyboard on Enter, so a second one,
+  // to answer "replace it?", comes with no field active); as pressed, not its repeats: a held
+  // Enter must not answer by itself.
+  if (ImGui::IsWindowFocused(ImGuiFocusedFlags_RootAndChildWindows) &&
+      (ImGui::IsKeyPressed(GLFW_KEY_ENTER, false) || ImGui::IsKeyPressed(GLFW_KEY_KP_ENTER, false)))
+    accept = true;
   ImGui::SameLine();
   const char* verb = d.purpose == FileDialog::Purpose::open      ? "open"
                      : d.purpose == FileDialog::Purpose::save_as ? "save"
@@ -1295,10 +1302,12 @@ void Editor::interactive_input(float dt) {
     const char* shortcut = nullptr;
     if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Z, false)) shortcut = "ctrl+z";
     if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Y, false)) shortcut = "ctrl+y";
-    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_S, false)) shortcut = "ctrl+s";
+    if (io.KeyCtrl && !io.KeyShift && ImGui::IsKeyPressed(GLFW_KEY_S, false)) shortcut = "ctrl+s";
     if (!io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_F, false)) shortcut = "f";
-    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_O, false) && !dialog_.visible)
+    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_O, false))
       show_file_dialog(FileDialog::Purpose::open, file_line_);
+    if (io.KeyCtrl && io.KeyShift && ImGui::IsKeyPressed(GLFW_KEY_S, false))
+      show_file_dialog(FileDialog::Purpose::save_as, file_line_);
     if (shortcut)
       if (Status st = press(shortcut, 0.0f); !st) report(st.error().to_string());
   }

@@ -15,7 +15,8 @@
 #   input     unknown flags, bad script lines, rejected values and unsaved quits fail clearly
 #   real_input  real X events (xdotool) during the script's `input` phases: right mouse + W flies
 #             forward, F frames the selection, Ctrl+Z undoes an edit, Ctrl+O's file dialog opens
-#             a typed scene (skipped, saying so, without xdotool)
+#             a typed scene, Ctrl+Shift+S's saves over a file after asking (skipped, saying so,
+#             without xdotool)
 # usage: editor_test.sh toggles|saving|entities|every_n|combos|input|real_input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
 set -u
 : "${KASKAD:?path to the kaskad binary}" "${KASKAD_CONTENT:?content dir}"
@@ -418,6 +419,7 @@ real_input)
   fi
   "$KASKAD" save "$scene" -o "$tmp/canonical.json" >/dev/null || fail "kaskad save"
   "$KASKAD" save "$scene" -o "$tmp/other.json" --set sun.light.intensity=2.5 >/dev/null || fail "kaskad save other"
+  cp "$tmp/canonical.json" "$tmp/target.json"  # replaced through the save-as dialog
   # Our own X server (xdotool needs its display): -displayfd writes the number it took.
   Xvfb -displayfd 3 -screen 0 1024x600x24 -nolisten tcp 3>"$tmp/display" 2>"$tmp/xvfb.log" &
   xvfb=$!
@@ -430,8 +432,8 @@ real_input)
   # Each `input N` lets the window take real events for N seconds (generous: frames on llvmpipe
   # are slow); the saves after them record what the events did.
   printf '%s\n' "select sphere" "frames 1" "input 6" "save $tmp/flown.json" "input 5" \
-    "save $tmp/framed.json" "set sun.light.intensity=3" "input 5" "save $tmp/undone.json" "input 8" \
-    "save $tmp/opened.json" "quit!" >"$tmp/script.txt"
+    "save $tmp/framed.json" "set sun.light.intensity=3" "input 5" "save $tmp/undone.json" "input 12" \
+    "save $tmp/opened.json" "input 15" "quit!" >"$tmp/script.txt"
   timeout 180 "$KASKAD" edit --size 800x360 --script "$tmp/script.txt" "$scene" >"$tmp/out" 2>&1 &
   editor=$!
   # phase K: waits (at most 90 s) for the editor's "input K for" line, then for its window.
@@ -468,6 +470,22 @@ real_input)
     sleep 2
     title=$(timeout 10 xdotool getwindowname "$window")
   else fail "no input phase 4"; fi
+  # Save as over target.json (the name typed without .json): the first Enter asks, the second
+  # replaces the file.
+  if phase 5; then
+    hold ctrl+shift+s
+    sleep 1
+    hold ctrl+a 0.3
+    timeout 20 xdotool type --delay 40 "$tmp/target"
+    sleep 0.5
+    hold Return
+    sleep 1.5
+    if cmp -s "$tmp/canonical.json" "$tmp/target.json"; then ok "save as asks before replacing a file"
+    else fail "save as replaced target.json without asking"; fi
+    hold Return
+    sleep 2
+    saved_title=$(timeout 10 xdotool getwindowname "$window")
+  else fail "no input phase 5"; fi
   wait "$editor"
   rc=$?
   editor=""
@@ -507,12 +525,17 @@ check(axis > 0.999 and abs(norm(to_sphere) - expected) < 0.05 * expected,
       f"F framed the selected sphere: {norm(to_sphere):.2f} m away (expected {expected:.2f}), axis cosine {axis:.4f}")
 check(ents("undone")["sun"]["light"]["intensity"] == 5.34, "Ctrl+Z undid the edit (intensity 3 -> 5.34)")
 check(ents("opened")["sun"]["light"]["intensity"] == 2.5, "Ctrl+O, a typed path and Enter opened other.json")
+check(ents("target")["sun"]["light"]["intensity"] == 2.5, "Ctrl+Shift+S, a typed name and Enter twice saved over target.json")
 sys.exit(0 if ok else 1)
 PY
   then :; else failed=1; grep -v '^frame' "$tmp/out" | tail -8; fi
   case "${title:-}" in
     *other.json) ok "the window's title names the opened scene" ;;
     *) fail "window title '${title:-}' after opening other.json" ;;
+  esac
+  case "${saved_title:-}" in
+    *target.json) ok "after save as, the window's title names the new file" ;;
+    *) fail "window title '${saved_title:-}' after saving as target.json" ;;
   esac
   ;;
 *)
