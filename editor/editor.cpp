@@ -1010,7 +1010,8 @@ void Editor::inspector() {
     std::snprintf(path, sizeof path, "%s", file_line_.c_str());
     ImGui::InputText("file", path, sizeof path);
     file_line_ = path;
-    if (ImGui::Button("open (Ctrl+O)") && !file_line_.empty()) {
+    // The typed path at once; the dialog with the "..." buttons.
+    if (ImGui::Button("open") && !file_line_.empty()) {
       const fs::path f = file_line_;
       operations_.push_back([this, f] { return open(f); });
     }
@@ -1020,8 +1021,10 @@ void Editor::inspector() {
       operations_.push_back([this, f] { return save_as(f); });
     }
     if (ImGui::Button("open...")) show_file_dialog(FileDialog::Purpose::open, file_line_);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+O");
     ImGui::SameLine();
     if (ImGui::Button("save as...")) show_file_dialog(FileDialog::Purpose::save_as, file_line_);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+Shift+S");
   }
   char buf[512];
   std::snprintf(buf, sizeof buf, "%s", set_line_.c_str());
@@ -1091,7 +1094,11 @@ void Editor::draw_ui(int w, int h) {
     operations_.push_back([this, shape] { return create(shape); });
   }
   // A glTF file (path as typed, Enter or the button): imported in front of the camera.
-  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.65f);
+  // The field takes what the two buttons after it leave.
+  const ImGuiStyle& style = ImGui::GetStyle();
+  const float buttons = ImGui::CalcTextSize("import").x + ImGui::CalcTextSize("...").x +
+                        4.0f * style.FramePadding.x + 2.0f * style.ItemSpacing.x;
+  ImGui::SetNextItemWidth(std::max(40.0f, ImGui::GetContentRegionAvail().x - buttons));
   const bool entered = ImGui::InputTextWithHint("##model", "model.gltf", import_path_,
                                                 sizeof import_path_,
                                                 ImGuiInputTextFlags_EnterReturnsTrue);
