@@ -838,7 +838,8 @@ void Editor::request(const std::string& assignment) {
 
 const std::vector<std::string>* Editor::choices(const std::string& key) {
   if (choices_from_ != enumerations_.fields().size()) {
-    for (const auto& [path, names] : enumerations_.fields()) choices_[enumeration_key(path, '/')] = names;
+    for (const auto& [path, names] : enumerations_.fields())
+      choices_[enumeration_key(path, '/')] = names;
     choices_from_ = enumerations_.fields().size();
   }
   const auto it = choices_.find(enumeration_key(key, '.'));
@@ -849,7 +850,8 @@ Status Editor::choose(const std::string& key, const std::string& name) {
   const std::vector<std::string>* names = choices(key);
   if (!names) return Error{"", "", "'" + key + "' is not an enumerated field"};
   if (std::find(names->begin(), names->end(), name) == names->end())
-    return Error{"", "", "'" + name + "' is not one of " + key + "'s choices (" + json_reader::join(*names) + ")"};
+    return Error{"", "", "'" + name + "' is not one of " + key + "'s choices (" +
+                             json_reader::join(*names) + ")"};
   return edit(key + "=" + json(name).dump(), false);
 }
 
@@ -1181,7 +1183,8 @@ void Editor::show_file_dialog(FileDialog::Purpose purpose, const std::string& ty
     std::snprintf(dialog_.name, sizeof dialog_.name, "%s", t.filename().string().c_str());
   } else {
     dialog_.enter(opt_.scene.parent_path().empty() ? fs::path(".") : opt_.scene.parent_path());
-    const std::string own = purpose == FileDialog::Purpose::save_as ? opt_.scene.filename().string() : "";
+    const std::string own =
+        purpose == FileDialog::Purpose::save_as ? opt_.scene.filename().string() : "";
     std::snprintf(dialog_.name, sizeof dialog_.name, "%s", own.c_str());
   }
   dialog_.replace.clear();
@@ -1230,9 +1233,11 @@ void Editor::file_dialog(int w, int h) {
     ImGui::OpenPopup("###file_dialog");
     d.appearing = false;
   }
-  ImGui::SetNextWindowSize(ImVec2(std::min(640.0f, 0.8f * float(w)), std::min(460.0f, 0.85f * float(h))),
-                           ImGuiCond_Appearing);
-  ImGui::SetNextWindowPos(ImVec2(0.5f * float(w), 0.5f * float(h)), ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowSize(
+      ImVec2(std::min(640.0f, 0.8f * float(w)), std::min(460.0f, 0.85f * float(h))),
+      ImGuiCond_Appearing);
+  ImGui::SetNextWindowPos(ImVec2(0.5f * float(w), 0.5f * float(h)), ImGuiCond_Appearing,
+                          ImVec2(0.5f, 0.5f));
   bool keep = true;
   if (!ImGui::BeginPopupModal(d.title(), &keep, ImGuiWindowFlags_NoSavedSettings)) {
     d.visible = false;  // closed by Escape or its close button
@@ -1345,7 +1350,8 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       // What the inspector's combo for KEY lists (the script cannot click it).
       const std::vector<std::string>* names = choices(a.args[0]);
       if (!names) return Error{"", "", "choices: '" + a.args[0] + "' is not an enumerated field"};
-      std::printf("kaskad edit: choices %s: %s\n", a.args[0].c_str(), json_reader::join(*names).c_str());
+      std::printf("kaskad edit: choices %s: %s\n", a.args[0].c_str(),
+                  json_reader::join(*names).c_str());
       return {};
     }
     case ActionKind::choose:
@@ -1469,7 +1475,8 @@ int Editor::run() {
         if (a.kind == ActionKind::frames) frames_left = std::stoi(a.args[0]);
         if (a.kind == ActionKind::window_screenshot) frames_left = 1;
         if (a.kind == ActionKind::input) {
-          input_until = std::chrono::steady_clock::now() + std::chrono::seconds(std::stoi(a.args[0]));
+          input_until =
+              std::chrono::steady_clock::now() + std::chrono::seconds(std::stoi(a.args[0]));
           // Flushed: a test driving the window with real events waits for this line.
           std::printf("kaskad edit: input %d for %s s\n", ++input_phases, a.args[0].c_str());
           std::fflush(stdout);

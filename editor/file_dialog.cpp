@@ -11,7 +11,8 @@ namespace kaskad::editor {
 namespace {
 
 std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
   return s;
 }
 
@@ -23,8 +24,9 @@ std::size_t utf8_length(const std::string& s, std::size_t i) {
   if (c < 0x80) return 1;
   std::size_t n = 0;
   unsigned char lo = 0x80, hi = 0xBF;  // the allowed range of the second byte
-  if (c >= 0xC2 && c <= 0xDF) n = 2;
-  else if (c >= 0xE0 && c <= 0xEF) {
+  if (c >= 0xC2 && c <= 0xDF) {
+    n = 2;
+  } else if (c >= 0xE0 && c <= 0xEF) {
     n = 3;
     if (c == 0xE0) lo = 0xA0;
     if (c == 0xED) hi = 0x9F;
@@ -88,11 +90,13 @@ FolderListing list_folder(const fs::path& folder, const std::vector<std::string>
     }
     listing.entries.push_back(std::move(entry));
   }
-  if (ec) listing.error = "cannot read all of " + display_name(folder.string()) + ": " + ec.message();
-  std::sort(listing.entries.begin(), listing.entries.end(), [](const FolderEntry& a, const FolderEntry& b) {
-    if (a.folder != b.folder) return a.folder;
-    return a.path.filename() < b.path.filename();
-  });
+  if (ec)
+    listing.error = "cannot read all of " + display_name(folder.string()) + ": " + ec.message();
+  std::sort(listing.entries.begin(), listing.entries.end(),
+            [](const FolderEntry& a, const FolderEntry& b) {
+              if (a.folder != b.folder) return a.folder;
+              return a.path.filename() < b.path.filename();
+            });
   return listing;
 }
 

@@ -24,7 +24,8 @@ struct FolderListing {
 /// compared without case). Hidden entries (a leading '.') and entries whose type cannot be read
 /// (broken links, no permission) are left out; an unreadable folder gives `error` and what was
 /// read before it. Never throws.
-FolderListing list_folder(const std::filesystem::path& folder, const std::vector<std::string>& extensions);
+FolderListing list_folder(const std::filesystem::path& folder,
+                          const std::vector<std::string>& extensions);
 
 /// `name` as valid UTF-8: bytes that are not part of a well-formed UTF-8 sequence become \xNN.
 std::string display_name(const std::string& name);

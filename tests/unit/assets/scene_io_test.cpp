@@ -914,7 +914,8 @@ TEST(SceneIo, EnumerationRecorderSeesEveryEnumeratedField) {
     json d = canonical;
     d[json::json_pointer(pointer)] = value;
     auto r = parse_scene(d, temp_dir() / "enums.json");
-    return !r.ok() && r.error().where == pointer && r.error().message.rfind("unknown value", 0) == 0;
+    return !r.ok() && r.error().where == pointer &&
+           r.error().message.rfind("unknown value", 0) == 0;
   };
   int enumerated = 0;
   const json leaves = canonical.flatten();
@@ -923,20 +924,24 @@ TEST(SceneIo, EnumerationRecorderSeesEveryEnumeratedField) {
     const auto it = fields.find(pointer);
     if (it == fields.end()) {
       // Not recorded: a free string (a path), which the reader takes as it is.
-      EXPECT_FALSE(unknown(pointer, "not_a_name")) << pointer << " rejects a word but was not recorded";
+      EXPECT_FALSE(unknown(pointer, "not_a_name"))
+          << pointer << " rejects a word but was not recorded";
       continue;
     }
     ++enumerated;
     ASSERT_FALSE(it->second.empty()) << pointer;
-    for (const std::string& name : it->second) EXPECT_FALSE(unknown(pointer, name)) << pointer << " = " << name;
+    for (const std::string& name : it->second)
+      EXPECT_FALSE(unknown(pointer, name)) << pointer << " = " << name;
     EXPECT_TRUE(unknown(pointer, "not_a_name")) << pointer;
     // Exactly the table: the reader's own message lists the names it accepts.
     json bad = canonical;
     bad[json::json_pointer(pointer)] = "not_a_name";
     auto r = parse_scene(bad, temp_dir() / "enums.json");
     ASSERT_FALSE(r.ok());
-    EXPECT_EQ(r.error().message, "unknown value 'not_a_name'; expected one of " + json_reader::join(it->second));
-    EXPECT_NE(std::find(it->second.begin(), it->second.end(), value.get<std::string>()), it->second.end())
+    EXPECT_EQ(r.error().message,
+              "unknown value 'not_a_name'; expected one of " + json_reader::join(it->second));
+    EXPECT_NE(std::find(it->second.begin(), it->second.end(), value.get<std::string>()),
+              it->second.end())
         << pointer << ": the canonical value " << value << " is not among the recorded names";
   }
   EXPECT_GE(enumerated, 11);

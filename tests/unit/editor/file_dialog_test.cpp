@@ -19,7 +19,9 @@ fs::path fresh_dir(const std::string& name) {
   return d;
 }
 
-void touch(const fs::path& p) { std::ofstream(p, std::ios::binary) << "{}"; }
+void touch(const fs::path& p) {
+  std::ofstream(p, std::ios::binary) << "{}";
+}
 
 std::vector<std::string> labels(const FolderListing& l) {
   std::vector<std::string> out;
@@ -41,7 +43,8 @@ TEST(FileDialog, ListsFoldersThenMatchingFilesSorted) {
   fs::create_directory(d / "folder.json");  // a folder, whatever its name
   const FolderListing l = list_folder(d, {".json"});
   EXPECT_EQ(l.error, "");
-  EXPECT_EQ(labels(l), (std::vector<std::string>{"a_models/", "folder.json/", "scenes/", "A.JSON", "b.json"}));
+  EXPECT_EQ(labels(l),
+            (std::vector<std::string>{"a_models/", "folder.json/", "scenes/", "A.JSON", "b.json"}));
   EXPECT_EQ(labels(list_folder(d, {".gltf", ".glb"})),
             (std::vector<std::string>{"a_models/", "folder.json/", "scenes/", "model.gltf"}));
   EXPECT_EQ(list_folder(d, {".json"}).entries.back().path, d / "b.json");
@@ -51,20 +54,22 @@ TEST(FileDialog, OddEntriesAreLeftOutOrEscapedNeverFatal) {
   const fs::path d = fresh_dir("odd");
   fs::create_symlink(d / "nowhere.json", d / "broken.json");  // a broken link: left out
   fs::create_directory(d / "real");
-  fs::create_directory_symlink(d / "real", d / "linked");     // a link to a folder: a folder
+  fs::create_directory_symlink(d / "real", d / "linked");  // a link to a folder: a folder
   touch(d / "real.json");
-  fs::create_symlink(d / "real.json", d / "alias.json");      // a link to a file: a file
+  fs::create_symlink(d / "real.json", d / "alias.json");         // a link to a file: a file
   const std::string bad = std::string("caf\xE9") + "\xFF.json";  // Latin-1 bytes, not UTF-8
   touch(d / bad);
   touch(d / "caf\xC3\xA9.json");  // UTF-8: shown as it is
   const FolderListing l = list_folder(d, {".json"});
   EXPECT_EQ(l.error, "");
   // Sorted by the names' bytes: 0xC3 (UTF-8 'é') before 0xE9 (Latin-1 'é').
-  EXPECT_EQ(labels(l), (std::vector<std::string>{"linked/", "real/", "alias.json", "caf\xC3\xA9.json",
-                                                 "caf\\xE9\\xFF.json", "real.json"}));
+  EXPECT_EQ(labels(l),
+            (std::vector<std::string>{"linked/", "real/", "alias.json", "caf\xC3\xA9.json",
+                                      "caf\\xE9\\xFF.json", "real.json"}));
   // The path keeps the bytes: the file opens.
-  const auto it = std::find_if(l.entries.begin(), l.entries.end(),
-                               [](const FolderEntry& e) { return e.label == "caf\\xE9\\xFF.json"; });
+  const auto it = std::find_if(l.entries.begin(), l.entries.end(), [](const FolderEntry& e) {
+    return e.label == "caf\\xE9\\xFF.json";
+  });
   ASSERT_NE(it, l.entries.end());
   EXPECT_TRUE(std::ifstream(it->path).good());
 }
@@ -89,11 +94,11 @@ TEST(FileDialog, UnreadableFoldersAreErrorsNotCrashes) {
 
 TEST(FileDialog, DisplayNamesAreValidUtf8) {
   EXPECT_EQ(display_name("plain.json"), "plain.json");
-  EXPECT_EQ(display_name("\xE2\x82\xAC.json"), "\xE2\x82\xAC.json");     // the euro sign
-  EXPECT_EQ(display_name("\xC0\xAF"), "\\xC0\\xAF");                     // an overlong '/'
-  EXPECT_EQ(display_name("\xED\xA0\x80"), "\\xED\\xA0\\x80");            // a surrogate
-  EXPECT_EQ(display_name("\xE2\x82"), "\\xE2\\x82");                     // cut short
-  EXPECT_EQ(display_name("a\nb"), "a\\x0Ab");                            // a control character
+  EXPECT_EQ(display_name("\xE2\x82\xAC.json"), "\xE2\x82\xAC.json");  // the euro sign
+  EXPECT_EQ(display_name("\xC0\xAF"), "\\xC0\\xAF");                  // an overlong '/'
+  EXPECT_EQ(display_name("\xED\xA0\x80"), "\\xED\\xA0\\x80");         // a surrogate
+  EXPECT_EQ(display_name("\xE2\x82"), "\\xE2\\x82");                  // cut short
+  EXPECT_EQ(display_name("a\nb"), "a\\x0Ab");                         // a control character
 }
 
 TEST(FileDialog, TypedNamesResolveAgainstTheFolder) {

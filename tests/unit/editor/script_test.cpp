@@ -20,7 +20,8 @@ TEST(EditorScript, EveryActionParses) {
   auto r = parse_script_text(
       "# a comment\n\nset sun.transform.direction=[0.2, -0.8, -0.3]\nselect box resting\n"
       "camera 1 2 3\ncamera 1 2 3 0 0 0\nkey ctrl+z\nview cascade\nframes 12\nscreenshot a.png\n"
-      "window_screenshot w.png\nsave\nsave b.json\nundo\nredo\nquit\nquit!\r\nchoices shadow.filter\nchoose sun.light.type point\ninput 5\n",
+      "window_screenshot w.png\nsave\nsave b.json\nundo\nredo\nquit\nquit!\r\n"
+      "choices shadow.filter\nchoose sun.light.type point\ninput 5\n",
       "s.txt");
   ASSERT_TRUE(r.ok()) << r.error().to_string();
   ASSERT_EQ(r->size(), 18u);
@@ -43,8 +44,9 @@ TEST(EditorScript, EveryActionParses) {
 
 TEST(EditorScript, BadLinesNameTheFileAndLine) {
   EXPECT_EQ(error_of("frames 1\nsett a=1\n"),
-            "s.txt: line 2: unknown action 'sett' (set, choices, choose, select, create, import, delete, duplicate, rename, "
-            "parent, camera, orbit, key, view, frames, screenshot, window_screenshot, input, open, save, "
+            "s.txt: line 2: unknown action 'sett' (set, choices, choose, select, create, import, "
+            "delete, duplicate, rename, parent, camera, orbit, key, view, frames, screenshot, "
+            "window_screenshot, input, open, save, "
             "save_as, undo, redo, quit, quit!)");
   EXPECT_NE(error_of("orbit 10\n").find("line 1: expected 'orbit YAW_DEG PITCH_DEG'"),
             std::string::npos);
@@ -58,7 +60,8 @@ TEST(EditorScript, BadLinesNameTheFileAndLine) {
   EXPECT_NE(error_of("key ctrl+q\n").find("unknown key 'ctrl+q'"), std::string::npos);
   EXPECT_NE(error_of("view shadows\n").find("unknown view 'shadows'"), std::string::npos);
   EXPECT_NE(error_of("frames 0\n").find("[1, 100000]"), std::string::npos);
-  EXPECT_NE(error_of("input 0\n").find("input: expected seconds in [1, 600], got '0'"), std::string::npos);
+  EXPECT_NE(error_of("input 0\n").find("input: expected seconds in [1, 600], got '0'"),
+            std::string::npos);
   EXPECT_NE(error_of("input 2.5\n").find("got '2.5'"), std::string::npos);
   EXPECT_NE(error_of("frames 3x\n").find("'3x'"), std::string::npos);
   EXPECT_NE(error_of("undo now\n").find("expected 'undo'"), std::string::npos);
