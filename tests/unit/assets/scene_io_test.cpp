@@ -945,6 +945,18 @@ TEST(SceneIo, EnumerationRecorderSeesEveryEnumeratedField) {
         << pointer << ": the canonical value " << value << " is not among the recorded names";
   }
   EXPECT_GE(enumerated, 11);
+  // The editor finds a combo's names by the field's object and name ("light.type", whichever
+  // entity; editor.cpp, enumeration_key): that pair must name one table wherever it is read.
+  std::map<std::string, std::pair<std::string, std::vector<std::string>>> by_pair;
+  for (const auto& [path, names] : fields) {
+    const auto last = path.rfind('/');
+    const auto before = last == 0 || last == std::string::npos ? last : path.rfind('/', last - 1);
+    const std::string pair = before == std::string::npos ? path : path.substr(before + 1);
+    const auto [it, added] = by_pair.try_emplace(pair, path, names);
+    if (!added) {
+      EXPECT_EQ(names, it->second.second) << path << " and " << it->second.first << " differ";
+    }
+  }
   // The shadow filter's names are the table's, in its order, each once.
   const auto& filters = fields.at("/shadow/filter");
   EXPECT_EQ(std::set<std::string>(filters.begin(), filters.end()).size(), filters.size());
