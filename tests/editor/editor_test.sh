@@ -420,8 +420,9 @@ real_input)
   "$KASKAD" save "$scene" -o "$tmp/canonical.json" >/dev/null || fail "kaskad save"
   "$KASKAD" save "$scene" -o "$tmp/other.json" --set sun.light.intensity=2.5 >/dev/null || fail "kaskad save other"
   cp "$tmp/canonical.json" "$tmp/target.json"  # replaced through the save-as dialog
-  # Our own X server (xdotool needs its display): -displayfd writes the number it took.
-  Xvfb -displayfd 3 -screen 0 1024x600x24 -nolisten tcp 3>"$tmp/display" 2>"$tmp/xvfb.log" &
+  # Our own X server (xdotool needs its display): -displayfd writes the number it took. It and the
+  # editor are bounded in time, in case this script is killed before its trap can stop them.
+  timeout 300 Xvfb -displayfd 3 -screen 0 1024x600x24 -nolisten tcp 3>"$tmp/display" 2>"$tmp/xvfb.log" &
   xvfb=$!
   editor=""
   trap '[ -n "$editor" ] && kill "$editor" 2>/dev/null; kill "$xvfb" 2>/dev/null; wait 2>/dev/null;
