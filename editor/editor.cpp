@@ -30,11 +30,13 @@
 #include "components/light.h"
 #include "components/name.h"
 #include "components/transform.h"
+#include "editor/file_dialog.h"
 #include "editor/script.h"
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
 #include "runtime/cli/player.h"
+#include "runtime/core/json_reader.h"
 #include "runtime/gpu/context.h"
 #include "runtime/gpu/gl_handles.h"
 #include "systems/transform_system.h"
@@ -254,11 +256,60 @@ Image grey(const Image& one) {
   return out;
 }
 
+// The last two parts of a field's path, "/" or "." separated ("/entities/2/light/type" and
+// "sun.light.type" give "light.type"; "/shadow/filter" and "shadow.filter" give "shadow.filter"):
+// the object and the field, which name one table of the readers whichever entity holds them.
+std::string enumeration_key(const std::string& path, char separator) {
+  const auto last = path.rfind(separator);
+  if (last == std::string::npos || last == 0) return path.substr(last == 0 ? 1 : 0);
+  const auto before = path.rfind(separator, last - 1);
+  std::string key = path.substr(before == std::string::npos ? 0 : before + 1);
+  std::replace(key.begin(), key.end(), separator, '.');
+  return key;
+}
+
+// The file dialog's state: what it is for, the folder shown and the name typed.
+struct FileDialog {
+  enum class Purpose { open, save_as, import };
+  Purpose purpose = Purpose::open;
+  bool visible = false;        ///< shown; the operation's success or Cancel ends it
+  bool appearing = false;      ///< open the popup on the next frame
+  fs::path folder;             ///< absolute
+  FolderListing listing;       ///< of `folder`, read when it changes (and on refresh)
+  char name[1024] = "";        ///< typed, or the label of the entry clicked
+  fs::path picked;             ///< the entry clicked (its bytes, whatever its label)
+  fs::path replace;            ///< save as: the existing file the user was asked about
+  std::string error;           ///< the last refusal (an operation's error), shown in the dialog
+
+  const char* title() const {
+    return purpose == Purpose::open ? "Open scene###file_dialog"
+           : purpose == Purpose::save_as ? "Save scene as###file_dialog"
+                                         : "Import model###file_dialog";
+  }
+  std::vector<std::string> extensions() const {
+    if (purpose == Purpose::import) return {".gltf", ".glb"};
+    return {".json"};
+  }
+  void enter(const fs::path& dir) {
+    std::error_code ec;
+    const fs::path abs = fs::absolute(dir, ec);
+    folder = (ec ? dir : abs).lexically_normal();
+    // "a/b/.." normalises to "a/": shown, and gone up from, as "a".
+    if (!folder.has_filename() && folder != folder.root_path()) folder = folder.parent_path();
+    listing = list_folder(folder, extensions());
+    picked.clear();
+    error.clear();
+  }
+};
+
 class Editor {
  public:
   Editor(Options options, Scene scene, Player& player, std::vector<ScriptAction> script)
       : opt_(std::move(options)), scene_(std::move(scene)), player_(player), script_(std::move(script)) {
     history_.push_back(scene_to_json(scene_));
+    // The scene's enumerations as its reader sees them, whether the file gave them or not (scenes
+    // read later, created entities and edits are recorded as they are read).
+    (void)parse_scene(history_.front(), opt_.scene);
     take_camera_from_scene();
     update_bounds_speed();
   }
@@ -307,7 +358,19 @@ class Editor {
   void inspector();
   void field(const std::string& key, const std::string& label, const json& value);
   void request(const std::string& assignment);
+  /// The names the readers accept for the enumerated field KEY (an inspector key such as
+  /// "shadow.filter" or "sun.light.type"); nullptr when KEY is not enumerated.
+  const std::vector<std::string>* choices(const std::string& key);
+  /// What picking NAME in KEY's combo does: the edit KEY="NAME", for a name of choices(KEY) only.
+  Status choose(const std::string& key, const std::string& name);
   void direction_helpers();
+  /// Shows the file dialog for `purpose`, in the folder of `typed` (a path typed in a panel) and
+  /// with its name, else in the scene's folder.
+  void show_file_dialog(FileDialog::Purpose purpose, const std::string& typed);
+  void file_dialog(int w, int h);
+  /// The dialog's OK: a folder is entered; a file is opened, saved to or imported after the frame,
+  /// the dialog staying with the error when that is refused.
+  void accept_file_dialog();
   void interactive_input(float dt);
   Status run_action(const ScriptAction& a, bool& quit);
 
@@ -325,6 +388,11 @@ class Editor {
   }
 
   Options opt_;
+  /// Every enumeration the scene readers are asked for while the editor runs: the combo boxes'
+  /// items are the readers' own tables.
+  json_reader::EnumerationRecorder enumerations_;
+  std::map<std::string, std::vector<std::string>> choices_;  ///< by enumeration_key()
+  std::size_t choices_from_ = 0;  ///< how many recorded fields choices_ was made from
   Scene scene_;
   Player& player_;  ///< outlives the editor: its context outlives the UI's GL objects
   std::vector<ScriptAction> script_;  ///< --script, parsed before the window opened
@@ -339,6 +407,7 @@ class Editor {
   std::string set_line_;          ///< the inspector's free "key=value" field
   std::vector<std::function<Status()>> operations_;  ///< UI entity operations, after the frame
   std::string file_line_;         ///< the inspector's path field for open and save as
+  FileDialog dialog_;
   int create_shape_ = 0;
   char import_path_[512] = "";
   json doc_;
@@ -767,8 +836,28 @@ void Editor::request(const std::string& assignment) {
   requests_.emplace_back(assignment, merge);
 }
 
+const std::vector<std::string>* Editor::choices(const std::string& key) {
+  if (choices_from_ != enumerations_.fields().size()) {
+    for (const auto& [path, names] : enumerations_.fields())
+      choices_[enumeration_key(path, '/')] = names;
+    choices_from_ = enumerations_.fields().size();
+  }
+  const auto it = choices_.find(enumeration_key(key, '.'));
+  return it == choices_.end() ? nullptr : &it->second;
+}
+
+Status Editor::choose(const std::string& key, const std::string& name) {
+  const std::vector<std::string>* names = choices(key);
+  if (!names) return Error{"", "", "'" + key + "' is not an enumerated field"};
+  if (std::find(names->begin(), names->end(), name) == names->end())
+    return Error{"", "", "'" + name + "' is not one of " + key + "'s choices (" +
+                             json_reader::join(*names) + ")"};
+  return edit(key + "=" + json(name).dump(), false);
+}
+
 void Editor::field(const std::string& key, const std::string& label, const json& v) {
   ImGui::PushID(key.c_str());
+  const std::vector<std::string>* names = v.is_string() ? choices(key) : nullptr;
   if (v.is_boolean()) {
     bool b = v.get<bool>();
     if (ImGui::Checkbox(label.c_str(), &b)) request(key + "=" + (b ? "true" : "false"));
@@ -782,8 +871,20 @@ void Editor::field(const std::string& key, const std::string& label, const json&
     const float speed = std::max(std::abs(f) * 0.01f, 0.001f);
     if (ImGui::DragFloat(label.c_str(), &f, speed, 0.0f, 0.0f, "%.5g"))
       request(key + "=" + json(double(f)).dump());
+  } else if (names) {
+    // The reader's names; a value outside them (none is read, but a file may be edited while
+    // open) is shown as it is. A choice is the same KEY=VALUE edit as a typed one.
+    const std::string current = v.get<std::string>();
+    if (ImGui::BeginCombo(label.c_str(), current.c_str())) {
+      for (const std::string& n : *names) {
+        const bool is_current = n == current;
+        if (ImGui::Selectable(n.c_str(), is_current) && !is_current)
+          operations_.push_back([this, key, n] { return choose(key, n); });
+        if (is_current) ImGui::SetItemDefaultFocus();
+      }
+      ImGui::EndCombo();
+    }
   } else if (v.is_string()) {
-    // Enumerations are shown as the file spells them, a value outside the list included.
     char buf[512];
     std::snprintf(buf, sizeof buf, "%s", v.get<std::string>().c_str());
     if (ImGui::InputText(label.c_str(), buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue))
@@ -911,7 +1012,8 @@ void Editor::inspector() {
     std::snprintf(path, sizeof path, "%s", file_line_.c_str());
     ImGui::InputText("file", path, sizeof path);
     file_line_ = path;
-    if (ImGui::Button("open (Ctrl+O)") && !file_line_.empty()) {
+    // The typed path at once; the dialog with the "..." buttons.
+    if (ImGui::Button("open") && !file_line_.empty()) {
       const fs::path f = file_line_;
       operations_.push_back([this, f] { return open(f); });
     }
@@ -920,6 +1022,11 @@ void Editor::inspector() {
       const fs::path f = file_line_;
       operations_.push_back([this, f] { return save_as(f); });
     }
+    if (ImGui::Button("open...")) show_file_dialog(FileDialog::Purpose::open, file_line_);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+O");
+    ImGui::SameLine();
+    if (ImGui::Button("save as...")) show_file_dialog(FileDialog::Purpose::save_as, file_line_);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+Shift+S");
   }
   char buf[512];
   std::snprintf(buf, sizeof buf, "%s", set_line_.c_str());
@@ -989,7 +1096,11 @@ void Editor::draw_ui(int w, int h) {
     operations_.push_back([this, shape] { return create(shape); });
   }
   // A glTF file (path as typed, Enter or the button): imported in front of the camera.
-  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.65f);
+  // The field takes what the two buttons after it leave.
+  const ImGuiStyle& style = ImGui::GetStyle();
+  const float buttons = ImGui::CalcTextSize("import").x + ImGui::CalcTextSize("...").x +
+                        4.0f * style.FramePadding.x + 2.0f * style.ItemSpacing.x;
+  ImGui::SetNextItemWidth(std::max(40.0f, ImGui::GetContentRegionAvail().x - buttons));
   const bool entered = ImGui::InputTextWithHint("##model", "model.gltf", import_path_,
                                                 sizeof import_path_,
                                                 ImGuiInputTextFlags_EnterReturnsTrue);
@@ -998,6 +1109,8 @@ void Editor::draw_ui(int w, int h) {
     const std::string path = import_path_;
     operations_.push_back([this, path] { return import_model(path); });
   }
+  ImGui::SameLine();
+  if (ImGui::Button("...")) show_file_dialog(FileDialog::Purpose::import, import_path_);
   ImGui::Separator();
   entity_list();
   left_w_ = ImGui::GetWindowWidth();
@@ -1030,6 +1143,8 @@ void Editor::draw_ui(int w, int h) {
   ImGui::PopItemWidth();
   ImGui::End();
 
+  file_dialog(w, h);
+
   if (ask_quit_) ImGui::OpenPopup("Unsaved changes");
   if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
     ImGui::Text("%s has unsaved changes.", opt_.scene.filename().string().c_str());
@@ -1056,20 +1171,155 @@ void Editor::draw_ui(int w, int h) {
   }
 }
 
+void Editor::show_file_dialog(FileDialog::Purpose purpose, const std::string& typed) {
+  dialog_.purpose = purpose;
+  std::error_code ec;
+  const fs::path t = typed;
+  if (!typed.empty() && fs::is_directory(t, ec)) {
+    dialog_.enter(t);
+    dialog_.name[0] = '\0';
+  } else if (!typed.empty() && fs::is_directory(fs::absolute(t, ec).parent_path(), ec)) {
+    dialog_.enter(fs::absolute(t, ec).parent_path());
+    std::snprintf(dialog_.name, sizeof dialog_.name, "%s", t.filename().string().c_str());
+  } else {
+    dialog_.enter(opt_.scene.parent_path().empty() ? fs::path(".") : opt_.scene.parent_path());
+    const std::string own =
+        purpose == FileDialog::Purpose::save_as ? opt_.scene.filename().string() : "";
+    std::snprintf(dialog_.name, sizeof dialog_.name, "%s", own.c_str());
+  }
+  dialog_.replace.clear();
+  dialog_.visible = dialog_.appearing = true;
+}
+
+void Editor::accept_file_dialog() {
+  FileDialog& d = dialog_;
+  const std::string typed = d.name;
+  fs::path file = !d.picked.empty() && typed == display_name(d.picked.filename().string())
+                      ? d.picked
+                      : resolve_typed(d.folder, typed);
+  if (file.empty()) {
+    d.error = "type a file name, or pick one";
+    return;
+  }
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) {
+    d.enter(file);
+    d.name[0] = '\0';
+    return;
+  }
+  if (d.purpose == FileDialog::Purpose::save_as) {
+    if (!file.has_extension()) file += ".json";
+    // A file that is there is replaced only when asked twice.
+    if (fs::exists(file, ec) && file != d.replace) {
+      d.replace = file;
+      d.error = display_name(file.filename().string()) + " exists: save again to replace it";
+      return;
+    }
+  }
+  const FileDialog::Purpose purpose = d.purpose;
+  operations_.push_back([this, file, purpose] {
+    const Status st = purpose == FileDialog::Purpose::open      ? open(file)
+                      : purpose == FileDialog::Purpose::save_as ? save_as(file)
+                                                                : import_model(file.string());
+    if (st) dialog_.visible = false;
+    else dialog_.error = st.error().to_string();
+    return st;
+  });
+}
+
+void Editor::file_dialog(int w, int h) {
+  FileDialog& d = dialog_;
+  if (d.appearing) {
+    ImGui::OpenPopup("###file_dialog");
+    d.appearing = false;
+  }
+  ImGui::SetNextWindowSize(
+      ImVec2(std::min(640.0f, 0.8f * float(w)), std::min(460.0f, 0.85f * float(h))),
+      ImGuiCond_Appearing);
+  ImGui::SetNextWindowPos(ImVec2(0.5f * float(w), 0.5f * float(h)), ImGuiCond_Appearing,
+                          ImVec2(0.5f, 0.5f));
+  bool keep = true;
+  if (!ImGui::BeginPopupModal(d.title(), &keep, ImGuiWindowFlags_NoSavedSettings)) {
+    d.visible = false;  // closed by Escape or its close button
+    return;
+  }
+  if (!keep || !d.visible) {
+    d.visible = false;
+    ImGui::CloseCurrentPopup();
+    ImGui::EndPopup();
+    return;
+  }
+  if (ImGui::Button("up") && d.folder.has_parent_path() && d.folder.parent_path() != d.folder)
+    d.enter(d.folder.parent_path());
+  ImGui::SameLine();
+  if (ImGui::Button("refresh")) d.enter(d.folder);
+  ImGui::SameLine();
+  ImGui::TextUnformatted(display_name(d.folder.string()).c_str());
+  const ImVec4 red(1.0f, 0.45f, 0.35f, 1.0f);
+  if (!d.listing.error.empty()) ImGui::TextColored(red, "%s", d.listing.error.c_str());
+  // The rows: a folder is entered with one click; a file is picked with one, accepted with two.
+  const float footer = ImGui::GetFrameHeightWithSpacing() * 2.0f +
+                       (d.error.empty() ? 0.0f : ImGui::GetTextLineHeightWithSpacing() * 2.0f);
+  ImGui::BeginChild("entries", ImVec2(0, -footer), true);
+  std::optional<fs::path> enter;
+  bool accept = false;
+  for (const FolderEntry& e : d.listing.entries) {
+    const std::string label = e.folder ? e.label + "/" : e.label;
+    const bool picked = !e.folder && e.path == d.picked;
+    if (ImGui::Selectable(label.c_str(), picked, ImGuiSelectableFlags_AllowDoubleClick)) {
+      if (e.folder) {
+        enter = e.path;
+      } else {
+        d.picked = e.path;
+        std::snprintf(d.name, sizeof d.name, "%s", e.label.c_str());
+        d.error.clear();
+        accept = ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left);
+      }
+    }
+  }
+  if (d.listing.entries.empty() && d.listing.error.empty())
+    ImGui::TextDisabled("no folders or %s files here", json_reader::join(d.extensions()).c_str());
+  ImGui::EndChild();
+  if (enter) d.enter(*enter);
+  if (ImGui::IsWindowAppearing()) ImGui::SetKeyboardFocusHere();
+  ImGui::SetNextItemWidth(-160.0f);
+  ImGui::InputText("##name", d.name, sizeof d.name);
+  // Enter anywhere in the dialog (the name field gives up the keyboard on Enter, so a second one,
+  // to answer "replace it?", comes with no field active); as pressed, not its repeats: a held
+  // Enter must not answer by itself.
+  if (ImGui::IsWindowFocused(ImGuiFocusedFlags_RootAndChildWindows) &&
+      (ImGui::IsKeyPressed(GLFW_KEY_ENTER, false) || ImGui::IsKeyPressed(GLFW_KEY_KP_ENTER, false)))
+    accept = true;
+  ImGui::SameLine();
+  const char* verb = d.purpose == FileDialog::Purpose::open      ? "open"
+                     : d.purpose == FileDialog::Purpose::save_as ? "save"
+                                                                 : "import";
+  if (ImGui::Button(verb)) accept = true;
+  ImGui::SameLine();
+  if (ImGui::Button("cancel")) {
+    d.visible = false;
+    ImGui::CloseCurrentPopup();
+  }
+  if (!d.error.empty()) ImGui::TextColored(red, "%s", d.error.c_str());
+  if (accept && d.visible) accept_file_dialog();
+  ImGui::EndPopup();
+}
+
 void Editor::interactive_input(float dt) {
   ImGuiIO& io = ImGui::GetIO();
   if (!ImGui::IsAnyItemActive()) last_drag_key_.clear();
-  // The Dear ImGui 1.86 GLFW backend indexes keys by GLFW key code.
-  if (!io.WantTextInput) {
+  // The Dear ImGui 1.86 GLFW backend indexes keys by GLFW key code. While the file dialog is up,
+  // keys are its own.
+  if (!io.WantTextInput && !dialog_.visible) {
     const char* shortcut = nullptr;
     if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Z, false)) shortcut = "ctrl+z";
     if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Y, false)) shortcut = "ctrl+y";
-    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_S, false)) shortcut = "ctrl+s";
+    if (io.KeyCtrl && !io.KeyShift && ImGui::IsKeyPressed(GLFW_KEY_S, false)) shortcut = "ctrl+s";
     if (!io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_F, false)) shortcut = "f";
-    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_O, false) && !file_line_.empty()) {
-      const fs::path f = file_line_;
-      operations_.push_back([this, f] { return open(f); });
-    }
+    if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_O, false))
+      show_file_dialog(FileDialog::Purpose::open, file_line_);
+    if (io.KeyCtrl && io.KeyShift && ImGui::IsKeyPressed(GLFW_KEY_S, false))
+      show_file_dialog(FileDialog::Purpose::save_as, file_line_);
     if (shortcut)
       if (Status st = press(shortcut, 0.0f); !st) report(st.error().to_string());
   }
@@ -1096,6 +1346,16 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
   switch (a.kind) {
     case ActionKind::set:
       return edit(a.args[0], false);
+    case ActionKind::choices: {
+      // What the inspector's combo for KEY lists (the script cannot click it).
+      const std::vector<std::string>* names = choices(a.args[0]);
+      if (!names) return Error{"", "", "choices: '" + a.args[0] + "' is not an enumerated field"};
+      std::printf("kaskad edit: choices %s: %s\n", a.args[0].c_str(),
+                  json_reader::join(*names).c_str());
+      return {};
+    }
+    case ActionKind::choose:
+      return choose(a.args[0], a.args[1]);
     case ActionKind::select:
       if (!find(a.args[0])) return Error{"", "", "select: no entity named '" + a.args[0] + "'"};
       selected_ = a.args[0];
@@ -1118,6 +1378,7 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       // refused) fails the script.
       return press(a.args[0], 1.0f / 30.0f);
     case ActionKind::frames:
+    case ActionKind::input:  // the run loop counts both
       return {};
     case ActionKind::create:
       return create(a.args[0]);
@@ -1173,6 +1434,9 @@ int Editor::run() {
   const std::vector<ScriptAction>& script = script_;
   std::size_t next = 0;
   int frames_left = 0;
+  // `input SECONDS`: until then the window takes real input and no script action runs.
+  std::optional<std::chrono::steady_clock::time_point> input_until;
+  int input_phases = 0;
   auto last = std::chrono::steady_clock::now();
   auto last_reload_check = last;
   for (;;) {
@@ -1189,7 +1453,12 @@ int Editor::run() {
     if (!opt_.script.empty()) {
       // Script actions run between frames; `frames N` lets N frames render, and a screenshot
       // after a change first renders the frame that shows it.
-      while (frames_left == 0 && next < script.size()) {
+      if (input_until && std::chrono::steady_clock::now() >= *input_until) {
+        input_until.reset();
+        std::printf("kaskad edit: input %d ended\n", input_phases);
+        std::fflush(stdout);
+      }
+      while (!input_until && frames_left == 0 && next < script.size()) {
         const ScriptAction& a = script[next];
         if (a.kind == ActionKind::screenshot && changed_since_frame_) {
           frames_left = 1;
@@ -1205,9 +1474,16 @@ int Editor::run() {
         ++next;
         if (a.kind == ActionKind::frames) frames_left = std::stoi(a.args[0]);
         if (a.kind == ActionKind::window_screenshot) frames_left = 1;
+        if (a.kind == ActionKind::input) {
+          input_until =
+              std::chrono::steady_clock::now() + std::chrono::seconds(std::stoi(a.args[0]));
+          // Flushed: a test driving the window with real events waits for this line.
+          std::printf("kaskad edit: input %d for %s s\n", ++input_phases, a.args[0].c_str());
+          std::fflush(stdout);
+        }
         if (quit) break;
       }
-      if (!quit && frames_left == 0 && next == script.size()) {
+      if (!quit && !input_until && frames_left == 0 && next == script.size()) {
         std::fprintf(stderr, "kaskad edit: error: %s: the script ended without quit or quit!\n",
                      opt_.script.string().c_str());
         return 1;
@@ -1244,7 +1520,7 @@ int Editor::run() {
     const auto now = std::chrono::steady_clock::now();
     const float dt = std::min(std::chrono::duration<float>(now - last).count(), 0.1f);
     last = now;
-    if (opt_.script.empty()) interactive_input(dt);
+    if (opt_.script.empty() || input_until) interactive_input(dt);
     draw_ui(w, h);
     ImGui::Render();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -24,6 +24,8 @@ struct Verb {
 
 constexpr Verb kVerbs[] = {
     {"set", ActionKind::set, 1, 1, "set KEY=VALUE"},
+    {"choices", ActionKind::choices, 1, 1, "choices KEY"},
+    {"choose", ActionKind::choose, 2, 2, "choose KEY NAME"},
     {"select", ActionKind::select, 1, 1, "select NAME"},
     {"create", ActionKind::create, 1, 1, "create SHAPE (box, sphere, cylinder, cone, plane)"},
     {"import", ActionKind::import, 1, 1, "import MODEL.gltf|.glb"},
@@ -38,6 +40,7 @@ constexpr Verb kVerbs[] = {
     {"frames", ActionKind::frames, 1, 1, "frames N (1..100000)"},
     {"screenshot", ActionKind::screenshot, 1, 1, "screenshot PATH.png"},
     {"window_screenshot", ActionKind::window_screenshot, 1, 1, "window_screenshot PATH.png"},
+    {"input", ActionKind::input, 1, 1, "input SECONDS (1..600)"},
     {"open", ActionKind::open, 1, 1, "open SCENE"},
     {"save", ActionKind::save, 0, 1, "save [PATH]"},
     {"save_as", ActionKind::save_as, 1, 1, "save_as PATH"},
@@ -102,6 +105,13 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
       return Error{file.string(), where, "unknown key '" + a.args[0] + "'; expected " + v->usage};
     if (a.kind == ActionKind::view && !view_named(a.args[0]))
       return Error{file.string(), where, "unknown view '" + a.args[0] + "'; expected " + v->usage};
+    if (a.kind == ActionKind::input) {
+      int seconds = 0;
+      const std::string& s = a.args[0];
+      auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), seconds);
+      if (ec != std::errc() || ptr != s.data() + s.size() || seconds < 1 || seconds > 600)
+        return Error{file.string(), where, "input: expected seconds in [1, 600], got '" + s + "'"};
+    }
     if (a.kind == ActionKind::frames) {
       int frames = 0;
       const std::string& s = a.args[0];

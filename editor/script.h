@@ -13,9 +13,9 @@
 namespace kaskad::editor {
 
 enum class ActionKind {
-  set, select, create, import, remove, duplicate, rename, parent, camera, orbit, key, view, frames,
-  screenshot,
-  window_screenshot, open, save, save_as, undo, redo, quit, force_quit
+  set, choices, choose, select, create, import, remove, duplicate, rename, parent, camera, orbit,
+  key, view, frames, screenshot, window_screenshot, input, open, save, save_as, undo, redo, quit,
+  force_quit
 };
 
 /// What the viewport shows: the colour, or as a debug view one of the frame's AOVs (README "AOV

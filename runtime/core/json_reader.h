@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -65,6 +66,31 @@ inline double num(float f) {
 inline json vec(const glm::vec2& v) { return json::array({num(v.x), num(v.y)}); }
 inline json vec(const glm::vec3& v) { return json::array({num(v.x), num(v.y), num(v.z)}); }
 inline json vec(const glm::vec4& v) { return json::array({num(v.x), num(v.y), num(v.z), num(v.w)}); }
+
+/// While one exists, collects on its thread every enumerated field the readers are asked for (given
+/// in the file or not) with the names their table accepts: the editor's combo boxes list the
+/// readers' own tables instead of copies. Scoped: the previous recorder is restored when it ends.
+class EnumerationRecorder {
+ public:
+  EnumerationRecorder() : previous_(current_) { current_ = this; }
+  ~EnumerationRecorder() { current_ = previous_; }
+  EnumerationRecorder(const EnumerationRecorder&) = delete;
+  EnumerationRecorder& operator=(const EnumerationRecorder&) = delete;
+
+  /// The recorder of this thread, or nullptr.
+  static EnumerationRecorder* current() { return current_; }
+  void record(const std::string& path, std::vector<std::string> names) {
+    fields_[path] = std::move(names);
+  }
+  /// The accepted names by field path as the reader names it in errors ("/shadow/filter",
+  /// "/entities/2/light/type"), in the table's order.
+  const std::map<std::string, std::vector<std::string>>& fields() const { return fields_; }
+
+ private:
+  static inline thread_local EnumerationRecorder* current_ = nullptr;
+  EnumerationRecorder* previous_;
+  std::map<std::string, std::vector<std::string>> fields_;
+};
 
 // Reads the fields of one JSON object, tracking which keys were used so that unknown keys are
 // reported with the list of valid ones.
@@ -131,10 +157,12 @@ class ObjectReader {
   }
   template <class E>
   void enumeration(const char* key, E& out, const std::vector<std::pair<const char*, E>>& table) {
-    if (!has(key)) return;
-    const json& v = j_.at(key);
     std::vector<std::string> names;
     for (const auto& [n, e] : table) names.push_back(n);
+    if (EnumerationRecorder* recorder = EnumerationRecorder::current())
+      recorder->record(at(key), names);
+    if (!has(key)) return;
+    const json& v = j_.at(key);
     if (!v.is_string()) fail(at(key), "expected one of " + join(names) + ", got " + type_name(v));
     for (const auto& [n, e] : table)
       if (v.get<std::string>() == n) {

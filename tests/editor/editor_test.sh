@@ -9,8 +9,15 @@
 #             a glTF model imported shows, is saved, and undo removes it
 #   every_n   a reflector with update every_n = 3 captures on editor frames 0, 3, 6, 9 only; a
 #             probe's map type changed live changes the image
+#   combos    an enumerated field's combo lists exactly the names the scene reader accepts (the
+#             reader's own error lists them), for sections, entities, and an entity made in the
+#             editor; choosing one (what a click does; the script cannot click) edits and saves it
 #   input     unknown flags, bad script lines, rejected values and unsaved quits fail clearly
-# usage: editor_test.sh toggles|saving|entities|every_n|input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
+#   real_input  real X events (xdotool) during the script's `input` phases: right mouse + W flies
+#             forward, F frames the selection, Ctrl+Z undoes an edit, Ctrl+O's file dialog opens
+#             a typed scene, Ctrl+Shift+S's saves over a file after asking (skipped, saying so,
+#             without xdotool)
+# usage: editor_test.sh toggles|saving|entities|every_n|combos|input|real_input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
 set -u
 : "${KASKAD:?path to the kaskad binary}" "${KASKAD_CONTENT:?content dir}"
 if ! command -v xvfb-run >/dev/null 2>&1; then
@@ -319,6 +326,54 @@ quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
     fail "views: faces $(png_size sphere_faces.png), sphere map $(png_size sphere_map.png)"
   fi
   ;;
+combos)
+  edit "choices shadow.filter
+choices sun.light.type
+choices box_resting.material.reflection_model
+choices render.tone_mapping
+create cone
+choices cone_1.primitive.shape
+choose shadow.filter bilinear
+choose box_resting.material.reflection_model s3
+choose sun.light.type spot
+save $tmp/chosen.json
+quit!" "$scene"
+  [ "$rc" -eq 0 ] || { fail "combos script exit $rc"; tail -5 "$tmp/out"; }
+  # The reader's list for KEY at JSON path PATH: what `kaskad info` says of a value it rejects.
+  reader_names() {
+    "$KASKAD" info "$scene" --set "$1=not_a_name" 2>&1 | sed -n "s|.*$2: unknown value 'not_a_name'; expected one of \(.*\) (after.*|\1|p"
+  }
+  for k in "shadow.filter /shadow/filter" "sun.light.type /entities/8/light/type" \
+           "box_resting.material.reflection_model /entities/1/material/reflection_model" \
+           "render.tone_mapping /render/tone_mapping" "box_resting.primitive.shape /entities/1/primitive/shape"; do
+    set -- $k
+    want=$(reader_names "$1" "$2")
+    key=$1
+    [ "$key" = box_resting.primitive.shape ] && key=cone_1.primitive.shape  # made in the editor
+    got=$(sed -n "s/^kaskad edit: choices $key: //p" "$tmp/out")
+    if [ -n "$want" ] && [ "$got" = "$want" ]; then ok "$key's combo lists the reader's names: $got"
+    else fail "$key's combo lists '$got', the reader accepts '$want'"; fi
+  done
+  if /usr/bin/env python3 - "$tmp/chosen.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+ents = {e["name"]: e for e in d["entities"]}
+assert d["shadow"]["filter"] == "bilinear", d["shadow"]
+assert ents["box_resting"]["material"]["reflection_model"] == "s3", ents["box_resting"]["material"]
+assert ents["sun"]["light"]["type"] == "spot", ents["sun"]["light"]
+PY
+  then
+    ok "choices made (a section, a reloaded section, a live one) are saved"
+  else
+    fail "chosen.json does not hold the choices"
+  fi
+  edit "choices render.exposure
+quit!" "$scene"
+  refused "line 1: choices: 'render.exposure' is not an enumerated field" "a number field has no combo"
+  edit "choose shadow.filter pcss
+quit!" "$scene"
+  refused "line 1: 'pcss' is not one of shadow.filter's choices (none, bilinear, pcf3x3)" "a name outside the list is not a choice"
+  ;;
 input)
   out=$("$KASKAD" edit --screenshot x.png 2>&1); code=$?
   if [ "$code" -eq 2 ] && grep -q "unknown option '--screenshot'" <<<"$out"; then
@@ -357,7 +412,134 @@ undo
 quit" "$scene"
   [ "$rc" -eq 0 ] && ok "an edit undone leaves nothing unsaved" || { fail "undone quit: exit $rc"; cat "$tmp/out"; }
   ;;
+real_input)
+  if ! command -v xdotool >/dev/null 2>&1 || ! command -v Xvfb >/dev/null 2>&1; then
+    echo "SKIPPED: no xdotool (install the xdotool package: scripts/setup.sh)"
+    exit 77
+  fi
+  "$KASKAD" save "$scene" -o "$tmp/canonical.json" >/dev/null || fail "kaskad save"
+  "$KASKAD" save "$scene" -o "$tmp/other.json" --set sun.light.intensity=2.5 >/dev/null || fail "kaskad save other"
+  cp "$tmp/canonical.json" "$tmp/target.json"  # replaced through the save-as dialog
+  # Our own X server (xdotool needs its display): -displayfd writes the number it took. It and the
+  # editor are bounded in time, in case this script is killed before its trap can stop them.
+  timeout 300 Xvfb -displayfd 3 -screen 0 1024x600x24 -nolisten tcp 3>"$tmp/display" 2>"$tmp/xvfb.log" &
+  xvfb=$!
+  editor=""
+  trap '[ -n "$editor" ] && kill "$editor" 2>/dev/null; kill "$xvfb" 2>/dev/null; wait 2>/dev/null;
+        [ -n "${KEEP:-}" ] || rm -rf "$tmp"' EXIT
+  for _ in $(seq 1 100); do [ -s "$tmp/display" ] && break; sleep 0.1; done
+  [ -s "$tmp/display" ] || { fail "Xvfb did not start"; cat "$tmp/xvfb.log"; exit 1; }
+  export DISPLAY=":$(cat "$tmp/display")"
+  # Each `input N` lets the window take real events for N seconds (generous: frames on llvmpipe
+  # are slow); the saves after them record what the events did.
+  printf '%s\n' "select sphere" "frames 1" "input 6" "save $tmp/flown.json" "input 5" \
+    "save $tmp/framed.json" "set sun.light.intensity=3" "input 5" "save $tmp/undone.json" "input 12" \
+    "save $tmp/opened.json" "input 15" "quit!" >"$tmp/script.txt"
+  timeout 180 "$KASKAD" edit --size 800x360 --script "$tmp/script.txt" "$scene" >"$tmp/out" 2>&1 &
+  editor=$!
+  # phase K: waits (at most 90 s) for the editor's "input K for" line, then for its window.
+  window=""
+  phase() {
+    for _ in $(seq 1 900); do
+      grep -q "^kaskad edit: input $1 for" "$tmp/out" && break
+      kill -0 "$editor" 2>/dev/null || return 1
+      sleep 0.1
+    done
+    grep -q "^kaskad edit: input $1 for" "$tmp/out" || return 1
+    [ -n "$window" ] || window=$(timeout 20 xdotool search --sync --name "^Kaskad editor" | head -1)
+    [ -n "$window" ] && timeout 10 xdotool windowfocus --sync "$window"
+  }
+  # A key held long enough for a frame to see it: Dear ImGui 1.86 reads key states once a frame,
+  # so a press and release between two frames would be lost.
+  hold() { timeout 10 xdotool keydown "$1"; sleep "${2:-0.5}"; timeout 10 xdotool keyup "$1"; }
+  # The viewport is the middle of the 800x360 window (panels 160 and 260 wide).
+  if phase 1; then
+    timeout 10 xdotool mousemove --window "$window" 350 180
+    sleep 0.5
+    timeout 10 xdotool mousedown 3
+    hold w 0.8
+    timeout 10 xdotool mouseup 3
+  else fail "no input phase 1"; fi
+  if phase 2; then hold f; else fail "no input phase 2"; fi
+  if phase 3; then hold ctrl+z; else fail "no input phase 3"; fi
+  if phase 4; then
+    hold ctrl+o
+    sleep 1
+    timeout 20 xdotool type --delay 40 "$tmp/other.json"
+    sleep 0.5
+    hold Return
+    sleep 2
+    title=$(timeout 10 xdotool getwindowname "$window")
+  else fail "no input phase 4"; fi
+  # Save as over target.json (the name typed without .json): the first Enter asks, the second
+  # replaces the file.
+  if phase 5; then
+    hold ctrl+shift+s
+    sleep 1
+    hold ctrl+a 0.3
+    timeout 20 xdotool type --delay 40 "$tmp/target"
+    sleep 0.5
+    hold Return
+    sleep 1.5
+    if cmp -s "$tmp/canonical.json" "$tmp/target.json"; then ok "save as asks before replacing a file"
+    else fail "save as replaced target.json without asking"; fi
+    hold Return
+    sleep 2
+    saved_title=$(timeout 10 xdotool getwindowname "$window")
+  else fail "no input phase 5"; fi
+  wait "$editor"
+  rc=$?
+  editor=""
+  [ "$rc" -eq 0 ] || { fail "real_input script exit $rc"; grep -v '^frame' "$tmp/out" | tail -5; }
+  if /usr/bin/env python3 - "$tmp" <<'PY'
+import json, math, sys
+tmp = sys.argv[1]
+def ents(name):
+    return {e["name"]: e for e in json.load(open(f"{tmp}/{name}.json"))["entities"]}
+def forward(q):  # (0, 0, -1) turned by the quaternion [x, y, z, w]: v + w t + q.xyz x t, t = 2 q.xyz x v
+    x, y, z, w = q
+    tx, ty, tz = 2 * y * -1.0, -2 * x * -1.0, 0.0
+    return (w * tx + (y * tz - z * ty), w * ty + (z * tx - x * tz), -1.0 + w * tz + (x * ty - y * tx))
+def sub(a, b): return [p - q for p, q in zip(a, b)]
+def dot(a, b): return sum(p * q for p, q in zip(a, b))
+def norm(a): return math.sqrt(dot(a, a))
+ok = True
+def check(cond, what):
+    global ok
+    print(("ok   " if cond else "FAIL ") + what)
+    ok = ok and cond
+before = ents("canonical")["camera"]["transform"]
+flown = ents("flown")["camera"]["transform"]
+f0 = forward(before["rotation"])
+move = sub(flown["translation"], before["translation"])
+along = dot(move, f0)
+check(along > 0.5 and norm(move) - along < 0.05 * along,
+      f"right mouse + W flew the camera forward: {along:.2f} m along its heading, {norm(move):.2f} m in all")
+framed = ents("framed")["camera"]["transform"]
+to_sphere = sub([2.4, 0.6, 1.6], framed["translation"])
+f1 = forward(framed["rotation"])
+# Framed: the sphere's centre on the view axis, at 1.2 r / sin(fov / 2) with r the half diagonal of
+# its bounds (radius 0.5 scaled by 1.2) and fov 45 degrees (editor.cpp, frame_selection).
+expected = 1.2 * (0.5 * 1.2 * math.sqrt(3.0)) / math.sin(math.radians(22.5))
+axis = dot(to_sphere, f1) / norm(to_sphere)
+check(axis > 0.999 and abs(norm(to_sphere) - expected) < 0.05 * expected,
+      f"F framed the selected sphere: {norm(to_sphere):.2f} m away (expected {expected:.2f}), axis cosine {axis:.4f}")
+check(ents("undone")["sun"]["light"]["intensity"] == 5.34, "Ctrl+Z undid the edit (intensity 3 -> 5.34)")
+check(ents("opened")["sun"]["light"]["intensity"] == 2.5, "Ctrl+O, a typed path and Enter opened other.json")
+check(ents("target")["sun"]["light"]["intensity"] == 2.5, "Ctrl+Shift+S, a typed name and Enter twice saved over target.json")
+sys.exit(0 if ok else 1)
+PY
+  then :; else failed=1; grep -v '^frame' "$tmp/out" | tail -8; fi
+  case "${title:-}" in
+    *other.json) ok "the window's title names the opened scene" ;;
+    *) fail "window title '${title:-}' after opening other.json" ;;
+  esac
+  case "${saved_title:-}" in
+    *target.json) ok "after save as, the window's title names the new file" ;;
+    *) fail "window title '${saved_title:-}' after saving as target.json" ;;
+  esac
+  ;;
 *)
-  echo "usage: editor_test.sh toggles|saving|entities|every_n|input"; exit 2 ;;
+  echo "usage: editor_test.sh toggles|saving|entities|every_n|combos|input|real_input"; exit 2 ;;
 esac
 exit $failed

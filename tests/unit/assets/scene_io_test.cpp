@@ -1,6 +1,7 @@
 // Scene files: round trip, overrides, and errors that name the file and the place.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -17,6 +18,7 @@
 #include "components/transform.h"
 #include "runtime/assets/scene_io.h"
 #include "runtime/assets/material_file.h"
+#include "runtime/core/json_reader.h"
 
 namespace kaskad {
 namespace {
@@ -871,6 +873,107 @@ TEST(SceneIo, EntitiesAreAddedAndRemovedBetweenFrames) {
   EXPECT_FALSE(find(*s, "box_floating").valid());
   EXPECT_FALSE(s->world.alive(*added));
   EXPECT_FALSE(remove_entity(*s, "box_floating").ok());
+}
+
+}  // namespace
+}  // namespace kaskad
+
+namespace kaskad {
+namespace {
+
+using json = nlohmann::json;
+
+// The editor's combo boxes list what json_reader::EnumerationRecorder saw the readers ask for.
+// Every string field of the canonical document that the reader checks against a table must be
+// recorded, with exactly the names that table accepts.
+TEST(SceneIo, EnumerationRecorderSeesEveryEnumeratedField) {
+  const json doc = json::parse(R"({
+    "kaskad_scene": 1, "render": {}, "shadow": {},
+    "entities": [
+      { "name": "mirror", "primitive": { "shape": "sphere" }, "material": { "roughness": 0.1 },
+        "reflector": { "map": "sphere" } },
+      { "name": "sun", "light": { "type": "directional" }, "shadow": { "filter": "bilinear" } },
+      { "name": "camera", "camera": {} } ] })");
+  json_reader::EnumerationRecorder recorder;
+  auto scene = parse_scene(doc, temp_dir() / "enums.json");
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  const json canonical = scene_to_json(*scene);
+  const auto& fields = recorder.fields();
+  for (const char* path : {"/render/tone_mapping", "/shadow/filter", "/shadow/split_scheme",
+                           "/shadow/fit_mode", "/entities/0/primitive/shape",
+                           "/entities/0/material/reflection_model", "/entities/0/reflector/map",
+                           "/entities/0/reflector/update", "/entities/1/light/type",
+                           "/entities/1/shadow/filter", "/entities/2/camera/projection"})
+    EXPECT_TRUE(fields.count(path)) << path << " not recorded";
+
+  // Through the reader again (a scoped recorder of its own, so these reads leave `fields` as is).
+  // A name may still be refused for another field's sake (update static_file needs a file): only
+  // "unknown value" at this field counts as not accepted.
+  auto unknown = [&](const std::string& pointer, const std::string& value) {
+    json_reader::EnumerationRecorder scratch;
+    json d = canonical;
+    d[json::json_pointer(pointer)] = value;
+    auto r = parse_scene(d, temp_dir() / "enums.json");
+    return !r.ok() && r.error().where == pointer &&
+           r.error().message.rfind("unknown value", 0) == 0;
+  };
+  int enumerated = 0;
+  const json leaves = canonical.flatten();
+  for (const auto& [pointer, value] : leaves.items()) {
+    if (!value.is_string() || pointer.ends_with("/name") || pointer.ends_with("/parent")) continue;
+    const auto it = fields.find(pointer);
+    if (it == fields.end()) {
+      // Not recorded: a free string (a path), which the reader takes as it is.
+      EXPECT_FALSE(unknown(pointer, "not_a_name"))
+          << pointer << " rejects a word but was not recorded";
+      continue;
+    }
+    ++enumerated;
+    ASSERT_FALSE(it->second.empty()) << pointer;
+    for (const std::string& name : it->second)
+      EXPECT_FALSE(unknown(pointer, name)) << pointer << " = " << name;
+    EXPECT_TRUE(unknown(pointer, "not_a_name")) << pointer;
+    // Exactly the table: the reader's own message lists the names it accepts.
+    json bad = canonical;
+    bad[json::json_pointer(pointer)] = "not_a_name";
+    auto r = parse_scene(bad, temp_dir() / "enums.json");
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().message,
+              "unknown value 'not_a_name'; expected one of " + json_reader::join(it->second));
+    EXPECT_NE(std::find(it->second.begin(), it->second.end(), value.get<std::string>()),
+              it->second.end())
+        << pointer << ": the canonical value " << value << " is not among the recorded names";
+  }
+  EXPECT_GE(enumerated, 11);
+  // The editor finds a combo's names by the field's object and name ("light.type", whichever
+  // entity; editor.cpp, enumeration_key): that pair must name one table wherever it is read.
+  std::map<std::string, std::pair<std::string, std::vector<std::string>>> by_pair;
+  for (const auto& [path, names] : fields) {
+    const auto last = path.rfind('/');
+    const auto before = last == 0 || last == std::string::npos ? last : path.rfind('/', last - 1);
+    const std::string pair = before == std::string::npos ? path : path.substr(before + 1);
+    const auto [it, added] = by_pair.try_emplace(pair, path, names);
+    if (!added) {
+      EXPECT_EQ(names, it->second.second) << path << " and " << it->second.first << " differ";
+    }
+  }
+  // The shadow filter's names are the table's, in its order, each once.
+  const auto& filters = fields.at("/shadow/filter");
+  EXPECT_EQ(std::set<std::string>(filters.begin(), filters.end()).size(), filters.size());
+  EXPECT_EQ(fields.at("/entities/1/shadow/filter"), filters);
+}
+
+TEST(SceneIo, EnumerationRecorderIsScoped) {
+  EXPECT_EQ(json_reader::EnumerationRecorder::current(), nullptr);
+  {
+    json_reader::EnumerationRecorder outer;
+    {
+      json_reader::EnumerationRecorder inner;
+      EXPECT_EQ(json_reader::EnumerationRecorder::current(), &inner);
+    }
+    EXPECT_EQ(json_reader::EnumerationRecorder::current(), &outer);
+  }
+  EXPECT_EQ(json_reader::EnumerationRecorder::current(), nullptr);
 }
 
 }  // namespace

@@ -20,10 +20,11 @@ TEST(EditorScript, EveryActionParses) {
   auto r = parse_script_text(
       "# a comment\n\nset sun.transform.direction=[0.2, -0.8, -0.3]\nselect box resting\n"
       "camera 1 2 3\ncamera 1 2 3 0 0 0\nkey ctrl+z\nview cascade\nframes 12\nscreenshot a.png\n"
-      "window_screenshot w.png\nsave\nsave b.json\nundo\nredo\nquit\nquit!\r\n",
+      "window_screenshot w.png\nsave\nsave b.json\nundo\nredo\nquit\nquit!\r\n"
+      "choices shadow.filter\nchoose sun.light.type point\ninput 5\n",
       "s.txt");
   ASSERT_TRUE(r.ok()) << r.error().to_string();
-  ASSERT_EQ(r->size(), 15u);
+  ASSERT_EQ(r->size(), 18u);
   EXPECT_EQ((*r)[0].kind, ActionKind::set);
   EXPECT_EQ((*r)[0].args.at(0), "sun.transform.direction=[0.2, -0.8, -0.3]");  // spaces kept
   EXPECT_EQ((*r)[0].line, 3);
@@ -34,12 +35,18 @@ TEST(EditorScript, EveryActionParses) {
   EXPECT_TRUE((*r)[9].args.empty());
   EXPECT_EQ((*r)[13].kind, ActionKind::quit);
   EXPECT_EQ((*r)[14].kind, ActionKind::force_quit);
+  EXPECT_EQ((*r)[15].kind, ActionKind::choices);
+  EXPECT_EQ((*r)[15].args.at(0), "shadow.filter");
+  EXPECT_EQ((*r)[16].kind, ActionKind::choose);
+  EXPECT_EQ((*r)[16].args.size(), 2u);
+  EXPECT_EQ((*r)[17].kind, ActionKind::input);
 }
 
 TEST(EditorScript, BadLinesNameTheFileAndLine) {
   EXPECT_EQ(error_of("frames 1\nsett a=1\n"),
-            "s.txt: line 2: unknown action 'sett' (set, select, create, import, delete, duplicate, rename, "
-            "parent, camera, orbit, key, view, frames, screenshot, window_screenshot, open, save, "
+            "s.txt: line 2: unknown action 'sett' (set, choices, choose, select, create, import, "
+            "delete, duplicate, rename, parent, camera, orbit, key, view, frames, screenshot, "
+            "window_screenshot, input, open, save, "
             "save_as, undo, redo, quit, quit!)");
   EXPECT_NE(error_of("orbit 10\n").find("line 1: expected 'orbit YAW_DEG PITCH_DEG'"),
             std::string::npos);
@@ -53,6 +60,9 @@ TEST(EditorScript, BadLinesNameTheFileAndLine) {
   EXPECT_NE(error_of("key ctrl+q\n").find("unknown key 'ctrl+q'"), std::string::npos);
   EXPECT_NE(error_of("view shadows\n").find("unknown view 'shadows'"), std::string::npos);
   EXPECT_NE(error_of("frames 0\n").find("[1, 100000]"), std::string::npos);
+  EXPECT_NE(error_of("input 0\n").find("input: expected seconds in [1, 600], got '0'"),
+            std::string::npos);
+  EXPECT_NE(error_of("input 2.5\n").find("got '2.5'"), std::string::npos);
   EXPECT_NE(error_of("frames 3x\n").find("'3x'"), std::string::npos);
   EXPECT_NE(error_of("undo now\n").find("expected 'undo'"), std::string::npos);
   EXPECT_NE(error_of("screenshot\n").find("expected 'screenshot PATH.png'"), std::string::npos);
