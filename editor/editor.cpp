@@ -760,7 +760,7 @@ Status Editor::render_viewport(int w, int h) {
   run.width = w;
   run.height = h;
   // The AOV targets cost fill rate: only for the views that show them.
-  run.write_aovs = view_ != View::colour && view_ != View::shadow_map;
+  run.write_aovs = view_ != View::colour && view_ != View::shadow_map && view_ != View::soft_maps;
   run.prewarm = prewarm_;
   auto t = render_frames(player_, scene_, run);
   if (!t) return t.error();
@@ -786,6 +786,14 @@ Status Editor::render_viewport(int w, int h) {
   } else if (view_ == View::shadow_map) {
     last_frame_ = grey(player_.renderer->read_shadow_map());
     if (last_frame_.width == 0) last_frame_ = player_.renderer->read_color();  // no shadowed light
+  } else if (view_ == View::soft_maps) {
+    Image maps = player_.renderer->read_soft_shadow_maps();
+    // Moments and evsm's warp exceed 1: scaled so the largest value is white.
+    float top = 0.0f;
+    for (float v : maps.pixels) top = std::max(top, v);
+    if (top > 1.0f)
+      for (float& v : maps.pixels) v /= top;
+    last_frame_ = maps.pixels.empty() ? player_.renderer->read_color() : grey(maps);
   } else {
     last_frame_ = aov_view(view_, player_.renderer->read_aovs());
   }
@@ -793,15 +801,25 @@ Status Editor::render_viewport(int w, int h) {
   if (frame_ms_.size() > 120) frame_ms_.erase(frame_ms_.begin());
   {
     const auto& st = t->last.stats;
-    char line[256];
+    char line[384];
     // GPU times from timer queries; on llvmpipe a pass's work can land in the next pass's timer
-    // (DESIGN.md, "Facts about these machines"), so they are indications only.
+    // (DESIGN.md, "Facts about these machines"), so they are indications only. The parts of
+    // the shadow and probe passes are shown when they ran.
+    std::string parts;
+    char part[64];
+    for (const auto& [name, ms] : {std::pair{"lom", st.lom_gpu_ms}, std::pair{"moments", st.moments_gpu_ms},
+                                   std::pair{"prefilter", st.prefilter_gpu_ms}})
+      if (ms > 0.0) {
+        std::snprintf(part, sizeof part, ", %s %.2f", name, ms);
+        parts += part;
+      }
     std::snprintf(line, sizeof line,
-                  "%.1f ms (GPU shadow %.2f, probes %.2f, forward %.2f), %d draws, %zu shadow "
-                  "tris, %d probe faces, %d programs",
+                  "%.1f ms (GPU shadow %.2f, probes %.2f, forward %.2f%s), %d draws, %zu shadow "
+                  "tris, %d probe faces, %d programs%s",
                   t->first_frame_ms, st.shadow_gpu_ms, st.probe_gpu_ms, st.forward_gpu_ms,
-                  st.draw_calls, st.shadow_triangles, st.probe_faces,
-                  int(player_.renderer->shaders().program_count()));
+                  parts.c_str(), st.draw_calls, st.shadow_triangles, st.probe_faces,
+                  int(player_.renderer->shaders().program_count()),
+                  st.visibility_reused ? ", visibility read back" : "");
     stats_ = line;
   }
   if (!opt_.script.empty()) {

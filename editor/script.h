@@ -21,11 +21,16 @@ enum class ActionKind {
 /// What the viewport shows: the colour, or as a debug view one of the frame's AOVs (README "AOV
 /// contract"), the shadow map (its layers stacked), a reflection probe's six cube faces (the
 /// selected entity's probe, else the first; +X -X +Y -Y +Z -Z left to right) or its sphere map
-/// (S3 eq. (2), made for the current camera; a probe of cube maps has none: the colour shows).
-enum class View { colour, visibility, cascade, normal, depth, shadow_map, probe_faces, sphere_map };
+/// (S3 eq. (2), made for the current camera; a probe of cube maps has none: the colour shows),
+/// or the soft-shadow technique's own maps (lom: each layer's occlusion factors of its first
+/// peel; vsm/evsm: the first moment, scaled to its largest value; other techniques have none:
+/// the colour shows).
+enum class View {
+  colour, visibility, cascade, normal, depth, shadow_map, probe_faces, sphere_map, soft_maps
+};
 /// The views' names, in View order: the viewport's combo and the script's `view NAME`.
 inline constexpr const char* kViewNames[] = {"colour", "visibility", "cascade", "normal", "depth",
-                                             "shadow_map", "probe_faces", "sphere_map"};
+                                             "shadow_map", "probe_faces", "sphere_map", "soft_maps"};
 inline std::optional<View> view_named(const std::string& name) {
   for (std::size_t i = 0; i < std::size(kViewNames); ++i)
     if (name == kViewNames[i]) return View(i);

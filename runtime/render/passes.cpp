@@ -842,6 +842,27 @@ void LomPass::bind() {
 Image LomPass::read_depths() const { return read_slices(depth_, GL_RED, {"Y"}, size_, slices_); }
 Image LomPass::read_factors() const { return read_slices(occlusion_, GL_RED, {"Y"}, size_, slices_); }
 
+Image LomPass::read_first_factors() const {
+  Image img;
+  img.channels = 1;
+  img.channel_names = {"Y"};
+  if (!occlusion_ || peels_ <= 0) return img;
+  const int layers = slices_ / peels_;
+  img.width = size_;
+  img.height = size_ * layers;
+  img.pixels.resize(std::size_t(size_) * std::size_t(img.height));
+  std::vector<float> slice(std::size_t(size_) * std::size_t(size_));
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  for (int l = 0; l < layers; ++l) {
+    glGetTextureSubImage(occlusion_.id(), 0, 0, 0, l * peels_, size_, size_, 1, GL_RED, GL_FLOAT,
+                         GLsizei(slice.size() * sizeof(float)), slice.data());
+    for (int y = 0; y < size_; ++y)  // rows top to bottom, as read_slices()
+      std::memcpy(&img.pixels[(std::size_t(l) * std::size_t(size_) + std::size_t(y)) * std::size_t(size_)],
+                  &slice[std::size_t(size_ - 1 - y) * std::size_t(size_)], std::size_t(size_) * sizeof(float));
+  }
+  return img;
+}
+
 // ---- MomentsPass ---------------------------------------------------------------------------------
 
 namespace {

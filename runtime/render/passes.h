@@ -134,6 +134,9 @@ class LomPass {
   Image read_depths() const;
   /// The occlusion factors, stacked the same way (tests).
   Image read_factors() const;
+  /// The occlusion factors of each shadow-map layer's first peel (the surfaces nearest the
+  /// light), stacked as read_factors() with one slice per layer: what a debug view shows.
+  Image read_first_factors() const;
 
  private:
   void ensure_storage(int size, int slices);

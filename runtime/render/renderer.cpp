@@ -541,6 +541,25 @@ Image Renderer::read_shadow_map() const { return impl_->shadow.read(); }
 Image Renderer::read_lom_depths() const { return impl_->lom.read_depths(); }
 Image Renderer::read_lom_factors() const { return impl_->lom.read_factors(); }
 
+Image Renderer::read_soft_shadow_maps() const {
+  const Impl& im = *impl_;
+  if (!im.frame_key || !im.frame_key->has(VariantKey::kShadow)) return {};
+  const std::uint32_t technique = im.frame_key->get(VariantKey::kShadowTechnique);
+  if (technique == VariantKey::kTechniqueLom) return im.lom.read_first_factors();
+  if (technique != VariantKey::kTechniqueVsm && technique != VariantKey::kTechniqueEvsm) return {};
+  const Image moments = im.moments.read();
+  if (moments.pixels.empty()) return {};
+  Image first;
+  first.width = moments.width;
+  first.height = moments.height;
+  first.channels = 1;
+  first.channel_names = {"Y"};
+  first.pixels.resize(std::size_t(moments.width) * std::size_t(moments.height));
+  for (std::size_t i = 0; i < first.pixels.size(); ++i)
+    first.pixels[i] = moments.pixels[i * std::size_t(moments.channels)];
+  return first;
+}
+
 CubeMap Renderer::read_probe_cube(ProbeHandle handle, int buffer) const {
   return impl_->cache->probes().read_cube(handle, buffer);
 }

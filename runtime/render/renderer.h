@@ -159,6 +159,11 @@ class Renderer {
   /// read_shadow_map() (lom_layers + 1 slices per shadow-map layer; empty before the first).
   Image read_lom_depths() const;
   Image read_lom_factors() const;
+  /// The soft-shadow technique's own maps of the last frame, one slice per shadow-map layer
+  /// stacked as read_shadow_map(): lom the occlusion factors of each layer's first peel, vsm
+  /// and evsm the first moment (evsm: the positive warp). Empty for techniques without maps of
+  /// their own (pcf, pcss, backprojection) and before the first frame.
+  Image read_soft_shadow_maps() const;
 
   /// The visibility of the shadow view the AOV shows (FrameInput::aov_shadow_view) at fixed world
   /// points

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # `kaskad edit` end to end in a real window on a virtual X display (xvfb-run), driven by --script:
-#   toggles   each toggle changes the viewport's image; with nothing changed, frames are identical;
+#   toggles   each toggle changes the viewport's image, and only where it should (the AOVs of the
+#             frame before: surfaces, or the penumbra for a filter change; changed_within.py);
+#             with nothing changed, frames are identical;
 #             the fly camera (key w) and F (frame the selection) move the view; the debug views
 #             (visibility, cascade, shadow map) differ and leave the colour as it was
 #   saving    save -> reload -> save gives the same bytes; edits then undo give the canonical bytes;
@@ -9,6 +11,8 @@
 #             a glTF model imported shows, is saved, and undo removes it
 #   every_n   a reflector with update every_n = 3 captures on editor frames 0, 3, 6, 9 only; a
 #             probe's map type changed live changes the image
+#   soft_maps the soft-shadow technique's maps view: vsm's and evsm's moments and lom's factors
+#             per cascade; pcf has none (the colour shows)
 #   combos    an enumerated field's combo lists exactly the names the scene reader accepts (the
 #             reader's own error lists them), for sections, entities, and an entity made in the
 #             editor; choosing one (what a click does; the script cannot click) edits and saves it
@@ -17,7 +21,7 @@
 #             forward, F frames the selection, Ctrl+Z undoes an edit, Ctrl+O's file dialog opens
 #             a typed scene, Ctrl+Shift+S's saves over a file after asking (skipped, saying so,
 #             without xdotool)
-# usage: editor_test.sh toggles|saving|entities|every_n|combos|input|real_input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
+# usage: editor_test.sh toggles|saving|entities|every_n|soft_maps|combos|input|real_input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
 set -u
 : "${KASKAD:?path to the kaskad binary}" "${KASKAD_CONTENT:?content dir}"
 if ! command -v xvfb-run >/dev/null 2>&1; then
@@ -61,15 +65,27 @@ toggles)
 screenshot $tmp/0.png
 frames 2
 screenshot $tmp/0b.png
+view normal
+screenshot $tmp/n0.png
+view colour
 set shadow.cascade_count=4
 frames 2
 screenshot $tmp/1.png
+view normal
+screenshot $tmp/n1.png
+view colour
 set shadow.fit_mode=crop
 frames 2
 screenshot $tmp/2.png
+view visibility
+screenshot $tmp/v2.png
+view colour
 set shadow.filter=none
 frames 2
 screenshot $tmp/3.png
+view normal
+screenshot $tmp/n3.png
+view colour
 set sun.transform.direction=[0.2,-0.8,-0.3]
 frames 2
 screenshot $tmp/4.png
@@ -101,6 +117,21 @@ quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
   differ "fit_mode stable -> crop" 1.png 2.png
   differ "filter pcf3x3 -> none" 2.png 3.png
   differ "sun.transform.direction moved" 3.png 4.png
+  # ... and only where it should, from the AOVs of the frame before (debug views): shadow
+  # settings and the sun change surfaces, never the background; pcf3x3 -> none changes only
+  # pixels the 3x3 kernel saw partly lit (where all nine taps agree, the centre tap alone, which
+  # is filter none, agrees too).
+  within() {
+    if python3 "$(dirname "$0")/changed_within.py" "$tmp/$2" "$tmp/$3" "$tmp/$4" "$5" >"$tmp/within" 2>&1; then
+      ok "$1: $(cat "$tmp/within")"
+    else
+      fail "$1: $(cat "$tmp/within")"
+    fi
+  }
+  within "cascade_count 1 -> 4 changed surfaces only" 0b.png 1.png n0.png geometry
+  within "fit_mode stable -> crop changed surfaces only" 1.png 2.png n1.png geometry
+  within "filter pcf3x3 -> none changed partly lit pixels only" 2.png 3.png v2.png penumbra
+  within "the sun moved: surfaces only" 3.png 4.png n3.png geometry
   same "nothing changed after the edits: identical frames" 4.png 4b.png
   differ "the fly camera moved forward (key w)" 4b.png 5.png
   differ "F framed the selected sphere" 5.png framed.png
@@ -112,7 +143,7 @@ quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
   # Frames kept coming: one stats line per frame, seven `frames 2`, four `frames 1` and one
   # frame before each screenshot of a new view (after `frames` a screenshot needs none).
   n=$(grep -c '^frame [0-9]*:' "$tmp/out")
-  if [ "$n" -eq 21 ]; then ok "21 frames rendered"; else fail "expected 21 frame lines, got $n"; fi
+  if [ "$n" -eq 25 ]; then ok "25 frames rendered"; else fail "expected 25 frame lines, got $n"; fi
   ;;
 saving)
   "$KASKAD" save "$scene" -o "$tmp/canonical.json" >/dev/null || fail "kaskad save"
@@ -325,6 +356,42 @@ quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
   else
     fail "views: faces $(png_size sphere_faces.png), sphere map $(png_size sphere_map.png)"
   fi
+  ;;
+soft_maps)
+  # The soft-shadow technique's maps: none for pcf (the colour shows, at the viewport's size);
+  # vsm's first moment and lom's first-peel factors, one 256^2 slice per cascade stacked.
+  png_size() { od -An -tu1 -j16 -N8 "$tmp/$1" | awk '{ printf "%dx%d", $3 * 256 + $4, $7 * 256 + $8 }'; }
+  edit "frames 1
+view soft_maps
+screenshot $tmp/pcf.png
+set shadow.technique=vsm
+frames 1
+screenshot $tmp/vsm.png
+set shadow.technique=evsm
+frames 1
+screenshot $tmp/evsm.png
+set shadow.technique=lom
+frames 1
+screenshot $tmp/lom.png
+view colour
+frames 1
+screenshot $tmp/lom_colour.png
+quit!" "$scene" --set shadow.map_size=256 --set shadow.cascade_count=4
+  [ "$rc" -eq 0 ] || { fail "soft_maps script exit $rc"; tail -20 "$tmp/out"; }
+  for f in vsm evsm lom; do
+    if [ "$(png_size $f.png)" = "256x1024" ]; then
+      ok "$f: its maps, 4 cascades of 256^2"
+    else
+      fail "$f: the view is $(png_size $f.png), expected 256x1024"
+    fi
+  done
+  if [ "$(png_size pcf.png)" = "$(png_size lom_colour.png)" ]; then
+    ok "pcf has no maps of its own: the view shows the colour"
+  else
+    fail "pcf: the view is $(png_size pcf.png), the colour $(png_size lom_colour.png)"
+  fi
+  differ "vsm's moments and lom's factors" vsm.png lom.png
+  differ "vsm's and evsm's first moments" vsm.png evsm.png
   ;;
 combos)
   edit "choices shadow.filter
@@ -540,6 +607,6 @@ PY
   esac
   ;;
 *)
-  echo "usage: editor_test.sh toggles|saving|entities|every_n|combos|input|real_input"; exit 2 ;;
+  echo "usage: editor_test.sh toggles|saving|entities|every_n|soft_maps|combos|input|real_input"; exit 2 ;;
 esac
 exit $failed
