@@ -15,6 +15,13 @@ bool is_number(const std::string& s) {
   return ec == std::errc() && ptr == s.data() + s.size() && std::isfinite(v);
 }
 
+// A whole decimal number in [lo, hi], nothing else.
+bool whole_number_in(const std::string& s, int lo, int hi) {
+  int v = 0;
+  auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  return ec == std::errc() && ptr == s.data() + s.size() && v >= lo && v <= hi;
+}
+
 struct Verb {
   const char* name;
   ActionKind kind;
@@ -105,20 +112,11 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
       return Error{file.string(), where, "unknown key '" + a.args[0] + "'; expected " + v->usage};
     if (a.kind == ActionKind::view && !view_named(a.args[0]))
       return Error{file.string(), where, "unknown view '" + a.args[0] + "'; expected " + v->usage};
-    if (a.kind == ActionKind::input) {
-      int seconds = 0;
-      const std::string& s = a.args[0];
-      auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), seconds);
-      if (ec != std::errc() || ptr != s.data() + s.size() || seconds < 1 || seconds > 600)
-        return Error{file.string(), where, "input: expected seconds in [1, 600], got '" + s + "'"};
-    }
-    if (a.kind == ActionKind::frames) {
-      int frames = 0;
-      const std::string& s = a.args[0];
-      auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), frames);
-      if (ec != std::errc() || ptr != s.data() + s.size() || frames < 1 || frames > 100000)
-        return Error{file.string(), where, "frames: expected a count in [1, 100000], got '" + s + "'"};
-    }
+    if (a.kind == ActionKind::input && !whole_number_in(a.args[0], 1, 600))
+      return Error{file.string(), where, "input: expected seconds in [1, 600], got '" + a.args[0] + "'"};
+    if (a.kind == ActionKind::frames && !whole_number_in(a.args[0], 1, 100000))
+      return Error{file.string(), where,
+                   "frames: expected a count in [1, 100000], got '" + a.args[0] + "'"};
     actions.push_back(std::move(a));
   }
   return actions;
