@@ -277,7 +277,7 @@ bool holds(const glm::ivec4& outer, const glm::ivec4& inner) {
 
 Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
                               const AssetStore& assets, bool layered, bool features_by_uniform,
-                              FrameStats& stats) {
+                              int shader_reloads, FrameStats& stats) {
   const std::vector<ShadowView>& views = frame.shadow_views;
   const ShadowMapSettings& map = frame.shadow_map;
   const int total = views.empty() ? 0 : views.back().first_layer + views.back().layer_count;
@@ -307,7 +307,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   auto layer_inputs = [&](std::size_t view, int c) {
     const ShadowView& v = views[view];
     InputHash h;
-    h.add(assets.uid).add(layered).add(v.projection).add(v.cull);
+    h.add(assets.uid).add(shader_reloads).add(layered).add(v.projection).add(v.cull);
     h.add(v.slope_bias).add(v.constant_bias);
     h.add(v.view_proj[std::size_t(c)]).add(v.skipped[std::size_t(c)]);
     // Only the paraboloid depth pass reads splits (near, far) and the margin (shadow_depth.vert).

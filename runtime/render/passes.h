@@ -70,10 +70,11 @@ class ShadowMapPass {
   /// Sizes the depth texture array for the frame's views (a size the driver refuses is an error
   /// before anything is drawn) and decides which layers to draw: a layer whose inputs (matrix,
   /// bias, culling, pass mode, casters with their meshes, matrices and depth programs) hash as
-  /// when it was last drawn keeps its depth. After it: stats hold the layers, casters per layer
-  /// and the layers to be drawn (shadow_layers_rendered).
+  /// when it was last drawn keeps its depth. `shader_reloads` counts the shader library's
+  /// reloads: a shader edited on disk redraws every layer. After it: stats hold the layers,
+  /// casters per layer and the layers to be drawn (shadow_layers_rendered).
   Status prepare(const FrameInput& frame, const DrawList& list, const AssetStore& assets,
-                 bool layered, bool features_by_uniform, FrameStats& stats);
+                 bool layered, bool features_by_uniform, int shader_reloads, FrameStats& stats);
   /// Draws those layers. After it: every layer of every view holds the depth of its casters.
   Status record(const FrameInput& frame, const DrawList& list, GpuCache& cache, DrawState& state,
                 FrameStats& stats);

@@ -172,12 +172,15 @@ std::string gib(double bytes) {
 
 /// What the main view's shadow visibility at each pixel depends on, besides the shadow maps'
 /// depths: the frame block (camera, lights, shadow views' matrices, splits and parameters), the
-/// frame's features, the target size, and every draw of the forward pass with what decides
-/// which of its fragments end up in front (mesh, matrix, program, sidedness, alpha mask).
+/// frame's features, the target size, the shaders (a reload of an edited file looks up again),
+/// and every draw of the forward pass with what decides which of its fragments end up in front
+/// (mesh, matrix, program, sidedness, alpha mask).
 std::uint64_t visibility_inputs(const FrameInput& frame, const DrawList& list,
-                                const AssetStore& assets, const FrameBlock& block) {
+                                const AssetStore& assets, const FrameBlock& block,
+                                int shader_reloads) {
   InputHash h;
-  h.add(assets.uid).add(frame.width).add(frame.height).add(list.frame_key.bits()).add(block);
+  h.add(assets.uid).add(shader_reloads).add(frame.width).add(frame.height);
+  h.add(list.frame_key.bits()).add(block);
   for (std::uint32_t i : list.forward_order) {
     const DrawItem& d = frame.draws[i];
     const Material& m = d.material;
@@ -286,7 +289,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
 
   // 1. Shadow maps. After it: every layer of every shadow view holds its casters' depth.
   KASKAD_TRY(im.shadow.prepare(frame, list, assets, list.frame_key.has(VariantKey::kShadowLayered),
-                               state.features_by_uniform(), stats_));
+                               state.features_by_uniform(), im.shaders->stats().reloads, stats_));
   im.timers.begin(TimedPart::shadow_depth);
   Status st = im.shadow.record(frame, list, *im.cache, state, stats_);
   im.timers.end(TimedPart::shadow_depth);
@@ -324,7 +327,8 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   std::uint32_t reuse = list.frame_key.get(VariantKey::kShadowReuse);
   const std::uint64_t stored = std::exchange(im.stored_visibility, 0);
   if (reuse != 0) {
-    const std::uint64_t inputs = visibility_inputs(frame, list, assets, block);
+    const std::uint64_t inputs =
+        visibility_inputs(frame, list, assets, block, im.shaders->stats().reloads);
     const bool maps_kept = stats_.shadow_layers_rendered == 0 && stats_.lom_layers_computed == 0 &&
                            stats_.vsm_layers_computed == 0;
     if (maps_kept && inputs == stored && im.forward.holds_visibility()) reuse = VariantKey::kReuseLoad;

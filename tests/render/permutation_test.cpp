@@ -271,6 +271,45 @@ TEST_F(PermutationTest, HotReloadKeepsTheLastGoodProgramAndMapsErrors) {
   EXPECT_GT(after.at(x, y, 0), before.at(x, y, 0) + 0.05f);
 }
 
+// An edited shadow lookup shows at once under a still camera: a hot reload invalidates the shadow
+// layers and the stored visibility (render.visibility_cache), which would otherwise be kept
+// because nothing in the scene moved. Fails when the reload count is left out of either's inputs.
+TEST_F(PermutationTest, HotReloadOfTheShadowCodeShowsUnderAStillCamera) {
+  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "hot_shadow_shaders";
+  fs::remove_all(dir);
+  fs::copy(content_dir() / "shaders", dir, fs::copy_options::recursive);
+  Scene s = scene("default.json");
+  auto r = make_renderer({}, false, dir);
+  render(*r, s);
+  const Image before = render(*r, s);
+  EXPECT_TRUE(r->stats().visibility_reused);  // still: read back, every layer kept
+  EXPECT_EQ(r->stats().shadow_layers_rendered, 0u);
+  // Edit the lookup: no shadows at all.
+  const fs::path shadow = dir / "shadow.glsl";
+  std::string text;
+  {
+    std::ifstream in(shadow);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::string from = "  return sum / 9.0;";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), "  return 1.0;");
+  std::ofstream(shadow, std::ios::trunc) << text;
+  fs::last_write_time(shadow, fs::last_write_time(shadow) + std::chrono::seconds(4));
+  EXPECT_TRUE(r->shaders().reload_changed().empty());
+  const Image after = render(*r, s);
+  EXPECT_FALSE(r->stats().visibility_reused);
+  EXPECT_NE(r->stats().shadow_layers_rendered, 0u);
+  // Shadowed ground got brighter; nothing got darker.
+  int brighter = 0;
+  for (std::size_t i = 0; i < after.pixels.size(); ++i) {
+    brighter += after.pixels[i] > before.pixels[i] + 0.05f;
+    EXPECT_GE(after.pixels[i], before.pixels[i] - 1e-6f) << "value " << i;
+    if (after.pixels[i] < before.pixels[i] - 1e-6f) break;
+  }
+  EXPECT_GT(brighter, 1000);
+}
+
 }  // namespace
 }  // namespace kaskad
 
