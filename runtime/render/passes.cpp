@@ -1261,7 +1261,8 @@ void ForwardPass::prepare(const FrameInput& frame, int samples) {
   }
 }
 
-Status ForwardPass::record(const FrameInput& frame, const DrawList& list, std::uint32_t reuse,
+Status ForwardPass::record(const FrameInput& frame, const DrawList& list,
+                           const std::vector<VariantKey>& keys, std::uint32_t reuse,
                            GpuCache& cache, DrawState& state, FrameStats& stats) {
   const GLenum bufs[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
                           GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
@@ -1309,8 +1310,6 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list, std::u
   // The stored visibility (render.visibility_cache, never with AOVs): a storing frame writes it
   // through output 1 into attachment 5, attached for this pass only (a loading frame samples
   // it, which an attached texture must not be).
-  const std::vector<VariantKey>* keys = &list.keys;
-  std::vector<VariantKey> load_keys;
   const GLenum visibility_attachment = GL_COLOR_ATTACHMENT5;
   if (reuse == VariantKey::kReuseStore) {
     const int views = std::min<int>(int(frame.shadow_views.size()), kMaxShadowedLights);
@@ -1327,11 +1326,6 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list, std::u
     KASKAD_CHECK(visibility_, "a frame loads shadow visibility that no frame stored");
     glBindTextureUnit(kTexCachedVisibility, visibility_.id());
     glBindSampler(kTexCachedVisibility, 0);
-    load_keys = list.keys;
-    for (VariantKey& k : load_keys)
-      if (k.get(VariantKey::kShadowReuse) == VariantKey::kReuseStore)
-        k.set(VariantKey::kShadowReuse, VariantKey::kReuseLoad);
-    keys = &load_keys;
   }
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
   if (single_colour) glClearBufferfv(GL_COLOR, 0, clear_color);
@@ -1340,7 +1334,7 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list, std::u
   glClearBufferfv(GL_DEPTH, 0, &one);
   // The AOV pass draws what the colour pass drew: its culling is counted once.
   const int culled = stats.frustum_culled;
-  const Status st = draw_forward(frame, list.forward_order, *keys, nullptr, 0, view_proj,
+  const Status st = draw_forward(frame, list.forward_order, keys, nullptr, 0, view_proj,
                                  cache, state, stats);
   if (!single_colour) stats.frustum_culled = culled;
   if (reuse == VariantKey::kReuseStore) glNamedFramebufferTexture(fbo_.id(), visibility_attachment, 0, 0);

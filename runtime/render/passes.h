@@ -225,12 +225,14 @@ class ForwardPass {
   /// multisampled colour and depth targets (made when the size or sample count changes).
   void prepare(const FrameInput& frame, int samples);
   /// Draws the main view's visible draws into colour (and the AOVs when asked for). After it:
-  /// colour holds the frame (resolved), the AOVs its surfaces when write_aovs. `reuse` is the
-  /// frame's VariantKey::kShadowReuse: with kReuseStore (the list's keys) the pass also stores
-  /// each pixel's shadow visibility per view; with kReuseLoad its programs read the stored
-  /// values back (the caller's promise: nothing they depend on changed since they were stored).
-  Status record(const FrameInput& frame, const DrawList& list, std::uint32_t reuse,
-                GpuCache& cache, DrawState& state, FrameStats& stats);
+  /// colour holds the frame (resolved), the AOVs its surfaces when write_aovs. `keys` are the
+  /// single-sample pass's (the list's, or with kReuseLoad the loading ones). `reuse` is the
+  /// frame's VariantKey::kShadowReuse: with kReuseStore the pass also stores each pixel's
+  /// shadow visibility per view; with kReuseLoad the programs read the stored values back (the
+  /// caller's promise: nothing they depend on changed since they were stored).
+  Status record(const FrameInput& frame, const DrawList& list,
+                const std::vector<VariantKey>& keys, std::uint32_t reuse, GpuCache& cache,
+                DrawState& state, FrameStats& stats);
 
   struct Target {
     const char* name;

@@ -334,13 +334,20 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     if (maps_kept && inputs == stored && im.forward.holds_visibility()) reuse = VariantKey::kReuseLoad;
     im.stored_visibility = inputs;
   }
-  // Loading programs not built yet are built now (prewarm() builds them up front). One that
-  // does not build (a shader edited into an error since the storing programs were built)
-  // leaves the frame to look up with the programs it has.
-  if (reuse == VariantKey::kReuseLoad)
+  // A loading frame draws with the loading programs. Those not built yet are built now
+  // (prewarm() builds them up front), each once (the order runs by program); one that does not
+  // build (a shader edited into an error since the storing programs were built) leaves the
+  // frame to look up with the programs it has.
+  std::vector<VariantKey> load_keys;
+  if (reuse == VariantKey::kReuseLoad) {
+    load_keys = list.keys;
+    for (VariantKey& k : load_keys)
+      if (k.get(VariantKey::kShadowReuse) == VariantKey::kReuseStore)
+        k.set(VariantKey::kShadowReuse, VariantKey::kReuseLoad);
+    std::optional<VariantKey> built;
     for (std::uint32_t i : list.forward_order) {
-      if (list.keys[i].get(VariantKey::kShadowReuse) != VariantKey::kReuseStore) continue;
-      const VariantKey load = VariantKey(list.keys[i]).set(VariantKey::kShadowReuse, VariantKey::kReuseLoad);
+      const VariantKey load = load_keys[i];
+      if (load.get(VariantKey::kShadowReuse) != VariantKey::kReuseLoad || load == built) continue;
       if (auto program = im.shaders->program(Pass::forward, load); !program) {
         log::warn_once("render.visibility_cache: a program that reads the stored visibility does "
                        "not build (%s); frames look the shadow maps up instead",
@@ -348,10 +355,13 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
         reuse = VariantKey::kReuseStore;
         break;
       }
+      built = load;
     }
+  }
   stats_.visibility_reused = reuse == VariantKey::kReuseLoad;
   im.timers.begin(TimedPart::forward);
-  st = im.forward.record(frame, list, reuse, *im.cache, state, stats_);
+  st = im.forward.record(frame, list, reuse == VariantKey::kReuseLoad ? load_keys : list.keys,
+                         reuse, *im.cache, state, stats_);
   im.timers.end(TimedPart::forward);
   if (!st) im.stored_visibility = 0;
   KASKAD_TRY(st);
