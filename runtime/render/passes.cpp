@@ -444,15 +444,9 @@ std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list
   const ShadowView& v = frame.shadow_views[view];
   auto outside_rect = [&](const DrawItem& d) {
     if (!rect || d.bounds.empty()) return false;
-    // The box's NDC bounds through the affine light matrix (Arvo's box transform).
-    const glm::vec3 centre = 0.5f * (d.bounds.min + d.bounds.max);
-    const glm::vec3 half = 0.5f * (d.bounds.max - d.bounds.min);
-    const glm::vec4 c = *light_vp * glm::vec4(centre, 1.0f);
-    glm::vec2 e(0.0f);
-    for (int col = 0; col < 3; ++col)
-      for (int row = 0; row < 2; ++row) e[row] += std::abs((*light_vp)[col][row]) * half[col];
-    const bool out = c.x + e.x < rect->x || c.x - e.x > rect->z || c.y + e.y < rect->y ||
-                     c.y - e.y > rect->w;
+    const Aabb ndc = d.bounds.transformed(*light_vp);  // the light matrix is affine (ortho)
+    const bool out = ndc.max.x < rect->x || ndc.min.x > rect->z || ndc.max.y < rect->y ||
+                     ndc.min.y > rect->w;
     if (out && rect_culled) ++*rect_culled;
     return out;
   };
