@@ -79,12 +79,12 @@ std::size_t triangles(const AssetStore& assets, MeshId id) {
   return assets.meshes[index(id)].indices.size() / 3;
 }
 
-// Every slice of a 2D array texture as one image, layer 0 first, rows top to bottom within each
-// (GL's bottom-to-top rows flipped), in the channels `format` reads (GL_DEPTH_COMPONENT, GL_RED,
-// GL_RG, GL_RGBA), named `names`: ShadowMapPass::read(), LomPass's and MomentsPass::read(). No
-// texture: an empty stack.
+// Slices 0, step, 2 step, ... (`slices` of them) of a 2D array texture as one image, the first
+// slice first, rows top to bottom within each (GL's bottom-to-top rows flipped), in the channels
+// `format` reads (GL_DEPTH_COMPONENT, GL_RED, GL_RG, GL_RGBA), named `names`:
+// ShadowMapPass::read(), LomPass's and MomentsPass::read(). No texture: an empty stack.
 Image read_slices(const gpu::Texture& t, GLenum format, std::vector<std::string> names, int size,
-                  int slices) {
+                  int slices, int step = 1) {
   Image img;
   img.width = size;
   img.height = size * slices;
@@ -95,8 +95,14 @@ Image read_slices(const gpu::Texture& t, GLenum format, std::vector<std::string>
   const std::size_t layer = row * std::size_t(size);
   std::vector<float> stack(layer * std::size_t(slices));
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(t.id(), 0, format, GL_FLOAT, GLsizei(stack.size() * sizeof(float)),
-                    stack.data());
+  if (step == 1) {
+    glGetTextureImage(t.id(), 0, format, GL_FLOAT, GLsizei(stack.size() * sizeof(float)),
+                      stack.data());
+  } else {
+    for (int l = 0; l < slices; ++l)
+      glGetTextureSubImage(t.id(), 0, 0, 0, l * step, size, size, 1, format, GL_FLOAT,
+                           GLsizei(layer * sizeof(float)), &stack[std::size_t(l) * layer]);
+  }
   img.pixels.resize(stack.size());
   for (int l = 0; l < slices; ++l)
     for (int y = 0; y < size; ++y)
@@ -837,24 +843,8 @@ Image LomPass::read_depths() const { return read_slices(depth_, GL_RED, {"Y"}, s
 Image LomPass::read_factors() const { return read_slices(occlusion_, GL_RED, {"Y"}, size_, slices_); }
 
 Image LomPass::read_first_factors() const {
-  Image img;
-  img.channels = 1;
-  img.channel_names = {"Y"};
-  if (!occlusion_ || peels_ <= 0) return img;
-  const int layers = slices_ / peels_;
-  img.width = size_;
-  img.height = size_ * layers;
-  img.pixels.resize(std::size_t(size_) * std::size_t(img.height));
-  std::vector<float> slice(std::size_t(size_) * std::size_t(size_));
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  for (int l = 0; l < layers; ++l) {
-    glGetTextureSubImage(occlusion_.id(), 0, 0, 0, l * peels_, size_, size_, 1, GL_RED, GL_FLOAT,
-                         GLsizei(slice.size() * sizeof(float)), slice.data());
-    for (int y = 0; y < size_; ++y)  // rows top to bottom, as read_slices()
-      std::memcpy(&img.pixels[(std::size_t(l) * std::size_t(size_) + std::size_t(y)) * std::size_t(size_)],
-                  &slice[std::size_t(size_ - 1 - y) * std::size_t(size_)], std::size_t(size_) * sizeof(float));
-  }
-  return img;
+  if (peels_ <= 0) return read_slices(occlusion_, GL_RED, {"Y"}, size_, 0);
+  return read_slices(occlusion_, GL_RED, {"Y"}, size_, slices_ / peels_, peels_);
 }
 
 // ---- MomentsPass ---------------------------------------------------------------------------------
