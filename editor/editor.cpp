@@ -213,8 +213,11 @@ Image aov_view(View view, const Image& aovs) {
   return out;
 }
 
-// A cube map's faces side by side (+X -X +Y -Y +Z -Z), linear colour encoded for display with a
-// 2.2 gamma (an approximation of sRGB is enough for a debug view).
+// Linear radiance clamped to [0, 1] and encoded for display with a 2.2 gamma (an approximation
+// of sRGB is enough for a debug view).
+float display_gamma(float linear) { return std::pow(std::clamp(linear, 0.0f, 1.0f), 1.0f / 2.2f); }
+
+// A cube map's faces side by side (+X -X +Y -Y +Z -Z), encoded by display_gamma().
 Image cube_strip(const CubeMap& cube) {
   Image out;
   out.width = cube.size * 6;
@@ -227,12 +230,12 @@ Image cube_strip(const CubeMap& cube) {
         const glm::vec4 c = cube.at(CubeFace(f), x, y);
         float* p = &out.pixels[(std::size_t(y) * std::size_t(out.width) +
                                 std::size_t(f * cube.size + x)) * 3];
-        for (int k = 0; k < 3; ++k) p[k] = std::pow(std::clamp(c[k], 0.0f, 1.0f), 1.0f / 2.2f);
+        for (int k = 0; k < 3; ++k) p[k] = display_gamma(c[k]);
       }
   return out;
 }
 
-// A sphere map (row 0 at the top) as an image, gamma-encoded like cube_strip().
+// A sphere map (row 0 at the top) as an image, encoded by display_gamma() like cube_strip().
 Image sphere_image(const SphereMap& map) {
   Image out;
   out.width = out.height = map.size;
@@ -240,7 +243,7 @@ Image sphere_image(const SphereMap& map) {
   out.pixels.resize(std::size_t(map.size) * std::size_t(map.size) * 3);
   for (std::size_t i = 0; i < map.texels.size(); ++i)
     for (int k = 0; k < 3; ++k)
-      out.pixels[3 * i + std::size_t(k)] = std::pow(std::clamp(map.texels[i][k], 0.0f, 1.0f), 1.0f / 2.2f);
+      out.pixels[3 * i + std::size_t(k)] = display_gamma(map.texels[i][k]);
   return out;
 }
 
