@@ -36,6 +36,7 @@
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
 #include "runtime/cli/player.h"
+#include "runtime/core/file_io.h"
 #include "runtime/core/json_reader.h"
 #include "runtime/gpu/context.h"
 #include "runtime/gpu/gl_handles.h"
@@ -684,9 +685,7 @@ Status Editor::redo() {
 }
 
 Status Editor::save(const fs::path& file) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  if (ext != ".json")
+  if (lowercase_extension(file) != ".json")
     return Error{file.string(), "", "scenes are saved as .json (a glTF file is never overwritten)"};
   KASKAD_TRY(save_scene(file, scene_));
   // Another path is a copy: the scene's own file is still the one with unsaved changes.

@@ -1,20 +1,15 @@
 #include "editor/file_dialog.h"
 
 #include <algorithm>
-#include <cctype>
 #include <system_error>
+
+#include "runtime/core/file_io.h"
 
 namespace fs = std::filesystem;
 
 namespace kaskad::editor {
 
 namespace {
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
-  return s;
-}
 
 // The length of the well-formed UTF-8 sequence at s[i] (RFC 3629: no overlongs, no surrogates,
 // at most U+10FFFF), or 0.
@@ -73,8 +68,6 @@ FolderListing list_folder(const fs::path& folder, const std::vector<std::string>
     listing.error = "cannot read " + display_name(folder.string()) + ": " + ec.message();
     return listing;
   }
-  std::vector<std::string> wanted;
-  for (const std::string& e : extensions) wanted.push_back(lower(e));
   for (; it != fs::directory_iterator(); it.increment(ec)) {
     const fs::path& p = it->path();
     const std::string name = p.filename().string();
@@ -85,7 +78,7 @@ FolderListing list_folder(const fs::path& folder, const std::vector<std::string>
     FolderEntry entry{p, display_name(name), fs::is_directory(st)};
     if (!entry.folder) {
       if (!fs::is_regular_file(st)) continue;
-      if (std::find(wanted.begin(), wanted.end(), lower(p.extension().string())) == wanted.end())
+      if (std::find(extensions.begin(), extensions.end(), lowercase_extension(p)) == extensions.end())
         continue;
     }
     listing.entries.push_back(std::move(entry));

@@ -20,8 +20,8 @@ struct FolderListing {
   std::string error;                 ///< why the folder could not be read (wholly or in part)
 };
 
-/// `folder`'s subfolders and its regular files whose extension is one of `extensions` (".json";
-/// compared without case). Hidden entries (a leading '.') and entries whose type cannot be read
+/// `folder`'s subfolders and its regular files whose extension, in lower case, is one of
+/// `extensions` (lower case, with the dot: ".json"). Hidden entries (a leading '.') and entries whose type cannot be read
 /// (broken links, no permission) are left out; an unreadable folder gives `error` and what was
 /// read before it. Never throws.
 FolderListing list_folder(const std::filesystem::path& folder,

@@ -315,8 +315,7 @@ Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadS
     std::size_t first = data.size() >= 3 && data[0] == 0xEF && data[1] == 0xBB && data[2] == 0xBF ? 3 : 0;
     while (first < data.size() && std::isspace(data[first])) ++first;
     if (first == data.size() || data[first] != '{') {
-      std::string ext = path.extension().string();
-      for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+      const std::string ext = lowercase_extension(path);
       return Error{file, "byte 0",
                    ext == ".glb" ? "not a binary glTF: it does not start with the magic 'glTF'"
                                  : "neither a binary glTF (magic 'glTF') nor glTF JSON (an object "

@@ -156,11 +156,10 @@ std::string format_from_mime(const std::string& mime) {
   return {};
 }
 
-std::string lowercase_extension(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  if (!ext.empty() && ext[0] == '.') ext.erase(0, 1);
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
+// The extension as a format name: lower case, without the dot ("png").
+std::string extension_format(const std::filesystem::path& path) {
+  const std::string ext = lowercase_extension(path);
+  return ext.empty() ? ext : ext.substr(1);
 }
 
 /// The still-image formats we let OIIO decode. Debian's OIIO also has readers for camera RAW,
@@ -212,7 +211,7 @@ std::string choose_format(const std::uint8_t* data, std::size_t size, const std:
                           const std::string& mime) {
   std::string format = format_from_magic(data, size);
   if (format.empty()) format = format_from_mime(mime);
-  if (format.empty()) format = lowercase_extension(name);
+  if (format.empty()) format = extension_format(name);
   const auto& known = known_formats();
   const auto it = known.find(format);
   return it == known.end() ? std::string() : it->second;
@@ -524,7 +523,7 @@ Status save_image(const std::filesystem::path& path, const Image& image) {
                    std::to_string(image.channel_names.size()));
 
   const std::string name = path.string();
-  const std::string ext = lowercase_extension(path);
+  const std::string ext = extension_format(path);
   // Declared before the writer, which may still use it while it is destroyed.
   std::vector<unsigned char> encoded;
   OIIO::Filesystem::IOVecOutput memory(encoded);

@@ -30,6 +30,7 @@
 #include "runtime/assets/primitives.h"
 #include "runtime/assets/reflector_io.h"
 #include "runtime/core/atomic_file.h"
+#include "runtime/core/file_io.h"
 #include "runtime/core/json_reader.h"
 #include "runtime/core/log.h"
 
@@ -540,8 +541,7 @@ bool entity_less(ecs::Entity a, ecs::Entity b) { return a.index < b.index; }
 }  // namespace
 
 Result<json> read_scene_document(const fs::path& file) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lowercase_extension(file);
   if (ext == ".gltf" || ext == ".glb") {
     // Inspect the file for its own lights and cameras; the real import happens in instantiate.
     Scene probe;

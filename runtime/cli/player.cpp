@@ -7,6 +7,7 @@
 
 #include "runtime/assets/scene_io.h"
 #include "components/light.h"
+#include "runtime/core/file_io.h"
 #include "runtime/core/log.h"
 #include "systems/camera_system.h"
 #include "systems/transform_system.h"
@@ -25,9 +26,7 @@ std::filesystem::path content_dir() {
 namespace {
 
 bool is_gltf(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
+  const std::string ext = lowercase_extension(file);
   return ext == ".gltf" || ext == ".glb";
 }
 

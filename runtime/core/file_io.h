@@ -1,6 +1,7 @@
 // Whole-file reads with messages for the common ways they fail.
 #pragma once
 
+#include <cctype>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,14 @@
 #include "runtime/core/result.h"
 
 namespace kaskad {
+
+/// A file's extension as path::extension() gives it (".glb": with the dot; empty without one),
+/// in ASCII lower case: how file types are told apart by name.
+inline std::string lowercase_extension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
 
 /// The bytes of a file. Errors name the file: missing, a directory, empty, larger than
 /// `max_bytes`, unreadable, or shorter than its size said.
