@@ -12,11 +12,11 @@
 #include "runtime/render/shader_interface.h"
 
 namespace kaskad::render {
-namespace {
 
-int mip_levels(int size) { return std::bit_width(unsigned(std::max(1, size))); }
+int cube_mip_levels(int size) { return std::bit_width(unsigned(std::max(1, size))); }
 
-void set_cube_sampling(GLuint t) {
+void set_cube_sampling(const gpu::Texture& cube) {
+  const GLuint t = cube.id();
   glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -24,15 +24,30 @@ void set_cube_sampling(GLuint t) {
   glTextureParameteri(t, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
 }
 
-Result<gpu::Program> fullscreen_program(const std::filesystem::path& dir, const char* fragment) {
-  auto vs = gpu::preprocess_shader(dir, "fullscreen.vert", {});
+CubeMap read_cube_level(const gpu::Texture& cube, int level) {
+  CubeMap out;
+  GLint n = 0;
+  glGetTextureLevelParameteriv(cube.id(), level, GL_TEXTURE_WIDTH, &n);
+  out.size = n;
+  const std::size_t face = std::size_t(n) * std::size_t(n);
+  std::vector<glm::vec4> all(face * 6);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(cube.id(), level, GL_RGBA, GL_FLOAT, GLsizei(all.size() * sizeof(glm::vec4)),
+                    all.data());
+  for (std::size_t f = 0; f < 6; ++f)
+    out.faces[f].assign(all.begin() + std::ptrdiff_t(f * face),
+                        all.begin() + std::ptrdiff_t((f + 1) * face));
+  return out;
+}
+
+Result<gpu::Program> fullscreen_program(const std::filesystem::path& shader_dir,
+                                        const char* fragment) {
+  auto vs = gpu::preprocess_shader(shader_dir, "fullscreen.vert", {});
   if (!vs) return vs.error();
-  auto fs = gpu::preprocess_shader(dir, fragment, {});
+  auto fs = gpu::preprocess_shader(shader_dir, fragment, {});
   if (!fs) return fs.error();
   return gpu::build_program(*vs, *fs);
 }
-
-}  // namespace
 
 Result<std::unique_ptr<IblMaps>> IblMaps::create(const std::filesystem::path& shader_dir) {
   std::unique_ptr<IblMaps> m(new IblMaps());
@@ -127,7 +142,7 @@ void IblMaps::prefilter_faces(const gpu::Texture& source, int size, gpu::Texture
   if (!target || have != size || levels_have != levels) {
     target = gpu::make_texture(GL_TEXTURE_CUBE_MAP);
     glTextureStorage2D(target.id(), levels, GL_RGBA16F, size, size);
-    set_cube_sampling(target.id());
+    set_cube_sampling(target);
   }
   first = std::clamp(first, 0, 6);
   count = std::clamp(count, 0, 6 - first);
@@ -155,7 +170,7 @@ void IblMaps::project_sh(const gpu::Texture& source, int size, int row) {
   // SH from a level of at most 16 x 16 texels a face (a box-filtered mip: SH are smooth).
   ensure_rows(row + 1);
   begin_fullscreen(source);
-  const int sh_level = std::max(0, mip_levels(size) - 5);
+  const int sh_level = std::max(0, cube_mip_levels(size) - 5);
   glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, sh_.id(), 0);
   glViewport(0, row, 9, 1);
   glUseProgram(sh_program_.id());
@@ -176,8 +191,8 @@ void IblMaps::set_environment(const CubeMap* cube, std::uint64_t key) {
   const int n = cube->size;
   // The map itself is needed only to prefilter it (level 0 of the result is a copy of it).
   const gpu::Texture source = gpu::make_texture(GL_TEXTURE_CUBE_MAP);
-  glTextureStorage2D(source.id(), mip_levels(n), GL_RGBA16F, n, n);
-  set_cube_sampling(source.id());
+  glTextureStorage2D(source.id(), cube_mip_levels(n), GL_RGBA16F, n, n);
+  set_cube_sampling(source);
   for (int f = 0; f < 6; ++f)
     glTextureSubImage3D(source.id(), 0, 0, 0, f, n, n, 1, GL_RGBA, GL_FLOAT,
                         cube->faces[std::size_t(f)].data());
@@ -204,19 +219,8 @@ std::vector<glm::vec3> IblMaps::read_sh_row(int row) const {
 }
 
 CubeMap IblMaps::read_environment_level(int level) const {
-  CubeMap out;
-  if (!environment_specular_ || level < 0 || level >= environment_levels_) return out;
-  GLint n = 0;
-  glGetTextureLevelParameteriv(environment_specular_.id(), level, GL_TEXTURE_WIDTH, &n);
-  out.size = n;
-  std::vector<glm::vec4> all(std::size_t(n) * std::size_t(n) * 6);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(environment_specular_.id(), level, GL_RGBA, GL_FLOAT,
-                    GLsizei(all.size() * sizeof(glm::vec4)), all.data());
-  const std::size_t face = std::size_t(n) * std::size_t(n);
-  for (std::size_t f = 0; f < 6; ++f)
-    out.faces[f].assign(all.begin() + std::ptrdiff_t(f * face), all.begin() + std::ptrdiff_t((f + 1) * face));
-  return out;
+  if (!environment_specular_ || level < 0 || level >= environment_levels_) return {};
+  return read_cube_level(environment_specular_, level);
 }
 
 }  // namespace kaskad::render

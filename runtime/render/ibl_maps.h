@@ -20,6 +20,17 @@ namespace kaskad::render {
 
 class GpuTimers;
 
+// Cube textures as IblMaps and ProbeMaps make and read them (RGBA16F, trilinear, clamped).
+/// Levels of a full mip chain for `size` texels a side.
+int cube_mip_levels(int size);
+/// Trilinear filtering and clamp to edge on every axis.
+void set_cube_sampling(const gpu::Texture& cube);
+/// Level `level` of a cube texture as floats (+X -X +Y -Y +Z -Z).
+CubeMap read_cube_level(const gpu::Texture& cube, int level);
+/// The program of a fullscreen pass: fullscreen.vert and `fragment` from `shader_dir`.
+Result<gpu::Program> fullscreen_program(const std::filesystem::path& shader_dir,
+                                        const char* fragment);
+
 class IblMaps {
  public:
   /// Builds both programs from `shader_dir` and uploads the split-sum table. Needs a current GL

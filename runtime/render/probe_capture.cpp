@@ -12,19 +12,13 @@
 namespace kaskad::render {
 namespace {
 
-int mip_levels(int size) { return 1 + int(std::floor(std::log2(double(std::max(1, size))))); }
-
 gpu::Texture make_cube(int size) {
   gpu::Texture t = gpu::make_texture(GL_TEXTURE_CUBE_MAP);
-  glTextureStorage2D(t.id(), mip_levels(size), GL_RGBA16F, size, size);
-  glTextureParameteri(t.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-  glTextureParameteri(t.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTextureParameteri(t.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(t.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(t.id(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  glTextureStorage2D(t.id(), cube_mip_levels(size), GL_RGBA16F, size, size);
+  set_cube_sampling(t);
   // A new map is black until its first capture or upload (never uninitialised memory).
   const float black[4] = {0, 0, 0, 1};
-  for (int level = 0; level < mip_levels(size); ++level)
+  for (int level = 0; level < cube_mip_levels(size); ++level)
     glClearTexImage(t.id(), level, GL_RGBA, GL_FLOAT, black);
   return t;
 }
@@ -33,11 +27,7 @@ gpu::Texture make_cube(int size) {
 
 Result<std::unique_ptr<ProbeMaps>> ProbeMaps::create(const std::filesystem::path& shader_dir) {
   std::unique_ptr<ProbeMaps> m(new ProbeMaps());
-  auto vs = gpu::preprocess_shader(shader_dir, "fullscreen.vert", {});
-  if (!vs) return vs.error();
-  auto fs = gpu::preprocess_shader(shader_dir, "probe_sphere.frag", {});
-  if (!fs) return fs.error();
-  auto prog = gpu::build_program(*vs, *fs);
+  auto prog = fullscreen_program(shader_dir, "probe_sphere.frag");
   if (!prog) return prog.error();
   m->sphere_program_ = std::move(prog.value());
   m->empty_vao_ = gpu::make_vertex_array();
@@ -210,16 +200,7 @@ CubeMap ProbeMaps::read_cube(ProbeHandle handle, int buffer) const {
   CubeMap out;
   auto it = probes_.find(handle);
   if (it == probes_.end() || !it->second.cubes[buffer & 1]) return out;
-  const int n = it->second.resolution;
-  out.size = n;
-  std::vector<glm::vec4> all(std::size_t(n) * n * 6);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(it->second.cubes[buffer & 1].id(), 0, GL_RGBA, GL_FLOAT,
-                    GLsizei(all.size() * sizeof(glm::vec4)), all.data());
-  for (std::size_t f = 0; f < 6; ++f)
-    out.faces[f].assign(all.begin() + std::ptrdiff_t(f * std::size_t(n) * n),
-                        all.begin() + std::ptrdiff_t((f + 1) * std::size_t(n) * n));
-  return out;
+  return read_cube_level(it->second.cubes[buffer & 1], 0);
 }
 
 SphereMap ProbeMaps::read_sphere(ProbeHandle handle) const {
