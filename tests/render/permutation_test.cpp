@@ -23,6 +23,28 @@ using render::VariantKey;
 
 class PermutationTest : public HeadlessGlTest {
  protected:
+  // A copy of content/shaders in the test tmp folder `name`: shaders a test edits and reloads.
+  static fs::path shader_copy(const std::string& name) {
+    const fs::path dir = fs::path(KASKAD_TEST_TMP) / name;
+    fs::remove_all(dir);
+    fs::copy(content_dir() / "shaders", dir, fs::copy_options::recursive);
+    return dir;
+  }
+  static std::string text_of(const fs::path& file) {
+    std::ifstream in(file);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  // Replaces the first `from` in `file` by `to` and moves its write time on by `seconds`
+  // (reload_changed() compares times); false, changing nothing, when `from` is not in it.
+  static bool replace_in(const fs::path& file, const std::string& from, const std::string& to,
+                         int seconds) {
+    std::string text = text_of(file);
+    if (text.find(from) == std::string::npos) return false;
+    text.replace(text.find(from), from.size(), to);
+    std::ofstream(file, std::ios::trunc) << text;
+    fs::last_write_time(file, fs::last_write_time(file) + std::chrono::seconds(seconds));
+    return true;
+  }
 
   static std::unique_ptr<render::Renderer> make_renderer(const fs::path& cache = {},
                                                          bool oracle = false,
@@ -223,20 +245,14 @@ TEST_F(PermutationTest, PrewarmLeavesNothingToCompileAndTheCacheIsHit) {
 }
 
 TEST_F(PermutationTest, HotReloadKeepsTheLastGoodProgramAndMapsErrors) {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "hot_shaders";
-  fs::remove_all(dir);
-  fs::copy(content_dir() / "shaders", dir, fs::copy_options::recursive);
+  const fs::path dir = shader_copy("hot_shaders");
   Scene s = scene("default.json");
   auto r = make_renderer({}, false, dir);
   const Image before = render(*r, s);
 
   // Break common.glsl (included by every program): each program reports the included file.
   const fs::path common = dir / "common.glsl";
-  std::string text;
-  {
-    std::ifstream in(common);
-    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
+  const std::string text = text_of(common);
   const int lines = int(std::count(text.begin(), text.end(), '\n'));
   std::ofstream(common, std::ios::app) << "this is not glsl;\n";
   fs::last_write_time(common, fs::last_write_time(common) + std::chrono::seconds(2));
@@ -250,18 +266,10 @@ TEST_F(PermutationTest, HotReloadKeepsTheLastGoodProgramAndMapsErrors) {
 
   // Fix it, with a visible change: everything gets brighter.
   std::ofstream(common, std::ios::trunc) << text;
-  std::ofstream(dir / "forward.frag", std::ios::app) << "\n";
-  {
-    std::ifstream in(dir / "forward.frag");
-    std::string f((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const std::string from = "o_color = vec4(tone_map(color * u_frame.x), coverage);";
-    ASSERT_NE(f.find(from), std::string::npos);
-    f.replace(f.find(from), from.size(),
-              "o_color = vec4(tone_map(color * u_frame.x) + 0.2, coverage);");
-    std::ofstream(dir / "forward.frag", std::ios::trunc) << f;
-  }
-  for (const char* name : {"common.glsl", "forward.frag"})
-    fs::last_write_time(dir / name, fs::last_write_time(dir / name) + std::chrono::seconds(4));
+  fs::last_write_time(common, fs::last_write_time(common) + std::chrono::seconds(4));
+  ASSERT_TRUE(replace_in(dir / "forward.frag",
+                         "o_color = vec4(tone_map(color * u_frame.x), coverage);",
+                         "o_color = vec4(tone_map(color * u_frame.x) + 0.2, coverage);", 4));
   EXPECT_TRUE(r->shaders().reload_changed().empty());
   EXPECT_EQ(r->stats().shaders.runtime_compiles, 0);  // reloads are not runtime compiles
   const Image after = render(*r, s);
@@ -275,9 +283,7 @@ TEST_F(PermutationTest, HotReloadKeepsTheLastGoodProgramAndMapsErrors) {
 // layers and the stored visibility (render.visibility_cache), which would otherwise be kept
 // because nothing in the scene moved. Fails when the reload count is left out of either's inputs.
 TEST_F(PermutationTest, HotReloadOfTheShadowCodeShowsUnderAStillCamera) {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "hot_shadow_shaders";
-  fs::remove_all(dir);
-  fs::copy(content_dir() / "shaders", dir, fs::copy_options::recursive);
+  const fs::path dir = shader_copy("hot_shadow_shaders");
   Scene s = scene("default.json");
   auto r = make_renderer({}, false, dir);
   render(*r, s);
@@ -285,17 +291,7 @@ TEST_F(PermutationTest, HotReloadOfTheShadowCodeShowsUnderAStillCamera) {
   EXPECT_TRUE(r->stats().visibility_reused);  // still: read back, every layer kept
   EXPECT_EQ(r->stats().shadow_layers_rendered, 0u);
   // Edit the lookup: no shadows at all.
-  const fs::path shadow = dir / "shadow.glsl";
-  std::string text;
-  {
-    std::ifstream in(shadow);
-    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  const std::string from = "  return sum / 9.0;";
-  ASSERT_NE(text.find(from), std::string::npos);
-  text.replace(text.find(from), from.size(), "  return 1.0;");
-  std::ofstream(shadow, std::ios::trunc) << text;
-  fs::last_write_time(shadow, fs::last_write_time(shadow) + std::chrono::seconds(4));
+  ASSERT_TRUE(replace_in(dir / "shadow.glsl", "  return sum / 9.0;", "  return 1.0;", 4));
   EXPECT_TRUE(r->shaders().reload_changed().empty());
   const Image after = render(*r, s);
   EXPECT_FALSE(r->stats().visibility_reused);
