@@ -21,6 +21,7 @@
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/gpu/shader.h"
 #include "tests/render/headless_gl.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -88,7 +89,7 @@ class BrdfTest : public HeadlessGlTest {};
 
 TEST_F(BrdfTest, GlslMatchesTheCpuEvaluationOfAppendixB) {
   const fs::path shaders = fs::path(KASKAD_CONTENT_DIR) / "shaders";
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "brdf_test";
+  const fs::path dir = testing_util::test_tmp();
   fs::create_directories(dir);
   for (const char* f : {"brdf.glsl", "fullscreen.vert"})
     fs::copy_file(shaders / f, dir / f, fs::copy_options::overwrite_existing);

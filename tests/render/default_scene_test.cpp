@@ -17,6 +17,7 @@
 #include "tests/render/player_fixture.h"
 #include "runtime/gpu/context.h"
 #include "systems/shadow_map_system.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -396,7 +397,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 // Scenes written on the fly: no geometry at all, and geometry that casts nothing.
 TEST_F(DefaultSceneTest, EmptySceneAndSceneWithoutCastersRender) {
-  const std::filesystem::path dir = std::filesystem::path(KASKAD_TEST_TMP) / "cascade_scenes";
+  const std::filesystem::path dir = testing_util::test_tmp();
   std::filesystem::create_directories(dir);
   const std::string light_and_camera = R"(
     { "name": "sun", "transform": { "direction": [0.5, -0.6, -0.45] },

@@ -11,6 +11,7 @@
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/gpu/shader.h"
 #include "tests/render/headless_gl.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -49,7 +50,7 @@ TEST_F(GlTest, HandlesFreeTheirObjects) {
 }
 
 TEST_F(GlTest, ShaderErrorsNameTheOriginalFileAndLine) {
-  const auto dir = std::filesystem::path(KASKAD_TEST_TMP) / "shaders";
+  const auto dir = testing_util::test_tmp();
   std::filesystem::create_directories(dir);
   {
     std::ofstream(dir / "inc.glsl") << "// line 1\nfloat helper() { return undefined_name; }\n";

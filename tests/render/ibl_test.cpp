@@ -20,6 +20,7 @@
 #include "runtime/cli/player.h"
 #include "systems/frame.h"
 #include "tests/render/player_fixture.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -183,7 +184,7 @@ TEST_F(IblTest, GpuPrefilteringAndShMatchTheCpuTwins) {
 // side... the probe sees red ahead of the camera's mirror direction.
 fs::path reflector_scene(const std::string& name, const std::string& model, float roughness,
                          const std::string& update = R"("update": "first_frame")") {
-  const fs::path file = fs::path(KASKAD_TEST_TMP) / "ibl" / (name + ".json");
+  const fs::path file = testing_util::test_tmp("ibl") / (name + ".json");
   std::ofstream(file) << R"({ "kaskad_scene": 1,
     "render": { "ground": "none", "clear_color": [0.1, 0.1, 0.1], "ambient": [0.02, 0.02, 0.02] },
     "entities": [

@@ -14,6 +14,7 @@
 
 #include "runtime/cli/player.h"
 #include "tests/render/player_fixture.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -75,7 +76,7 @@ TEST_F(NormalsTest, MirroredTransformRendersLikeTheUnmirroredOne) {
 TEST_F(NormalsTest, DoubleSidedCardIsLitOnBothSides) {
   // The lamp and the camera on side `z` of the card (which faces +z).
   auto card_seen_from = [](float z) {
-    const std::filesystem::path file = std::filesystem::path(KASKAD_TEST_TMP) /
+    const std::filesystem::path file = testing_util::test_tmp() /
                                        (z > 0 ? "card_front.json" : "card_back.json");
     std::ofstream out(file);
     out << R"({ "kaskad_scene": 1,

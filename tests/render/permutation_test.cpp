@@ -13,6 +13,7 @@
 #include "runtime/gpu/context.h"
 #include "systems/frame.h"
 #include "tests/render/headless_gl.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -25,7 +26,7 @@ class PermutationTest : public HeadlessGlTest {
  protected:
   // A copy of content/shaders in the test tmp folder `name`: shaders a test edits and reloads.
   static fs::path shader_copy(const std::string& name) {
-    const fs::path dir = fs::path(KASKAD_TEST_TMP) / name;
+    const fs::path dir = testing_util::test_tmp() / name;
     fs::remove_all(dir);
     fs::copy(content_dir() / "shaders", dir, fs::copy_options::recursive);
     return dir;
@@ -167,7 +168,7 @@ TEST_F(PermutationTest, EveryVariantMatchesTheUberShaderOracle) {
 // transforms, also on an alpha-masked caster) render the same through their variants as through
 // the oracle.
 TEST_F(PermutationTest, NewMaterialInputsMatchTheUberShaderOracle) {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "permutation_inputs";
+  const fs::path dir = testing_util::test_tmp();
   fs::create_directories(dir);
   const std::string textures = (content_dir() / "materials" / "textures").string() + "/";
   std::ofstream(dir / "orm.json") << R"({ "features": ["base_color_texture", "occlusion_texture",
@@ -217,7 +218,7 @@ TEST_F(PermutationTest, NewMaterialInputsMatchTheUberShaderOracle) {
 }
 
 TEST_F(PermutationTest, PrewarmLeavesNothingToCompileAndTheCacheIsHit) {
-  const fs::path cache = fs::path(KASKAD_TEST_TMP) / "perm_cache";
+  const fs::path cache = testing_util::test_tmp() / "perm_cache";
   fs::remove_all(cache);
   Scene s = scene("materials.json");
   auto cold = make_renderer(cache);

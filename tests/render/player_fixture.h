@@ -17,6 +17,7 @@
 #include "components/limits.h"
 #include "runtime/cli/player.h"
 #include "runtime/gpu/context.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 
@@ -49,11 +50,9 @@ class PlayerTest : public ::testing::Test {
 
   static inline Player* player_ = nullptr;  ///< the suite's player (suites run one at a time)
 
-  /// A folder of the test tmp tree for a test's files, created.
+  /// Folder `name` of the running test's scratch folder (tests/test_tmp.h), created.
   static std::filesystem::path test_dir(const std::string& name) {
-    const std::filesystem::path d = std::filesystem::path(KASKAD_TEST_TMP) / name;
-    std::filesystem::create_directories(d);
-    return d;
+    return testing_util::test_tmp(name);
   }
 
   /// One frame of the scene file `file` (with `sets` overrides) at width x height: its colour

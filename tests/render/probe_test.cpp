@@ -19,6 +19,7 @@
 #include "runtime/cli/player.h"
 #include "tests/render/player_fixture.h"
 #include "runtime/gpu/context.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -26,7 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path temp_dir() {
-  const fs::path d = fs::path(KASKAD_TEST_TMP) / "probes";
+  const fs::path d = testing_util::test_tmp();
   fs::create_directories(d);
   return d;
 }

@@ -19,6 +19,7 @@
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
 #include "tests/render/player_fixture.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -116,7 +117,7 @@ class AspectTest : public PlayerTest {};
 // A camera with aspect 1 rendered at 16:9: the output is fitted to 180x180 and a sphere in the
 // middle of the view stays round (its mask is as wide as it is tall), never stretched 1.78x.
 TEST_F(AspectTest, ACameraWithItsOwnAspectIsFittedNotStretched) {
-  const std::filesystem::path dir = std::filesystem::path(KASKAD_TEST_TMP) / "aspect";
+  const std::filesystem::path dir = testing_util::test_tmp();
   std::filesystem::create_directories(dir);
   const std::filesystem::path file = dir / "square_camera.json";
   std::FILE* f = std::fopen(file.c_str(), "wb");

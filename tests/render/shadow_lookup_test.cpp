@@ -27,6 +27,7 @@
 #include "runtime/render/feature_manifest.h"
 #include "tests/render/headless_gl.h"
 #include "tests/render/player_fixture.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -95,7 +96,7 @@ std::vector<float> draw_lookup(const std::string& dir_name, const std::string& f
                                const std::vector<std::pair<const char*, int>>& features,
                                GLenum format) {
   const fs::path shaders = fs::path(KASKAD_CONTENT_DIR) / "shaders";
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / dir_name;
+  const fs::path dir = testing_util::test_tmp(dir_name);
   fs::create_directories(dir);
   for (const char* f : {"common.glsl", "features.glsl", "shadow.glsl", "fullscreen.vert"})
     fs::copy_file(shaders / f, dir / f, fs::copy_options::overwrite_existing);

@@ -3,7 +3,6 @@
 // similar triangles give; the visibility AOV of the default scene with a 5-degree sun against the
 // ray-traced area-light reference (RMSE); world-space flicker of every new lookup under camera
 // translation with stable cascades.
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -22,6 +21,7 @@
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
 #include "tests/render/player_fixture.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -32,17 +32,11 @@ namespace fs = std::filesystem;
 // angular size theta (degrees). Its edge x = 2 casts a straight penumbra along z on the ground.
 constexpr float kSlabBottom = 1.0f, kSlabTop = 1.05f, kEdge = 2.0f;
 
-// A scene file of this test named `stem` and the process: CTest runs the tests that write
-// them in parallel processes.
-fs::path scene_file(const std::string& stem) {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "soft_shadow";
-  fs::create_directories(dir);
-  return dir / (stem + "_" + std::to_string(::getpid()) + ".json");
-}
+// A scene file named `stem` in the running test's scratch folder.
+fs::path scene_file(const std::string& stem) { return testing_util::test_tmp() / (stem + ".json"); }
 
 // The slab scene under a sun of angular size theta_deg, with `extra` entities (JSON, each
-// followed by a comma) and the shadow technique `technique`; named `name`, the process and the
-// angle, since CTest runs the tests that write it in parallel processes.
+// followed by a comma) and the shadow technique `technique`; named `name` and the angle.
 fs::path write_scene(const std::string& name, float theta_deg, const std::string& technique,
                      const std::string& extra) {
   const fs::path file = scene_file(name + "_" + std::to_string(int(theta_deg * 100.0f)));

@@ -14,6 +14,7 @@
 #include "components/tone_mapping.h"
 #include "runtime/cli/player.h"
 #include "tests/render/player_fixture.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -23,7 +24,7 @@ class ToneMappingTest : public PlayerTest {
   // An emissive card of radiance `e` filling the middle of the view, black clear colour
   // `clear` around it, no lights, no ambient.
   static std::filesystem::path card(glm::vec3 e, glm::vec3 clear) {
-    const std::filesystem::path file = std::filesystem::path(KASKAD_TEST_TMP) / "tone_card.json";
+    const std::filesystem::path file = testing_util::test_tmp() / "tone_card.json";
     std::ofstream out(file);
     out << R"({ "kaskad_scene": 1,
       "render": { "ambient": [0, 0, 0], "ground": "none", "clear_color": [)"

@@ -1,13 +1,13 @@
-// Helpers shared by the asset tests: content paths, byte files, a per-process temp directory.
+// Helpers shared by the asset tests: content paths, byte files, the running test's scratch folder.
 #pragma once
-
-#include <unistd.h>
 
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
+
+#include "tests/test_tmp.h"
 
 #ifndef KASKAD_CONTENT_DIR
 #error "KASKAD_CONTENT_DIR must be defined (a string: the path of the repository's content/)"
@@ -38,28 +38,7 @@ inline void write_text(const std::filesystem::path& path, const std::string& tex
   write_bytes(path, text.data(), text.size());
 }
 
-/// A directory for this test process's files, unique per process so that tests run in parallel
-/// do not collide; created on first use, removed when the process exits. It lies under
-/// KASKAD_TEST_TMP when the build defines it (the build tree), else under the system temp dir.
-inline std::filesystem::path temp_dir() {
-  struct Dir {
-    std::filesystem::path path;
-    Dir()
-#ifdef KASKAD_TEST_TMP
-        : path(std::filesystem::path(KASKAD_TEST_TMP) /
-#else
-        : path(std::filesystem::temp_directory_path() /
-#endif
-               ("kaskad_asset_tests_" + std::to_string(::getpid()))) {
-      std::filesystem::create_directories(path);
-    }
-    ~Dir() {
-      std::error_code ec;
-      std::filesystem::remove_all(path, ec);
-    }
-  };
-  static const Dir dir;
-  return dir.path;
-}
+/// The running test's scratch folder (tests/test_tmp.h).
+inline std::filesystem::path temp_dir() { return testing_util::test_tmp(); }
 
 }  // namespace kaskad::test

@@ -19,6 +19,7 @@
 #include "runtime/assets/scene_io.h"
 #include "runtime/assets/material_file.h"
 #include "runtime/core/json_reader.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
@@ -27,7 +28,7 @@ namespace fs = std::filesystem;
 const fs::path kContent = KASKAD_CONTENT_DIR;
 
 fs::path temp_dir() {
-  const fs::path d = fs::path(KASKAD_TEST_TMP) / "scene_io";
+  const fs::path d = testing_util::test_tmp();
   fs::create_directories(d);
   return d;
 }

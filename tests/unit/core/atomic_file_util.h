@@ -11,6 +11,7 @@
 #include <string>
 
 #include "runtime/core/result.h"
+#include "tests/test_tmp.h"
 
 #ifndef KASKAD_TEST_TMP
 #error "KASKAD_TEST_TMP must be defined (a string: the tests' scratch folder)"
@@ -21,7 +22,7 @@ namespace kaskad::test {
 namespace fs = std::filesystem;
 
 inline fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "atomic_file" / name;
+  const fs::path dir = testing_util::test_tmp() / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <string>
 
+#include "tests/test_tmp.h"
+
 namespace kaskad {
 namespace {
 
@@ -34,7 +36,7 @@ TEST(JsonReader, SyntaxErrorsAndBadBytesAreShownPrintably) {
 }
 
 TEST(JsonReader, FoldersMissingAndEmptyFiles) {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "json_reader";
+  const fs::path dir = testing_util::test_tmp("json_reader");
   fs::remove_all(dir);
   fs::create_directories(dir / "folder.json");
   std::ofstream(dir / "empty.json").close();

@@ -7,13 +7,15 @@
 
 #include <fstream>
 
+#include "tests/test_tmp.h"
+
 using namespace kaskad::editor;
 namespace fs = std::filesystem;
 
 namespace {
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::path(KASKAD_TEST_TMP) / "file_dialog" / name;
+  const fs::path d = kaskad::testing_util::test_tmp() / name;
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

@@ -15,6 +15,7 @@
 #include "runtime/render/frame_uniforms.h"
 #include "runtime/render/renderer.h"
 #include "runtime/render/variant_key.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad::render {
 namespace {
@@ -29,7 +30,7 @@ FeatureManifest manifest() {
 }
 
 fs::path temp(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::path(KASKAD_TEST_TMP) / "variants";
+  const fs::path dir = testing_util::test_tmp();
   fs::create_directories(dir);
   std::ofstream(dir / name, std::ios::binary) << text;
   return dir / name;
