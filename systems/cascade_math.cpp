@@ -332,7 +332,8 @@ NearFar tighten_near_far(const glm::mat4& light_view, std::span<const Aabb> cast
 //              snap never uncovers the sphere and texels stay exactly u wide).
 //  3. Depths: the slice's own range (crop: the corners; stable: c.z -+ r), combined with the
 //     geometry inside the rectangle (S0 step 3 pull-back to casters, S2 ComputeNearAndFar or per
-//     object bounds) as DepthFit says, plus a small margin against rounding at the planes.
+//     object bounds) as DepthFit says, plus a small margin against rounding at the planes;
+//     stable: then snapped outwards to whole steps of r / 2.
 //  4. The projection: crop  M_proj = M_crop * M_Lprj (S0 step 5, T = -(max + min) / 2,
 //     S = 2 / (max - min)); stable  ortho(min, max, near, far).
 CascadeFit fit_cascade(const CameraSlice& slice, const LightFrame& light,
@@ -364,6 +365,7 @@ CascadeFit fit_cascade(const CameraSlice& slice, const LightFrame& light,
   // 2. Rectangle and the slice's depth range.
   Rect rect{};
   double slice_near = 0.0, slice_far = 0.0;
+  double depth_step = 0.0;  // stable only
   dvec2 lprj_min(0.0), lprj_max(0.0), crop_min(0.0), crop_max(0.0);  // crop only
   if (crop) {
     slice_near = -hi.z;
@@ -414,6 +416,7 @@ CascadeFit fit_cascade(const CameraSlice& slice, const LightFrame& light,
     rect = {smin.x, smax.x, smin.y, smax.y};
     slice_near = -c.z - r;
     slice_far = -c.z + r;
+    depth_step = 0.5 * r;
     out.world_units_per_texel = static_cast<float>(u);
   }
 
@@ -442,6 +445,15 @@ CascadeFit fit_cascade(const CameraSlice& slice, const LightFrame& light,
   const double pad = 1e-4 * (far - near) + scale_eps(near, far);
   near -= pad;
   far += pad;
+  // Stable: the depth range is snapped outwards to whole steps of r / 2 (its span at most 3r
+  // where it would be 2r), as the rectangle is to whole texels. A camera moving through the
+  // scene then changes the cascade's matrix by whole texels of translation only, most frames,
+  // and the renderer scrolls the layer instead of redrawing it (ShadowMapPass): the depth it
+  // kept is the depth it would draw. A 24-bit map over the wider range still resolves microns.
+  if (!crop && depth_step > 0.0) {
+    near = std::floor(near / depth_step) * depth_step;
+    far = std::ceil(far / depth_step) * depth_step;
+  }
 
   // 4. Projection.
   dmat4 proj;

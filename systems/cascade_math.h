@@ -178,7 +178,9 @@ struct CascadeFit {
 /// Fits the light camera of one cascade (procedure in cascade_math.cpp, steps cite S0/S2).
 /// crop: S0 steps 2-5. stable: S2's bounding sphere of side 2r, origin snapped to whole texels;
 /// texels are u = 2r / (map_size - 1) wide so the map (map_size * u = 2r + u) is one texel larger
-/// than the fitted area, as S2 requires. Preconditions (KASKAD_CHECK): validate_camera_slice()
+/// than the fitted area, as S2 requires; its depth range snapped outwards to whole steps of r / 2,
+/// so a small camera move changes only the x/y translation, by whole texels (the renderer then
+/// scrolls the layer instead of redrawing it). Preconditions (KASKAD_CHECK): validate_camera_slice()
 /// and validate_light_frame() pass, map_size >= 2, beam_radius finite and >= 0.
 CascadeFit fit_cascade(const CameraSlice& slice, const LightFrame& light,
                        const CascadeFitOptions& options, const ShadowGeometry& geometry = {});

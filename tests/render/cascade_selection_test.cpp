@@ -42,7 +42,7 @@ TEST_F(CascadeSelectionTest, ShaderPicksTheCascadeTheCpuHelpersPick) {
     const glm::mat4 view = t->last.camera.view;
     const glm::mat4 world = glm::inverse(view);
 
-    // Points in view space: depth from 5 m behind the camera to 10% past the last split, spread
+    // Points in view space: depth from 5 m behind the camera to 40% past the last split, spread
     // sideways a little wider than the view.
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
@@ -53,7 +53,7 @@ TEST_F(CascadeSelectionTest, ShaderPicksTheCascadeTheCpuHelpersPick) {
     ASSERT_GT(band, 0.0f);
     std::array<int, 5> per_cascade{};  // -1 .. 3
     while (points.size() < 6000) {
-      const float depth = -5.0f + unit(rng) * (1.1f * D[std::size_t(n)] + 5.0f);
+      const float depth = -5.0f + unit(rng) * (1.4f * D[std::size_t(n)] + 5.0f);
       const float spread = 0.6f * (std::abs(depth) + 1.0f);
       const glm::vec3 pv((2.0f * unit(rng) - 1.0f) * spread * 1.8f,
                          (2.0f * unit(rng) - 1.0f) * spread, -depth);

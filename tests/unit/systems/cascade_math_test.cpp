@@ -531,6 +531,50 @@ TEST(CascadeStable, SubTexelCameraMotionMovesTheMapInWholeTexels) {
   }
 }
 
+// The depth range is snapped to whole steps of r / 2 and holds the slice's sphere: a camera moving
+// a little at a time keeps it (to the bit) on most fits, and then the matrix differs from the
+// fit before only by a whole-texel x/y translation, which is what lets the renderer scroll a
+// layer (ShadowMapPass). Fails if the range follows the camera continuously.
+TEST(CascadeStable, SmallCameraMovesKeepTheDepthRangeAndMoveByWholeTexels) {
+  Rng rng;
+  CameraSetup cam;
+  const glm::quat rot = rng.rotation();
+  const LightFrame light{glm::normalize(glm::vec3(-0.4f, -0.8f, 0.45f)), {0, 0, 0}};
+  CascadeFitOptions o;
+  o.mode = FitMode::stable;
+  o.map_size = 1024;
+  const glm::vec3 step = rng.unit() * 0.01f;  // 1 cm a fit, in a random direction
+  CascadeFit before;
+  int kept = 0, moves = 0;
+  for (int i = 0; i <= 300; ++i) {
+    cam.world = pose(glm::vec3(4.0f, 3.0f, -2.0f) + float(i) * step, rot);
+    const CameraSlice slice = cam.slice(2.0f, 20.0f);
+    const CascadeFit fit = fit_cascade(slice, light, o);
+    // The range holds the slice's corners (depth along the light).
+    for (const glm::vec3& c : slice_corners_world(slice)) {
+      const float z = -(fit.view * glm::vec4(c, 1.0f)).z;
+      EXPECT_LE(fit.near, z + 1e-4f) << i;
+      EXPECT_GE(fit.far, z - 1e-4f) << i;
+    }
+    if (i > 0) {
+      ++moves;
+      if (fit.near == before.near && fit.far == before.far) {
+        ++kept;
+        const glm::mat4 a = before.view_proj(), b = fit.view_proj();
+        for (int col = 0; col < 3; ++col)
+          for (int row = 0; row < 4; ++row) EXPECT_EQ(a[col][row], b[col][row]) << i;
+        EXPECT_EQ(a[3][2], b[3][2]) << i;
+        for (int axis = 0; axis < 2; ++axis) {
+          const float texels = (b[3][axis] - a[3][axis]) * 0.5f * float(o.map_size);
+          EXPECT_NEAR(texels, std::round(texels), 1e-2f) << i << " axis " << axis;
+        }
+      }
+    }
+    before = fit;
+  }
+  EXPECT_GT(kept, moves * 9 / 10);
+}
+
 TEST(CascadeStable, RotatingTheCameraKeepsTheSize) {
   Rng rng;
   CameraSetup cam;
