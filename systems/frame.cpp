@@ -92,6 +92,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.write_aovs = ctx.write_aovs;
   in.msaa = scene.render.msaa;
   in.shadow_cache = scene.render.shadow_cache;
+  in.shadow_scroll = scene.render.shadow_scroll;
   in.visibility_cache = scene.render.visibility_cache;
   if (!shadows.empty()) {
     const ShadowSettings& s = shadows.front().settings;  // shared by every view (ShadowData)

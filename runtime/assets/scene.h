@@ -59,6 +59,9 @@ struct RenderSettings {
   /// Shadow caching: a shadow-map layer whose inputs are those it was last drawn from keeps its
   /// depth. Off, every layer is drawn every frame (for measurements and comparisons).
   bool shadow_cache = true;
+  /// Shadow scrolling: with shadow_cache, a stable cascade that moved by whole texels keeps the
+  /// depth it holds and draws only the texels that came into view. Off, it is redrawn whole.
+  bool shadow_scroll = true;
   /// Visibility caching: a frame that sees what the frame before saw (camera, draws, lights,
   /// shadow maps) reads each pixel's shadow visibility back instead of looking the maps up.
   /// Images are identical either way; off, every frame looks up (for measurements).

@@ -269,6 +269,7 @@ void read_render(ObjectReader& r, RenderSettings& s) {
   r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
   r.enumeration("ground", s.ground, kGroundModes);
   r.boolean("shadow_cache", s.shadow_cache);
+  r.boolean("shadow_scroll", s.shadow_scroll);
   r.boolean("visibility_cache", s.visibility_cache);
   r.integer("probe_bounces", s.probe_bounces, kMinProbeBounces, kMaxProbeBounces);
   r.finish();
@@ -1193,6 +1194,7 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
                    {"aov_shadow_light", r.aov_shadow_light},
                    {"ground", enum_name(r.ground, kGroundModes)},
                    {"shadow_cache", r.shadow_cache},
+                   {"shadow_scroll", r.shadow_scroll},
                    {"visibility_cache", r.visibility_cache},
                    {"probe_bounces", r.probe_bounces}};
   doc["shadow"] = write_shadow(scene.shadow_defaults, nullptr);

@@ -454,6 +454,12 @@ int run_render(Args a) {
     }
     std::printf("%s\n", drawn < st.shadow_layers ? "; the others kept their depth (same matrix "
                                                     "and casters)" : "");
+    if (st.shadow_layers_scrolled != 0)
+      std::printf("          shadow layers scrolled: %d (moved by whole texels, they kept their "
+                  "depth and drew only what came into view; render.shadow_scroll)\n",
+                  std::popcount(st.shadow_layers_scrolled));
+    if (st.shadow_texels_drawn > 0)
+      std::printf("          shadow texels drawn: %.2f M\n", double(st.shadow_texels_drawn) * 1e-6);
     if (st.shadow_rect_culled > 0)
       std::printf("          %d caster instances left out of layers drawn in part: their boxes "
                   "miss the texels drawn (shadow.scissor_to_receivers)\n",

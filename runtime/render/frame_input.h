@@ -208,6 +208,8 @@ struct FrameInput {
   int msaa = 1;
   /// Keep shadow-map layers whose inputs did not change (ShadowMapPass); off: draw all.
   bool shadow_cache = true;
+  /// render.shadow_scroll: with shadow_cache, scroll a moved stable cascade (ShadowMapPass).
+  bool shadow_scroll = true;
   /// render.visibility_cache: the main view keeps each pixel's shadow visibility, and a frame
   /// whose visibility inputs equal the frame before's reads it back instead of looking the
   /// shadow maps up (Renderer::render()). Not with AOVs, MSAA or the cascade tint.

@@ -211,6 +211,10 @@ void ShadowMapPass::ensure_storage(int size, int layers, DepthFormat format, Sha
     glTextureParameteri(map_.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
     drawn_from_.assign(std::size_t(layers), 0);  // new storage: nothing to keep
     drawn_rect_.assign(std::size_t(layers), glm::ivec4(0));
+    origin_.assign(std::size_t(layers), glm::ivec2(0));
+    drawn_matrix_.assign(std::size_t(layers), glm::mat4(0.0f));
+    drawn_fixed_.assign(std::size_t(layers), 0);
+    wrapped_ = false;
     fbo_ = gpu::make_framebuffer();
     glNamedFramebufferTextureLayer(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0, 0);
     glNamedFramebufferDrawBuffer(fbo_.id(), GL_NONE);
@@ -279,6 +283,77 @@ bool holds(const glm::ivec4& outer, const glm::ivec4& inner) {
                                outer.w >= inner.w);
 }
 
+// `r` moved by `shift` texels and cut to a layer of `size`^2.
+glm::ivec4 shifted(const glm::ivec4& r, glm::ivec2 shift, int size) {
+  if (empty_rect(r)) return glm::ivec4(0);
+  const glm::ivec4 moved = glm::clamp(r + glm::ivec4(shift, shift), glm::ivec4(0), glm::ivec4(size));
+  return empty_rect(moved) ? glm::ivec4(0) : moved;
+}
+
+// The texels of `r` outside `kept`: up to four rectangles (below, above, left and right of it).
+std::vector<glm::ivec4> outside(const glm::ivec4& r, const glm::ivec4& kept) {
+  if (empty_rect(r)) return {};
+  const glm::ivec4 k(std::max(r.x, kept.x), std::max(r.y, kept.y), std::min(r.z, kept.z),
+                     std::min(r.w, kept.w));
+  if (empty_rect(kept) || empty_rect(k)) return {r};
+  std::vector<glm::ivec4> out;
+  if (r.y < k.y) out.push_back({r.x, r.y, r.z, k.y});
+  if (k.w < r.w) out.push_back({r.x, k.w, r.z, r.w});
+  if (r.x < k.x) out.push_back({r.x, k.y, k.x, k.w});
+  if (k.z < r.z) out.push_back({k.z, k.y, r.z, k.w});
+  return out;
+}
+
+// Whether ortho matrix `now` is `before` moved by whole texels of a layer of `size`^2 (every
+// entry the same but the x and y translation), and by how many: a fixed point's map texel moves
+// by `shift`.
+bool moved_by_texels(const glm::mat4& before, const glm::mat4& now, int size, glm::ivec2& shift) {
+  for (int col = 0; col < 4; ++col)
+    for (int row = 0; row < 4; ++row)
+      if ((col != 3 || row > 1) && before[col][row] != now[col][row]) return false;
+  for (int a = 0; a < 2; ++a) {
+    const double texels = (double(now[3][a]) - double(before[3][a])) * 0.5 * size;
+    const double whole = std::round(texels);
+    if (!(std::abs(texels - whole) < 1e-3 && std::abs(whole) < size)) return false;
+    shift[a] = int(whole);
+  }
+  return true;
+}
+
+// Whether this frame's lookups can read a scrolled layer: through its matrix with the origin
+// added (FrameBlock), at coordinates that may wrap. The plain lookups (pcf, filter none,
+// bilinear, 3x3) select cascades by depth and read only around the point; cascades selected by
+// map bounds, the wide kernels, PCSS, LOM and the moments read or derive from the maps in ways
+// that do not wrap.
+bool lookups_can_wrap(const VariantKey& frame_key) {
+  const bool wide = frame_key.get(VariantKey::kShadowFilter) == 2 &&
+                    frame_key.get(VariantKey::kShadowKernel) != 0;
+  return frame_key.get(VariantKey::kCascadeSelection) == 0 &&
+         frame_key.get(VariantKey::kShadowTechnique) == 0 && !wide;
+}
+
+// The texture rectangles of map rectangle `r` in a layer whose texture holds map texel x at
+// (x + origin) mod size (origin in [0, size)): up to two pieces per axis, each within one wrap.
+template <typename Piece>
+void add_pieces(const glm::ivec4& r, glm::ivec2 origin, int size, std::vector<Piece>& out) {
+  if (empty_rect(r)) return;
+  // Per axis: [lo, hi) of the unwrapped texture in [0, 2 size), cut at size.
+  auto parts = [size](int lo, int hi, int o) {
+    std::array<glm::ivec3, 2> p{};  // texture x0, x1, viewport
+    int n = 0;
+    if (lo + o < size) p[std::size_t(n++)] = {lo + o, std::min(hi + o, size), o};
+    if (hi + o > size) p[std::size_t(n++)] = {std::max(lo + o, size) - size, hi + o - size, o - size};
+    return std::pair(p, n);
+  };
+  const auto [xs, nx] = parts(r.x, r.z, origin.x);
+  const auto [ys, ny] = parts(r.y, r.w, origin.y);
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
+      const glm::ivec3 x = xs[std::size_t(i)], y = ys[std::size_t(j)];
+      out.push_back({glm::ivec4(x.x, y.x, x.y, y.y), glm::ivec2(x.z, y.z)});
+    }
+}
+
 }  // namespace
 
 Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
@@ -294,6 +369,8 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   stats.shadow_layers = total;
   stats.shadow_layers_rendered = 0;
   stats.shadow_rect_culled = 0;
+  stats.shadow_layers_scrolled = 0;
+  stats.shadow_texels_drawn = 0;
   stats.shadow_draw_calls = 0;
   stats.shadow_instances = 0;
   stats.shadow_triangles = 0;
@@ -310,26 +387,48 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   // casters (mesh, model matrix, depth program, alpha-mask parameters) in order. A moved caster
   // changes its matrix, a moved camera the layer's matrix or casters; other assets (another
   // scene) change assets.uid. New storage invalidated every layer.
+  auto add_caster = [&](InputHash& h, std::size_t view, std::uint32_t i) {
+    const DrawItem& d = frame.draws[i];
+    const VariantKey key = list.depth_key(view, i);
+    h.add(d.mesh).add(d.model).add(key.filtered_for(Pass::depth).bits());
+    if (key.has(VariantKey::kAlphaMask) || features_by_uniform)
+      h.add(d.material.base_color.a)
+          .add(d.material.alpha_cutoff)
+          .add(d.material.base_color_texture)
+          .add(d.material.base_color_transform);
+  };
+  auto add_pass = [&](InputHash& h, const ShadowView& v) {
+    h.add(assets.uid).add(shader_reloads).add(layered).add(v.projection).add(v.cull);
+    h.add(v.slope_bias).add(v.constant_bias);
+  };
   auto layer_inputs = [&](std::size_t view, int c) {
     const ShadowView& v = views[view];
     InputHash h;
-    h.add(assets.uid).add(shader_reloads).add(layered).add(v.projection).add(v.cull);
-    h.add(v.slope_bias).add(v.constant_bias);
+    add_pass(h, v);
     h.add(v.view_proj[std::size_t(c)]).add(v.skipped[std::size_t(c)]);
     // Only the paraboloid depth pass reads splits (near, far) and the margin (shadow_depth.vert).
     if (v.projection == ShadowProjection::dual_paraboloid) h.add(v.splits).add(v.paraboloid_margin);
     if (v.skipped[std::size_t(c)]) return h.value();
-    for (std::uint32_t i : list.depth_order) {
-      const DrawItem& d = frame.draws[i];
-      if (!(caster_mask(v, d) & (1u << c))) continue;
-      const VariantKey key = list.depth_key(view, i);
-      h.add(d.mesh).add(d.model).add(key.filtered_for(Pass::depth).bits());
-      if (key.has(VariantKey::kAlphaMask) || features_by_uniform)
-        h.add(d.material.base_color.a)
-            .add(d.material.alpha_cutoff)
-            .add(d.material.base_color_texture)
-            .add(d.material.base_color_transform);
-    }
+    for (std::uint32_t i : list.depth_order)
+      if (caster_mask(v, frame.draws[i]) & (1u << c)) add_caster(h, view, i);
+    return h.value();
+  };
+  // What a scrolled layer's kept texels were drawn from, but its translation: the pass, the
+  // matrix without its x and y translation, and every caster of the view wherever it lies (a
+  // caster that moved anywhere redraws the layer whole).
+  auto fixed_inputs = [&](std::size_t view, int c, std::uint64_t casters) {
+    const ShadowView& v = views[view];
+    glm::mat4 m = v.view_proj[std::size_t(c)];
+    m[3][0] = m[3][1] = 0.0f;
+    InputHash h;
+    add_pass(h, v);
+    h.add(m).add(casters);
+    return h.value();
+  };
+  auto view_casters = [&](std::size_t view) {
+    InputHash h;
+    for (std::uint32_t i : list.depth_order)
+      if (frame.draws[i].cast_shadows) add_caster(h, view, i);
     return h.value();
   };
   // The texels each layer needs: its read rectangle, or all of it when a pass that reads
@@ -338,22 +437,75 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   // over at least those texels and its inputs are unchanged or it is held (ShadowView::held).
   const bool whole = layered || std::any_of(frame.probes.begin(), frame.probes.end(),
                                             [](const ProbeJob& p) { return p.faces != 0; });
+  // Scrolling (render.shadow_scroll): a layer to be redrawn whose matrix only moved by whole
+  // texels, and whose other inputs (fixed_inputs) are those it was drawn from, keeps its texture
+  // and moves its origin the other way; only its read rectangle's texels outside what it held
+  // are cleared and drawn. Where scrolling does not apply, a layer's origin returns to 0 (and
+  // the layer is redrawn) so that lookups read it through its own matrix.
+  const bool scroll =
+      frame.shadow_cache && frame.shadow_scroll && !whole && lookups_can_wrap(list.frame_key);
   inputs_.assign(std::size_t(total), 0);
+  fixed_.assign(std::size_t(total), 0);
   rects_.assign(std::size_t(total), glm::ivec4(0, 0, map.size, map.size));
-  for (std::size_t view = 0; view < views.size(); ++view)
-    for (int c = 0; c < views[view].layer_count; ++c) {
-      const std::size_t layer = std::size_t(views[view].first_layer + c);
+  pieces_.assign(std::size_t(total), {});
+  std::uint32_t drawn_now = 0;  // layers with texels to draw
+  for (std::size_t view = 0; view < views.size(); ++view) {
+    const ShadowView& v = views[view];
+    const bool scrolls = scroll && v.projection == ShadowProjection::ortho;
+    const std::uint64_t casters = scrolls ? view_casters(view) : 0;
+    for (int c = 0; c < v.layer_count; ++c) {
+      const std::size_t layer = std::size_t(v.first_layer + c);
+      const bool skipped = v.skipped[std::size_t(c)];
       inputs_[layer] = layer_inputs(view, c);
-      if (!whole && !views[view].skipped[std::size_t(c)])
-        rects_[layer] = texel_rect(views[view].read_rect[std::size_t(c)], map.size);
+      if (!whole && !skipped) rects_[layer] = texel_rect(v.read_rect[std::size_t(c)], map.size);
       const bool drawn = drawn_from_[layer] != 0 && holds(drawn_rect_[layer], rects_[layer]);
-      const bool held = ((views[view].held >> c) & 1u) != 0;
-      if (!frame.shadow_cache || !drawn || (inputs_[layer] != drawn_from_[layer] && !held))
+      const bool held = ((v.held >> c) & 1u) != 0;
+      const bool keep =
+          frame.shadow_cache && drawn && (inputs_[layer] == drawn_from_[layer] || held);
+      std::vector<Piece>& pieces = pieces_[layer];
+      if (!scrolls || skipped) {
+        if (keep && origin_[layer] == glm::ivec2(0)) continue;
+        origin_[layer] = glm::ivec2(0);
+        add_pieces(rects_[layer], origin_[layer], map.size, pieces);
         redraw_ |= 1u << layer;
+        drawn_now |= 1u << layer;
+        continue;
+      }
+      if (keep) continue;
+      fixed_[layer] = fixed_inputs(view, c, casters);
+      std::vector<glm::ivec4> regions{rects_[layer]};
+      glm::ivec2 shift(0);
+      if (drawn_from_[layer] != 0 && drawn_fixed_[layer] == fixed_[layer] &&
+          moved_by_texels(drawn_matrix_[layer], v.view_proj[std::size_t(c)], map.size, shift)) {
+        origin_[layer] = ((origin_[layer] - shift) % map.size + map.size) % map.size;
+        regions = outside(rects_[layer], shifted(drawn_rect_[layer], shift, map.size));
+        stats.shadow_layers_scrolled |= 1u << layer;
+      }
+      for (const glm::ivec4& r : regions) add_pieces(r, origin_[layer], map.size, pieces);
+      redraw_ |= 1u << layer;
+      if (!pieces.empty()) drawn_now |= 1u << layer;
     }
+  }
   // The layered pass draws every layer at once: it redraws all of them or none.
-  if (layered && redraw_ != 0) redraw_ = ~0u >> (32 - total);  // total <= 32: no 1u << 32
-  stats.shadow_layers_rendered = redraw_;
+  if (layered && redraw_ != 0) redraw_ = drawn_now = ~0u >> (32 - total);  // total <= 32
+  stats.shadow_layers_rendered = drawn_now;
+  if (layered) {
+    stats.shadow_texels_drawn = std::int64_t(std::popcount(drawn_now)) * map.size * map.size;
+  } else {
+    for (const std::vector<Piece>& pieces : pieces_)
+      for (const Piece& p : pieces)
+        stats.shadow_texels_drawn +=
+            std::int64_t(p.texture.z - p.texture.x) * (p.texture.w - p.texture.y);
+  }
+  // Lookups wrap while any layer is scrolled; otherwise the border (depth 1) lies outside.
+  const bool wrap = std::any_of(origin_.begin(), origin_.end(),
+                                [](glm::ivec2 o) { return o != glm::ivec2(0); });
+  if (wrap != wrapped_) {
+    const GLint mode = wrap ? GL_REPEAT : GL_CLAMP_TO_BORDER;
+    glTextureParameteri(map_.id(), GL_TEXTURE_WRAP_S, mode);
+    glTextureParameteri(map_.id(), GL_TEXTURE_WRAP_T, mode);
+    wrapped_ = wrap;
+  }
 
   // Stats: the casters each layer holds, whether drawn now or kept from an earlier frame (the
   // draw calls are counted as they are recorded).
@@ -554,50 +706,97 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
     }
     for (int c = 0; c < v.layer_count && status; ++c) {
       const int layer = v.first_layer + c;
-      if (!((redraw_ >> layer) & 1u)) continue;
-      // Only the texels lookups read are cleared and drawn (ShadowView::read_rect). On llvmpipe
-      // a scissored glClear draws a quad and cost more than clearing the whole layer, so part of
-      // a layer is cleared as a texture region (about half the time for half the texels) and a
-      // whole layer by the framebuffer clear (faster than the same as a texture region).
-      const glm::ivec4 r = rects_[std::size_t(layer)];
-      if (empty_rect(r)) continue;
+      if (!((redraw_ >> layer) & 1u) || pieces_[std::size_t(layer)].empty()) continue;
       glNamedFramebufferTextureLayer(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0, layer);
-      if (r == glm::ivec4(0, 0, size_, size_)) {
-        glDisable(GL_SCISSOR_TEST);
-        glClear(GL_DEPTH_BUFFER_BIT);
-      } else {
-        const float far_depth = 1.0f;
-        glClearTexSubImage(map_.id(), 0, r.x, r.y, layer, r.z - r.x, r.w - r.y, 1,
-                           GL_DEPTH_COMPONENT, GL_FLOAT, &far_depth);
-        glEnable(GL_SCISSOR_TEST);
-        glScissor(r.x, r.y, r.z - r.x, r.w - r.y);
+      // Only the texels lookups read are cleared and drawn (ShadowView::read_rect), and of a
+      // scrolled layer only those it did not hold, each piece within one wrap of the texture. On
+      // llvmpipe a scissored glClear draws a quad and cost more than clearing the whole layer,
+      // so part of a layer is cleared as a texture region (about half the time for half the
+      // texels) and a whole layer by the framebuffer clear (faster than the same as a texture
+      // region).
+      for (const Piece& piece : pieces_[std::size_t(layer)]) {
+        const glm::ivec4 t = piece.texture;
+        const bool whole = t == glm::ivec4(0, 0, size_, size_);
+        if (whole) {
+          glDisable(GL_SCISSOR_TEST);
+          glClear(GL_DEPTH_BUFFER_BIT);
+        } else {
+          const float far_depth = 1.0f;
+          glClearTexSubImage(map_.id(), 0, t.x, t.y, layer, t.z - t.x, t.w - t.y, 1,
+                             GL_DEPTH_COMPONENT, GL_FLOAT, &far_depth);
+          glEnable(GL_SCISSOR_TEST);
+          glScissor(t.x, t.y, t.z - t.x, t.w - t.y);
+        }
+        if (v.skipped[std::size_t(c)]) continue;
+        // Map texel x lands on texture texel x + viewport.
+        glViewport(piece.viewport.x, piece.viewport.y, size_, size_);
+        // Part of a cascade: casters outside the drawn texels (two texels wider, as the
+        // rectangle is whole texels and the rasteriser's coverage rules are its own) are left
+        // out.
+        const glm::mat4& vp = v.view_proj[std::size_t(c)];
+        const bool part = !whole && v.projection == ShadowProjection::ortho;
+        const float texel = 2.0f / float(size_);
+        const glm::vec4 map_rect = glm::vec4(t - glm::ivec4(piece.viewport, piece.viewport));
+        const glm::vec4 ndc = map_rect * texel - 1.0f + glm::vec4(-2, -2, 2, 2) * texel;
+        const auto runs = caster_runs(frame, list, cache, state, view, 1u << c, false, records,
+                                      &vp, part ? &ndc : nullptr, &stats.shadow_rect_culled);
+        status = draw_runs(frame, list, cache, state, stats, view, runs, records, &vp);
+        if (!status) break;
       }
-      if (v.skipped[std::size_t(c)]) continue;
-      // Part of a cascade: casters outside the drawn texels (two texels wider, as the
-      // rectangle is whole texels and the rasteriser's coverage rules are its own) are left out.
-      const glm::mat4& vp = v.view_proj[std::size_t(c)];
-      const bool part = r != glm::ivec4(0, 0, size_, size_) && v.projection == ShadowProjection::ortho;
-      const float texel = 2.0f / float(size_);
-      const glm::vec4 ndc = glm::vec4(r) * texel - 1.0f + glm::vec4(-2, -2, 2, 2) * texel;
-      const auto runs = caster_runs(frame, list, cache, state, view, 1u << c, false, records,
-                                    &vp, part ? &ndc : nullptr, &stats.shadow_rect_culled);
-      status = draw_runs(frame, list, cache, state, stats, view, runs, records, &vp);
     }
   }
+  glViewport(0, 0, size_, size_);
   glDisable(GL_POLYGON_OFFSET_FILL);
   glDisable(GL_CLIP_DISTANCE0);
   glDisable(GL_SCISSOR_TEST);
-  if (!status) return status;
-  for (std::size_t layer = 0; layer < inputs_.size(); ++layer)
-    if ((redraw_ >> layer) & 1u) {
+  if (!status) {
+    // Origins have moved for layers not drawn: none of them can be kept or scrolled.
+    std::fill(drawn_from_.begin(), drawn_from_.end(), 0);
+    return status;
+  }
+  for (const ShadowView& v : frame.shadow_views)
+    for (int c = 0; c < v.layer_count; ++c) {
+      const std::size_t layer = std::size_t(v.first_layer + c);
+      if (!((redraw_ >> layer) & 1u)) continue;
       drawn_from_[layer] = inputs_[layer];
       drawn_rect_[layer] = rects_[layer];
+      drawn_matrix_[layer] = v.view_proj[std::size_t(c)];
+      drawn_fixed_[layer] = fixed_[layer];
     }
   return {};
 }
 
+void ShadowMapPass::offset_lookups(const FrameInput& frame, FrameBlock& block) const {
+  for (std::size_t k = 0; k < frame.shadow_views.size(); ++k) {
+    const ShadowView& v = frame.shadow_views[k];
+    for (int c = 0; c < v.layer_count; ++c) {
+      const glm::ivec2 o = origin_[std::size_t(v.first_layer + c)];
+      glm::mat4& m = block.shadow_views[k].view_proj[c];
+      for (int a = 0; a < 2; ++a)
+        if (o[a] != 0) m[3][a] = float(double(m[3][a]) + 2.0 * o[a] / size_);
+    }
+  }
+}
+
 Image ShadowMapPass::read() const {
-  return read_slices(map_, GL_DEPTH_COMPONENT, {"Y"}, size_, layers_);  // empty before the first frame
+  Image img = read_slices(map_, GL_DEPTH_COMPONENT, {"Y"}, size_, layers_);  // empty before the first frame
+  if (img.pixels.empty()) return img;
+  // A scrolled layer's texture holds map texel (x, y) at (x + origin) mod size, GL rows bottom
+  // to top; the image's rows run top to bottom.
+  const std::size_t n = std::size_t(size_);
+  std::vector<float> layer(n * n);
+  for (std::size_t l = 0; l < origin_.size() && l < std::size_t(layers_); ++l) {
+    const glm::ivec2 o = origin_[l];
+    if (o == glm::ivec2(0)) continue;
+    float* base = &img.pixels[l * n * n];
+    std::copy(base, base + n * n, layer.begin());
+    for (std::size_t gy = 0; gy < n; ++gy) {
+      const std::size_t from_row = n - 1 - (gy + std::size_t(o.y)) % n, to_row = n - 1 - gy;
+      for (std::size_t x = 0; x < n; ++x)
+        base[to_row * n + x] = layer[from_row * n + (x + std::size_t(o.x)) % n];
+    }
+  }
+  return img;
 }
 
 // ---- LomPass -------------------------------------------------------------------------------------

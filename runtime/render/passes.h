@@ -87,7 +87,12 @@ class ShadowMapPass {
   /// reads raw depths (PCSS's blocker search), and to UNIT_SHADOW_LINEAR compared with linear
   /// filtering (the disc kernels' taps).
   void bind();
-  /// Depth of every layer, stacked top to bottom (layer 0 first), rows top to bottom.
+  /// The lookups' matrices of the layers that scrolled: `block`'s (packed from `frame`) get
+  /// their layer's origin added to the translation, so a lookup at map coordinates uv reads
+  /// texture coordinates uv + origin / size, wrapping (GL_REPEAT while any origin is not 0).
+  void offset_lookups(const FrameInput& frame, FrameBlock& block) const;
+  /// Depth of every layer, stacked top to bottom (layer 0 first), rows top to bottom; a
+  /// scrolled layer as its matrix sees it (texel (0, 0) the map's corner, not the texture's).
   Image read() const;
   /// This frame's hash of what layer `layer` is drawn from (after prepare()).
   std::uint64_t layer_inputs(int layer) const { return inputs_[std::size_t(layer)]; }
@@ -108,8 +113,25 @@ class ShadowMapPass {
   std::vector<std::uint64_t> drawn_from_;
   std::vector<glm::ivec4> drawn_rect_;
   std::vector<std::uint64_t> inputs_;  // this frame's hashes
-  std::vector<glm::ivec4> rects_;      // this frame's texels to clear and draw per layer
-  std::uint32_t redraw_ = 0;           // bit l: layer l is drawn this frame
+  std::vector<glm::ivec4> rects_;      // this frame's texels lookups read per layer
+  std::uint32_t redraw_ = 0;           // bit l: layer l is drawn (in part or whole) this frame
+  /// Scrolling (render.shadow_scroll). A stable cascade whose matrix moved by whole texels, and
+  /// nothing else changed, keeps the depth it holds and draws only the texels that came into
+  /// view. Its texture is a torus: map texel x lies at texel (x + origin) mod size, so nothing
+  /// is copied. Per layer: the origin, and the matrix and hash of everything but the
+  /// translation it was last drawn with. The drawn rectangle (drawn_rect_) is in map texels.
+  std::vector<glm::ivec2> origin_;
+  std::vector<glm::mat4> drawn_matrix_;
+  std::vector<std::uint64_t> drawn_fixed_;
+  /// A part of a layer drawn this frame: texels `texture` (x0, y0, x1, y1 of the texture,
+  /// within one wrap) drawn through a viewport at `viewport` (map texel x lands on x + it).
+  struct Piece {
+    glm::ivec4 texture;
+    glm::ivec2 viewport;
+  };
+  std::vector<std::vector<Piece>> pieces_;  // this frame's, per layer
+  std::vector<std::uint64_t> fixed_;        // this frame's hashes of all but the translation
+  bool wrapped_ = false;                    // the texture's wrap is GL_REPEAT
 };
 
 /// S1's layered occlusion map (ShadowTechnique::lom), pass 1, after the shadow maps: for every

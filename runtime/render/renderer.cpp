@@ -275,10 +275,9 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.probe_prefilters = stats_.probe_prefilter_faces = 0;
   stats_.cascade_receiver_pixels.fill(0);
 
-  // The frame block of the main view is bound at binding 0 (every pass reads it).
-  const FrameBlock block = pack_frame_block(frame);
-  glNamedBufferSubData(im.frame_ubo.id(), 0, sizeof block, &block);
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
+  // The frame block of the main view (uploaded once the shadow pass has said where its scrolled
+  // layers lie) is bound at binding 0: every pass reads it.
+  FrameBlock block = pack_frame_block(frame);
   // The GPU cache holds this frame's assets (another scene's ids start it afresh).
   im.cache->use(assets);
   im.cache->begin_frame();
@@ -290,6 +289,9 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   // 1. Shadow maps. After it: every layer of every shadow view holds its casters' depth.
   KASKAD_TRY(im.shadow.prepare(frame, list, assets, list.frame_key.has(VariantKey::kShadowLayered),
                                state.features_by_uniform(), im.shaders->stats().reloads, stats_));
+  im.shadow.offset_lookups(frame, block);
+  glNamedBufferSubData(im.frame_ubo.id(), 0, sizeof block, &block);
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, im.frame_ubo.id());
   im.timers.begin(TimedPart::shadow_depth);
   Status st = im.shadow.record(frame, list, *im.cache, state, stats_);
   im.timers.end(TimedPart::shadow_depth);

@@ -7,8 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <bit>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -19,9 +21,12 @@
 #include "components/transform.h"
 #include "runtime/cli/player.h"
 #include "tests/render/player_fixture.h"
+#include "tests/test_tmp.h"
 
 namespace kaskad {
 namespace {
+
+namespace fs = std::filesystem;
 
 class ShadowCacheTest : public PlayerTest {
  protected:
@@ -124,9 +129,12 @@ TEST_F(ShadowCacheTest, LayersAreRedrawnOnlyWhenTheirInputsChange) {
   render(*player_, scene);
 
   // The camera moves: the cascades move with it and are redrawn; again as drawn from scratch.
+  // Without scrolling (ScrollTest), to the bit.
+  scene.render.shadow_scroll = false;
   scene.world.get<Transform>(named(scene, "camera")).translation += glm::vec3(0.7f, 0.0f, -0.4f);
   const Frame walked = render(*player_, scene);
   EXPECT_NE(walked.stats.shadow_layers_rendered, 0u);
+  EXPECT_EQ(walked.stats.shadow_layers_scrolled, 0u);
   const Frame walked_fresh = fresh(scene);
   EXPECT_EQ(walked.map, walked_fresh.map);
   EXPECT_EQ(walked.visibility, walked_fresh.visibility);
@@ -222,9 +230,10 @@ TEST_F(ShadowCacheTest, ReceiverCullingAndScissorChangeNoPixel) {
       ASSERT_TRUE(other.ok()) << other.error().to_string();
       render(*player_, *other);
       const std::string flag = on ? "true" : "false";
+      // Without scrolling, which draws layers in part either way (ScrollTest).
       auto loaded = load_scene(content_dir() / "scenes" / c.scene,
                                {"shadow.cull_by_receivers=" + flag,
-                                "shadow.scissor_to_receivers=" + flag});
+                                "shadow.scissor_to_receivers=" + flag, "render.shadow_scroll=false"});
       ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
       Scene& scene = *loaded;
       Transform& cam = scene.world.get<Transform>(named(scene, c.camera));
@@ -302,6 +311,101 @@ TEST_F(ShadowCacheTest, FarCascadesAreRedrawnEveryKthFrame) {
   for (std::size_t f = 0; f < 9; ++f) lagging += visibility[0][f] != visibility[1][f];
   EXPECT_GT(lagging, 0) << "the far cascades should lag while the caster moves";
   EXPECT_EQ(visibility[0].back(), visibility[1].back());
+}
+
+// render.shadow_scroll: under a camera that walks across the sun, stable cascades that moved by
+// whole texels keep their depth (the texture scrolls, nothing is copied) and draw only the texels
+// that came into view, and every frame shades as the same frames drawn without scrolling: the same
+// visibility at every pixel but a few where the redrawn depth differs by rasterisation rounding,
+// and the colour within one 8-bit step elsewhere. On a field of casters that the camera walks
+// over (the texels coming into view hold shadows that are seen at once), the default scene with
+// a caster moving on the way (its layers are redrawn whole), the probes' scene (faces read the
+// maps anywhere: whole layers on capture frames) and the terrain.
+TEST_F(ShadowCacheTest, ScrolledLayersShadeAsRedrawnOnes) {
+  const fs::path field = testing_util::test_tmp() / "field.json";
+  {
+    std::ofstream out(field);
+    out << R"({ "kaskad_scene": 1, "render": { "ground": "none" },
+      "shadow": { "map_size": 1024, "cascade_count": 4, "fit_mode": "stable" },
+      "entities": [
+        { "name": "ground", "transform": { "scale": [80, 1, 80] }, "primitive": { "shape": "plane" } },
+        { "name": "sun", "transform": { "direction": [0.5, -0.6, -0.45] },
+          "light": { "type": "directional", "cast_shadows": true } },
+        { "name": "camera", "transform": { "translation": [-20, 3, 0], "look_at": [-12, 0, -2] },
+          "camera": { "fov_y_deg": 60, "near": 0.1, "far": 60, "active": true } })";
+    for (int i = 0; i < 26 * 26; ++i)
+      out << R"(, { "transform": { "translation": [)" << -37.5 + 3.0 * (i % 26) << ", 0.5, "
+          << -37.5 + 3.0 * (i / 26) << R"(], "euler_deg": [0, )" << (i * 37) % 90
+          << R"(, 0] }, "primitive": { "shape": "box" } })";
+    out << "] }";
+  }
+  for (const std::string& name : {field.string(), std::string("default.json"),
+                                 std::string("terrain.json"), std::string("reflections.json")}) {
+    SCOPED_TRACE(name);
+    struct Run {
+      std::vector<std::vector<float>> visibility;
+      std::vector<Image> color;
+      std::vector<render::FrameStats> stats;
+    };
+    std::array<Run, 2> runs;  // scrolling off, on
+    for (int on = 0; on < 2; ++on) {
+      auto other = load_scene(content_dir() / "scenes" / "default.json", {"shadow.map_size=256"});
+      ASSERT_TRUE(other.ok()) << other.error().to_string();
+      render(*player_, *other);  // new map storage: nothing of the other run survives
+      auto loaded = load_scene(name == field.string() ? field : content_dir() / "scenes" / name,
+                               {std::string("render.shadow_scroll=") + (on ? "true" : "false")});
+      ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+      Scene& scene = *loaded;
+      Transform& cam = scene.world.get<Transform>(named(scene, "camera"));
+      ecs::Entity caster = ecs::kNullEntity;
+      if (name == "default.json") caster = named(scene, "box_floating");
+      for (int f = 0; f < 12; ++f) {
+        // Across the sun (direction (0.5, -0.6, -0.45)): the cascades' depth ranges stay, so
+        // the layers scroll frame after frame and the texels they drew come into the view.
+        cam.translation += 0.4f * glm::normalize(glm::vec3(0.45f, 0.0f, 0.5f));
+        if (f == 7 && caster.valid())
+          scene.world.get<Transform>(caster).translation += glm::vec3(0.1f, 0.0f, 0.0f);
+        const Frame fr = render(*player_, scene);
+        runs[std::size_t(on)].visibility.push_back(fr.visibility);
+        runs[std::size_t(on)].color.push_back(player_->renderer->read_color());
+        runs[std::size_t(on)].stats.push_back(fr.stats);
+      }
+    }
+    std::int64_t texels[2] = {0, 0};
+    int scrolled = 0, most_differ = 0, most_far_off = 0;
+    for (std::size_t f = 0; f < runs[0].stats.size(); ++f) {
+      EXPECT_EQ(runs[0].stats[f].shadow_layers_scrolled, 0u);
+      scrolled += runs[1].stats[f].shadow_layers_scrolled != 0;
+      for (int on = 0; on < 2; ++on) texels[on] += runs[std::size_t(on)].stats[f].shadow_texels_drawn;
+      const std::vector<float>& a = runs[0].visibility[f];
+      const std::vector<float>& b = runs[1].visibility[f];
+      ASSERT_EQ(a.size(), b.size());
+      int differ = 0;
+      for (std::size_t i = 0; i < a.size(); ++i) differ += a[i] != b[i];
+      EXPECT_LE(differ, int(a.size() / 2000)) << "frame " << f;  // 0.05% of the pixels
+      most_differ = std::max(most_differ, differ);
+      const Image& ca = runs[0].color[f];
+      const Image& cb = runs[1].color[f];
+      ASSERT_EQ(ca.pixels.size(), cb.pixels.size());
+      int far_off = 0;
+      for (std::size_t i = 0; i < ca.pixels.size(); ++i)
+        far_off += std::abs(ca.pixels[i] - cb.pixels[i]) > 1.5f / 255.0f;
+      EXPECT_LE(far_off, 3 * int(a.size() / 2000)) << "frame " << f;
+      most_far_off = std::max(most_far_off, far_off);
+    }
+    // Every frame moves the cascades: most scroll, and draw a small part of what redrawing does
+    // (the probes' scene less so: its capture frames draw whole layers either way).
+    EXPECT_GE(scrolled, 6);
+    if (name == "reflections.json") {
+      EXPECT_LT(texels[1], texels[0]);
+    } else {
+      EXPECT_LT(texels[1] * 3, texels[0]);
+    }
+    std::printf("%s: %d of %zu frames scrolled; texels drawn %lld scrolling, %lld redrawing; at "
+                "most %d pixels' visibility and %d colour values (of %zu) differ in a frame\n",
+                fs::path(name).filename().c_str(), scrolled, runs[1].stats.size(), (long long)texels[1], (long long)texels[0],
+                most_differ, most_far_off, runs[0].visibility[0].size());
+  }
 }
 
 }  // namespace
