@@ -85,6 +85,9 @@ struct FrameStats {
   /// render.visibility_cache: the forward pass read each pixel's shadow visibility back from
   /// the frame before instead of looking the shadow maps up (nothing it depends on changed).
   bool visibility_reused = false;
+  /// render.visibility_cache: the forward pass stored each pixel's visibility for the next frame
+  /// (a frame that sees what the frame before saw and does not read back).
+  bool visibility_stored = false;
   /// GPU times are the previous frame's (queries are read a frame late); 0 until frame 3.
   /// GPU time (GL_TIMESTAMP pairs, GpuTimers) of the shadow pass with LOM and moments, the
   /// forward pass and the probe captures (previous frame).

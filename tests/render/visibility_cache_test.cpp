@@ -1,8 +1,9 @@
 // The visibility cache (render.visibility_cache, issue 13): a frame whose camera, draws, lights
-// and shadow maps are those of the frame before reads each pixel's shadow visibility back
-// instead of looking the maps up. Checked by replaying one sequence of scene changes with the
-// cache on and off: every frame's colour is the same bit for bit, still frames read back, and a
-// frame after a change looks up again. Fails when the visibility inputs leave out the draws'
+// and shadow maps are those of the frame that stored its visibility reads each pixel's shadow
+// visibility back instead of looking the maps up; a frame stores only when it sees what the
+// frame before saw (a moving camera's frames do not). Checked by replaying one sequence of scene
+// changes with the cache on and off: every frame's colour is the same bit for bit, still frames
+// store and then read back, and a frame after a change looks up again. Fails when the visibility inputs leave out the draws'
 // matrices (a moved object that casts nothing then shows stale visibility), or when a storing
 // frame stores nothing.
 #include <gtest/gtest.h>
@@ -25,18 +26,21 @@ namespace {
 
 class VisibilityCacheTest : public PlayerTest {
  protected:
-  // One step of the replay: what changes before the frame, and whether the frame reads the
-  // visibility back (nothing it depends on changed; kEither: not asserted).
+  // One step of the replay: what changes before the frame, and what the frame does with the
+  // stored visibility: kLookUp (it changed since the frame before), kStore (the same as the
+  // frame before: it looks up and stores), kReadBack (the same as the frame stored), kEither (not
+  // asserted).
   enum class Change { none, caster, receiver, light, camera, size, base_colour };
-  static constexpr int kEither = -1;
+  static constexpr int kLookUp = 0, kReadBack = 1, kStore = 2, kEither = -1;
   struct Step {
     Change change;
-    int reused;
+    int use;
   };
 
   struct Frame {
     Image colour;
     bool reused = false;
+    bool stored = false;
   };
 
   static ecs::Entity find(const Scene& s, const char* name) {
@@ -104,7 +108,8 @@ class VisibilityCacheTest : public PlayerTest {
       auto t = render_frames(*player_, scene, run);
       EXPECT_TRUE(t.ok()) << file << ": " << t.error().to_string();
       if (!t.ok()) return out;
-      out.push_back({player_->renderer->read_color(), t->last.stats.visibility_reused});
+      out.push_back({player_->renderer->read_color(), t->last.stats.visibility_reused,
+                     t->last.stats.visibility_stored});
     }
     return out;
   }
@@ -115,18 +120,23 @@ TEST_F(VisibilityCacheTest, ReadBackFramesAreThoseLookedUp) {
   // The default scene: a caster, the sun, the camera and the size change in turn. A change of
   // base colours leaves the visibility as it was, but may reorder the draws (they sort by
   // material), which looks up again: either way the colour must be right.
+  const int L = kLookUp, S = kStore, R = kReadBack;
   const std::vector<Step> with_caster = {
-      {C::none, 0},   {C::none, 1},   {C::none, 1},          {C::caster, 0},
-      {C::none, 1},   {C::light, 0},  {C::none, 1},          {C::camera, 0},
-      {C::none, 1},   {C::base_colour, kEither}, {C::size, 0}, {C::none, 1}};
+      {C::none, L},  {C::none, S},   {C::none, R},   {C::none, R},
+      {C::caster, L}, {C::none, S},  {C::none, R},   {C::light, L},
+      {C::none, S},  {C::none, R},   {C::camera, L}, {C::camera, L},
+      {C::none, S},  {C::none, R},   {C::base_colour, kEither}, {C::size, L},
+      {C::none, S},  {C::none, R}};
   // The floating box casts nothing and moves sideways: no shadow layer is redrawn, but the
   // pixels it covers changed.
-  const std::vector<Step> receiver = {{C::none, 0},     {C::none, 1}, {C::receiver, 0},
-                                      {C::none, 1},     {C::receiver, 0}, {C::none, 1}};
+  const std::vector<Step> receiver = {{C::none, L},     {C::none, S}, {C::none, R},
+                                      {C::receiver, L}, {C::none, S}, {C::none, R},
+                                      {C::receiver, L}, {C::none, S}, {C::none, R}};
   // Other shadow views (two suns: two channels; a spot light; a point light's cube faces) and
   // techniques: the same replay without a named caster.
-  const std::vector<Step> without_caster = {{C::none, 0}, {C::none, 1},   {C::light, 0},
-                                            {C::none, 1}, {C::camera, 0}, {C::none, 1}};
+  const std::vector<Step> without_caster = {{C::none, L},   {C::none, S}, {C::none, R},
+                                            {C::light, L},  {C::none, S}, {C::none, R},
+                                            {C::camera, L}, {C::none, S}, {C::none, R}};
   struct Case {
     const char* file;
     std::vector<std::string> sets;
@@ -152,10 +162,13 @@ TEST_F(VisibilityCacheTest, ReadBackFramesAreThoseLookedUp) {
     ASSERT_EQ(looked_up.size(), c.steps->size()) << what;
     int reused = 0;
     for (std::size_t i = 0; i < cached.size(); ++i) {
-      if ((*c.steps)[i].reused != kEither) {
-        EXPECT_EQ(int(cached[i].reused), (*c.steps)[i].reused) << what << ", frame " << i;
+      const int use = (*c.steps)[i].use;
+      if (use != kEither) {
+        EXPECT_EQ(cached[i].reused, use == kReadBack) << what << ", frame " << i;
+        EXPECT_EQ(cached[i].stored, use == kStore) << what << ", frame " << i;
       }
       EXPECT_FALSE(looked_up[i].reused) << what << ", frame " << i;
+      EXPECT_FALSE(looked_up[i].stored) << what << ", frame " << i;
       EXPECT_EQ(cached[i].colour.width, looked_up[i].colour.width);
       EXPECT_TRUE(cached[i].colour.pixels == looked_up[i].colour.pixels)
           << what << ", frame " << i << " differs from the frame that looked the maps up";
