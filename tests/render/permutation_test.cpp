@@ -124,7 +124,7 @@ TEST_F(PermutationTest, CompilesExactlyTheCombinationsTheSceneUses) {
   EXPECT_EQ(depth.size(), 2u);
 
   auto r = make_renderer();
-  render(*r, s, 2);  // the second frame is still: it reads the visibility back
+  render(*r, s, 3);  // still frames: the second stores the visibility, the third reads it back
   EXPECT_EQ(r->shaders().built_keys(Pass::forward).size(), forward.size());
   EXPECT_EQ(r->shaders().built_keys(Pass::depth).size(), depth.size());
   EXPECT_EQ(r->stats().shaders.programs_compiled, int(forward.size() + depth.size()));
