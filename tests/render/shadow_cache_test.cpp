@@ -322,24 +322,33 @@ TEST_F(ShadowCacheTest, FarCascadesAreRedrawnEveryKthFrame) {
 // a caster moving on the way (its layers are redrawn whole), the probes' scene (faces read the
 // maps anywhere: whole layers on capture frames) and the terrain.
 TEST_F(ShadowCacheTest, ScrolledLayersShadeAsRedrawnOnes) {
-  const fs::path field = testing_util::test_tmp() / "field.json";
-  {
-    std::ofstream out(field);
+  // The field around `centre` (x and z), the sun's entity off the origin (its position is the
+  // light view's origin): 4 km away, the light matrices' translations are in the thousands and
+  // carry the rounding of float products; the layers must scroll there too.
+  auto write_field = [](const fs::path& file, double centre) {
+    std::ofstream out(file);
     out << R"({ "kaskad_scene": 1, "render": { "ground": "none" },
       "shadow": { "map_size": 1024, "cascade_count": 4, "fit_mode": "stable" },
       "entities": [
-        { "name": "ground", "transform": { "scale": [80, 1, 80] }, "primitive": { "shape": "plane" } },
-        { "name": "sun", "transform": { "direction": [0.5, -0.6, -0.45] },
+        { "name": "ground", "transform": { "translation": [)" << centre << ", 0, " << centre
+        << R"(], "scale": [80, 1, 80] }, "primitive": { "shape": "plane" } },
+        { "name": "sun", "transform": { "translation": [17.3, 40.1, -9.7],
+                                        "direction": [0.5, -0.6, -0.45] },
           "light": { "type": "directional", "cast_shadows": true } },
-        { "name": "camera", "transform": { "translation": [-20, 3, 0], "look_at": [-12, 0, -2] },
+        { "name": "camera", "transform": { "translation": [)" << centre - 20 << ", 3, " << centre
+        << R"(], "look_at": [)" << centre - 12 << ", 0, " << centre - 2 << R"(] },
           "camera": { "fov_y_deg": 60, "near": 0.1, "far": 60, "active": true } })";
     for (int i = 0; i < 26 * 26; ++i)
-      out << R"(, { "transform": { "translation": [)" << -37.5 + 3.0 * (i % 26) << ", 0.5, "
-          << -37.5 + 3.0 * (i / 26) << R"(], "euler_deg": [0, )" << (i * 37) % 90
+      out << R"(, { "transform": { "translation": [)" << centre - 37.5 + 3.0 * (i % 26) << ", 0.5, "
+          << centre - 37.5 + 3.0 * (i / 26) << R"(], "euler_deg": [0, )" << (i * 37) % 90
           << R"(, 0] }, "primitive": { "shape": "box" } })";
     out << "] }";
-  }
-  for (const std::string& name : {field.string(), std::string("default.json"),
+  };
+  const fs::path field = testing_util::test_tmp() / "field.json";
+  const fs::path far_field = testing_util::test_tmp() / "far_field.json";
+  write_field(field, 0.0);
+  write_field(far_field, 4000.0);
+  for (const std::string& name : {field.string(), far_field.string(), std::string("default.json"),
                                  std::string("terrain.json"), std::string("reflections.json")}) {
     SCOPED_TRACE(name);
     struct Run {
@@ -352,7 +361,8 @@ TEST_F(ShadowCacheTest, ScrolledLayersShadeAsRedrawnOnes) {
       auto other = load_scene(content_dir() / "scenes" / "default.json", {"shadow.map_size=256"});
       ASSERT_TRUE(other.ok()) << other.error().to_string();
       render(*player_, *other);  // new map storage: nothing of the other run survives
-      auto loaded = load_scene(name == field.string() ? field : content_dir() / "scenes" / name,
+      const fs::path file = fs::path(name).is_absolute() ? fs::path(name) : content_dir() / "scenes" / name;
+      auto loaded = load_scene(file,
                                {std::string("render.shadow_scroll=") + (on ? "true" : "false")});
       ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
       Scene& scene = *loaded;
