@@ -214,6 +214,7 @@ void ShadowMapPass::ensure_storage(int size, int layers, DepthFormat format, Sha
     origin_.assign(std::size_t(layers), glm::ivec2(0));
     drawn_matrix_.assign(std::size_t(layers), glm::mat4(0.0f));
     drawn_fixed_.assign(std::size_t(layers), 0);
+    drawn_casters_.assign(std::size_t(layers), {});
     wrapped_ = false;
     fbo_ = gpu::make_framebuffer();
     glNamedFramebufferTextureLayer(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0, 0);
@@ -425,11 +426,47 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
     h.add(m).add(casters);
     return h.value();
   };
+  // Every caster of the view: one hash each (caster_ids, by draw) and one of them all.
+  std::vector<std::uint64_t> caster_ids;
   auto view_casters = [&](std::size_t view) {
-    InputHash h;
+    caster_ids.assign(frame.draws.size(), 0);
+    InputHash all;
     for (std::uint32_t i : list.depth_order)
-      if (frame.draws[i].cast_shadows) add_caster(h, view, i);
-    return h.value();
+      if (frame.draws[i].cast_shadows) {
+        InputHash one;
+        add_caster(one, view, i);
+        caster_ids[i] = one.value();
+        all.add(caster_ids[i]);
+      }
+    return all.value();
+  };
+  // The casters layer c of the view holds (its caster_mask), sorted: a layer that keeps texels
+  // must have held every caster that falls on them.
+  auto layer_casters = [&](const ShadowView& v, int c, std::vector<std::uint64_t>& out) {
+    out.clear();
+    for (std::uint32_t i : list.depth_order)
+      if (caster_mask(v, frame.draws[i]) & (1u << c)) out.push_back(caster_ids[i]);
+    std::sort(out.begin(), out.end());
+  };
+  // Whether a caster of layer c that the layer did not hold when drawn (as can happen without
+  // any caster moving: shadow.cull_by_receivers assigns casters by the receivers the slice
+  // serves) reaches the texels `kept` (two texels wider, as in caster_runs()).
+  auto newcomer_over = [&](const ShadowView& v, int c, std::size_t layer, const glm::ivec4& kept) {
+    if (empty_rect(kept)) return false;
+    const std::vector<std::uint64_t>& before = drawn_casters_[layer];
+    const float texel = 2.0f / float(map.size);
+    const glm::vec4 ndc = glm::vec4(kept) * texel - 1.0f + glm::vec4(-2, -2, 2, 2) * texel;
+    for (std::uint32_t i : list.depth_order) {
+      const DrawItem& d = frame.draws[i];
+      if (!(caster_mask(v, d) & (1u << c)) ||
+          std::binary_search(before.begin(), before.end(), caster_ids[i]))
+        continue;
+      if (d.bounds.empty()) return true;
+      const Aabb box = d.bounds.transformed(v.view_proj[std::size_t(c)]);
+      if (box.max.x >= ndc.x && box.min.x <= ndc.z && box.max.y >= ndc.y && box.min.y <= ndc.w)
+        return true;
+    }
+    return false;
   };
   // The texels each layer needs: its read rectangle, or all of it when a pass that reads
   // anywhere in the maps runs this frame (a probe face selects cascades by map bounds; the
@@ -446,13 +483,18 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
       frame.shadow_cache && frame.shadow_scroll && !whole && lookups_can_wrap(list.frame_key);
   inputs_.assign(std::size_t(total), 0);
   fixed_.assign(std::size_t(total), 0);
+  casters_.assign(std::size_t(total), {});
   rects_.assign(std::size_t(total), glm::ivec4(0, 0, map.size, map.size));
   pieces_.assign(std::size_t(total), {});
   std::uint32_t drawn_now = 0;  // layers with texels to draw
   for (std::size_t view = 0; view < views.size(); ++view) {
     const ShadowView& v = views[view];
     const bool scrolls = scroll && v.projection == ShadowProjection::ortho;
-    const std::uint64_t casters = scrolls ? view_casters(view) : 0;
+    // What a later frame needs to scroll a layer drawn now (also by a frame that cannot scroll,
+    // such as a probe capture's, which draws whole layers at origin 0).
+    const bool tracks = frame.shadow_cache && frame.shadow_scroll && !layered &&
+                        v.projection == ShadowProjection::ortho;
+    const std::uint64_t casters = tracks ? view_casters(view) : 0;
     for (int c = 0; c < v.layer_count; ++c) {
       const std::size_t layer = std::size_t(v.first_layer + c);
       const bool skipped = v.skipped[std::size_t(c)];
@@ -466,6 +508,10 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
       if (!scrolls || skipped) {
         if (keep && origin_[layer] == glm::ivec2(0)) continue;
         origin_[layer] = glm::ivec2(0);
+        if (tracks && !skipped) {
+          fixed_[layer] = fixed_inputs(view, c, casters);
+          layer_casters(v, c, casters_[layer]);
+        }
         add_pieces(rects_[layer], origin_[layer], map.size, pieces);
         redraw_ |= 1u << layer;
         drawn_now |= 1u << layer;
@@ -473,13 +519,17 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
       }
       if (keep) continue;
       fixed_[layer] = fixed_inputs(view, c, casters);
+      layer_casters(v, c, casters_[layer]);
       std::vector<glm::ivec4> regions{rects_[layer]};
       glm::ivec2 shift(0);
       if (drawn_from_[layer] != 0 && drawn_fixed_[layer] == fixed_[layer] &&
           moved_by_texels(drawn_matrix_[layer], v.view_proj[std::size_t(c)], map.size, shift)) {
-        origin_[layer] = ((origin_[layer] - shift) % map.size + map.size) % map.size;
-        regions = outside(rects_[layer], shifted(drawn_rect_[layer], shift, map.size));
-        stats.shadow_layers_scrolled |= 1u << layer;
+        const glm::ivec4 kept = shifted(drawn_rect_[layer], shift, map.size);
+        if (!newcomer_over(v, c, layer, kept)) {
+          origin_[layer] = ((origin_[layer] - shift) % map.size + map.size) % map.size;
+          regions = outside(rects_[layer], kept);
+          stats.shadow_layers_scrolled |= 1u << layer;
+        }
       }
       for (const glm::ivec4& r : regions) add_pieces(r, origin_[layer], map.size, pieces);
       redraw_ |= 1u << layer;
@@ -768,6 +818,7 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
       drawn_rect_[layer] = rects_[layer];
       drawn_matrix_[layer] = v.view_proj[std::size_t(c)];
       drawn_fixed_[layer] = fixed_[layer];
+      drawn_casters_[layer].swap(casters_[layer]);
     }
   return {};
 }

@@ -123,6 +123,7 @@ class ShadowMapPass {
   std::vector<glm::ivec2> origin_;
   std::vector<glm::mat4> drawn_matrix_;
   std::vector<std::uint64_t> drawn_fixed_;
+  std::vector<std::vector<std::uint64_t>> drawn_casters_;  // sorted caster hashes drawn
   /// A part of a layer drawn this frame: texels `texture` (x0, y0, x1, y1 of the texture,
   /// within one wrap) drawn through a viewport at `viewport` (map texel x lands on x + it).
   struct Piece {
@@ -131,6 +132,7 @@ class ShadowMapPass {
   };
   std::vector<std::vector<Piece>> pieces_;  // this frame's, per layer
   std::vector<std::uint64_t> fixed_;        // this frame's hashes of all but the translation
+  std::vector<std::vector<std::uint64_t>> casters_;  // this frame's casters per layer, sorted
   bool wrapped_ = false;                    // the texture's wrap is GL_REPEAT
 };
 

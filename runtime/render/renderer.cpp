@@ -343,9 +343,10 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     if (maps_kept && inputs == stored && im.forward.holds_visibility()) reuse = VariantKey::kReuseLoad;
     store = reuse == VariantKey::kReuseStore && inputs == im.last_visibility;
     im.last_visibility = inputs;
-    // What the target holds: this frame's visibility, or what it held (a frame that neither
-    // stores nor loads leaves it as it was).
-    im.stored_visibility = reuse == VariantKey::kReuseLoad || store ? inputs : stored;
+    // What the target holds and a later frame may read: this frame's visibility. After a frame
+    // that neither stores nor loads, nothing: what changed in between may not all be in the
+    // inputs (a caster's cast_shadows redraws the maps, and the maps' inputs are their own).
+    im.stored_visibility = reuse == VariantKey::kReuseLoad || store ? inputs : 0;
   }
   // A loading frame draws with the loading programs. Those not built yet are built now
   // (prewarm() builds them up front), each once (the order runs by program); one that does not

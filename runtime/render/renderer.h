@@ -52,8 +52,8 @@ struct FrameStats {
   /// (shadow.scissor_to_receivers) because their boxes miss those texels.
   int shadow_rect_culled = 0;
   /// Bit l: layer l scrolled this frame (render.shadow_scroll): its matrix moved by whole texels
-  /// and it kept the depth it held, drawing only the texels that came into view (if any, its
-  /// bit in shadow_layers_rendered is set too).
+  /// (or not at all, its read rectangle having grown) and it kept the depth it held, drawing
+  /// only the texels it did not hold (if any, its bit in shadow_layers_rendered is set too).
   std::uint32_t shadow_layers_scrolled = 0;
   /// Texels cleared and drawn this frame over all layers (each layer's size^2 when redrawn whole).
   std::int64_t shadow_texels_drawn = 0;

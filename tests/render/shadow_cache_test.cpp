@@ -17,6 +17,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "components/camera.h"
+#include "components/mesh_renderer.h"
 #include "components/name.h"
 #include "components/transform.h"
 #include "runtime/cli/player.h"
@@ -416,6 +417,47 @@ TEST_F(ShadowCacheTest, ScrolledLayersShadeAsRedrawnOnes) {
                 fs::path(name).filename().c_str(), scrolled, runs[1].stats.size(), (long long)texels[1], (long long)texels[0],
                 most_differ, most_far_off, runs[0].visibility[0].size());
   }
+}
+
+// A caster can join a layer without moving and without the layer's matrix moving: with
+// shadow.cull_by_receivers it is assigned by the receivers the slice serves. Here a box (which
+// receives nothing) hangs under a platform (a receiver that casts nothing), below every
+// receiver: it shadows none and is left out. Then the floor under it, inside the platform's rectangle in the map, starts to
+// receive shadows: the box joins the layer, and its shadow falls on texels the layer kept. The
+// layer must be redrawn there, not scrolled: the floor is as shadowed as with nothing cached.
+TEST_F(ShadowCacheTest, ACasterThatJoinsALayerIsDrawnOverTheTexelsItKept) {
+  const fs::path file = testing_util::test_tmp() / "joins.json";
+  std::ofstream(file) << R"({ "kaskad_scene": 1, "render": { "ground": "none" },
+    "shadow": { "map_size": 1024, "cascade_count": 2, "fit_mode": "stable" },
+    "entities": [
+      { "name": "platform", "transform": { "translation": [0, 4, 0], "scale": [4, 1, 4] },
+        "primitive": { "shape": "plane" }, "renderer": { "cast_shadows": false } },
+      { "name": "floor", "transform": { "scale": [4, 1, 4] }, "primitive": { "shape": "plane" },
+        "renderer": { "cast_shadows": false, "receive_shadows": false } },
+      { "name": "box", "transform": { "translation": [0, 1.5, 0] }, "primitive": { "shape": "box" },
+        "renderer": { "receive_shadows": false } },
+      { "name": "sun", "transform": { "direction": [0.1, -1, 0.15] },
+        "light": { "type": "directional", "cast_shadows": true } },
+      { "name": "camera", "transform": { "translation": [0, 2, 9], "look_at": [0, 1, 0] },
+        "camera": { "fov_y_deg": 60, "near": 0.5, "far": 40, "active": true } } ] })";
+  auto run = [&](bool scroll) {
+    auto loaded = load_scene(file, {std::string("render.shadow_scroll=") + (scroll ? "true" : "false")});
+    EXPECT_TRUE(loaded.ok()) << loaded.error().to_string();
+    if (!loaded.ok()) return Frame{};
+    render(*player_, *loaded);
+    EXPECT_EQ(render(*player_, *loaded).stats.layer_casters[0], 0);  // the box is left out
+    loaded->world.get<MeshRenderer>(named(*loaded, "floor")).receive_shadows = true;
+    const Frame joined = render(*player_, *loaded);
+    EXPECT_EQ(joined.stats.layer_casters[0], 1);  // the box joins
+    return joined;
+  };
+  const Frame scrolled = run(true);
+  const Frame redrawn = run(false);
+  ASSERT_EQ(scrolled.visibility.size(), redrawn.visibility.size());
+  // The floor is shadowed somewhere, and exactly as drawn without scrolling.
+  EXPECT_NE(std::count(redrawn.visibility.begin(), redrawn.visibility.end(), 0.0f), 0);
+  EXPECT_EQ(scrolled.visibility, redrawn.visibility);
+  EXPECT_EQ(scrolled.stats.shadow_layers_scrolled, 0u);
 }
 
 }  // namespace
