@@ -284,6 +284,20 @@ bool holds(const glm::ivec4& outer, const glm::ivec4& inner) {
                                outer.w >= inner.w);
 }
 
+// The NDC rectangle (x0, y0, x1, y1) of texels `r` of a layer of `size`^2, two texels wider on
+// each side: casters are tested against it, as the rectangle is whole texels and the
+// rasteriser's coverage rules are its own.
+glm::vec4 drawn_ndc(const glm::ivec4& r, int size) {
+  const float texel = 2.0f / float(size);
+  return glm::vec4(r) * texel - 1.0f + glm::vec4(-2, -2, 2, 2) * texel;
+}
+
+// Whether `box`, through the affine (ortho) light matrix `light_vp`, misses NDC rectangle `ndc`.
+bool box_misses(const Aabb& box, const glm::mat4& light_vp, const glm::vec4& ndc) {
+  const Aabb b = box.transformed(light_vp);
+  return b.max.x < ndc.x || b.min.x > ndc.z || b.max.y < ndc.y || b.min.y > ndc.w;
+}
+
 // `r` moved by `shift` texels and cut to a layer of `size`^2.
 glm::ivec4 shifted(const glm::ivec4& r, glm::ivec2 shift, int size) {
   if (empty_rect(r)) return glm::ivec4(0);
@@ -402,6 +416,21 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
     h.add(assets.uid).add(shader_reloads).add(layered).add(v.projection).add(v.cull);
     h.add(v.slope_bias).add(v.constant_bias);
   };
+  // Every caster of the view: one hash each (caster_ids, by draw, made once per view by
+  // view_casters()) and one of them all.
+  std::vector<std::uint64_t> caster_ids;
+  auto view_casters = [&](std::size_t view) {
+    caster_ids.assign(frame.draws.size(), 0);
+    InputHash all;
+    for (std::uint32_t i : list.depth_order)
+      if (frame.draws[i].cast_shadows) {
+        InputHash one;
+        add_caster(one, view, i);
+        caster_ids[i] = one.value();
+        all.add(caster_ids[i]);
+      }
+    return all.value();
+  };
   auto layer_inputs = [&](std::size_t view, int c) {
     const ShadowView& v = views[view];
     InputHash h;
@@ -411,7 +440,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
     if (v.projection == ShadowProjection::dual_paraboloid) h.add(v.splits).add(v.paraboloid_margin);
     if (v.skipped[std::size_t(c)]) return h.value();
     for (std::uint32_t i : list.depth_order)
-      if (caster_mask(v, frame.draws[i]) & (1u << c)) add_caster(h, view, i);
+      if (caster_mask(v, frame.draws[i]) & (1u << c)) h.add(caster_ids[i]);
     return h.value();
   };
   // What a scrolled layer's kept texels were drawn from, but its translation: the pass, the
@@ -425,20 +454,6 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
     add_pass(h, v);
     h.add(m).add(casters);
     return h.value();
-  };
-  // Every caster of the view: one hash each (caster_ids, by draw) and one of them all.
-  std::vector<std::uint64_t> caster_ids;
-  auto view_casters = [&](std::size_t view) {
-    caster_ids.assign(frame.draws.size(), 0);
-    InputHash all;
-    for (std::uint32_t i : list.depth_order)
-      if (frame.draws[i].cast_shadows) {
-        InputHash one;
-        add_caster(one, view, i);
-        caster_ids[i] = one.value();
-        all.add(caster_ids[i]);
-      }
-    return all.value();
   };
   // The casters layer c of the view holds (its caster_mask), sorted: a layer that keeps texels
   // must have held every caster that falls on them.
@@ -454,17 +469,13 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   auto newcomer_over = [&](const ShadowView& v, int c, std::size_t layer, const glm::ivec4& kept) {
     if (empty_rect(kept)) return false;
     const std::vector<std::uint64_t>& before = drawn_casters_[layer];
-    const float texel = 2.0f / float(map.size);
-    const glm::vec4 ndc = glm::vec4(kept) * texel - 1.0f + glm::vec4(-2, -2, 2, 2) * texel;
+    const glm::vec4 ndc = drawn_ndc(kept, map.size);
     for (std::uint32_t i : list.depth_order) {
       const DrawItem& d = frame.draws[i];
       if (!(caster_mask(v, d) & (1u << c)) ||
           std::binary_search(before.begin(), before.end(), caster_ids[i]))
         continue;
-      if (d.bounds.empty()) return true;
-      const Aabb box = d.bounds.transformed(v.view_proj[std::size_t(c)]);
-      if (box.max.x >= ndc.x && box.min.x <= ndc.z && box.max.y >= ndc.y && box.min.y <= ndc.w)
-        return true;
+      if (d.bounds.empty() || !box_misses(d.bounds, v.view_proj[std::size_t(c)], ndc)) return true;
     }
     return false;
   };
@@ -494,7 +505,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
     // such as a probe capture's, which draws whole layers at origin 0).
     const bool tracks = frame.shadow_cache && frame.shadow_scroll && !layered &&
                         v.projection == ShadowProjection::ortho;
-    const std::uint64_t casters = tracks ? view_casters(view) : 0;
+    const std::uint64_t casters = view_casters(view);
     for (int c = 0; c < v.layer_count; ++c) {
       const std::size_t layer = std::size_t(v.first_layer + c);
       const bool skipped = v.skipped[std::size_t(c)];
@@ -652,9 +663,7 @@ std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list
   const ShadowView& v = frame.shadow_views[view];
   auto outside_rect = [&](const DrawItem& d) {
     if (!rect || d.bounds.empty()) return false;
-    const Aabb ndc = d.bounds.transformed(*light_vp);  // the light matrix is affine (ortho)
-    const bool out = ndc.max.x < rect->x || ndc.min.x > rect->z || ndc.max.y < rect->y ||
-                     ndc.min.y > rect->w;
+    const bool out = box_misses(d.bounds, *light_vp, *rect);
     if (out && rect_culled) ++*rect_culled;
     return out;
   };
@@ -786,14 +795,10 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
         if (v.skipped[std::size_t(c)]) continue;
         // Map texel x lands on texture texel x + viewport.
         glViewport(piece.viewport.x, piece.viewport.y, size_, size_);
-        // Part of a cascade: casters outside the drawn texels (two texels wider, as the
-        // rectangle is whole texels and the rasteriser's coverage rules are its own) are left
-        // out.
+        // Part of a cascade: casters outside the drawn texels are left out.
         const glm::mat4& vp = v.view_proj[std::size_t(c)];
         const bool part = !whole && v.projection == ShadowProjection::ortho;
-        const float texel = 2.0f / float(size_);
-        const glm::vec4 map_rect = glm::vec4(t - glm::ivec4(piece.viewport, piece.viewport));
-        const glm::vec4 ndc = map_rect * texel - 1.0f + glm::vec4(-2, -2, 2, 2) * texel;
+        const glm::vec4 ndc = drawn_ndc(t - glm::ivec4(piece.viewport, piece.viewport), size_);
         const auto runs = caster_runs(frame, list, cache, state, view, 1u << c, false, records,
                                       &vp, part ? &ndc : nullptr, &stats.shadow_rect_culled);
         status = draw_runs(frame, list, cache, state, stats, view, runs, records, &vp);
