@@ -159,10 +159,57 @@ void clip_polygon(Poly& p, int axis, double bound, double sign) {
   p = out;
 }
 
+// A box in light view space from its centre and half-extent through the rigid view (Arvo's box
+// transform): one transform instead of eight corners. The corners' bounds differ from
+// centre +- extent by rounding only, which `slack` bounds.
+struct LightBounds {
+  dvec3 centre, extent;
+  double slack;
+  // The depth range (depth = -z) of the whole box, widened by the slack: the range of any part
+  // of the box lies within it.
+  Range depths() const {
+    Range r;
+    r.add(-(centre.z + extent.z) - slack, -(centre.z - extent.z) + slack);
+    return r;
+  }
+};
+
+LightBounds light_bounds(const dmat4& light_view, const Aabb& box) {
+  const dvec3 lo(box.min), hi(box.max);
+  LightBounds b;
+  b.centre = transform_point(light_view, 0.5 * (lo + hi));
+  const dvec3 half = 0.5 * (hi - lo);
+  b.extent = dvec3(0.0);
+  double terms = 1.0;  // a bound on the magnitudes each coordinate sums
+  for (int row = 0; row < 3; ++row) {
+    terms += std::abs(light_view[3][row]) + std::abs(b.centre[row]);
+    for (int col = 0; col < 3; ++col) {
+      b.extent[row] += std::abs(light_view[col][row]) * half[col];
+      terms += std::abs(light_view[col][row]) * std::max(std::abs(lo[col]), std::abs(hi[col]));
+    }
+  }
+  b.slack = 1e-9 * terms;
+  return b;
+}
+
 // Depth range (along the light) of `box` inside the light-space prism over `r`.
 Range box_range_in_rect(const dmat4& light_view, const Aabb& box, const Rect& r) {
   Range out;
   if (box.empty() || !(r.min_x <= r.max_x) || !(r.min_y <= r.max_y)) return out;
+  // 0. From the box's light-space bounds (light_bounds()): most boxes of a large scene miss a
+  //    cascade's rectangle or lie well inside it, and are done without transforming 8 corners.
+  {
+    const LightBounds b = light_bounds(light_view, box);
+    const double ex = b.extent.x + b.slack, ey = b.extent.y + b.slack;
+    if (b.centre.x + ex < r.min_x || b.centre.x - ex > r.max_x || b.centre.y + ey < r.min_y ||
+        b.centre.y - ey > r.max_y)
+      return out;
+    if (b.centre.x - ex >= r.min_x && b.centre.x + ex <= r.max_x && b.centre.y - ey >= r.min_y &&
+        b.centre.y + ey <= r.max_y) {
+      out.add(-(b.centre.z + b.extent.z), -(b.centre.z - b.extent.z));
+      return out;
+    }
+  }
   // 1. The 8 corners in light view space (corner i: bit 0 = x, bit 1 = y, bit 2 = z).
   std::array<dvec3, 8> c;
   for (int i = 0; i < 8; ++i) {
@@ -209,16 +256,23 @@ Range tighten_d(const dmat4& light_view, std::span<const Aabb> casters,
                 std::span<const Aabb> receivers, const Rect& r, double slice_near,
                 double slice_far) {
   // 1. Receivers: the parts inside the slice volume (rectangle x [slice_near, slice_far]).
+  //    A box whose whole depth range lies within the range found so far cannot widen it.
   Range out;
   for (const Aabb& b : receivers) {
+    if (!out.empty() && !b.empty()) {
+      const Range whole = light_bounds(light_view, b).depths();
+      if (whole.near >= out.near && whole.far <= out.far) continue;
+    }
     const Range range = box_range_in_rect(light_view, b, r);
     if (range.empty() || range.far < slice_near || range.near > slice_far) continue;
     out.add(std::max(range.near, slice_near), std::min(range.far, slice_far));
   }
   if (out.empty()) return out;
   // 2. Casters inside the rectangle whose nearest point is in front of the farthest receiver
-  //    point can shadow it: pull the near plane back to them (S0 step 3).
+  //    point can shadow it: pull the near plane back to them (S0 step 3). A caster whose whole
+  //    box lies behind the near plane found so far cannot pull it.
   for (const Aabb& b : casters) {
+    if (b.empty() || light_bounds(light_view, b).depths().near >= out.near) continue;
     const Range range = box_range_in_rect(light_view, b, r);
     if (!range.empty() && range.near < out.far) out.near = std::min(out.near, range.near);
   }

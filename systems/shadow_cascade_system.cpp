@@ -252,15 +252,6 @@ DepthRange quantize_depth_range(DepthRange r) {
   return q;
 }
 
-std::vector<std::uint32_t> cull_casters(const glm::mat4& light_view_proj,
-                                        std::span<const Aabb> casters) {
-  std::vector<std::uint32_t> out;
-  for (std::size_t i = 0; i < casters.size(); ++i)
-    if (!casters[i].empty() && maybe_inside(clip_corners(light_view_proj, casters[i])))
-      out.push_back(std::uint32_t(i));
-  return out;
-}
-
 namespace {
 
 // NDC bounds of `box` through the affine map `m` (an orthographic projection): the centre
@@ -274,23 +265,74 @@ Aabb ndc_bounds(const glm::mat4& m, const Aabb& box) {
   return Aabb{c - e, c + e};
 }
 
-// Whether `box` lies wholly outside the convex slice with corners `c` (near 0-3, far 4-7, in
-// slice_corners_world()'s order): outside one of its six face planes.
-bool outside_slice(const std::array<glm::vec3, 8>& c, const Aabb& box) {
-  static constexpr int kFaces[6][3] = {{0, 1, 2}, {4, 5, 6}, {0, 1, 5},
-                                       {3, 2, 6}, {0, 3, 7}, {1, 2, 6}};
-  glm::vec3 centre(0.0f);
-  for (const glm::vec3& p : c) centre += p * 0.125f;
-  for (const auto& f : kFaces) {
-    glm::vec3 n = glm::cross(c[f[1]] - c[f[0]], c[f[2]] - c[f[0]]);
-    if (!(glm::dot(n, n) > 0.0f)) continue;  // a degenerate face bounds nothing
-    if (glm::dot(n, centre - c[f[0]]) > 0.0f) n = -n;  // n points out of the slice
-    // The box corner farthest against n: outside when even it is in front of the plane.
-    const glm::vec3 v = glm::mix(box.max, box.min, glm::vec3(glm::greaterThan(n, glm::vec3(0.0f))));
-    if (glm::dot(n, v - c[f[0]]) > 0.0f) return true;
+// Whether `box` certainly lies outside the clip volume of the affine map `m` (an orthographic
+// projection: w = 1 everywhere), from its NDC box: the margin covers the rounding by which the
+// box's transformed corners could differ from it, so a box this rejects is one maybe_inside()
+// rejects too, and it costs one transform instead of eight.
+bool clearly_outside_ortho(const glm::mat4& m, const Aabb& box) {
+  const Aabb b = ndc_bounds(m, box);
+  for (int row = 0; row < 3; ++row) {
+    float size = 1.0f + std::abs(m[3][row]);  // a bound on the terms each coordinate sums
+    for (int col = 0; col < 3; ++col)
+      size += std::abs(m[col][row]) * std::max(std::abs(box.min[col]), std::abs(box.max[col]));
+    const float slack = 1e-5f * size;
+    if (b.min[row] - slack > 1.0f || b.max[row] + slack < -1.0f) return true;
   }
   return false;
 }
+
+bool affine(const glm::mat4& m) {
+  return m[0][3] == 0.0f && m[1][3] == 0.0f && m[2][3] == 0.0f && m[3][3] == 1.0f;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> cull_casters(const glm::mat4& light_view_proj,
+                                        std::span<const Aabb> casters) {
+  const bool ortho = affine(light_view_proj);
+  std::vector<std::uint32_t> out;
+  for (std::size_t i = 0; i < casters.size(); ++i) {
+    if (casters[i].empty() || (ortho && clearly_outside_ortho(light_view_proj, casters[i])))
+      continue;
+    if (maybe_inside(clip_corners(light_view_proj, casters[i]))) out.push_back(std::uint32_t(i));
+  }
+  return out;
+}
+
+namespace {
+
+// The convex slice with corners `c` (near 0-3, far 4-7, in slice_corners_world()'s order) as its
+// six face planes, normals pointing out; a degenerate face bounds nothing and is left out.
+struct SlicePlanes {
+  std::array<glm::vec3, 6> normal, point;
+  int count = 0;
+
+  explicit SlicePlanes(const std::array<glm::vec3, 8>& c) {
+    static constexpr int kFaces[6][3] = {{0, 1, 2}, {4, 5, 6}, {0, 1, 5},
+                                         {3, 2, 6}, {0, 3, 7}, {1, 2, 6}};
+    glm::vec3 centre(0.0f);
+    for (const glm::vec3& p : c) centre += p * 0.125f;
+    for (const auto& f : kFaces) {
+      glm::vec3 n = glm::cross(c[f[1]] - c[f[0]], c[f[2]] - c[f[0]]);
+      if (!(glm::dot(n, n) > 0.0f)) continue;
+      if (glm::dot(n, centre - c[f[0]]) > 0.0f) n = -n;
+      normal[std::size_t(count)] = n;
+      point[std::size_t(count)] = c[f[0]];
+      ++count;
+    }
+  }
+
+  // Whether `box` lies wholly outside the slice: outside one of its planes.
+  bool outside(const Aabb& box) const {
+    for (int i = 0; i < count; ++i) {
+      const glm::vec3& n = normal[std::size_t(i)];
+      // The box corner farthest against n: outside when even it is in front of the plane.
+      const glm::vec3 v = glm::mix(box.max, box.min, glm::vec3(glm::greaterThan(n, glm::vec3(0.0f))));
+      if (glm::dot(n, v - point[std::size_t(i)]) > 0.0f) return true;
+    }
+    return false;
+  }
+};
 
 }  // namespace
 
@@ -299,12 +341,14 @@ glm::vec4 receiver_rect(const glm::mat4& light_view_proj,
                         std::span<const Aabb> receivers, float margin_ndc, Aabb* touched) {
   Aabb slice;
   for (const glm::vec3& p : slice_corners) slice.expand(glm::vec3(light_view_proj * glm::vec4(p, 1.0f)));
+  const SlicePlanes planes(slice_corners);
   glm::vec2 lo(std::numeric_limits<float>::infinity()), hi(-lo);
   for (const Aabb& box : receivers) {
-    if (box.empty() || outside_slice(slice_corners, box)) continue;
+    if (box.empty()) continue;
     const Aabb b = ndc_bounds(light_view_proj, box);
     if (b.max.x < slice.min.x || b.min.x > slice.max.x || b.max.y < slice.min.y ||
-        b.min.y > slice.max.y || b.max.z < slice.min.z || b.min.z > slice.max.z)
+        b.min.y > slice.max.y || b.max.z < slice.min.z || b.min.z > slice.max.z ||
+        planes.outside(box))
       continue;
     if (touched) touched->expand(box);
     lo = glm::min(lo, glm::max(glm::vec2(b.min), glm::vec2(slice.min)));

@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <random>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -666,6 +668,125 @@ TEST(CascadeNearFar, MatchesBruteForceSurfaceSampling) {
     EXPECT_NEAR(nf.far, bf, 2.0f * spacing + 1e-4f) << trial;
   }
   EXPECT_GT(non_empty, 40);
+}
+
+// The depths of the part of `b` inside the light-space prism over the rectangle, in double:
+// every face clipped by the four side planes (the reference the tighten test compares with).
+std::pair<double, double> clipped_depths(const glm::dmat4& v, const Aabb& b, double x0, double x1,
+                                         double y0, double y1) {
+  double near = 1e300, far = -1e300;
+  const glm::dvec3 lo(b.min), hi(b.max);
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      std::vector<glm::dvec3> poly;
+      for (int k = 0; k < 4; ++k) {
+        glm::dvec3 p;
+        p[axis] = side ? hi[axis] : lo[axis];
+        p[(axis + 1) % 3] = (k == 1 || k == 2) ? hi[(axis + 1) % 3] : lo[(axis + 1) % 3];
+        p[(axis + 2) % 3] = k >= 2 ? hi[(axis + 2) % 3] : lo[(axis + 2) % 3];
+        poly.push_back(glm::dvec3(v * glm::dvec4(p, 1.0)));
+      }
+      // Keep a * (coordinate - bound) >= 0: x >= x0, x <= x1, y >= y0, y <= y1.
+      const std::array<std::tuple<int, double, double>, 4> planes = {
+          std::tuple{0, x0, 1.0}, {0, x1, -1.0}, {1, y0, 1.0}, {1, y1, -1.0}};
+      for (const auto& [c, bound, a] : planes) {
+        std::vector<glm::dvec3> next;
+        for (std::size_t k = 0; k < poly.size(); ++k) {
+          const glm::dvec3 p = poly[k], q = poly[(k + 1) % poly.size()];
+          const double dp = a * (p[c] - bound), dq = a * (q[c] - bound);
+          if (dp >= 0.0) next.push_back(p);
+          if ((dp >= 0.0) != (dq >= 0.0)) next.push_back(p + (q - p) * (dp / (dp - dq)));
+        }
+        poly = next;
+      }
+      for (const glm::dvec3& p : poly) {
+        near = std::min(near, -p.z);
+        far = std::max(far, -p.z);
+      }
+    }
+  return {near, far};
+}
+
+// Fields of boxes under a tilted light, the rectangle over part of a field: boxes well inside
+// it, outside it and across its edges, near the origin and 4 km from it. tighten_near_far()
+// follows its rule (the farthest and nearest receiver point in the slice, the near end pulled to
+// casters in front of that far) with every box's part in the rectangle clipped exactly. Fields
+// of 1-3 boxes make every box count; in the large fields the boxes come in the order that moves
+// an end a little at a time (receivers by their near or far end, casters nearest last), so
+// that passing over any box that moves an end shows.
+TEST(CascadeNearFar, TightenFollowsItsRuleOnFieldsOfBoxes) {
+  Rng rng;
+  int pulled = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const glm::vec3 origin = trial % 2 ? glm::vec3(0.0f) : rng.point(4000.0f);
+    const int count = trial < 150 ? rng.integer(1, 3) : 300;
+    const float spread = count < 10 ? 3.0f : 60.0f;
+    std::vector<Aabb> boxes;
+    for (int i = 0; i < count; ++i) {
+      const glm::vec3 lo =
+          origin + glm::vec3(rng.uniform(-spread, spread), rng.uniform(0, 8), rng.uniform(-spread, spread));
+      boxes.push_back(Aabb::from_corners(
+          lo, lo + glm::vec3(rng.uniform(0.2f, 3), rng.uniform(0.2f, 3), rng.uniform(0.2f, 3))));
+    }
+    glm::vec3 dir = rng.unit();
+    if (dir.y > -0.2f) dir.y = -0.2f - std::abs(dir.y);
+    dir = glm::normalize(dir);
+    const glm::mat4 v = light_view_matrix(dir, origin - 200.0f * dir);
+    const glm::vec3 c = glm::vec3(v * glm::vec4(origin, 1.0f));
+    // Around part of the field, or for the small ones, around part of the first box's footprint.
+    float x0 = c.x + rng.uniform(-40, 0), x1 = x0 + rng.uniform(15, 50);
+    float y0 = c.y + rng.uniform(-40, 0), y1 = y0 + rng.uniform(15, 50);
+    if (count < 10) {
+      const Aabb ls = boxes[0].transformed(v);
+      const float ex = ls.max.x - ls.min.x, ey = ls.max.y - ls.min.y;
+      x0 = rng.uniform(ls.min.x - 0.3f * ex, ls.max.x);
+      x1 = x0 + rng.uniform(0.2f, 1.5f) * ex;
+      y0 = rng.uniform(ls.min.y - 0.3f * ey, ls.max.y);
+      y1 = y0 + rng.uniform(0.2f, 1.5f) * ey;
+    }
+    // Every fourth slice cuts the field's depths (the receivers clamped to it); the others hold them.
+    const bool cut = trial % 4 == 0;
+    const float slice_near = cut ? 185.0f + rng.uniform(0, 10) : 100.0f;
+    const float slice_far = cut ? slice_near + rng.uniform(5, 30) : 300.0f;
+    const glm::dmat4 vd(v);
+    struct Clipped {
+      Aabb box;
+      double near, far;
+    };
+    std::vector<Clipped> rs, cs;
+    for (int i = 0; i < count; ++i) {
+      const auto [n, f] = clipped_depths(vd, boxes[std::size_t(i)], x0, x1, y0, y1);
+      if (i % 3 != 1 || count < 10) rs.push_back({boxes[std::size_t(i)], n, f});
+      if (i % 2 == 0 || count < 10) cs.push_back({boxes[std::size_t(i)], n, f});
+    }
+    std::sort(rs.begin(), rs.end(), [&](const Clipped& a, const Clipped& b) {
+      return trial % 2 ? a.near > b.near : a.far < b.far;
+    });
+    std::sort(cs.begin(), cs.end(), [](const Clipped& a, const Clipped& b) { return a.near > b.near; });
+    std::vector<Aabb> receivers, casters;
+    double near = 1e300, far = -1e300;
+    for (const Clipped& r : rs) {
+      receivers.push_back(r.box);
+      if (r.near > r.far || r.far < slice_near || r.near > slice_far) continue;
+      near = std::min(near, std::max(r.near, double(slice_near)));
+      far = std::max(far, std::min(r.far, double(slice_far)));
+    }
+    const double receivers_near = near;
+    for (const Clipped& k : cs) {
+      casters.push_back(k.box);
+      if (k.near <= k.far && k.near < far) near = std::min(near, k.near);
+    }
+    const NearFar nf = tighten_near_far(v, casters, receivers, x0, x1, y0, y1, slice_near, slice_far);
+    if (far < -1e299) {
+      EXPECT_TRUE(nf.empty) << trial;
+      continue;
+    }
+    pulled += near < receivers_near;
+    ASSERT_FALSE(nf.empty) << trial;
+    EXPECT_NEAR(nf.near, near, 1e-4) << trial;
+    EXPECT_NEAR(nf.far, far, 1e-4) << trial;
+  }
+  EXPECT_GT(pulled, 10);  // casters in front of the receivers were found
 }
 
 TEST(CascadeNearFar, EmptyWhenTheRectangleMissesTheBox) {

@@ -3,7 +3,9 @@
 // No GL.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <limits>
 #include <vector>
 
@@ -448,6 +450,64 @@ TEST(ShadowCascadeSystem, NoShadowedLightOrNoGeometryGivesNoShadow) {
   const ShadowData d = update_shadow_cascades(empty, camera(empty), state);
   EXPECT_FALSE(d.light.valid());
   EXPECT_TRUE(d.error.empty());
+}
+
+}  // namespace
+}  // namespace kaskad
+
+namespace kaskad {
+namespace {
+
+// cull_casters() keeps exactly the boxes the 8-corner test keeps (a box is out when all its
+// corners lie beyond one clip plane), for orthographic maps whose quick test rejects from the
+// box's NDC bounds, near the origin and 4 km from it, with boxes placed across every edge of
+// the clip volume; and for a perspective map, which takes the corner test alone.
+TEST(CasterCulling, KeepsWhatTheCornerTestKeepsAtEveryEdge) {
+  std::mt19937 gen(7u);
+  auto uniform = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(gen); };
+  auto corner_test = [](const glm::mat4& m, const Aabb& b) {
+    for (int axis = 0; axis < 3; ++axis)
+      for (float sign : {-1.0f, 1.0f}) {
+        bool all_out = true;
+        for (int i = 0; i < 8; ++i) {
+          const glm::vec4 c = m * glm::vec4((i & 1) ? b.max.x : b.min.x, (i & 2) ? b.max.y : b.min.y,
+                                            (i & 4) ? b.max.z : b.min.z, 1.0f);
+          all_out = all_out && sign * c[axis] > c.w;
+        }
+        if (all_out) return false;
+      }
+    return true;
+  };
+  int kept = 0, culled = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const glm::vec3 origin = trial % 2 ? glm::vec3(0.0f)
+                                       : glm::vec3(uniform(-4000, 4000), uniform(-50, 50), uniform(-4000, 4000));
+    const glm::vec3 dir = glm::normalize(glm::vec3(uniform(-1, 1), uniform(-1.0f, -0.2f), uniform(-1, 1)));
+    const glm::mat4 view = glm::lookAt(origin - 100.0f * dir, origin, glm::vec3(0, 1, 0));
+    const float w = uniform(5, 60);
+    const glm::mat4 vp = trial % 8 == 7 ? glm::perspective(0.8f, 1.0f, 1.0f, 200.0f) * view
+                                        : glm::ortho(-w, w, -w, w, 1.0f, 200.0f) * view;
+    const glm::mat4 inv = glm::inverse(vp);
+    std::vector<Aabb> boxes;
+    for (int i = 0; i < 300; ++i) {
+      // A point on or near a face of the clip volume, the box around it small or large.
+      glm::vec3 ndc(uniform(-1.2f, 1.2f), uniform(-1.2f, 1.2f), uniform(-1.2f, 1.2f));
+      ndc[i % 3] = (i % 2 ? 1.0f : -1.0f) * (1.0f + uniform(-0.02f, 0.02f));
+      const glm::vec4 p = inv * glm::vec4(ndc, 1.0f);
+      const glm::vec3 centre = glm::vec3(p) / p.w;
+      const glm::vec3 half(uniform(0.01f, 2.0f), uniform(0.01f, 2.0f), uniform(0.01f, 2.0f));
+      boxes.push_back(Aabb::from_corners(centre - half, centre + half));
+    }
+    boxes.push_back(Aabb{});  // empty: never kept
+    std::vector<std::uint32_t> expected;
+    for (std::uint32_t i = 0; i < boxes.size(); ++i)
+      if (!boxes[i].empty() && corner_test(vp, boxes[i])) expected.push_back(i);
+    EXPECT_EQ(cull_casters(vp, boxes), expected) << trial;
+    kept += int(expected.size());
+    culled += int(boxes.size() - expected.size());
+  }
+  EXPECT_GT(kept, 2000);
+  EXPECT_GT(culled, 2000);
 }
 
 }  // namespace
