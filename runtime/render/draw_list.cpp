@@ -1,7 +1,12 @@
 #include "runtime/render/draw_list.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <tuple>
+#include <type_traits>
+#include <unordered_map>
+#include <utility>
 
 #include "components/bounds.h"
 
@@ -146,27 +151,84 @@ auto material_fields(const Material& m) {
                   m.alpha_cutoff, m.k_s, m.features);
 }
 
+// One material field as bits to hash: a float with -0 made +0 (they compare equal), an enum
+// or integer as it is.
+template <class T>
+std::uint64_t field_bits(const T& v) {
+  if constexpr (std::is_floating_point_v<T>)
+    return std::bit_cast<std::uint32_t>(float(v) + 0.0f);
+  else if constexpr (std::is_enum_v<T>)
+    return std::uint64_t(static_cast<std::underlying_type_t<T>>(v));
+  else
+    return std::uint64_t(v);
+}
+
+// A material's fields as bits, for finding equal materials by hashing.
+auto material_bits(const Material& m) {
+  return std::apply(
+      [](const auto&... f) { return std::array<std::uint64_t, sizeof...(f)>{field_bits(f)...}; },
+      material_fields(m));
+}
+using MaterialBits = decltype(material_bits(Material{}));
+
+struct MaterialBitsHash {
+  std::size_t operator()(const MaterialBits& bits) const {
+    std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a over the fields
+    for (std::uint64_t b : bits) h = (h ^ b) * 0x100000001b3ull;
+    return std::size_t(h);
+  }
+};
+
+// Each draw's material as a rank: draws with equal material_fields() share a rank, and ranks
+// order as material_fields() do. A scene's thousands of draws have few materials: they are
+// found by hashing and only they are sorted.
+std::vector<std::uint32_t> material_ranks(const FrameInput& frame) {
+  std::unordered_map<MaterialBits, std::uint32_t, MaterialBitsHash> id_of;
+  std::vector<std::uint32_t> first_draw;  // of each distinct material
+  std::vector<std::uint32_t> id(frame.draws.size());
+  for (std::uint32_t i = 0; i < frame.draws.size(); ++i) {
+    const auto [it, added] =
+        id_of.try_emplace(material_bits(frame.draws[i].material), std::uint32_t(first_draw.size()));
+    if (added) first_draw.push_back(i);
+    id[i] = it->second;
+  }
+  std::vector<std::uint32_t> order(first_draw.size()), rank(first_draw.size());
+  for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return material_fields(frame.draws[first_draw[a]].material) <
+           material_fields(frame.draws[first_draw[b]].material);
+  });
+  for (std::uint32_t r = 0; r < order.size(); ++r) rank[order[r]] = r;
+  for (std::uint32_t& k : id) k = rank[k];
+  return id;
+}
+
 // Draw indices sorted by `by[i]` as pass `pass` sees it, then by material, then by mesh: draws
 // that may share one instanced draw (same program, material and mesh) end up next to each other.
+// The depth pass reads a material only to discard alpha-masked texels: without that, draws of
+// one mesh share a draw whatever their materials, so there mesh comes before material.
 std::vector<std::uint32_t> sorted_by(const FrameInput& frame, Pass pass,
-                                     const std::vector<VariantKey>& by) {
-  auto material_order = [&](std::uint32_t a, std::uint32_t b) {
-    const DrawItem& da = frame.draws[a];
-    const DrawItem& db = frame.draws[b];
-    // The depth pass reads a material only to discard alpha-masked texels: without that, draws
-    // of one mesh share a draw whatever their materials.
-    if (pass == Pass::depth && !by[a].has(VariantKey::kAlphaMask) && da.mesh != db.mesh)
-      return da.mesh < db.mesh;
-    const auto fa = material_fields(da.material), fb = material_fields(db.material);
-    if (fa != fb) return fa < fb;
-    return da.mesh < db.mesh;
+                                     const std::vector<VariantKey>& by,
+                                     const std::vector<std::uint32_t>& material_rank) {
+  struct SortKey {
+    VariantKey key;
+    bool mesh_first;
+    std::uint32_t material;
+    MeshId mesh;
   };
+  std::vector<SortKey> k(frame.draws.size());
+  for (std::size_t i = 0; i < k.size(); ++i)
+    k[i] = {by[i].filtered_for(pass), pass == Pass::depth && !by[i].has(VariantKey::kAlphaMask),
+            material_rank[i], frame.draws[i].mesh};
   std::vector<std::uint32_t> order(frame.draws.size());
   for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    const VariantKey ka = by[a].filtered_for(pass), kb = by[b].filtered_for(pass);
-    if (ka != kb) return ka < kb;
-    return material_order(a, b);
+    const SortKey& ka = k[a];
+    const SortKey& kb = k[b];
+    if (ka.key != kb.key) return ka.key < kb.key;
+    if (ka.mesh_first && ka.mesh != kb.mesh) return ka.mesh < kb.mesh;
+    if (ka.material != kb.material) return ka.material < kb.material;
+    return ka.mesh < kb.mesh;
   });
   return order;
 }
@@ -179,8 +241,10 @@ DrawList build_draw_list(const FrameInput& frame, VariantKey frame_key) {
   list.keys.resize(frame.draws.size());
   for (std::size_t i = 0; i < frame.draws.size(); ++i)
     list.keys[i] = material_variant(frame.draws[i]) | frame_key;
-  if (!frame.shadow_views.empty()) list.depth_order = sorted_by(frame, Pass::depth, list.keys);
-  list.forward_order = sorted_by(frame, Pass::forward, list.keys);
+  const std::vector<std::uint32_t> material_rank = material_ranks(frame);
+  if (!frame.shadow_views.empty())
+    list.depth_order = sorted_by(frame, Pass::depth, list.keys, material_rank);
+  list.forward_order = sorted_by(frame, Pass::forward, list.keys, material_rank);
   if (frame.msaa > 1) {
     const VariantKey msaa = msaa_frame_variant(frame_key);
     list.msaa_keys.resize(frame.draws.size());
@@ -192,7 +256,7 @@ DrawList build_draw_list(const FrameInput& frame, VariantKey frame_key) {
     list.capture_keys.resize(frame.draws.size());
     for (std::size_t i = 0; i < frame.draws.size(); ++i)
       list.capture_keys[i] = material_variant(frame.draws[i]) | capture;
-    list.capture_order = sorted_by(frame, Pass::forward, list.capture_keys);
+    list.capture_order = sorted_by(frame, Pass::forward, list.capture_keys, material_rank);
   }
   return list;
 }

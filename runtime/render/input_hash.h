@@ -1,6 +1,10 @@
-// FNV-1a over the bytes of plain values: what a cached result was made from (shadow-map layers,
-// the main view's stored shadow visibility). Equal inputs give equal values; a value is never 0,
-// which callers keep for "nothing stored".
+// A 64-bit hash of plain values: what a cached result was made from (shadow-map layers, the main
+// view's stored shadow visibility). Equal inputs give equal values; a value is never 0, which
+// callers keep for "nothing stored".
+//
+// The bytes are taken 8 at a time, each word folded in by a 64x64 -> 128-bit multiply whose
+// halves are xored (the mixing step of wyhash): a frame hashes every caster's matrix, and a
+// byte-at-a-time hash (FNV-1a) of 10,000 casters cost about a millisecond.
 #pragma once
 
 #include <cstdint>
@@ -10,16 +14,35 @@
 namespace kaskad::render {
 
 struct InputHash {
-  std::uint64_t h = 14695981039346656037ull;
+  std::uint64_t h = 0x243f6a8885a308d3ull;
+
   template <typename T>
   InputHash& add(const T& v) {
     static_assert(std::is_trivially_copyable_v<T>);
     unsigned char bytes[sizeof(T)];
     std::memcpy(bytes, &v, sizeof(T));
-    for (unsigned char b : bytes) h = (h ^ b) * 1099511628211ull;
+    std::size_t i = 0;
+    for (; i + 8 <= sizeof(T); i += 8) {
+      std::uint64_t word;
+      std::memcpy(&word, bytes + i, 8);
+      fold(word);
+    }
+    if (i < sizeof(T)) {  // the last 1-7 bytes, with their count in the top byte
+      std::uint64_t word = std::uint64_t(sizeof(T) - i) << 56;
+      std::memcpy(&word, bytes + i, sizeof(T) - i);
+      fold(word);
+    }
     return *this;
   }
   std::uint64_t value() const { return h | 1u; }
+
+ private:
+  __extension__ using Wide = unsigned __int128;  // GCC's and Clang's, on 64-bit targets
+
+  void fold(std::uint64_t word) {
+    const Wide r = Wide(h ^ word ^ 0xa0761d6478bd642full) * 0xe7037ed1a0b428dbull;
+    h = std::uint64_t(r) ^ std::uint64_t(r >> 64);
+  }
 };
 
 }  // namespace kaskad::render

@@ -1,0 +1,139 @@
+// The draw list's order (runtime/render/draw_list.h) and the cache's input hash
+// (runtime/render/input_hash.h), without GL. Draws that may share one instanced draw must be
+// neighbours in every pass's order; equal inputs hash equal and a changed byte changes the hash.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <random>
+#include <set>
+#include <tuple>
+#include <vector>
+
+#include "runtime/render/draw_list.h"
+#include "runtime/render/input_hash.h"
+
+namespace kaskad::render {
+namespace {
+
+// Materials that sort apart, and two that differ only by the sign of a zero (equal materials).
+std::vector<Material> materials() {
+  std::vector<Material> out(7);
+  out[1].base_color = {0.2f, 0.4f, 0.6f, 1.0f};
+  out[2].roughness = 0.9f;
+  out[3].metallic = 0.0f;
+  out[4].metallic = -0.0f;  // equal to out[3]
+  out[5].alpha_mask = true;
+  out[5].features = VariantKey().set(VariantKey::kAlphaMask, 1).bits();
+  out[5].alpha_cutoff = 0.3f;
+  out[6].double_sided = true;
+  out[6].metallic = 1.0f;
+  return out;
+}
+
+FrameInput shuffled_draws(int count, unsigned seed) {
+  std::mt19937 gen(seed);
+  const std::vector<Material> mats = materials();
+  FrameInput frame;
+  for (int i = 0; i < count; ++i) {
+    DrawItem d;
+    d.mesh = MeshId{std::uint32_t(gen() % 3)};
+    d.material = mats[gen() % mats.size()];
+    d.receive_shadows = gen() % 4 != 0;
+    d.model[3] = glm::vec4(float(i), 0.0f, 0.0f, 1.0f);
+    frame.draws.push_back(d);
+  }
+  frame.shadow_views.push_back(ShadowView{});
+  frame.shadow_views.back().layer_count = 4;
+  return frame;
+}
+
+// Every class of draws (by `same`) occupies one run of `order`, in ascending draw index unless
+// `ascending` is false (a class that spans several materials, sorted by material within). The
+// materials that differ only by a zero's sign are equal, so they share their runs too.
+template <typename Same>
+void expect_runs(const std::vector<std::uint32_t>& order, std::size_t draws, Same same,
+                 const char* what, bool ascending = true) {
+  std::vector<std::uint32_t> sorted = order;
+  std::sort(sorted.begin(), sorted.end());
+  ASSERT_EQ(sorted.size(), draws) << what;
+  for (std::uint32_t i = 0; i < sorted.size(); ++i) ASSERT_EQ(sorted[i], i) << what;  // a permutation
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const std::uint32_t i = order[k];
+    if (k > 0 && same(order[k - 1], i)) {
+      if (ascending) {
+        EXPECT_LT(order[k - 1], i) << what << ": a run keeps the draws' order";
+      }
+      continue;
+    }
+    for (std::size_t j = 0; j < k; ++j)
+      if (same(order[j], i)) {
+        ADD_FAILURE() << what << ": draw " << i << " is apart from draw " << order[j];
+        return;
+      }
+  }
+}
+
+TEST(DrawList, DrawsThatMayShareADrawAreNeighboursInEveryOrder) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const FrameInput frame = shuffled_draws(3000, seed);
+    const DrawList list = build_draw_list(frame, frame_variant(frame));
+    const auto& d = frame.draws;
+    auto fwd = [&](std::uint32_t a) { return list.keys[a].filtered_for(Pass::forward); };
+    expect_runs(list.forward_order, d.size(), [&](std::uint32_t a, std::uint32_t b) {
+      return fwd(a) == fwd(b) && d[a].material == d[b].material && d[a].mesh == d[b].mesh;
+    }, "forward");
+    // The depth pass: one draw per mesh whatever the material, unless alpha-masked.
+    auto depth = [&](std::uint32_t a) { return list.keys[a].filtered_for(Pass::depth); };
+    expect_runs(list.depth_order, d.size(), [&](std::uint32_t a, std::uint32_t b) {
+      if (depth(a) != depth(b) || d[a].mesh != d[b].mesh) return false;
+      return !list.keys[a].has(VariantKey::kAlphaMask) || d[a].material == d[b].material;
+    }, "depth", false);
+  }
+}
+
+// The order does not depend on the order the draws arrive in: the same multiset of draws, fed
+// in two orders, gives the same sequence of (key, material, mesh).
+TEST(DrawList, TheOrderOfClassesIsTheSameWhateverOrderDrawsArriveIn) {
+  FrameInput a = shuffled_draws(500, 9u);
+  FrameInput b = a;
+  std::reverse(b.draws.begin(), b.draws.end());
+  auto classes = [](const FrameInput& f) {
+    const DrawList list = build_draw_list(f, frame_variant(f));
+    std::vector<std::tuple<std::uint64_t, std::uint32_t, bool, float, float, float>> out;
+    for (std::uint32_t i : list.forward_order) {
+      const DrawItem& d = f.draws[i];
+      out.emplace_back(list.keys[i].bits(), std::uint32_t(d.mesh), d.material.alpha_mask, d.material.roughness,
+                       d.material.base_color.r, d.material.metallic == 0.0f ? 0.0f : d.material.metallic);
+    }
+    return out;
+  };
+  EXPECT_EQ(classes(a), classes(b));
+}
+
+struct Odd {
+  std::uint8_t bytes[13];
+};
+
+TEST(InputHash, EqualInputsHashEqualAndEveryBitCounts) {
+  Odd x{};
+  for (int i = 0; i < 13; ++i) x.bytes[i] = std::uint8_t(i * 37);
+  const std::uint64_t base = InputHash().add(x).add(2.5f).value();
+  EXPECT_EQ(InputHash().add(x).add(2.5f).value(), base);
+  EXPECT_NE(base, 0u);
+  std::set<std::uint64_t> seen{base};
+  for (int byte = 0; byte < 13; ++byte)
+    for (int bit = 0; bit < 8; ++bit) {
+      Odd y = x;
+      y.bytes[byte] ^= std::uint8_t(1u << bit);
+      const std::uint64_t h = InputHash().add(y).add(2.5f).value();
+      EXPECT_NE(h, 0u);
+      EXPECT_TRUE(seen.insert(h).second) << "byte " << byte << " bit " << bit;
+    }
+  // Order and grouping count.
+  EXPECT_NE(InputHash().add(1.0f).add(2.0f).value(), InputHash().add(2.0f).add(1.0f).value());
+  EXPECT_NE(InputHash().add(std::uint32_t(0)).value(), InputHash().add(std::uint64_t(0)).value());
+}
+
+}  // namespace
+}  // namespace kaskad::render
