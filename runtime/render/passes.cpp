@@ -7,6 +7,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <map>
 #include <type_traits>
 
@@ -466,14 +467,21 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   // Whether a caster of layer c that the layer did not hold when drawn (as can happen without
   // any caster moving: shadow.cull_by_receivers assigns casters by the receivers the slice
   // serves) reaches the texels `kept` (two texels wider, as in caster_runs()).
-  auto newcomer_over = [&](const ShadowView& v, int c, std::size_t layer, const glm::ivec4& kept) {
+  // `now` is the layer's casters (layer_casters()), sorted like the ones it was drawn with: the
+  // newcomers are found by one merge of the two.
+  auto newcomer_over = [&](const ShadowView& v, int c, std::size_t layer, const glm::ivec4& kept,
+                           const std::vector<std::uint64_t>& now) {
     if (empty_rect(kept)) return false;
     const std::vector<std::uint64_t>& before = drawn_casters_[layer];
+    std::vector<std::uint64_t> joined;
+    std::set_difference(now.begin(), now.end(), before.begin(), before.end(),
+                        std::back_inserter(joined));
+    if (joined.empty()) return false;
     const glm::vec4 ndc = drawn_ndc(kept, map.size);
     for (std::uint32_t i : list.depth_order) {
       const DrawItem& d = frame.draws[i];
       if (!(caster_mask(v, d) & (1u << c)) ||
-          std::binary_search(before.begin(), before.end(), caster_ids[i]))
+          !std::binary_search(joined.begin(), joined.end(), caster_ids[i]))
         continue;
       if (d.bounds.empty() || !box_misses(d.bounds, v.view_proj[std::size_t(c)], ndc)) return true;
     }
@@ -536,7 +544,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
       if (drawn_from_[layer] != 0 && drawn_fixed_[layer] == fixed_[layer] &&
           moved_by_texels(drawn_matrix_[layer], v.view_proj[std::size_t(c)], map.size, shift)) {
         const glm::ivec4 kept = shifted(drawn_rect_[layer], shift, map.size);
-        if (!newcomer_over(v, c, layer, kept)) {
+        if (!newcomer_over(v, c, layer, kept, casters_[layer])) {
           origin_[layer] = ((origin_[layer] - shift) % map.size + map.size) % map.size;
           regions = outside(rects_[layer], kept);
           stats.shadow_layers_scrolled |= 1u << layer;
