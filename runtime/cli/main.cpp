@@ -27,6 +27,7 @@
 #include "runtime/cli/player.h"
 #include "runtime/core/atomic_file.h"
 #include "runtime/core/log.h"
+#include "runtime/core/memory.h"
 #include "runtime/gpu/context.h"
 #ifdef KASKAD_HAS_EDITOR
 #include "editor/editor.h"
@@ -613,6 +614,7 @@ int run_command(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
+  keep_freed_memory();  // frames reuse their memory instead of faulting it in again
   // A file-size limit (`ulimit -f`) or a full disk must fail the write with an error, not kill
   // the process: write() then returns EFBIG and the atomic writer keeps the previous file.
   std::signal(SIGXFSZ, SIG_IGN);
