@@ -159,9 +159,10 @@ void clip_polygon(Poly& p, int axis, double bound, double sign) {
   p = out;
 }
 
-// A box in light view space from its centre and half-extent through the rigid view (Arvo's box
-// transform): one transform instead of eight corners. The corners' bounds differ from
-// centre +- extent by rounding only, which `slack` bounds.
+// A box in light view space from its centre and half-extent through the view (Arvo's box
+// transform; transform_point() drops w, so the map is affine whatever the matrix): one
+// transform instead of eight corners. The corners' bounds differ from centre +- extent by
+// rounding only, which `slack` bounds.
 struct LightBounds {
   dvec3 centre, extent;
   double slack;
@@ -196,19 +197,14 @@ LightBounds light_bounds(const dmat4& light_view, const Aabb& box) {
 Range box_range_in_rect(const dmat4& light_view, const Aabb& box, const Rect& r) {
   Range out;
   if (box.empty() || !(r.min_x <= r.max_x) || !(r.min_y <= r.max_y)) return out;
-  // 0. From the box's light-space bounds (light_bounds()): most boxes of a large scene miss a
-  //    cascade's rectangle or lie well inside it, and are done without transforming 8 corners.
+  // 0. Most boxes of a large scene miss a cascade's rectangle: reject them from the box's
+  //    light-space bounds (light_bounds()), one transform instead of eight corners.
   {
     const LightBounds b = light_bounds(light_view, box);
     const double ex = b.extent.x + b.slack, ey = b.extent.y + b.slack;
     if (b.centre.x + ex < r.min_x || b.centre.x - ex > r.max_x || b.centre.y + ey < r.min_y ||
         b.centre.y - ey > r.max_y)
       return out;
-    if (b.centre.x - ex >= r.min_x && b.centre.x + ex <= r.max_x && b.centre.y - ey >= r.min_y &&
-        b.centre.y + ey <= r.max_y) {
-      out.add(-(b.centre.z + b.extent.z), -(b.centre.z - b.extent.z));
-      return out;
-    }
   }
   // 1. The 8 corners in light view space (corner i: bit 0 = x, bit 1 = y, bit 2 = z).
   std::array<dvec3, 8> c;
@@ -217,15 +213,14 @@ Range box_range_in_rect(const dmat4& light_view, const Aabb& box, const Rect& r)
                   (i & 4) ? box.max.z : box.min.z};
     c[i] = transform_point(light_view, w);
   }
-  // Quick reject: the light-space box of the corners misses the rectangle.
+  // The light-space box of the corners: it may still miss the rectangle by rounding.
   dvec3 lo = c[0], hi = c[0];
   for (const dvec3& p : c) {
     lo = glm::min(lo, p);
     hi = glm::max(hi, p);
   }
   if (hi.x < r.min_x || lo.x > r.max_x || hi.y < r.min_y || lo.y > r.max_y) return out;
-  // Wholly inside the rectangle (most boxes of a cascade): nothing is clipped, the corners are
-  // the vertices.
+  // Wholly inside the rectangle: nothing is clipped, the corners are the vertices.
   if (lo.x >= r.min_x && hi.x <= r.max_x && lo.y >= r.min_y && hi.y <= r.max_y) {
     out.add(-hi.z, -lo.z);
     return out;

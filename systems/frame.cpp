@@ -103,14 +103,19 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
     in.aov_shadow_view = aov_shadow_index(scene, shadows.size());
   }
 
-  // Each entity's shadow layers, by entity index: one pass over every layer's sorted casters
-  // (ShadowData::cascade_mask() per draw and view would search every list once per draw).
-  std::vector<std::uint32_t> layers_of;
+  // Each entity's shadow layers, by entity index (with its generation): one pass over every
+  // layer's casters, instead of a search of every list per draw.
+  struct Layers {
+    std::uint32_t generation = 0, mask = 0;
+  };
+  std::vector<Layers> layers_of;
   for (const ShadowData& v : shadows)
     for (int c = 0; c < v.cascade_count; ++c)
       for (ecs::Entity e : v.casters[std::size_t(c)]) {
-        if (e.index >= layers_of.size()) layers_of.resize(std::size_t(e.index) + 1, 0u);
-        layers_of[e.index] |= 1u << (v.first_layer + c);
+        if (!world.alive(e)) continue;
+        if (e.index >= layers_of.size()) layers_of.resize(std::size_t(e.index) + 1);
+        layers_of[e.index].generation = e.generation;
+        layers_of[e.index].mask |= 1u << (v.first_layer + c);
       }
   const Material default_material;
   std::vector<ProbeHandle> pbr_probes;  // probes a draw of the pbr reflection model reflects
@@ -126,7 +131,9 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         d.material = mat ? *mat : default_material;
         d.cast_shadows = mr.cast_shadows;
         d.receive_shadows = mr.receive_shadows;
-        d.shadow_layers = e.index < layers_of.size() ? layers_of[e.index] : 0u;
+        d.shadow_layers = e.index < layers_of.size() && layers_of[e.index].generation == e.generation
+                              ? layers_of[e.index].mask
+                              : 0u;
         d.layer = mr.layer;
         if (const auto* wb = world.try_get<WorldBounds>(e)) d.bounds = wb->box;
         // A reflector's own draw reflects its probe's map once one is complete (S3 eq. (3)).

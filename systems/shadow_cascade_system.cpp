@@ -257,7 +257,8 @@ namespace {
 // NDC bounds of `box` through the affine map `m` (an orthographic projection): the centre
 // mapped, the half-extent through |m| (Arvo's box transform).
 Aabb ndc_bounds(const glm::mat4& m, const Aabb& box) {
-  const glm::vec3 centre = 0.5f * (box.min + box.max), half = 0.5f * (box.max - box.min);
+  // Halves first: min + max overflows for boxes beyond half of float's range.
+  const glm::vec3 centre = 0.5f * box.min + 0.5f * box.max, half = 0.5f * box.max - 0.5f * box.min;
   const glm::vec3 c = glm::vec3(m * glm::vec4(centre, 1.0f));
   glm::vec3 e(0.0f);
   for (int col = 0; col < 3; ++col)

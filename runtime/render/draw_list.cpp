@@ -173,7 +173,7 @@ using MaterialBits = decltype(material_bits(Material{}));
 
 struct MaterialBitsHash {
   std::size_t operator()(const MaterialBits& bits) const {
-    std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a over the fields
+    std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a's steps over the fields' 64-bit words
     for (std::uint64_t b : bits) h = (h ^ b) * 0x100000001b3ull;
     return std::size_t(h);
   }
@@ -194,9 +194,10 @@ std::vector<std::uint32_t> material_ranks(const FrameInput& frame) {
   }
   std::vector<std::uint32_t> order(first_draw.size()), rank(first_draw.size());
   for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return material_fields(frame.draws[first_draw[a]].material) <
-           material_fields(frame.draws[first_draw[b]].material);
+  // Stable: a NaN field makes the order no strict weak ordering, which std::sort may overrun.
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return material_sorts_before(frame.draws[first_draw[a]].material,
+                                 frame.draws[first_draw[b]].material);
   });
   for (std::uint32_t r = 0; r < order.size(); ++r) rank[order[r]] = r;
   for (std::uint32_t& k : id) k = rank[k];
@@ -234,6 +235,10 @@ std::vector<std::uint32_t> sorted_by(const FrameInput& frame, Pass pass,
 }
 
 }  // namespace
+
+bool material_sorts_before(const Material& a, const Material& b) {
+  return material_fields(a) < material_fields(b);
+}
 
 DrawList build_draw_list(const FrameInput& frame, VariantKey frame_key) {
   DrawList list;

@@ -26,6 +26,10 @@ VariantKey capture_frame_variant(VariantKey frame);
 VariantKey msaa_frame_variant(VariantKey frame);
 /// The material features of a draw (MATERIAL_* part): from the material's data.
 VariantKey material_variant(const DrawItem& draw);
+/// The order of materials within draws of one program key (DrawList's orders): textures first
+/// (the costliest binds), then the factors. Materials that compare equal (operator==) are
+/// neither before the other.
+bool material_sorts_before(const Material& a, const Material& b);
 
 /// Every (pass, key) a frame draws with, sorted and unique: what prewarm compiles and what
 /// `kaskad variants` lists. Pure: no GL.

@@ -2,9 +2,10 @@
 // view's stored shadow visibility). Equal inputs give equal values; a value is never 0, which
 // callers keep for "nothing stored".
 //
-// The bytes are taken 8 at a time, each word folded in by a 64x64 -> 128-bit multiply whose
-// halves are xored (the mixing step of wyhash): a frame hashes every caster's matrix, and a
-// byte-at-a-time hash (FNV-1a) of 10,000 casters cost about a millisecond.
+// The bytes are taken 8 at a time, each word folded in by a 64x64 -> 128-bit multiply by a
+// constant whose halves are xored (after wyhash's mixing step): a frame hashes every caster's
+// matrix, and a byte-at-a-time hash (FNV-1a) of 10,000 casters cost about a millisecond. Good
+// enough for cache keys of non-adversarial data, not a cryptographic hash.
 #pragma once
 
 #include <cstdint>

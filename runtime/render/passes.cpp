@@ -7,7 +7,6 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <iterator>
 #include <map>
 #include <type_traits>
 
@@ -468,14 +467,18 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   // any caster moving: shadow.cull_by_receivers assigns casters by the receivers the slice
   // serves) reaches the texels `kept` (two texels wider, as in caster_runs()).
   // `now` is the layer's casters (layer_casters()), sorted like the ones it was drawn with: the
-  // newcomers are found by one merge of the two.
+  // newcomers, the hashes in `now` that `before` does not hold at all, come from one merge.
   auto newcomer_over = [&](const ShadowView& v, int c, std::size_t layer, const glm::ivec4& kept,
                            const std::vector<std::uint64_t>& now) {
     if (empty_rect(kept)) return false;
     const std::vector<std::uint64_t>& before = drawn_casters_[layer];
     std::vector<std::uint64_t> joined;
-    std::set_difference(now.begin(), now.end(), before.begin(), before.end(),
-                        std::back_inserter(joined));
+    auto b = before.begin();
+    for (std::uint64_t id : now) {
+      while (b != before.end() && *b < id) ++b;
+      if ((b == before.end() || *b != id) && (joined.empty() || joined.back() != id))
+        joined.push_back(id);
+    }
     if (joined.empty()) return false;
     const glm::vec4 ndc = drawn_ndc(kept, map.size);
     for (std::uint32_t i : list.depth_order) {

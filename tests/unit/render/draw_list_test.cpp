@@ -74,7 +74,9 @@ void expect_runs(const std::vector<std::uint32_t>& order, std::size_t draws, Sam
   }
 }
 
-TEST(DrawList, DrawsThatMayShareADrawAreNeighboursInEveryOrder) {
+// Each order is sorted by its keys (materials by material_sorts_before()), and every class of
+// draws that may share one instanced draw is one run of it.
+TEST(DrawList, EveryOrderIsSortedAndDrawsThatMayShareADrawAreNeighbours) {
   for (unsigned seed : {1u, 2u, 3u}) {
     const FrameInput frame = shuffled_draws(3000, seed);
     const DrawList list = build_draw_list(frame, frame_variant(frame));
@@ -83,12 +85,31 @@ TEST(DrawList, DrawsThatMayShareADrawAreNeighboursInEveryOrder) {
     expect_runs(list.forward_order, d.size(), [&](std::uint32_t a, std::uint32_t b) {
       return fwd(a) == fwd(b) && d[a].material == d[b].material && d[a].mesh == d[b].mesh;
     }, "forward");
+    // Sorted by (key, material, mesh): no draw sorts before the one ahead of it.
+    auto forward_less = [&](std::uint32_t a, std::uint32_t b) {
+      if (fwd(a) != fwd(b)) return fwd(a) < fwd(b);
+      if (material_sorts_before(d[a].material, d[b].material)) return true;
+      if (material_sorts_before(d[b].material, d[a].material)) return false;
+      return d[a].mesh < d[b].mesh;
+    };
+    for (std::size_t k = 1; k < list.forward_order.size(); ++k)
+      EXPECT_FALSE(forward_less(list.forward_order[k], list.forward_order[k - 1])) << k;
     // The depth pass: one draw per mesh whatever the material, unless alpha-masked.
     auto depth = [&](std::uint32_t a) { return list.keys[a].filtered_for(Pass::depth); };
     expect_runs(list.depth_order, d.size(), [&](std::uint32_t a, std::uint32_t b) {
       if (depth(a) != depth(b) || d[a].mesh != d[b].mesh) return false;
       return !list.keys[a].has(VariantKey::kAlphaMask) || d[a].material == d[b].material;
     }, "depth", false);
+    // Sorted by (key, mesh, material) where the key has no alpha mask, else (key, material, mesh).
+    auto depth_less = [&](std::uint32_t a, std::uint32_t b) {
+      if (depth(a) != depth(b)) return depth(a) < depth(b);
+      if (!list.keys[a].has(VariantKey::kAlphaMask) && d[a].mesh != d[b].mesh) return d[a].mesh < d[b].mesh;
+      if (material_sorts_before(d[a].material, d[b].material)) return true;
+      if (material_sorts_before(d[b].material, d[a].material)) return false;
+      return d[a].mesh < d[b].mesh;
+    };
+    for (std::size_t k = 1; k < list.depth_order.size(); ++k)
+      EXPECT_FALSE(depth_less(list.depth_order[k], list.depth_order[k - 1])) << k;
   }
 }
 
