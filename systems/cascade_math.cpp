@@ -193,19 +193,18 @@ LightBounds light_bounds(const dmat4& light_view, const Aabb& box) {
   return b;
 }
 
-// Depth range (along the light) of `box` inside the light-space prism over `r`.
-Range box_range_in_rect(const dmat4& light_view, const Aabb& box, const Rect& r) {
+// Depth range (along the light) of non-empty `box`, whose light_bounds() are `b`, inside the
+// light-space prism over `r`.
+Range box_range_in_rect(const dmat4& light_view, const Aabb& box, const LightBounds& b,
+                        const Rect& r) {
   Range out;
-  if (box.empty() || !(r.min_x <= r.max_x) || !(r.min_y <= r.max_y)) return out;
+  if (!(r.min_x <= r.max_x) || !(r.min_y <= r.max_y)) return out;
   // 0. Most boxes of a large scene miss a cascade's rectangle: reject them from the box's
-  //    light-space bounds (light_bounds()), one transform instead of eight corners.
-  {
-    const LightBounds b = light_bounds(light_view, box);
-    const double ex = b.extent.x + b.slack, ey = b.extent.y + b.slack;
-    if (b.centre.x + ex < r.min_x || b.centre.x - ex > r.max_x || b.centre.y + ey < r.min_y ||
-        b.centre.y - ey > r.max_y)
-      return out;
-  }
+  //    light-space bounds, one transform instead of eight corners.
+  const double ex = b.extent.x + b.slack, ey = b.extent.y + b.slack;
+  if (b.centre.x + ex < r.min_x || b.centre.x - ex > r.max_x || b.centre.y + ey < r.min_y ||
+      b.centre.y - ey > r.max_y)
+    return out;
   // 1. The 8 corners in light view space (corner i: bit 0 = x, bit 1 = y, bit 2 = z).
   std::array<dvec3, 8> c;
   for (int i = 0; i < 8; ++i) {
@@ -246,6 +245,11 @@ Range box_range_in_rect(const dmat4& light_view, const Aabb& box, const Rect& r)
   return out;
 }
 
+Range box_range_in_rect(const dmat4& light_view, const Aabb& box, const Rect& r) {
+  if (box.empty()) return {};
+  return box_range_in_rect(light_view, box, light_bounds(light_view, box), r);
+}
+
 // tighten_near_far in double; see the header for the rules.
 Range tighten_d(const dmat4& light_view, std::span<const Aabb> casters,
                 std::span<const Aabb> receivers, const Rect& r, double slice_near,
@@ -254,11 +258,11 @@ Range tighten_d(const dmat4& light_view, std::span<const Aabb> casters,
   //    A box whose whole depth range lies within the range found so far cannot widen it.
   Range out;
   for (const Aabb& b : receivers) {
-    if (!out.empty() && !b.empty()) {
-      const Range whole = light_bounds(light_view, b).depths();
-      if (whole.near >= out.near && whole.far <= out.far) continue;
-    }
-    const Range range = box_range_in_rect(light_view, b, r);
+    if (b.empty()) continue;
+    const LightBounds bounds = light_bounds(light_view, b);
+    const Range whole = bounds.depths();
+    if (!out.empty() && whole.near >= out.near && whole.far <= out.far) continue;
+    const Range range = box_range_in_rect(light_view, b, bounds, r);
     if (range.empty() || range.far < slice_near || range.near > slice_far) continue;
     out.add(std::max(range.near, slice_near), std::min(range.far, slice_far));
   }
@@ -267,8 +271,10 @@ Range tighten_d(const dmat4& light_view, std::span<const Aabb> casters,
   //    point can shadow it: pull the near plane back to them (S0 step 3). A caster whose whole
   //    box lies behind the near plane found so far cannot pull it.
   for (const Aabb& b : casters) {
-    if (b.empty() || light_bounds(light_view, b).depths().near >= out.near) continue;
-    const Range range = box_range_in_rect(light_view, b, r);
+    if (b.empty()) continue;
+    const LightBounds bounds = light_bounds(light_view, b);
+    if (bounds.depths().near >= out.near) continue;
+    const Range range = box_range_in_rect(light_view, b, bounds, r);
     if (!range.empty() && range.near < out.far) out.near = std::min(out.near, range.near);
   }
   return out;

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "components/bounds.h"
+#include "runtime/render/input_hash.h"
 
 namespace kaskad::render {
 
@@ -173,9 +174,7 @@ using MaterialBits = decltype(material_bits(Material{}));
 
 struct MaterialBitsHash {
   std::size_t operator()(const MaterialBits& bits) const {
-    std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a's steps over the fields' 64-bit words
-    for (std::uint64_t b : bits) h = (h ^ b) * 0x100000001b3ull;
-    return std::size_t(h);
+    return std::size_t(InputHash().add(bits).value());
   }
 };
 
