@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "runtime/ecs/entity.h"
 
@@ -22,9 +23,22 @@ struct PrimitiveMesh {
   int tiles = 1;
 };
 
+/// Fields of one section of one imported glTF node set over what the file gives (scene files:
+/// the model's `nodes` block; the editor and --set on the node's name). Saved from the node's
+/// live component, so the values have one home: the entity.
+struct NodeOverride {
+  std::string node;     ///< the imported entity's name (unique among the model's nodes)
+  std::string section;  ///< transform, light, shadow, camera or renderer
+  std::vector<std::string> fields;  ///< the section's fields that were set, in a stable order
+  /// The block as the scene file gave it (JSON text: components do not depend on the JSON
+  /// library), applied when the model is imported; saved as it is while no node has the name.
+  std::string block;
+};
+
 /// A glTF file (.gltf or .glb) instanced under this entity; path relative to the scene file.
 struct ModelRef {
   std::string path;
+  std::vector<NodeOverride> nodes;  ///< by (node, section), in the order first set
 };
 
 /// A material file (content/materials/*.json) used by this entity; path relative to the scene.

@@ -23,11 +23,14 @@
 #include <backends/imgui_impl_opengl3.h>
 
 #include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
 #include "components/bounds.h"
 #include "components/camera.h"
 #include "components/light.h"
+#include "components/model.h"
 #include "components/name.h"
 #include "components/transform.h"
 #include "editor/file_dialog.h"
@@ -418,6 +421,8 @@ class Editor {
   bool doc_stale_ = true;
   FlyCamera camera_;
   float speed_ = 1.0f;            ///< fly speed, metres per second (from the scene's size)
+  Aabb bounds_;                   ///< the scene's bounds when loaded (fly speed, auto near/far)
+  bool planes_follow_ = false;    ///< the camera was auto_frame: its near and far follow it
   bool prewarm_ = true;           ///< compile the scene's programs before its first frame
   bool changed_since_frame_ = true;
   bool viewport_hovered_ = false;
@@ -467,9 +472,44 @@ void Editor::write_camera() {
   const auto cam = active_camera();
   if (!cam) return;
   Transform& t = scene_.world.get<Transform>(*cam);
-  // A camera under a parent is moved in its parent's space: the fly camera drives roots only.
   t.translation = camera_.position;
   t.rotation = look_rotation(camera_.forward());
+  // A camera under a parent (a glTF model's camera) gets the pose in its parent's space.
+  if (const auto* parent = t.parent.valid() ? scene_.world.try_get<WorldTransform>(t.parent) : nullptr) {
+    const glm::mat4 local = glm::inverse(parent->matrix) *
+                            glm::translate(glm::mat4(1.0f), camera_.position) * glm::mat4_cast(t.rotation);
+    const glm::vec3 scale{glm::length(glm::vec3(local[0])), glm::length(glm::vec3(local[1])),
+                          glm::length(glm::vec3(local[2]))};
+    t.translation = glm::vec3(local[3]);
+    t.rotation = glm::normalize(glm::quat_cast(glm::mat3(glm::vec3(local[0]) / scale.x,
+                                                         glm::vec3(local[1]) / scale.y,
+                                                         glm::vec3(local[2]) / scale.z)));
+    t.scale = scale;
+  }
+  // A glTF model's camera: the pose is kept in the model's nodes block when saved.
+  note_node_override(scene_, *cam, "transform", {"translation", "rotation", "scale"});
+  // An auto_frame camera moved by the user is placed where they put it: saved and reloaded
+  // there, not framed again. Its near and far planes had been fitted to the scene from where the
+  // load put it; they follow the camera, so that flying in (or F) does not clip what is close.
+  Camera& c = scene_.world.get<Camera>(*cam);
+  if (c.auto_frame) {
+    c.auto_frame = false;
+    planes_follow_ = true;
+  }
+  if (planes_follow_ && !bounds_.empty()) {
+    const glm::vec3 forward = camera_.forward();
+    float far = 0.0f;
+    for (int i = 0; i < 8; ++i) {
+      const glm::vec3 corner{(i & 1) ? bounds_.max.x : bounds_.min.x,
+                             (i & 2) ? bounds_.max.y : bounds_.min.y,
+                             (i & 4) ? bounds_.max.z : bounds_.min.z};
+      far = std::max(far, glm::dot(corner - camera_.position, forward));
+    }
+    far = std::max(far * 1.01f, 1e-3f * glm::length(bounds_.extent()));
+    const glm::vec3 nearest = glm::clamp(camera_.position, bounds_.min, bounds_.max);
+    c.near = std::max(0.9f * glm::length(nearest - camera_.position), 1e-3f * far);
+    c.far = far;
+  }
   camera_.moved = true;
   doc_stale_ = true;
   changed_since_frame_ = true;
@@ -477,12 +517,27 @@ void Editor::write_camera() {
 
 void Editor::update_bounds_speed() {
   const Aabb b = scene_bounds(scene_.world);
+  bounds_ = b;
   // About five seconds to cross the scene, whatever its units.
   const float size = b.empty() ? 10.0f : glm::length(b.max - b.min);
   speed_ = std::max(size / 5.0f, 0.01f);
 }
 
 Status Editor::edit(const std::string& assignment, bool merge) {
+  // What the load makes on its own (the ground, a terrain's tiles) is not saved: an edit of it
+  // would be lost, so it is refused.
+  std::optional<std::string> made_at_load;
+  scene_.world.view<Imported>().each([&](ecs::Entity e, const Imported& imp) {
+    const auto* n = scene_.world.try_get<Name>(e);
+    if (n && !(imp.source.valid() && scene_.world.alive(imp.source) &&
+               scene_.world.has<ModelRef>(imp.source)) &&
+        assignment.starts_with(n->value + "."))
+      made_at_load = n->value;
+  });
+  if (made_at_load)
+    return Error{"--set", assignment.substr(0, assignment.find('=')),
+                 "'" + *made_at_load + "' is made when the scene loads and is not saved; change "
+                 "render.ground instead"};
   Status live = apply_live_override(scene_, assignment);
   if (!live) {
     // Sections a loaded entity does not take live (material, primitive, model, name) are set on
@@ -657,6 +712,7 @@ Status Editor::open(const fs::path& file) {
   doc_stale_ = true;
   changed_since_frame_ = true;
   camera_ = FlyCamera{};
+  planes_follow_ = false;
   take_camera_from_scene();
   update_bounds_speed();
   glfwSetWindowTitle(player_.context->window(), ("Kaskad editor - " + file.string()).c_str());
@@ -668,7 +724,20 @@ Status Editor::open(const fs::path& file) {
 Status Editor::save_as(const fs::path& file) {
   KASKAD_TRY(save(file));
   // From now on the scene is that file: Ctrl+S writes it and it is what "unsaved" refers to.
+  // The undo history's paths (models, material files, maps) are relative to the scene's file:
+  // each document is rewritten relative to the new one, and the scene reloaded from its own.
+  const fs::path old_file = scene_.file;
+  const fs::path dir = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+  std::vector<json> rebased;
+  for (const json& doc : history_) {
+    auto parsed = parse_scene(doc, old_file);
+    if (!parsed) return parsed.error();
+    rebased.push_back(scene_to_json(*parsed, dir));
+  }
+  history_ = std::move(rebased);
   opt_.scene = file;
+  camera_.moved = true;  // the reload keeps the view (an auto_frame camera is not framed again)
+  KASKAD_TRY(restore(position_));
   saved_ = position_;
   glfwSetWindowTitle(player_.context->window(), ("Kaskad editor - " + file.string()).c_str());
   return {};
@@ -737,8 +806,18 @@ Status Editor::orbit(float yaw, float pitch) {
 Status Editor::frame_selection() {
   const auto e = find(selected_);
   if (!e) return Error{"", "", "F frames the selection: select an entity first"};
+  // The entity and everything below it: a model's entity, or a glTF node, has no mesh of its own.
   Aabb box;
-  if (const auto* b = scene_.world.try_get<WorldBounds>(*e)) box = b->box;
+  std::vector<ecs::Entity> subtree{*e};
+  for (std::size_t i = 0; i < subtree.size(); ++i) {
+    if (const auto* b = scene_.world.try_get<WorldBounds>(subtree[i]); b && !b->box.empty()) {
+      box.expand(b->box.min);
+      box.expand(b->box.max);
+    }
+    scene_.world.view<Transform>().each([&](ecs::Entity x, const Transform& t) {
+      if (t.parent == subtree[i]) subtree.push_back(x);
+    });
+  }
   if (box.empty()) {
     const auto* wt = scene_.world.try_get<WorldTransform>(*e);
     const glm::vec3 p = wt ? glm::vec3(wt->matrix[3]) : glm::vec3(0.0f);
@@ -1084,9 +1163,28 @@ void Editor::inspector() {
             field(selected_ + "." + it.key() + "." + f.key(), f.key(), f.value());
       }
       direction_helpers();
-    } else {
-      ImGui::TextWrapped("'%s' is imported from a model: its transform, light and camera are set "
-                         "with --set %s.SECTION.FIELD=VALUE", selected_.c_str(), selected_.c_str());
+    } else if (const auto e = find(selected_)) {
+      // A glTF model's node: the sections a loaded entity takes, saved in its model's nodes
+      // block. The ground and terrain tiles are remade at load: shown, not edited.
+      ImGui::Separator();
+      const auto* imp = scene_.world.try_get<Imported>(*e);
+      const auto* model = imp && scene_.world.alive(imp->source)
+                              ? scene_.world.try_get<Name>(imp->source) : nullptr;
+      if (!model || !scene_.world.has<ModelRef>(imp->source)) {
+        ImGui::TextWrapped("'%s' is made when the scene loads (render.ground, a terrain's tiles) "
+                           "and is not saved: it cannot be edited", selected_.c_str());
+      } else {
+        ImGui::TextWrapped("'%s' is a node of model '%s': its edits are saved in that model's "
+                           "nodes block", selected_.c_str(), model->value.c_str());
+        const json sections = live_entity_sections(scene_, *e);
+        for (const char* section : {"transform", "light", "shadow", "camera", "renderer"}) {
+          if (!sections.contains(section)) continue;
+          if (ImGui::CollapsingHeader(section, ImGuiTreeNodeFlags_DefaultOpen))
+            for (auto f = sections[section].begin(); f != sections[section].end(); ++f)
+              field(selected_ + "." + section + "." + f.key(), f.key(), f.value());
+        }
+        direction_helpers();
+      }
     }
   }
   for (const char* section : {"render", "shadow"}) {

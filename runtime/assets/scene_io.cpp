@@ -1,6 +1,7 @@
 #include "runtime/assets/scene_io.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -349,6 +350,9 @@ struct FirstSun {
   bool cast_shadows_given = false;
 };
 
+std::vector<NodeOverride> read_node_overrides(const json& nodes, const std::string& where);
+json write_node_overrides(const Scene& scene, ecs::Entity model);
+
 void parse_entity(const json& j, const std::string& path, Scene& scene,
                   std::map<std::string, ecs::Entity>& by_name, std::vector<Pending>& parents,
                   FirstSun& first_sun) {
@@ -398,6 +402,7 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
     ModelRef m;
     ObjectReader mr(r.raw("model"), r.at("model"));
     mr.string("path", m.path);
+    if (mr.has("nodes")) m.nodes = read_node_overrides(mr.raw("nodes"), mr.at("nodes"));
     mr.finish();
     if (m.path.empty()) fail(r.at("model") + "/path", "a model needs a path");
     w.emplace<ModelRef>(e, m);
@@ -488,7 +493,10 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
     if (p->shape == PrimitiveShape::terrain) j["primitive"]["tiles"] = p->tiles;
   }
   auto rebase = [&](const std::string& path) { return rebase_path(scene, base, path); };
-  if (const auto* m = w.try_get<ModelRef>(e)) j["model"] = {{"path", rebase(m->path)}};
+  if (const auto* m = w.try_get<ModelRef>(e)) {
+    j["model"] = {{"path", rebase(m->path)}};
+    if (!m->nodes.empty()) j["model"]["nodes"] = write_node_overrides(scene, e);
+  }
   if (const auto* mr = w.try_get<MeshRenderer>(e))
     j["renderer"] = {{"cast_shadows", mr->cast_shadows},
                      {"receive_shadows", mr->receive_shadows},
@@ -677,7 +685,143 @@ bool document_holds(const json& doc, const std::string& key) {
   return false;
 }
 
+// Entity e's sections as apply_entity_override() and a model's node blocks set them: transform
+// without its parent (kept as it is), shadow with every field, the rest as scene files hold them.
+json settable_sections(const Scene& scene, ecs::Entity e) {
+  json ej = entity_to_json(scene, e, {});
+  if (const auto* s = scene.world.try_get<ShadowSettings>(e)) ej["shadow"] = write_shadow(*s, nullptr);
+  ej.erase("name");
+  if (ej.contains("transform")) ej["transform"].erase("parent");
+  return ej;
+}
+
+// Reads `block` over entity e's `section` with the scene file's reader for it (validated, the
+// fields it does not name kept). False for a section a loaded entity does not take.
+bool read_section(ecs::World& w, ecs::Entity e, const std::string& section, const json& block,
+                  const std::string& where) {
+  if (section == "transform") {
+    reread<Transform>(w, e, block, where, [](ObjectReader& r, Transform& t) {
+      read_transform(r, t);
+      r.finish();
+    });
+  } else if (section == "light" && w.has<Light>(e)) {
+    reread<Light>(w, e, block, where, [](ObjectReader& r, Light& l) { read_light(r, l); });
+  } else if (section == "shadow" && w.has<ShadowSettings>(e)) {
+    reread<ShadowSettings>(w, e, block, where, read_shadow);
+  } else if (section == "camera" && w.has<Camera>(e)) {
+    reread<Camera>(w, e, block, where, read_camera);
+  } else if (section == "renderer" && w.has<MeshRenderer>(e)) {
+    reread<MeshRenderer>(w, e, block, where, read_renderer);
+  } else if (section == "reflector" && w.has<Reflector>(e)) {
+    reread<Reflector>(w, e, block, where, read_reflector);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// The sections a model's node block may hold (a glTF node has no reflector).
+constexpr std::array<const char*, 5> kNodeSections = {"transform", "light", "shadow", "camera",
+                                                      "renderer"};
+
+// The field a node override records for a field set in `section`: any form of a rotation is
+// saved as the rotation.
+std::string recorded_field(const std::string& section, const std::string& field) {
+  if (section == "transform" &&
+      std::find(kRotationKeys.begin(), kRotationKeys.end(), field) != kRotationKeys.end())
+    return "rotation";
+  return field;
+}
+
+// The model entity that imported e, when e is one of a glTF model's nodes; else none.
+ecs::Entity model_of(const ecs::World& w, ecs::Entity e) {
+  const auto* imp = w.try_get<Imported>(e);
+  if (!imp || !imp->source.valid() || !w.alive(imp->source) || !w.has<ModelRef>(imp->source))
+    return ecs::kNullEntity;
+  return imp->source;
+}
+
+// The entities imported for model entity `model` that are named `node`.
+std::vector<ecs::Entity> nodes_named(const ecs::World& w, ecs::Entity model, const std::string& node) {
+  std::vector<ecs::Entity> found;
+  w.view<Imported>().each([&](ecs::Entity x, const Imported& imp) {
+    if (imp.source != model) return;
+    if (const auto* n = w.try_get<Name>(x); n && n->value == node) found.push_back(x);
+  });
+  std::sort(found.begin(), found.end(), entity_less);
+  return found;
+}
+
+// A model's `nodes` block: node name -> section -> fields. Checked for shape here; the values
+// are read when the model is imported, over what its file gives.
+std::vector<NodeOverride> read_node_overrides(const json& nodes, const std::string& where) {
+  if (!nodes.is_object()) fail(where, "expected an object of node names, got " + type_name(nodes));
+  std::vector<NodeOverride> out;
+  for (auto n = nodes.begin(); n != nodes.end(); ++n) {
+    const std::string at = where + "/" + n.key();
+    if (n.key().empty()) fail(at, "a node name may not be empty");
+    if (!n.value().is_object()) fail(at, "expected an object of sections, got " + type_name(n.value()));
+    for (auto s = n.value().begin(); s != n.value().end(); ++s) {
+      const std::string sat = at + "/" + s.key();
+      if (std::find_if(kNodeSections.begin(), kNodeSections.end(),
+                       [&](const char* k) { return s.key() == k; }) == kNodeSections.end())
+        fail(sat, "unknown section '" + s.key() + "'; a node takes transform, light, shadow, "
+                  "camera and renderer");
+      if (!s.value().is_object()) fail(sat, "expected an object, got " + type_name(s.value()));
+      if (s.key() == "transform" && s.value().contains("parent"))
+        fail(sat + "/parent", "an imported node keeps its parent from the model file");
+      NodeOverride o{n.key(), s.key(), {}, s.value().dump()};
+      for (auto f = s.value().begin(); f != s.value().end(); ++f) {
+        const std::string field = recorded_field(s.key(), f.key());
+        if (std::find(o.fields.begin(), o.fields.end(), field) == o.fields.end())
+          o.fields.push_back(field);
+      }
+      out.push_back(std::move(o));
+    }
+  }
+  return out;
+}
+
+// The `nodes` block written for model entity `model`: each set field's value as the node has it
+// now, or the block as it was read while no node of the model has the name.
+json write_node_overrides(const Scene& scene, ecs::Entity model) {
+  json out = json::object();
+  for (const NodeOverride& o : scene.world.get<ModelRef>(model).nodes) {
+    const std::vector<ecs::Entity> found = nodes_named(scene.world, model, o.node);
+    if (found.size() != 1) {
+      out[o.node][o.section] = json::parse(o.block, nullptr, /*allow_exceptions=*/false);
+      continue;
+    }
+    const json live = settable_sections(scene, found.front());
+    json& block = out[o.node][o.section];
+    block = json::object();
+    for (const std::string& f : o.fields)
+      if (live.contains(o.section) && live[o.section].contains(f)) block[f] = live[o.section][f];
+  }
+  return out;
+}
+
 }  // namespace
+
+void note_node_override(Scene& scene, ecs::Entity e, const std::string& section,
+                        const std::vector<std::string>& fields) {
+  ecs::World& w = scene.world;
+  const ecs::Entity model = model_of(w, e);
+  const auto* name = w.try_get<Name>(e);
+  if (!model.valid() || !name) return;
+  std::vector<NodeOverride>& nodes = w.get<ModelRef>(model).nodes;
+  auto it = std::find_if(nodes.begin(), nodes.end(), [&](const NodeOverride& o) {
+    return o.node == name->value && o.section == section;
+  });
+  if (it == nodes.end()) it = nodes.insert(nodes.end(), NodeOverride{name->value, section, {}, "{}"});
+  for (const std::string& f : fields) {
+    const std::string field = recorded_field(section, f);
+    if (std::find(it->fields.begin(), it->fields.end(), field) == it->fields.end())
+      it->fields.push_back(field);
+  }
+}
+
+json live_entity_sections(const Scene& scene, ecs::Entity e) { return settable_sections(scene, e); }
 
 Status apply_override(json& doc, const std::string& assignment) {
   const auto eq = assignment.find('=');
@@ -781,39 +925,27 @@ Status apply_entity_override(Scene& scene, const std::string& assignment) {
     return Error{"--set", key, std::to_string(matches.size()) + " entities are named '" + name +
                                    "'; only a unique name can be set"};
   const ecs::Entity e = matches.front();
-  json ej = entity_to_json(scene, e, {});
-  if (const auto* s = w.try_get<ShadowSettings>(e)) ej["shadow"] = write_shadow(*s, nullptr);
-  ej.erase("name");
-  if (ej.contains("transform")) ej["transform"].erase("parent");  // kept as it is
+  json ej = settable_sections(scene, e);
   const std::vector<std::string> parts = split_key(key.substr(best + 1));
   KASKAD_TRY(set_field(&ej, parts, key, text));
   const std::string& section = parts[0];
   const std::string where = "/" + name + "/" + section;
   try {
-    const json& block = ej[section];
-    if (section == "transform") {
-      reread<Transform>(w, e, block, where, [](ObjectReader& r, Transform& t) {
-        read_transform(r, t);
-        r.finish();
-      });
-    } else if (section == "light") {
-      reread<Light>(w, e, block, where, [](ObjectReader& r, Light& l) { read_light(r, l); });
-    } else if (section == "shadow") {
-      reread<ShadowSettings>(w, e, block, where, read_shadow);
-    } else if (section == "camera") {
-      reread<Camera>(w, e, block, where, read_camera);
-    } else if (section == "renderer") {
-      reread<MeshRenderer>(w, e, block, where, read_renderer);
-    } else if (section == "reflector" && w.has<Reflector>(e)) {
-      reread<Reflector>(w, e, block, where, read_reflector);
-    } else {
+    if (!read_section(w, e, section, ej[section], where))
       return Error{"--set", key, "'" + section + "' of '" + name +
                                      "' cannot be set on a loaded entity; it takes transform, "
                                      "light, shadow, camera, renderer and reflector"};
-    }
   } catch (const ContentError& err) {
     return Error{"--set", err.where, err.message};
   }
+  // A glTF node's edit is kept in its model's nodes block, so that a save holds it.
+  std::vector<std::string> fields;
+  if (parts.size() > 1) {
+    fields.push_back(parts[1]);
+  } else if (ej[section].is_object()) {
+    for (auto f = ej[section].begin(); f != ej[section].end(); ++f) fields.push_back(f.key());
+  }
+  note_node_override(scene, e, section, fields);
   return {};
 }
 
@@ -925,8 +1057,9 @@ std::vector<ecs::Entity> copy_import(ecs::World& w, const FirstImport& from, ecs
 // Imports entity e's glTF model (ModelRef): the meshes take e's renderer flags and layer, the
 // lights the scene's shadow settings. `imported` (file -> the first entity that imported it):
 // a file imported before is copied from that entity's import instead of read again.
-Status import_model(Scene& scene, ecs::Entity e, bool activate_first_camera,
-                    std::map<std::string, FirstImport>* imported = nullptr) {
+// Returns the entities it made.
+Result<std::vector<ecs::Entity>> import_model(Scene& scene, ecs::Entity e, bool activate_first_camera,
+                                              std::map<std::string, FirstImport>* imported = nullptr) {
   ecs::World& w = scene.world;
   const fs::path path = scene.file.parent_path() / w.get<ModelRef>(e).path;
   std::error_code ec;
@@ -963,6 +1096,41 @@ Status import_model(Scene& scene, ecs::Entity e, bool activate_first_camera,
       w.get<ShadowSettings>(l) = scene.shadow_defaults;
     else
       w.emplace<ShadowSettings>(l, scene.shadow_defaults);
+  }
+  return made;
+}
+
+// The scene's own settings of model entity e's nodes (model.nodes; `made`: what its import
+// made), over what the file gives. After every import of a load: a later instance of the file
+// is copied from the first one's entities, which must not carry the first one's settings yet. A
+// name no node has is kept as it is for saving: the file may have changed since.
+Status apply_node_overrides(Scene& scene, ecs::Entity e, const std::vector<ecs::Entity>& made) {
+  ecs::World& w = scene.world;
+  const fs::path path = scene.file.parent_path() / w.get<ModelRef>(e).path;
+  const std::string model_name = w.has<Name>(e) ? w.get<Name>(e).value : std::string();
+  const std::vector<NodeOverride> overrides = w.get<ModelRef>(e).nodes;  // a copy: pools move
+  for (const NodeOverride& o : overrides) {
+    const std::string where = "/" + model_name + "/model/nodes/" + o.node + "/" + o.section;
+    std::vector<ecs::Entity> found;
+    for (ecs::Entity x : made)
+      if (const auto* n = w.try_get<Name>(x); n && n->value == o.node) found.push_back(x);
+    if (found.empty()) {
+      log::warn("%s: %s: %s has no node named '%s'; its settings are kept for saving",
+                scene.file.string().c_str(), where.c_str(), path.string().c_str(), o.node.c_str());
+      continue;
+    }
+    if (found.size() > 1)
+      return Error{scene.file.string(), where,
+                   std::to_string(found.size()) + " nodes of " + path.string() + " are named '" +
+                       o.node + "'; only a unique name can be set"};
+    const json block = json::parse(o.block, nullptr, /*allow_exceptions=*/false);
+    try {
+      if (!read_section(w, found.front(), o.section, block, where))
+        return Error{scene.file.string(), where,
+                     "node '" + o.node + "' has no " + o.section + " in " + path.string()};
+    } catch (const ContentError& err) {
+      return Error{scene.file.string(), err.where, err.message};
+    }
   }
   return {};
 }
@@ -1059,8 +1227,14 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
     w.get<MeshRenderer>(e).mesh = it->second;
   }
   std::map<std::string, FirstImport> imported;  // each file is read once (copy_import)
-  for (auto& model : models)
-    KASKAD_TRY(import_model(scene, model.first, /*activate_first_camera=*/true, &imported));
+  std::vector<std::vector<ecs::Entity>> made;
+  for (auto& model : models) {
+    auto m = import_model(scene, model.first, /*activate_first_camera=*/true, &imported);
+    if (!m) return m.error();
+    made.push_back(std::move(m.value()));
+  }
+  for (std::size_t i = 0; i < models.size(); ++i)
+    KASKAD_TRY(apply_node_overrides(scene, models[i].first, made[i]));
   return {};
 }
 
@@ -1152,7 +1326,15 @@ Result<ecs::Entity> add_entity(Scene& scene, const json& block, const std::strin
   for (const Pending& p : parents) w.get<Transform>(p.entity).parent = by_name.at(p.parent);
   if (const auto* pm = w.try_get<PrimitiveMesh>(e))
     w.get<MeshRenderer>(e).mesh = scene.assets.add_mesh(make_primitive(pm->shape, pm->segments));
-  if (w.has<ModelRef>(e)) KASKAD_TRY(import_model(scene, e, /*activate_first_camera=*/false));
+  if (w.has<ModelRef>(e)) {
+    // A model that cannot be imported, or a nodes block its file refuses, leaves no entity.
+    auto made = import_model(scene, e, /*activate_first_camera=*/false);
+    Status st = made ? apply_node_overrides(scene, e, made.value()) : Status(made.error());
+    if (!st) {
+      (void)remove_entity(scene, block.at("name").get<std::string>());
+      return st.error();
+    }
+  }
   return e;
 }
 

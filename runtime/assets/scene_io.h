@@ -49,6 +49,18 @@ Result<Scene> read_scene(const std::filesystem::path& file,
 /// and validated as in scene files. Unknown or ambiguous names are errors that list the names.
 Status apply_entity_override(Scene& scene, const std::string& assignment);
 
+/// Records that `fields` of `section` were set on entity e, when e is a node a glTF model entity
+/// imported: scene_to_json() then writes their values, as e has them, in that model's
+/// `nodes` block (apply_entity_override() records its own edits; the editor's fly camera, which
+/// moves the active camera directly, calls this). Does nothing for other entities.
+void note_node_override(Scene& scene, ecs::Entity e, const std::string& section,
+                        const std::vector<std::string>& fields);
+
+/// Entity e's sections as apply_entity_override() sets them: transform (without its parent),
+/// light, shadow (every field), camera, renderer, reflector, as scene files write them; with
+/// the other sections it has (material, primitive, model), which only a document edit changes.
+nlohmann::json live_entity_sections(const Scene& scene, ecs::Entity e);
+
 /// Loads material files (validated against `manifest`; required when the scene has any), creates
 /// meshes for primitives and imports glTF references (paths relative to scene.file). Cameras with
 /// auto_frame are framed by the load phase (load_scene in runtime/cli/player.h).

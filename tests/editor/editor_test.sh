@@ -4,9 +4,11 @@
 #             frame before: surfaces, or the penumbra for a filter change; changed_within.py);
 #             with nothing changed, frames are identical;
 #             the fly camera (key w) and F (frame the selection) move the view; the debug views
-#             (visibility, cascade, shadow map) differ and leave the colour as it was
+#             (visibility, cascade, shadow map) differ and leave the colour as it was; F on a
+#             glTF model's entity frames it at scales 0.01 and 100 (geometry_extent.py)
 #   saving    save -> reload -> save gives the same bytes; edits then undo give the canonical bytes;
-#             an editor killed (SIGKILL) while it saves over and over leaves a whole file
+#             an editor killed (SIGKILL) while it saves over and over leaves a whole file; a glTF
+#             node's edit is saved in its model's nodes block; save_as elsewhere keeps undo working
 #   entities  duplicate, create, delete and rename show and are saved; five undos give the original;
 #             a glTF model imported shows, is saved, and undo removes it
 #   every_n   a reflector with update every_n = 3 captures on editor frames 0, 3, 6, 9 only; a
@@ -144,6 +146,30 @@ quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
   # frame before each screenshot of a new view (after `frames` a screenshot needs none).
   n=$(grep -c '^frame [0-9]*:' "$tmp/out")
   if [ "$n" -eq 25 ]; then ok "25 frames rendered"; else fail "expected 25 frame lines, got $n"; fi
+  # F on a glTF model's entity (no mesh of its own: its nodes' bounds), at a hundredth and a
+  # hundred times the truck's size, with the camera far off: the truck fills the view, centred.
+  truck="$KASKAD_CONTENT/models/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf"
+  for s in 0.01 100; do
+    printf '{"render": {"ground": "none"}, "entities": [
+      {"name": "truck", "transform": {"scale": [%s, %s, %s]}, "model": {"path": "%s"}},
+      {"name": "camera", "transform": {"translation": [0, 1, 5]}, "camera": {"auto_frame": true}},
+      {"name": "sun", "transform": {"direction": [-0.4, -1, -0.3]}, "light": {"type": "directional"}}]}\n' \
+      "$s" "$s" "$s" "$truck" >"$tmp/truck_$s.json"
+    edit "camera 3000 1000 3000 0 0 0
+select truck
+key f
+view normal
+frames 1
+screenshot $tmp/truck_framed_$s.png
+quit!" "$tmp/truck_$s.json"
+    [ "$rc" -eq 0 ] || { fail "F on a model script exit $rc"; tail -5 "$tmp/out"; }
+    extent=$(python3 "$(dirname "$0")/geometry_extent.py" "$tmp/truck_framed_$s.png")
+    if echo "$extent" | awk '{ exit !(($1 > 0.3 || $2 > 0.3) && $1 < 1 && $2 < 1 && $3 > 0.4 && $3 < 0.6 && $4 > 0.4 && $4 < 0.6) }'; then
+      ok "F frames a model's entity at scale $s (extent and centre: $extent)"
+    else
+      fail "F on a model's entity at scale $s: the geometry's extent and centre are $extent"
+    fi
+  done
   ;;
 saving)
   "$KASKAD" save "$scene" -o "$tmp/canonical.json" >/dev/null || fail "kaskad save"
@@ -229,6 +255,51 @@ quit!" "$scene"
   done
   [ "$whole" -eq 5 ] && ok "killed mid-save five times: the file was a whole version each time"
   same "open another scene, save it: its canonical bytes" a.json opened.json
+  # A glTF node's edit (the milk truck's rear wheels raised onto its roof) is saved in its model's
+  # nodes block, and an undo of a later edit keeps it; after save_as into another folder, undo
+  # and redo still find the model (the history's relative paths follow the file).
+  truck="$KASKAD_CONTENT/models/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf"
+  mkdir -p "$tmp/deep/er"
+  # The camera placed first: the wrapped glTF's auto_frame camera then stays where it was put.
+  edit "camera 4 2 6 0 1 0
+set node_2.transform.translation=[0,2,0]
+save_as $tmp/deep/er/truck.json
+set sun.light.intensity=1.5
+undo
+redo
+undo
+save $tmp/deep/er/truck_undone.json
+screenshot $tmp/truck_edited.png
+quit" "$truck"
+  [ "$rc" -eq 0 ] || { fail "glTF node edit script exit $rc"; tail -5 "$tmp/out"; }
+  if tr -d ' \n' <"$tmp/deep/er/truck.json" | grep -q '"nodes":{"node_2":{"transform":{"translation":\[0.0,2.0,0.0\]}}}'; then
+    ok "a glTF node's edit is saved in its model's nodes block"
+  else
+    fail "truck.json lacks node_2's translation"; grep -A8 '"model"' "$tmp/deep/er/truck.json"
+  fi
+  # The model's blocks.
+  model_block() { python3 -c 'import json,sys; print([e for e in json.load(open(sys.argv[1]))["entities"] if "model" in e])' "$1"; }
+  same_model() {
+    if [ "$(model_block "$tmp/$2")" = "$(model_block "$tmp/$3")" ]; then ok "$1"; else fail "$1: $2 and $3 differ"; fi
+  }
+  same_model "an undo of a later edit keeps the node's edit" deep/er/truck.json deep/er/truck_undone.json
+  edit "screenshot $tmp/truck_reloaded.png
+save $tmp/deep/er/truck_again.json
+quit" "$tmp/deep/er/truck.json"
+  [ "$rc" -eq 0 ] || { fail "truck reload script exit $rc"; tail -5 "$tmp/out"; }
+  same "the node's edit and the placed camera reload: save -> load -> save" deep/er/truck.json deep/er/truck_again.json
+  same "the node's edit reloads: the same image" truck_edited.png truck_reloaded.png
+  edit "set sun.light.intensity=2
+save_as $tmp/deep/er/materials.json
+undo
+redo
+key ctrl+s
+quit" "$KASKAD_CONTENT/scenes/materials.json"
+  [ "$rc" -eq 0 ] || { fail "save_as then undo and redo (material files) exit $rc"; tail -5 "$tmp/out"; }
+  "$KASKAD" save "$tmp/deep/er/materials.json" -o "$tmp/materials_check.json" >/dev/null 2>&1 &&
+    grep -q '"intensity": 2' "$tmp/deep/er/materials.json" &&
+    ok "save_as into another folder: undo and redo work, the file loads" ||
+    fail "materials.json after save_as, undo, redo, ctrl+s does not load or lacks the edit"
   ls "$tmp" | grep -q '\.tmp' && fail "a temporary file was left behind"
   ;;
 entities)

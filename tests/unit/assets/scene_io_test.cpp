@@ -681,6 +681,106 @@ TEST(SceneIo, ImportedLightsTakeTheSceneShadowSettingsAndAnswerToSetByNodeName) 
       << section.error().to_string();
 }
 
+// A model's nodes block: the scene's own settings of a glTF file's nodes, applied over what the
+// file gives, kept by scene_to_json (so an editor save keeps edits of imported nodes), per model
+// entity (two instances of a file take their own), and errors that name the place.
+TEST(SceneIo, ModelNodeSettingsApplyOverTheFileAndSaveWithTheModel) {
+  write_file("lit.gltf", kLitGltf);
+  const fs::path file = write_file("nodes_scene.json", R"({"entities": [
+      {"name": "m", "model": {"path": "lit.gltf", "nodes": {
+          "Sun.001": {"light": {"intensity": 5}, "transform": {"direction": [0, -1, 0]}},
+          "Moon": {"light": {"intensity": 2}}}}},
+      {"name": "m2", "model": {"path": "lit.gltf", "nodes": {
+          "Sun.001": {"renderer": {}, "light": {"color": [0, 1, 0]}}}}}]})");
+  auto loaded = read_scene(file);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+  // Sun.001 has no renderer: m2's block names a section the node lacks.
+  auto lacking = instantiate_scene(*loaded);
+  ASSERT_FALSE(lacking.ok());
+  EXPECT_NE(lacking.error().to_string().find("/m2/model/nodes/Sun.001/renderer"), std::string::npos)
+      << lacking.error().to_string();
+  std::string text = read_file(file);
+  text.replace(text.find(R"("renderer": {}, )"), std::string(R"("renderer": {}, )").size(), "");
+  write_file("nodes_scene.json", text);
+
+  auto s = read_scene(file);
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  ASSERT_TRUE(instantiate_scene(*s).ok());
+  std::vector<ecs::Entity> suns;
+  s->world.view<Light>().each([&](ecs::Entity e, const Light&) { suns.push_back(e); });
+  ASSERT_EQ(suns.size(), 2u);
+  std::sort(suns.begin(), suns.end(), [](ecs::Entity a, ecs::Entity b) { return a.index < b.index; });
+  const Light& first = s->world.get<Light>(suns[0]);
+  const Light& second = s->world.get<Light>(suns[1]);
+  EXPECT_FLOAT_EQ(first.intensity, 5.0f);
+  EXPECT_EQ(first.color, glm::vec3(1.0f));  // what the file gives, where the block is silent
+  EXPECT_FLOAT_EQ(second.intensity, 3.0f);  // the other instance: only its own block
+  EXPECT_EQ(second.color, glm::vec3(0.0f, 1.0f, 0.0f));
+  const glm::vec3 down = s->world.get<Transform>(suns[0]).rotation * glm::vec3(0, 0, -1);
+  EXPECT_NEAR(down.y, -1.0f, 1e-6f);
+
+  // Written back with each set field's value as the node has it (the rotation in its saved
+  // form); a node the file does not have keeps its block as it was read.
+  nlohmann::json doc = scene_to_json(*s);
+  const nlohmann::json& nodes = doc["entities"][0]["model"]["nodes"];
+  EXPECT_EQ(nodes["Sun.001"]["light"], nlohmann::json::parse(R"({"intensity": 5.0})"));
+  ASSERT_TRUE(nodes["Sun.001"]["transform"].contains("rotation"));
+  EXPECT_EQ(nodes["Sun.001"]["transform"].size(), 1u);
+  EXPECT_EQ(nodes["Moon"], nlohmann::json::parse(R"({"light": {"intensity": 2}})"));
+  EXPECT_EQ(doc["entities"][1]["model"]["nodes"]["Sun.001"],
+            nlohmann::json::parse(R"({"light": {"color": [0.0, 1.0, 0.0]}})"));
+
+  // A --set (or editor) edit of a node is kept too, with the fields set before it. Both instances
+  // name their sun "Sun.001", so only a unique name can be set: rename one model away first.
+  ASSERT_TRUE(remove_entity(*s, "m2").ok());
+  ASSERT_TRUE(apply_entity_override(*s, "Sun.001.light.color=[1,0,0]").ok());
+  ASSERT_TRUE(apply_entity_override(*s, "Sun.001.shadow.filter=none").ok());
+  ASSERT_TRUE(apply_entity_override(*s, "Sun.001.transform.translation.1=7").ok());
+  doc = scene_to_json(*s);
+  const nlohmann::json& edited = doc["entities"][0]["model"]["nodes"]["Sun.001"];
+  EXPECT_EQ(edited["light"], nlohmann::json::parse(R"({"intensity": 5.0, "color": [1.0, 0.0, 0.0]})"));
+  EXPECT_EQ(edited["shadow"], nlohmann::json::parse(R"({"filter": "none"})"));
+  EXPECT_EQ(edited["transform"]["translation"], nlohmann::json::parse("[0.0, 7.0, 0.0]"));
+  EXPECT_TRUE(edited["transform"].contains("rotation"));
+
+  // save -> load -> save: the same bytes, the same values.
+  const fs::path saved = temp_dir() / "nodes_saved.json";
+  ASSERT_TRUE(save_scene(saved, *s).ok());
+  auto again = read_scene(saved);
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  ASSERT_TRUE(instantiate_scene(*again).ok());
+  const ecs::Entity sun = find(*again, "Sun.001");
+  ASSERT_TRUE(sun.valid());
+  EXPECT_EQ(again->world.get<Light>(sun).color, glm::vec3(1.0f, 0.0f, 0.0f));
+  EXPECT_EQ(again->world.get<ShadowSettings>(sun).filter, ShadowFilter::none);
+  EXPECT_FLOAT_EQ(again->world.get<Transform>(sun).translation.y, 7.0f);
+  const fs::path resaved = temp_dir() / "nodes_resaved.json";
+  ASSERT_TRUE(save_scene(resaved, *again).ok());
+  EXPECT_EQ(read_file(saved), read_file(resaved));
+
+  // Bad blocks are errors naming the file and the place.
+  auto error_of = [&](const std::string& nodes_block) {
+    const fs::path bad = write_file("nodes_bad.json", R"({"entities": [{"name": "m", "model":
+        {"path": "lit.gltf", "nodes": )" + nodes_block + "}}]}");
+    auto r = read_scene(bad);
+    if (r.ok()) {
+      Status st = instantiate_scene(*r);
+      return st.ok() ? std::string() : st.error().to_string();
+    }
+    return r.error().to_string();
+  };
+  std::string e = error_of(R"({"Sun.001": {"material": {}}})");
+  EXPECT_NE(e.find("/entities/0/model/nodes/Sun.001/material"), std::string::npos) << e;
+  EXPECT_NE(e.find("transform, light, shadow, camera and renderer"), std::string::npos) << e;
+  e = error_of(R"({"Sun.001": {"light": {"intensity": -1}}})");
+  EXPECT_NE(e.find("nodes_bad.json"), std::string::npos) << e;
+  EXPECT_NE(e.find("/m/model/nodes/Sun.001/light/intensity"), std::string::npos) << e;
+  e = error_of(R"({"Sun.001": {"transform": {"parent": "m"}}})");
+  EXPECT_NE(e.find("keeps its parent"), std::string::npos) << e;
+  e = error_of(R"([1])");
+  EXPECT_NE(e.find("/entities/0/model/nodes"), std::string::npos) << e;
+}
+
 TEST(SceneIo, AParentCycleIsALoadErrorNamingTheChain) {
   expect_error(read_scene(write_file("cycle.json", R"({"entities": [
     {"name": "a", "transform": {"parent": "c"}},
