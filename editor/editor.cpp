@@ -594,6 +594,8 @@ Status Editor::import_model(const std::string& path) {
   std::error_code ec;
   fs::path file = fs::absolute(path, ec);
   if (!fs::is_regular_file(file, ec)) return Error{path, "", "import: no such model file"};
+  if (const std::string ext = lowercase_extension(file); ext != ".gltf" && ext != ".glb")
+    return Error{path, "", "import: a model is a .gltf or .glb file"};
   const fs::path base = fs::absolute(scene_.file.parent_path(), ec);
   const fs::path relative = file.lexically_normal().lexically_relative(base.lexically_normal());
   const glm::vec3 at = camera_.position + camera_.forward() * std::max(0.5f * speed_, 0.5f);
@@ -1674,6 +1676,8 @@ int Editor::run() {
 }  // namespace
 
 int run_edit_command(int argc, char** argv) {
+  // Whole lines: the frame lines (stdout) and errors (stderr) do not cut into each other.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   Options opt = parse_options(argc, argv);
   std::vector<ScriptAction> script;
   if (!opt.script.empty()) {

@@ -43,7 +43,7 @@ constexpr Verb kVerbs[] = {
     {"camera", ActionKind::camera, 3, 6, "camera X Y Z [LOOK_X LOOK_Y LOOK_Z]"},
     {"orbit", ActionKind::orbit, 2, 2, "orbit YAW_DEG PITCH_DEG"},
     {"key", ActionKind::key, 1, 1, "key K (w a s d q e f ctrl+z ctrl+y ctrl+s)"},
-    {"view", ActionKind::view, 1, 1, "view colour|visibility|cascade|normal|depth|shadow_map|probe_faces|sphere_map"},
+    {"view", ActionKind::view, 1, 1, "view VIEW"},
     {"frames", ActionKind::frames, 1, 1, "frames N (1..100000)"},
     {"screenshot", ActionKind::screenshot, 1, 1, "screenshot PATH.png"},
     {"window_screenshot", ActionKind::window_screenshot, 1, 1, "window_screenshot PATH.png"},
@@ -110,8 +110,14 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
           return Error{file.string(), where, verb + ": '" + c + "' is not a number"};
     if (a.kind == ActionKind::key && !is_script_key(a.args[0]))
       return Error{file.string(), where, "unknown key '" + a.args[0] + "'; expected " + v->usage};
-    if (a.kind == ActionKind::view && !view_named(a.args[0]))
-      return Error{file.string(), where, "unknown view '" + a.args[0] + "'; expected " + v->usage};
+    if (a.kind == ActionKind::view && !view_named(a.args[0])) {
+      std::string views;  // from the one table
+      for (const char* name : kViewNames) {
+        if (!views.empty()) views += '|';
+        views += name;
+      }
+      return Error{file.string(), where, "unknown view '" + a.args[0] + "'; expected view " + views};
+    }
     if (a.kind == ActionKind::input && !whole_number_in(a.args[0], 1, 600))
       return Error{file.string(), where, "input: expected seconds in [1, 600], got '" + a.args[0] + "'"};
     if (a.kind == ActionKind::frames && !whole_number_in(a.args[0], 1, 100000))

@@ -1070,7 +1070,14 @@ Result<std::vector<ecs::Entity>> import_model(Scene& scene, ecs::Entity e, bool 
     made = copy_import(w, earlier->second, e);
   } else {
     auto report = import_gltf(path, w, scene.assets, e, e, activate_first_camera);
-    if (!report) return report.error();
+    if (!report) {
+      // A scene file's model: the scene and the entity come first, then the model's own error.
+      if (fs::path(w.get<ModelRef>(e).path).filename() == scene.file.filename() &&
+          lowercase_extension(scene.file) != ".json")
+        return report.error();  // a glTF opened directly: its own error says it all
+      const std::string name = w.has<Name>(e) ? w.get<Name>(e).value : std::string("?");
+      return Error{scene.file.string(), "/" + name + "/model/path", report.error().to_string()};
+    }
     for (const auto& warning : report->warnings) log::warn("%s: %s", path.string().c_str(), warning.c_str());
     w.view<Imported>().each([&](ecs::Entity x, const Imported& imp) {
       if (imp.source == e) made.push_back(x);

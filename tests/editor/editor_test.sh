@@ -412,6 +412,9 @@ PY
   edit "import $tmp/nope.glb
 quit!" "$scene"
   refused "line 1: .*nope.glb.*no such model file" "importing a missing file: exit 1, the file named"
+  edit "import $scene
+quit!" "$scene"
+  refused "line 1: .*default.json.*a model is a .gltf or .glb file" "importing a scene file as a model: refused"
   ;;
 every_n)
   edit "frames 10

@@ -481,6 +481,10 @@ TEST(SceneIo, MissingModelIsAnErrorAtInstantiation) {
   Status st = instantiate_scene(*s);
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.error().to_string().find("nowhere.glb"), std::string::npos) << st.error().to_string();
+  // The scene file and the entity that names the model come first.
+  EXPECT_LT(st.error().to_string().find("missing_model.json: /m/model/path: "),
+            st.error().to_string().find("nowhere.glb"))
+      << st.error().to_string();
 }
 
 TEST(SceneIo, GltfFileIsWrappedWithDefaultCameraAndSun) {

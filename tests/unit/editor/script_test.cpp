@@ -59,6 +59,9 @@ TEST(EditorScript, BadLinesNameTheFileAndLine) {
   EXPECT_NE(error_of("camera 1 2 nan\n").find("'nan' is not a number"), std::string::npos);
   EXPECT_NE(error_of("key ctrl+q\n").find("unknown key 'ctrl+q'"), std::string::npos);
   EXPECT_NE(error_of("view shadows\n").find("unknown view 'shadows'"), std::string::npos);
+  // The message lists every view, from the views' one table.
+  for (const char* name : kViewNames)
+    EXPECT_NE(error_of("view shadows\n").find(name), std::string::npos) << name;
   EXPECT_NE(error_of("frames 0\n").find("[1, 100000]"), std::string::npos);
   EXPECT_NE(error_of("input 0\n").find("input: expected seconds in [1, 600], got '0'"),
             std::string::npos);
