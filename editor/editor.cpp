@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <cmath>
 #include <cstdio>
+#include <deque>
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -368,6 +370,12 @@ class Editor {
   /// The names the readers accept for the enumerated field KEY (an inspector key such as
   /// "shadow.filter" or "sun.light.type"); nullptr when KEY is not enumerated.
   const std::vector<std::string>* choices(const std::string& key);
+  /// The bounds the readers check the number (or numbers) of field KEY against; nullptr when
+  /// they check none.
+  const json_reader::FieldRecorder::Range* limits(const std::string& key);
+  /// A number field's edit after its widget: a drag applies as it moves, a number typed into the
+  /// field (Ctrl+click or double-click) only when Enter or a click elsewhere ends the typing.
+  void number_edit(const std::string& key, bool changed, const std::string& assignment);
   /// What picking NAME in KEY's combo does: the edit KEY="NAME", for a name of choices(KEY) only.
   Status choose(const std::string& key, const std::string& name);
   void direction_helpers();
@@ -379,6 +387,18 @@ class Editor {
   /// the dialog staying with the error when that is refused.
   void accept_file_dialog();
   void interactive_input(float dt);
+  /// Records the last widget's place under `name` (its label without a "##..." part).
+  void name_item(const std::string& name);
+  bool button(const char* label) {
+    const bool pressed = ImGui::Button(label);
+    name_item(label);
+    return pressed;
+  }
+  /// Queues a script's click (and Ctrl, or a second click) on the widget named `what`.
+  void queue_click(const std::string& what, bool ctrl, bool twice, int line);
+  /// Feeds the next queued script step to Dear ImGui (between the backend's frame and its own);
+  /// an error when the widget a click names was not drawn in the last frame.
+  Status feed_ui_step();
   Status run_action(const ScriptAction& a, bool& quit);
 
   const json& document() {
@@ -395,11 +415,34 @@ class Editor {
   }
 
   Options opt_;
-  /// Every enumeration the scene readers are asked for while the editor runs: the combo boxes'
-  /// items are the readers' own tables.
-  json_reader::EnumerationRecorder enumerations_;
+  /// Every enumeration and range-checked number the scene readers are asked for while the
+  /// editor runs: the combo boxes' items and the drag fields' limits are the readers' own.
+  json_reader::FieldRecorder recorded_;
   std::map<std::string, std::vector<std::string>> choices_;  ///< by enumeration_key()
   std::size_t choices_from_ = 0;  ///< how many recorded fields choices_ was made from
+  std::map<std::string, json_reader::FieldRecorder::Range> limits_;  ///< by enumeration_key()
+  std::size_t limits_from_ = 0;   ///< how many recorded ranges limits_ was made from
+  std::pair<std::string, std::string> typed_;  ///< a number being typed: its key and edit
+  /// The named widgets of the last UI frame and where they were (min x, min y, max x, max y):
+  /// fields by their key, buttons and text fields by their label, entity rows "entity:NAME",
+  /// a combo's items "KEY=ITEM", the file dialog's rows "dialog:NAME" (README, `click`).
+  struct Widget {
+    std::array<float, 4> rect;  ///< min x, min y, max x, max y
+    bool visible;               ///< not scrolled out of its panel
+  };
+  std::map<std::string, Widget> widgets_;
+  std::string scroll_to_;  ///< a widget to scroll into view as it is drawn (a script's click)
+  /// A script's input to the panels (click, ctrl_click, double_click, type, key enter|escape):
+  /// one step a frame, fed to Dear ImGui before its frame starts.
+  struct UiStep {
+    enum class Kind { settle, move, press, release, move_by, text, key_down, key_up } kind;
+    std::string what;  ///< move: the widget; text: the characters
+    bool ctrl = false;
+    int key = 0;
+    int line = 0;      ///< the script line, for messages
+  };
+  std::deque<UiStep> ui_steps_;
+  ImVec2 ui_mouse_{-FLT_MAX, -FLT_MAX};  ///< where the script's mouse is
   Scene scene_;
   Player& player_;  ///< outlives the editor: its context outlives the UI's GL objects
   std::vector<ScriptAction> script_;  ///< --script, parsed before the window opened
@@ -555,6 +598,7 @@ void Editor::record(bool merge) {
   doc_stale_ = true;
   changed_since_frame_ = true;
   json snapshot = scene_to_json(scene_);
+  if (snapshot == history_[position_]) return;  // an edit that changed nothing is no undo step
   if (merge && position_ + 1 == history_.size() && position_ != saved_ && position_ > 0) {
     history_[position_] = std::move(snapshot);
   } else {
@@ -896,13 +940,17 @@ Status Editor::render_viewport(int w, int h) {
         std::snprintf(part, sizeof part, ", %s %.2f", name, ms);
         parts += part;
       }
+    // Three lines whatever their contents, so that the panel below does not move from frame to
+    // frame (a narrow panel cuts them).
+    const auto& shaders = player_.renderer->shaders().stats();
     std::snprintf(line, sizeof line,
-                  "%.1f ms (GPU shadow %.2f, probes %.2f, forward %.2f%s), %d draws, %zu shadow "
-                  "tris, %d probe faces, %d programs%s",
+                  "%.1f ms; GPU ms: shadow %.2f, probes %.2f, forward %.2f%s\n"
+                  "%d draws, %zu shadow triangles, %d probe faces%s\n"
+                  "%d programs compiled, %d from the binary cache",
                   t->first_frame_ms, st.shadow_gpu_ms, st.probe_gpu_ms, st.forward_gpu_ms,
                   parts.c_str(), st.draw_calls, st.shadow_triangles, st.probe_faces,
-                  int(player_.renderer->shaders().program_count()),
-                  st.visibility_reused ? ", visibility read back" : "");
+                  st.visibility_reused ? ", visibility read back" : "", shaders.programs_compiled,
+                  shaders.cache_hits);
     stats_ = line;
   }
   if (!opt_.script.empty()) {
@@ -938,13 +986,41 @@ void Editor::request(const std::string& assignment) {
 }
 
 const std::vector<std::string>* Editor::choices(const std::string& key) {
-  if (choices_from_ != enumerations_.fields().size()) {
-    for (const auto& [path, names] : enumerations_.fields())
+  if (choices_from_ != recorded_.enumerations().size()) {
+    for (const auto& [path, names] : recorded_.enumerations())
       choices_[enumeration_key(path, '/')] = names;
-    choices_from_ = enumerations_.fields().size();
+    choices_from_ = recorded_.enumerations().size();
   }
   const auto it = choices_.find(enumeration_key(key, '.'));
   return it == choices_.end() ? nullptr : &it->second;
+}
+
+const json_reader::FieldRecorder::Range* Editor::limits(const std::string& key) {
+  if (limits_from_ != recorded_.ranges().size()) {
+    for (const auto& [path, range] : recorded_.ranges()) limits_[enumeration_key(path, '/')] = range;
+    limits_from_ = recorded_.ranges().size();
+  }
+  const auto it = limits_.find(enumeration_key(key, '.'));
+  return it == limits_.end() ? nullptr : &it->second;
+}
+
+void Editor::number_edit(const std::string& key, bool changed, const std::string& assignment) {
+  // While typing, the widget hands over each keystroke's number ("9" on the way to "90"): only
+  // the last one, when the typing ends, is an edit.
+  if (ImGui::IsItemActive() && ImGui::GetIO().WantTextInput) {
+    if (changed) typed_ = {key, assignment};
+    return;
+  }
+  // Enter or a click elsewhere ends the typing with its number; Escape with the old one.
+  const bool escaped = ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape), false);
+  if (changed) {
+    request(assignment);
+  } else if (ImGui::IsItemDeactivated() && typed_.first == key && !escaped) {
+    request(typed_.second);
+  }
+  if (changed || ImGui::IsItemDeactivated()) typed_ = {};
+  // A drag ends with the mouse released: the next drag of the field is another undo step.
+  if (ImGui::IsItemDeactivated() && last_drag_key_ == key) last_drag_key_.clear();
 }
 
 Status Editor::choose(const std::string& key, const std::string& name) {
@@ -962,25 +1038,43 @@ void Editor::field(const std::string& key, const std::string& label, const json&
   if (v.is_boolean()) {
     bool b = v.get<bool>();
     if (ImGui::Checkbox(label.c_str(), &b)) request(key + "=" + (b ? "true" : "false"));
-  } else if (v.is_number_integer() || v.is_number_unsigned()) {
-    // Drag fields without limits: the scene readers decide what is valid (one source of truth),
-    // and a rejected value shows their message.
-    int i = v.get<int>();
-    if (ImGui::DragInt(label.c_str(), &i, 1.0f)) request(key + "=" + std::to_string(i));
-  } else if (v.is_number_float()) {
-    float f = v.get<float>();
-    const float speed = std::max(std::abs(f) * 0.01f, 0.001f);
-    if (ImGui::DragFloat(label.c_str(), &f, speed, 0.0f, 0.0f, "%.5g"))
-      request(key + "=" + json(double(f)).dump());
+    name_item(key);
+  } else if (v.is_number()) {
+    // Drag fields within the readers' own limits (one source of truth): a drag stops at them; a
+    // typed value outside them is refused with the readers' message.
+    const auto* range = limits(key);
+    if (v.is_number_integer() || v.is_number_unsigned()) {
+      int i = v.get<int>();
+      // An int drag computes max - min: only limits that cannot overflow it.
+      const bool bounded = range && range->lo > -1e9 && range->hi < 1e9;
+      const bool changed = ImGui::DragInt(label.c_str(), &i, 1.0f, bounded ? int(range->lo) : 0,
+                                          bounded ? int(range->hi) : 0);
+      name_item(key);
+      number_edit(key, changed, key + "=" + std::to_string(i));
+    } else {
+      float f = v.get<float>();
+      float speed = std::max(std::abs(f) * 0.01f, 0.001f);
+      if (range && range->hi - range->lo <= 1000.0)
+        speed = std::max(speed, float(range->hi - range->lo) * 0.002f);
+      const bool changed = ImGui::DragFloat(label.c_str(), &f, speed, range ? float(range->lo) : 0.0f,
+                                            range ? float(range->hi) : 0.0f, "%.5g");
+      name_item(key);
+      number_edit(key, changed, key + "=" + json(double(f)).dump());
+    }
+    if (range && ImGui::IsItemHovered())
+      ImGui::SetTooltip("%s: [%g, %g]", key.c_str(), range->lo, range->hi);
   } else if (names) {
     // The reader's names; a value outside them (none is read, but a file may be edited while
     // open) is shown as it is. A choice is the same KEY=VALUE edit as a typed one.
     const std::string current = v.get<std::string>();
-    if (ImGui::BeginCombo(label.c_str(), current.c_str())) {
+    const bool open = ImGui::BeginCombo(label.c_str(), current.c_str());
+    name_item(key);
+    if (open) {
       for (const std::string& n : *names) {
         const bool is_current = n == current;
         if (ImGui::Selectable(n.c_str(), is_current) && !is_current)
           operations_.push_back([this, key, n] { return choose(key, n); });
+        name_item(key + "=" + n);
         if (is_current) ImGui::SetItemDefaultFocus();
       }
       ImGui::EndCombo();
@@ -990,19 +1084,25 @@ void Editor::field(const std::string& key, const std::string& label, const json&
     std::snprintf(buf, sizeof buf, "%s", v.get<std::string>().c_str());
     if (ImGui::InputText(label.c_str(), buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue))
       request(key + "=" + json(std::string(buf)).dump());
+    name_item(key);
   } else if (v.is_array() && v.size() >= 2 && v.size() <= 4 &&
              std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); })) {
     float f[4] = {};
     for (std::size_t i = 0; i < v.size(); ++i) f[i] = v[i].get<float>();
     float largest = 0.0f;
     for (float x : f) largest = std::max(largest, std::abs(x));
-    const float speed = std::max(largest * 0.01f, 0.001f);
-    if (ImGui::DragScalarN(label.c_str(), ImGuiDataType_Float, f, int(v.size()), speed, nullptr,
-                           nullptr, "%.4g")) {
-      json a = json::array();
-      for (std::size_t i = 0; i < v.size(); ++i) a.push_back(double(f[i]));
-      request(key + "=" + a.dump());
-    }
+    float speed = std::max(largest * 0.01f, 0.001f);
+    const auto* range = limits(key);
+    const float lo = range ? float(range->lo) : 0.0f, hi = range ? float(range->hi) : 0.0f;
+    if (range && range->hi - range->lo <= 1000.0) speed = std::max(speed, (hi - lo) * 0.002f);
+    const bool changed = ImGui::DragScalarN(label.c_str(), ImGuiDataType_Float, f, int(v.size()),
+                                            speed, range ? &lo : nullptr, range ? &hi : nullptr, "%.4g");
+    name_item(key);
+    json a = json::array();
+    for (std::size_t i = 0; i < v.size(); ++i) a.push_back(double(f[i]));
+    number_edit(key, changed, key + "=" + a.dump());
+    if (range && ImGui::IsItemHovered())
+      ImGui::SetTooltip("%s: each in [%g, %g]", key.c_str(), range->lo, range->hi);
   } else if (v.is_object() || v.is_array()) {
     if (ImGui::TreeNode(label.c_str())) {
       if (v.is_object())
@@ -1024,13 +1124,15 @@ void Editor::direction_helpers() {
   if (!e || !(scene_.world.has<Light>(*e) || scene_.world.has<Camera>(*e))) return;
   const auto* wt = scene_.world.try_get<WorldTransform>(*e);
   if (!wt) return;
-  if (!ImGui::CollapsingHeader("aim", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  const bool aim_open = ImGui::CollapsingHeader("aim", ImGuiTreeNodeFlags_DefaultOpen);
+  name_item(selected_ + ".aim");
+  if (!aim_open) return;
   glm::vec3 d = glm::normalize(-glm::vec3(wt->matrix[2]));
   if (ImGui::DragFloat3("direction", &d.x, 0.01f, -1.0f, 1.0f, "%.3f") && glm::length(d) > 1e-4f)
     request(selected_ + ".transform.direction=" +
             json::array({double(d.x), double(d.y), double(d.z)}).dump());
   ImGui::DragFloat3("look-at point", &look_at_.x, 0.05f, 0.0f, 0.0f, "%.3g");
-  if (ImGui::Button("look at it"))
+  if (button("look at it"))
     requests_.emplace_back(selected_ + ".transform.look_at=" +
                                json::array({double(look_at_.x), double(look_at_.y), double(look_at_.z)}).dump(),
                            false);
@@ -1048,6 +1150,7 @@ void Editor::entity_node(ecs::Entity e,
   ImGui::PushID(int(e.index));
   const bool open = ImGui::TreeNodeEx(name.c_str(), flags);
   if (ImGui::IsItemClicked() && n) selected_ = n->value;
+  if (n) name_item("entity:" + n->value);
   // Drag an entity onto another to parent it there.
   if (n && ImGui::BeginDragDropSource()) {
     ImGui::SetDragDropPayload("kaskad_entity", n->value.data(), n->value.size());
@@ -1091,7 +1194,7 @@ void Editor::entity_list() {
 
 void Editor::inspector() {
   ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
-  ImGui::TextWrapped("%s", stats_.c_str());
+  ImGui::TextUnformatted(stats_.c_str());
   ImGui::PopStyleColor();
   if (!frame_ms_.empty())
     ImGui::PlotLines("frame ms", frame_ms_.data(), int(frame_ms_.size()), 0, nullptr, 0.0f,
@@ -1101,6 +1204,7 @@ void Editor::inspector() {
     view_ = View(view);
     changed_since_frame_ = true;
   }
+  name_item("view");
   if (!message_.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, message_is_error_ ? ImVec4(1.0f, 0.45f, 0.35f, 1.0f)
                                                            : ImVec4(0.55f, 0.85f, 0.55f, 1.0f));
@@ -1112,31 +1216,30 @@ void Editor::inspector() {
     char path[1024];
     std::snprintf(path, sizeof path, "%s", file_line_.c_str());
     ImGui::InputText("file", path, sizeof path);
+    name_item("file");
     file_line_ = path;
     // The typed path at once; the dialog with the "..." buttons.
-    if (ImGui::Button("open") && !file_line_.empty()) {
+    if (button("open") && !file_line_.empty()) {
       const fs::path f = file_line_;
       operations_.push_back([this, f] { return open(f); });
     }
     ImGui::SameLine();
-    if (ImGui::Button("save as") && !file_line_.empty()) {
+    if (button("save as") && !file_line_.empty()) {
       const fs::path f = file_line_;
       operations_.push_back([this, f] { return save_as(f); });
     }
-    if (ImGui::Button("open...")) show_file_dialog(FileDialog::Purpose::open, file_line_);
+    if (button("open...")) show_file_dialog(FileDialog::Purpose::open, file_line_);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+O");
     ImGui::SameLine();
-    if (ImGui::Button("save as...")) show_file_dialog(FileDialog::Purpose::save_as, file_line_);
+    if (button("save as...")) show_file_dialog(FileDialog::Purpose::save_as, file_line_);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+Shift+S");
   }
   char buf[512];
   std::snprintf(buf, sizeof buf, "%s", set_line_.c_str());
-  if (ImGui::InputText("--set", buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue)) {
-    set_line_ = buf;
-    requests_.emplace_back(set_line_, false);
-  } else {
-    set_line_ = buf;
-  }
+  const bool set_entered = ImGui::InputText("--set", buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue);
+  name_item("--set");
+  set_line_ = buf;
+  if (set_entered) requests_.emplace_back(set_line_, false);
   const json& doc = document();
   if (!selected_.empty()) {
     const json* ent = nullptr;
@@ -1146,21 +1249,25 @@ void Editor::inspector() {
       ImGui::Separator();
       char name[256];
       std::snprintf(name, sizeof name, "%s", selected_.c_str());
-      if (ImGui::InputText("name", name, sizeof name, ImGuiInputTextFlags_EnterReturnsTrue)) {
+      const bool renamed = ImGui::InputText("name", name, sizeof name, ImGuiInputTextFlags_EnterReturnsTrue);
+      name_item("name");
+      if (renamed) {
         const std::string n = name;
         operations_.push_back([this, n] { return rename_selected(n); });
       }
-      if (ImGui::Button("duplicate")) operations_.push_back([this] { return duplicate_selected(); });
+      if (button("duplicate")) operations_.push_back([this] { return duplicate_selected(); });
       ImGui::SameLine();
-      if (ImGui::Button("delete")) operations_.push_back([this] { return remove_selected(); });
+      if (button("delete")) operations_.push_back([this] { return remove_selected(); });
       if (ent->contains("transform") && ent->at("transform").contains("parent")) {
         ImGui::SameLine();
-        if (ImGui::Button("make root")) operations_.push_back([this] { return reparent_selected(""); });
+        if (button("make root")) operations_.push_back([this] { return reparent_selected(""); });
       }
       ImGui::TextDisabled("drag an entity onto another to parent it");
       for (auto it = ent->begin(); it != ent->end(); ++it) {
         if (it.key() == "name" || !it.value().is_object()) continue;
-        if (ImGui::CollapsingHeader(it.key().c_str(), ImGuiTreeNodeFlags_DefaultOpen))
+        const bool open = ImGui::CollapsingHeader(it.key().c_str(), ImGuiTreeNodeFlags_DefaultOpen);
+        name_item(selected_ + "." + it.key());
+        if (open)
           for (auto f = it.value().begin(); f != it.value().end(); ++f)
             field(selected_ + "." + it.key() + "." + f.key(), f.key(), f.value());
       }
@@ -1181,7 +1288,9 @@ void Editor::inspector() {
         const json sections = live_entity_sections(scene_, *e);
         for (const char* section : {"transform", "light", "shadow", "camera", "renderer"}) {
           if (!sections.contains(section)) continue;
-          if (ImGui::CollapsingHeader(section, ImGuiTreeNodeFlags_DefaultOpen))
+          const bool open = ImGui::CollapsingHeader(section, ImGuiTreeNodeFlags_DefaultOpen);
+          name_item(selected_ + "." + section);
+          if (open)
             for (auto f = sections[section].begin(); f != sections[section].end(); ++f)
               field(selected_ + "." + section + "." + f.key(), f.key(), f.value());
         }
@@ -1191,13 +1300,113 @@ void Editor::inspector() {
   }
   for (const char* section : {"render", "shadow"}) {
     if (!doc.contains(section)) continue;
-    if (ImGui::CollapsingHeader(section))
+    const bool open = ImGui::CollapsingHeader(section);
+    name_item(section);
+    if (open)
       for (auto f = doc[section].begin(); f != doc[section].end(); ++f)
         field(std::string(section) + "." + f.key(), f.key(), f.value());
   }
 }
 
+void Editor::name_item(const std::string& label) {
+  const std::string name = label.substr(0, label.find("##"));
+  const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+  widgets_[name] = {{lo.x, lo.y, hi.x, hi.y}, ImGui::IsItemVisible()};
+  if (name == scroll_to_) {
+    ImGui::SetScrollHereY(0.5f);
+    scroll_to_.clear();
+  }
+}
+
+void Editor::queue_click(const std::string& what, bool ctrl, bool twice, int line) {
+  using K = UiStep::Kind;
+  // A frame first, so that the panels show what the actions before changed (a selection's
+  // inspector); then the mouse goes there, and presses and releases, a frame each.
+  ui_steps_.push_back({K::settle, "", false, 0, line});
+  ui_steps_.push_back({K::move, what, ctrl, 0, line});
+  for (int i = 0; i < (twice ? 2 : 1); ++i) {
+    ui_steps_.push_back({K::press, what, ctrl, 0, line});
+    ui_steps_.push_back({K::release, what, ctrl, 0, line});
+  }
+  ui_steps_.push_back({K::settle, "", false, 0, line});
+}
+
+Status Editor::feed_ui_step() {
+  ImGuiIO& io = ImGui::GetIO();
+  if (ui_steps_.empty()) {
+    if (ui_mouse_.x != -FLT_MAX) io.MousePos = ui_mouse_;  // the script's mouse stays put
+    return {};
+  }
+  const UiStep step = ui_steps_.front();
+  ui_steps_.pop_front();
+  using K = UiStep::Kind;
+  // A script's frames are a user's: two clicks a few frames apart make a double click; a settle
+  // step lasts half a second, so that clicks of separate actions never do.
+  io.DeltaTime = step.kind == UiStep::Kind::settle ? 0.5f : 1.0f / 60.0f;
+  io.KeyCtrl = step.ctrl;
+  // The mouse follows the widget to where the last frame drew it (a panel's lines may move).
+  auto centre = [&](const Widget& w) {
+    ui_mouse_ = ImVec2(0.5f * (w.rect[0] + w.rect[2]), 0.5f * (w.rect[1] + w.rect[3]));
+  };
+  if (step.kind == K::press)
+    if (const auto it = widgets_.find(step.what); it != widgets_.end()) centre(it->second);
+  switch (step.kind) {
+    case K::settle:
+      break;
+    case K::move: {
+      const auto it = widgets_.find(step.what);
+      if (it == widgets_.end()) {
+        ui_steps_.clear();
+        std::vector<std::string> shown;
+        for (const auto& [name, widget] : widgets_)
+          if (shown.size() < 40) shown.push_back(name);
+        if (widgets_.size() > shown.size())
+          shown.push_back("... (" + std::to_string(widgets_.size()) + " in all)");
+        return Error{opt_.script.string(), "line " + std::to_string(step.line),
+                     "no widget named '" + step.what + "' in the last frame; it showed: " +
+                         json_reader::join(shown)};
+      }
+      if (!it->second.visible) {
+        // Scrolled out of its panel: scrolled to as it is drawn, then looked for again.
+        if (step.key >= 3)
+          return Error{opt_.script.string(), "line " + std::to_string(step.line),
+                       "widget '" + step.what + "' stays out of view"};
+        scroll_to_ = step.what;
+        UiStep again = step;
+        ++again.key;  // the attempts
+        ui_steps_.push_front(again);
+        ui_steps_.push_front({K::settle, "", step.ctrl, 0, step.line});
+        break;
+      }
+      centre(it->second);
+      break;
+    }
+    case K::press:
+      io.MouseDown[0] = true;
+      break;
+    case K::move_by:
+      io.MouseDown[0] = true;
+      ui_mouse_.x += float(step.key);
+      break;
+    case K::release:
+      io.MouseDown[0] = false;
+      break;
+    case K::text:
+      io.AddInputCharactersUTF8(step.what.c_str());
+      break;
+    case K::key_down:
+      io.KeysDown[step.key] = true;
+      break;
+    case K::key_up:
+      io.KeysDown[step.key] = false;
+      break;
+  }
+  if (ui_mouse_.x != -FLT_MAX) io.MousePos = ui_mouse_;
+  return {};
+}
+
 void Editor::draw_ui(int w, int h) {
+  widgets_.clear();
   const Layout l = layout_for(w, h, left_w_, right_w_);
   const ImGuiWindowFlags panel = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse |
                                  ImGuiWindowFlags_NoSavedSettings;
@@ -1210,8 +1419,9 @@ void Editor::draw_ui(int w, int h) {
   static const char* kShapes[] = {"box", "sphere", "cylinder", "cone", "plane"};
   ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
   ImGui::Combo("##shape", &create_shape_, kShapes, int(std::size(kShapes)));
+  name_item("shape");
   ImGui::SameLine();
-  if (ImGui::Button("create")) {
+  if (button("create")) {
     const std::string shape = kShapes[create_shape_];
     operations_.push_back([this, shape] { return create(shape); });
   }
@@ -1224,13 +1434,14 @@ void Editor::draw_ui(int w, int h) {
   const bool entered = ImGui::InputTextWithHint("##model", "model.gltf", import_path_,
                                                 sizeof import_path_,
                                                 ImGuiInputTextFlags_EnterReturnsTrue);
+  name_item("model path");
   ImGui::SameLine();
-  if ((ImGui::Button("import") || entered) && import_path_[0] != '\0') {
+  if ((button("import") || entered) && import_path_[0] != '\0') {
     const std::string path = import_path_;
     operations_.push_back([this, path] { return import_model(path); });
   }
   ImGui::SameLine();
-  if (ImGui::Button("...")) show_file_dialog(FileDialog::Purpose::import, import_path_);
+  if (button("...")) show_file_dialog(FileDialog::Purpose::import, import_path_);
   ImGui::Separator();
   entity_list();
   left_w_ = ImGui::GetWindowWidth();
@@ -1269,21 +1480,21 @@ void Editor::draw_ui(int w, int h) {
   if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
     ImGui::Text("%s has unsaved changes.", opt_.scene.filename().string().c_str());
     GLFWwindow* window = player_.context->window();
-    if (ImGui::Button("Save and quit")) {
+    if (button("Save and quit")) {
       if (Status st = save(opt_.scene); st) glfwSetWindowShouldClose(window, true);
       else report(st.error().to_string());
       ask_quit_ = false;
       ImGui::CloseCurrentPopup();
     }
     ImGui::SameLine();
-    if (ImGui::Button("Quit without saving")) {
+    if (button("Quit without saving")) {
       saved_ = position_;
       glfwSetWindowShouldClose(window, true);
       ask_quit_ = false;
       ImGui::CloseCurrentPopup();
     }
     ImGui::SameLine();
-    if (ImGui::Button("Cancel")) {
+    if (button("Cancel")) {
       ask_quit_ = false;
       ImGui::CloseCurrentPopup();
     }
@@ -1369,10 +1580,10 @@ void Editor::file_dialog(int w, int h) {
     ImGui::EndPopup();
     return;
   }
-  if (ImGui::Button("up") && d.folder.has_parent_path() && d.folder.parent_path() != d.folder)
+  if (button("up") && d.folder.has_parent_path() && d.folder.parent_path() != d.folder)
     d.enter(d.folder.parent_path());
   ImGui::SameLine();
-  if (ImGui::Button("refresh")) d.enter(d.folder);
+  if (button("refresh")) d.enter(d.folder);
   ImGui::SameLine();
   ImGui::TextUnformatted(display_name(d.folder.string()).c_str());
   const ImVec4 red(1.0f, 0.45f, 0.35f, 1.0f);
@@ -1386,7 +1597,9 @@ void Editor::file_dialog(int w, int h) {
   for (const FolderEntry& e : d.listing.entries) {
     const std::string label = e.folder ? e.label + "/" : e.label;
     const bool picked = !e.folder && e.path == d.picked;
-    if (ImGui::Selectable(label.c_str(), picked, ImGuiSelectableFlags_AllowDoubleClick)) {
+    const bool clicked = ImGui::Selectable(label.c_str(), picked, ImGuiSelectableFlags_AllowDoubleClick);
+    name_item("dialog:" + label);
+    if (clicked) {
       if (e.folder) {
         enter = e.path;
       } else {
@@ -1404,6 +1617,7 @@ void Editor::file_dialog(int w, int h) {
   if (ImGui::IsWindowAppearing()) ImGui::SetKeyboardFocusHere();
   ImGui::SetNextItemWidth(-160.0f);
   ImGui::InputText("##name", d.name, sizeof d.name);
+  name_item("dialog name");
   // Enter anywhere in the dialog (the name field gives up the keyboard on Enter, so a second one,
   // to answer "replace it?", comes with no field active); as pressed, not its repeats: a held
   // Enter must not answer by itself.
@@ -1414,9 +1628,9 @@ void Editor::file_dialog(int w, int h) {
   const char* verb = d.purpose == FileDialog::Purpose::open      ? "open"
                      : d.purpose == FileDialog::Purpose::save_as ? "save"
                                                                  : "import";
-  if (ImGui::Button(verb)) accept = true;
+  if (button(verb)) accept = true;
   ImGui::SameLine();
-  if (ImGui::Button("cancel")) {
+  if (button("cancel")) {
     d.visible = false;
     ImGui::CloseCurrentPopup();
   }
@@ -1467,7 +1681,7 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
     case ActionKind::set:
       return edit(a.args[0], false);
     case ActionKind::choices: {
-      // What the inspector's combo for KEY lists (the script cannot click it).
+      // What the inspector's combo for KEY lists.
       const std::vector<std::string>* names = choices(a.args[0]);
       if (!names) return Error{"", "", "choices: '" + a.args[0] + "' is not an enumerated field"};
       std::printf("kaskad edit: choices %s: %s\n", a.args[0].c_str(),
@@ -1494,9 +1708,46 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       return {};
     }
     case ActionKind::key:
+      if (a.args[0] == "enter" || a.args[0] == "escape") {
+        // To the panels: pressed for a frame, then released.
+        const int key = a.args[0] == "enter" ? GLFW_KEY_ENTER : GLFW_KEY_ESCAPE;
+        ui_steps_.push_back({UiStep::Kind::key_down, "", false, key, a.line});
+        ui_steps_.push_back({UiStep::Kind::key_up, "", false, key, a.line});
+        ui_steps_.push_back({UiStep::Kind::settle, "", false, 0, a.line});
+        return {};
+      }
       // One fly step is a frame's worth at 30 Hz; a key that fails (nothing to undo, a save
       // refused) fails the script.
       return press(a.args[0], 1.0f / 30.0f);
+    case ActionKind::click:
+    case ActionKind::ctrl_click:
+    case ActionKind::double_click:
+      queue_click(a.args[0], a.kind == ActionKind::ctrl_click, a.kind == ActionKind::double_click,
+                  a.line);
+      return {};
+    case ActionKind::drag: {
+      // Press on the widget, move the mouse PIXELS to the right (left if negative) over eight
+      // frames, release.
+      using K = UiStep::Kind;
+      const int pixels = std::stoi(a.args[1]);
+      ui_steps_.push_back({K::settle, "", false, 0, a.line});
+      ui_steps_.push_back({K::move, a.args[0], false, 0, a.line});
+      ui_steps_.push_back({K::press, a.args[0], false, 0, a.line});
+      for (int i = 0; i < 8; ++i)
+        ui_steps_.push_back({K::move_by, "", false, (pixels * (i + 1)) / 8 - (pixels * i) / 8, a.line});
+      ui_steps_.push_back({K::release, "", false, 0, a.line});
+      ui_steps_.push_back({K::settle, "", false, 0, a.line});
+      return {};
+    }
+    case ActionKind::type:
+      // A character a frame (UTF-8 sequences whole), as typed.
+      for (std::size_t i = 0; i < a.args[0].size();) {
+        std::size_t n = 1;
+        while (i + n < a.args[0].size() && (static_cast<unsigned char>(a.args[0][i + n]) & 0xC0) == 0x80) ++n;
+        ui_steps_.push_back({UiStep::Kind::text, a.args[0].substr(i, n), false, 0, a.line});
+        i += n;
+      }
+      return {};
     case ActionKind::frames:
     case ActionKind::input:  // the run loop counts both
       return {};
@@ -1578,7 +1829,7 @@ int Editor::run() {
         std::printf("kaskad edit: input %d ended\n", input_phases);
         std::fflush(stdout);
       }
-      while (!input_until && frames_left == 0 && next < script.size()) {
+      while (!input_until && frames_left == 0 && ui_steps_.empty() && next < script.size()) {
         const ScriptAction& a = script[next];
         if (a.kind == ActionKind::screenshot && changed_since_frame_) {
           frames_left = 1;
@@ -1603,7 +1854,7 @@ int Editor::run() {
         }
         if (quit) break;
       }
-      if (!quit && !input_until && frames_left == 0 && next == script.size()) {
+      if (!quit && !input_until && frames_left == 0 && ui_steps_.empty() && next == script.size()) {
         std::fprintf(stderr, "kaskad edit: error: %s: the script ended without quit or quit!\n",
                      opt_.script.string().c_str());
         return 1;
@@ -1636,6 +1887,13 @@ int Editor::run() {
 
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
+    // A script's clicks and typing, between the backend's input and Dear ImGui's frame.
+    if (!opt_.script.empty() && !input_until) {
+      if (Status st = feed_ui_step(); !st) {
+        std::fprintf(stderr, "kaskad edit: error: %s\n", st.error().to_string().c_str());
+        return 1;
+      }
+    }
     ImGui::NewFrame();
     const auto now = std::chrono::steady_clock::now();
     const float dt = std::min(std::chrono::duration<float>(now - last).count(), 0.1f);

@@ -42,7 +42,12 @@ constexpr Verb kVerbs[] = {
     {"parent", ActionKind::parent, 1, 1, "parent NAME (or - for none)"},
     {"camera", ActionKind::camera, 3, 6, "camera X Y Z [LOOK_X LOOK_Y LOOK_Z]"},
     {"orbit", ActionKind::orbit, 2, 2, "orbit YAW_DEG PITCH_DEG"},
-    {"key", ActionKind::key, 1, 1, "key K (w a s d q e f ctrl+z ctrl+y ctrl+s)"},
+    {"key", ActionKind::key, 1, 1, "key K"},
+    {"click", ActionKind::click, 1, 1, "click WIDGET"},
+    {"ctrl_click", ActionKind::ctrl_click, 1, 1, "ctrl_click WIDGET"},
+    {"double_click", ActionKind::double_click, 1, 1, "double_click WIDGET"},
+    {"drag", ActionKind::drag, 2, 2, "drag WIDGET PIXELS"},
+    {"type", ActionKind::type, 1, 1, "type TEXT"},
     {"view", ActionKind::view, 1, 1, "view VIEW"},
     {"frames", ActionKind::frames, 1, 1, "frames N (1..100000)"},
     {"screenshot", ActionKind::screenshot, 1, 1, "screenshot PATH.png"},
@@ -60,7 +65,7 @@ constexpr Verb kVerbs[] = {
 }  // namespace
 
 bool is_script_key(const std::string& name) {
-  for (const char* k : {"w", "a", "s", "d", "q", "e", "f", "ctrl+z", "ctrl+y", "ctrl+s"})
+  for (const char* k : kScriptKeys)
     if (name == k) return true;
   return false;
 }
@@ -88,7 +93,8 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
     a.kind = v->kind;
     a.line = n;
     if (a.kind == ActionKind::set || a.kind == ActionKind::select || a.kind == ActionKind::rename ||
-        a.kind == ActionKind::parent) {
+        a.kind == ActionKind::parent || a.kind == ActionKind::type || a.kind == ActionKind::click ||
+        a.kind == ActionKind::ctrl_click || a.kind == ActionKind::double_click) {
       // The rest of the line, spaces included: a value may be a JSON array or a name with spaces.
       std::string rest;
       std::getline(words, rest);
@@ -97,6 +103,11 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
       if (first != std::string::npos) a.args.push_back(rest.substr(first, last - first + 1));
     } else {
       for (std::string w; words >> w;) a.args.push_back(w);
+      // drag WIDGET PIXELS: the widget's name may hold spaces ("make root").
+      while (a.kind == ActionKind::drag && a.args.size() > 2) {
+        a.args[0] += " " + a.args[1];
+        a.args.erase(a.args.begin() + 1);
+      }
     }
     const int count = int(a.args.size());
     if (count < v->min_args || count > v->max_args || (a.kind == ActionKind::camera && count == 4) ||
@@ -108,8 +119,14 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
       for (const std::string& c : a.args)
         if (!is_number(c))
           return Error{file.string(), where, verb + ": '" + c + "' is not a number"};
-    if (a.kind == ActionKind::key && !is_script_key(a.args[0]))
-      return Error{file.string(), where, "unknown key '" + a.args[0] + "'; expected " + v->usage};
+    if (a.kind == ActionKind::key && !is_script_key(a.args[0])) {
+      std::string keys;  // from the one table
+      for (const char* k : kScriptKeys) {
+        if (!keys.empty()) keys += ", ";
+        keys += k;
+      }
+      return Error{file.string(), where, "unknown key '" + a.args[0] + "'; expected one of " + keys};
+    }
     if (a.kind == ActionKind::view && !view_named(a.args[0])) {
       std::string views;  // from the one table
       for (const char* name : kViewNames) {
@@ -118,6 +135,9 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
       }
       return Error{file.string(), where, "unknown view '" + a.args[0] + "'; expected view " + views};
     }
+    if (a.kind == ActionKind::drag && !whole_number_in(a.args[1], -100000, 100000))
+      return Error{file.string(), where,
+                   "drag: expected pixels in [-100000, 100000], got '" + a.args[1] + "'"};
     if (a.kind == ActionKind::input && !whole_number_in(a.args[0], 1, 600))
       return Error{file.string(), where, "input: expected seconds in [1, 600], got '" + a.args[0] + "'"};
     if (a.kind == ActionKind::frames && !whole_number_in(a.args[0], 1, 100000))

@@ -14,8 +14,8 @@ namespace kaskad::editor {
 
 enum class ActionKind {
   set, choices, choose, select, create, import, remove, duplicate, rename, parent, camera, orbit,
-  key, view, frames, screenshot, window_screenshot, input, open, save, save_as, undo, redo, quit,
-  force_quit
+  key, click, ctrl_click, double_click, drag, type, view, frames, screenshot, window_screenshot, input, open, save, save_as, undo,
+  redo, quit, force_quit
 };
 
 /// What the viewport shows: the colour, or as a debug view one of the frame's AOVs (README "AOV
@@ -44,8 +44,12 @@ struct ScriptAction {
 };
 
 /// The names `key` takes (the same keys a user presses): w a s d q e (one fly step of 1/30 s),
-/// f (frame the selection), ctrl+z, ctrl+y, ctrl+s.
+/// f (frame the selection), ctrl+z, ctrl+y, ctrl+s, and enter and escape (to the panels: they
+/// end the typing in a field).
+inline constexpr const char* kScriptKeys[] = {"w", "a", "s", "d", "q", "e", "f", "ctrl+z",
+                                              "ctrl+y", "ctrl+s", "enter", "escape"};
 bool is_script_key(const std::string& name);
+
 
 /// Parses a whole script before anything runs, so a bad line fails before the first frame.
 /// Blank lines and lines starting with '#' are skipped. Errors name the file and the line.

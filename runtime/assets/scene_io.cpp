@@ -123,10 +123,12 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
   if (s.vsm_blur % 2 == 0)
     fail(r.at("vsm_blur"), "must be an odd number of texels in [1, 15], was " +
                                std::to_string(s.vsm_blur));
-  r.number("vsm_bleed_reduction", s.vsm_bleed_reduction, 0.0f, 1.0f);
-  if (s.vsm_bleed_reduction >= 1.0f)
+  // [0, 1): 1 would shadow everything. The largest float under 1 is the bound (the editor's).
+  if (r.has("vsm_bleed_reduction") && r.raw("vsm_bleed_reduction").is_number() &&
+      r.raw("vsm_bleed_reduction").get<double>() >= 1.0)
     fail(r.at("vsm_bleed_reduction"), "must be in [0, 1) (1 would shadow everything), was " +
-                                          json(num(s.vsm_bleed_reduction)).dump());
+                                          r.raw("vsm_bleed_reduction").dump());
+  r.number("vsm_bleed_reduction", s.vsm_bleed_reduction, 0.0f, std::nextafter(1.0f, 0.0f));
   r.integer("cascade_count", s.cascade_count, 1, 8);
   r.enumeration("split_scheme", s.split_scheme, kSplitSchemes);
   r.number("lambda", s.lambda, 0.0f, 1.0f);

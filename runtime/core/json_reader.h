@@ -68,28 +68,40 @@ inline json vec(const glm::vec3& v) { return json::array({num(v.x), num(v.y), nu
 inline json vec(const glm::vec4& v) { return json::array({num(v.x), num(v.y), num(v.z), num(v.w)}); }
 
 /// While one exists, collects on its thread every enumerated field the readers are asked for (given
-/// in the file or not) with the names their table accepts: the editor's combo boxes list the
-/// readers' own tables instead of copies. Scoped: the previous recorder is restored when it ends.
-class EnumerationRecorder {
+/// in the file or not) with the names their table accepts, and every range-checked number with
+/// its bounds: the editor's combo boxes and drag fields take the readers' own tables and limits
+/// instead of copies. Scoped: the previous recorder is restored when it ends.
+class FieldRecorder {
  public:
-  EnumerationRecorder() : previous_(current_) { current_ = this; }
-  ~EnumerationRecorder() { current_ = previous_; }
-  EnumerationRecorder(const EnumerationRecorder&) = delete;
-  EnumerationRecorder& operator=(const EnumerationRecorder&) = delete;
+  FieldRecorder() : previous_(current_) { current_ = this; }
+  ~FieldRecorder() { current_ = previous_; }
+  FieldRecorder(const FieldRecorder&) = delete;
+  FieldRecorder& operator=(const FieldRecorder&) = delete;
 
   /// The recorder of this thread, or nullptr.
-  static EnumerationRecorder* current() { return current_; }
+  static FieldRecorder* current() { return current_; }
+  /// The bounds a number (or each number of an array) must lie in, inclusive.
+  struct Range {
+    double lo = 0.0, hi = 0.0;
+    bool operator==(const Range&) const = default;
+  };
   void record(const std::string& path, std::vector<std::string> names) {
-    fields_[path] = std::move(names);
+    enumerations_[path] = std::move(names);
   }
+  void record(const std::string& path, Range range) { ranges_[path] = range; }
   /// The accepted names by field path as the reader names it in errors ("/shadow/filter",
   /// "/entities/2/light/type"), in the table's order.
-  const std::map<std::string, std::vector<std::string>>& fields() const { return fields_; }
+  const std::map<std::string, std::vector<std::string>>& enumerations() const {
+    return enumerations_;
+  }
+  /// The bounds of each range-checked number or array of numbers, by field path.
+  const std::map<std::string, Range>& ranges() const { return ranges_; }
 
  private:
-  static inline thread_local EnumerationRecorder* current_ = nullptr;
-  EnumerationRecorder* previous_;
-  std::map<std::string, std::vector<std::string>> fields_;
+  static inline thread_local FieldRecorder* current_ = nullptr;
+  FieldRecorder* previous_;
+  std::map<std::string, std::vector<std::string>> enumerations_;
+  std::map<std::string, Range> ranges_;
 };
 
 // Reads the fields of one JSON object, tracking which keys were used so that unknown keys are
@@ -108,6 +120,7 @@ class ObjectReader {
   std::string at(const char* key) const { return path_ + "/" + key; }
 
   void number(const char* key, float& out, float lo, float hi) {
+    record_range(key, lo, hi);
     if (!has(key)) return;
     const json& v = j_.at(key);
     if (!v.is_number()) fail(at(key), "expected a number, got " + type_name(v));
@@ -117,6 +130,7 @@ class ObjectReader {
     out = float(d);
   }
   void integer(const char* key, int& out, int lo, int hi) {
+    record_range(key, lo, hi);
     if (!has(key)) return;
     const json& v = j_.at(key);
     if (!v.is_number_integer()) fail(at(key), "expected an integer, got " + type_name(v));
@@ -140,6 +154,7 @@ class ObjectReader {
   }
   template <int N>
   void vector(const char* key, glm::vec<N, float>& out, float lo, float hi) {
+    record_range(key, lo, hi);
     if (!has(key)) return;
     const json& v = j_.at(key);
     if (!v.is_array() || v.size() != N)
@@ -159,7 +174,7 @@ class ObjectReader {
   void enumeration(const char* key, E& out, const std::vector<std::pair<const char*, E>>& table) {
     std::vector<std::string> names;
     for (const auto& [n, e] : table) names.push_back(n);
-    if (EnumerationRecorder* recorder = EnumerationRecorder::current())
+    if (FieldRecorder* recorder = FieldRecorder::current())
       recorder->record(at(key), names);
     if (!has(key)) return;
     const json& v = j_.at(key);
@@ -181,6 +196,9 @@ class ObjectReader {
   }
 
  private:
+  void record_range(const char* key, double lo, double hi) const {
+    if (FieldRecorder* recorder = FieldRecorder::current()) recorder->record(at(key), {lo, hi});
+  }
   static std::string fmt(double d) {
     std::ostringstream s;
     s << d;

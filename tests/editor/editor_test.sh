@@ -17,13 +17,16 @@
 #             per cascade; pcf has none (the colour shows)
 #   combos    an enumerated field's combo lists exactly the names the scene reader accepts (the
 #             reader's own error lists them), for sections, entities, and an entity made in the
-#             editor; choosing one (what a click does; the script cannot click) edits and saves it
+#             editor; choosing one (what a click on the item does) edits and saves it
+#   clicks    the panels driven by clicks, drags and typing: a typed number applies on Enter (not
+#             at each keystroke), Escape cancels it; drags stop at the readers' limits; a
+#             checkbox, a combo item, an entity row and a button act
 #   input     unknown flags, bad script lines, rejected values and unsaved quits fail clearly
 #   real_input  real X events (xdotool) during the script's `input` phases: right mouse + W flies
 #             forward, F frames the selection, Ctrl+Z undoes an edit, Ctrl+O's file dialog opens
 #             a typed scene, Ctrl+Shift+S's saves over a file after asking (skipped, saying so,
 #             without xdotool)
-# usage: editor_test.sh toggles|saving|entities|every_n|soft_maps|combos|input|real_input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
+# usage: editor_test.sh toggles|saving|entities|every_n|soft_maps|combos|clicks|input|real_input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
 set -u
 : "${KASKAD:?path to the kaskad binary}" "${KASKAD_CONTENT:?content dir}"
 if ! command -v xvfb-run >/dev/null 2>&1; then
@@ -535,6 +538,82 @@ quit!" "$scene"
   edit "choose shadow.filter pcss
 quit!" "$scene"
   refused "line 1: 'pcss' is not one of shadow.filter's choices (none, bilinear, pcf3x3)" "a name outside the list is not a choice"
+  ;;
+clicks)
+  # The panels driven as a user drives them (click, ctrl_click, drag, type, key enter|escape): a
+  # number typed into a field is an edit only when the typing ends (Enter, or a click
+  # elsewhere), Escape keeps the old one; a drag stops at the scene reader's limits; a typed
+  # value outside them is refused with the reader's message; a checkbox, a combo's item (in a
+  # section scrolled into view), an entity row and a button each do what a click does.
+  value() {  # value FILE ENTITY SECTION FIELD
+    python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); e=[x for x in d["entities"] if x["name"]==sys.argv[2]][0]; print(e[sys.argv[3]][sys.argv[4]])' "$tmp/$1" "$2" "$3" "$4"
+  }
+  is() {  # is WHAT ACTUAL EXPECTED
+    if [ "$2" = "$3" ]; then ok "$1 ($2)"; else fail "$1: $2, expected $3"; fi
+  }
+  edit "select box_resting
+ctrl_click box_resting.material.roughness
+type 0.25
+frames 2
+save $tmp/typing.json
+key enter
+frames 1
+save $tmp/typed.json
+ctrl_click box_resting.material.roughness
+type 0.75
+key escape
+frames 1
+save $tmp/escaped.json
+ctrl_click box_resting.material.roughness
+type 0.125
+click box_resting.material.metallic
+frames 1
+save $tmp/clicked_away.json
+drag box_resting.material.roughness 3000
+save $tmp/drag_up.json
+drag box_resting.material.roughness -3000
+save $tmp/drag_down.json
+undo
+save $tmp/drag_undone.json
+redo
+drag box_resting.renderer.layer 5000
+save $tmp/drag_layer.json
+ctrl_click box_resting.material.roughness
+type 2
+key enter
+frames 1
+save $tmp/typed_out.json
+click box_resting.renderer.cast_shadows
+save $tmp/checkbox.json
+click shadow
+click shadow.filter
+click shadow.filter=none
+save $tmp/combo.json
+click entity:sphere
+click duplicate
+save $tmp/duplicated.json
+quit!" "$scene"
+  [ "$rc" -eq 0 ] || { fail "clicks script exit $rc"; tail -5 "$tmp/out"; }
+  is "while a number is typed, nothing is applied" "$(value typing.json box_resting material roughness)" 0.5
+  is "Enter applies the typed number" "$(value typed.json box_resting material roughness)" 0.25
+  is "Escape keeps the old number" "$(value escaped.json box_resting material roughness)" 0.25
+  is "a click elsewhere applies the typed number" "$(value clicked_away.json box_resting material roughness)" 0.125
+  is "a drag up stops at the reader's upper bound" "$(value drag_up.json box_resting material roughness)" 1.0
+  is "a drag down stops at the reader's lower bound" "$(value drag_down.json box_resting material roughness)" 0.0
+  is "each drag is one undo step" "$(value drag_undone.json box_resting material roughness)" 1.0
+  is "an integer drag stops at the reader's bound" "$(value drag_layer.json box_resting renderer layer)" 31
+  is "a typed value out of range changes nothing" "$(value typed_out.json box_resting material roughness)" 0.0
+  if grep -q "/entities/1/material/roughness: must be in \[0, 1\], was 2" "$tmp/out"; then
+    ok "a typed value out of range shows the reader's message"
+  else
+    fail "no reader's message for roughness 2"; grep "kaskad edit:" "$tmp/out" | tail -5
+  fi
+  is "a click on a checkbox toggles it" "$(value checkbox.json box_resting renderer cast_shadows)" False
+  is "a click on a combo's item picks it" "$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["shadow"]["filter"])' "$tmp/combo.json")" none
+  is "a click on an entity's row, then on duplicate" "$(value duplicated.json sphere_1 primitive shape)" sphere
+  edit "click no_such_widget
+quit!" "$scene"
+  refused "line 1: no widget named 'no_such_widget' in the last frame; it showed: " "a click on a widget the panels do not show: exit 1, named"
   ;;
 input)
   out=$("$KASKAD" edit --screenshot x.png 2>&1); code=$?

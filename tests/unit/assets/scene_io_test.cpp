@@ -988,10 +988,10 @@ namespace {
 
 using json = nlohmann::json;
 
-// The editor's combo boxes list what json_reader::EnumerationRecorder saw the readers ask for.
+// The editor's combo boxes list what json_reader::FieldRecorder saw the readers ask for.
 // Every string field of the canonical document that the reader checks against a table must be
 // recorded, with exactly the names that table accepts.
-TEST(SceneIo, EnumerationRecorderSeesEveryEnumeratedField) {
+TEST(SceneIo, FieldRecorderSeesEveryEnumeratedField) {
   const json doc = json::parse(R"({
     "kaskad_scene": 1, "render": {}, "shadow": {},
     "entities": [
@@ -999,11 +999,11 @@ TEST(SceneIo, EnumerationRecorderSeesEveryEnumeratedField) {
         "reflector": { "map": "sphere" } },
       { "name": "sun", "light": { "type": "directional" }, "shadow": { "filter": "bilinear" } },
       { "name": "camera", "camera": {} } ] })");
-  json_reader::EnumerationRecorder recorder;
+  json_reader::FieldRecorder recorder;
   auto scene = parse_scene(doc, temp_dir() / "enums.json");
   ASSERT_TRUE(scene.ok()) << scene.error().to_string();
   const json canonical = scene_to_json(*scene);
-  const auto& fields = recorder.fields();
+  const auto& fields = recorder.enumerations();
   for (const char* path : {"/render/tone_mapping", "/shadow/filter", "/shadow/split_scheme",
                            "/shadow/fit_mode", "/entities/0/primitive/shape",
                            "/entities/0/material/reflection_model", "/entities/0/reflector/map",
@@ -1015,7 +1015,7 @@ TEST(SceneIo, EnumerationRecorderSeesEveryEnumeratedField) {
   // A name may still be refused for another field's sake (update static_file needs a file): only
   // "unknown value" at this field counts as not accepted.
   auto unknown = [&](const std::string& pointer, const std::string& value) {
-    json_reader::EnumerationRecorder scratch;
+    json_reader::FieldRecorder scratch;
     json d = canonical;
     d[json::json_pointer(pointer)] = value;
     auto r = parse_scene(d, temp_dir() / "enums.json");
@@ -1068,17 +1068,70 @@ TEST(SceneIo, EnumerationRecorderSeesEveryEnumeratedField) {
   EXPECT_EQ(fields.at("/entities/1/shadow/filter"), filters);
 }
 
-TEST(SceneIo, EnumerationRecorderIsScoped) {
-  EXPECT_EQ(json_reader::EnumerationRecorder::current(), nullptr);
-  {
-    json_reader::EnumerationRecorder outer;
-    {
-      json_reader::EnumerationRecorder inner;
-      EXPECT_EQ(json_reader::EnumerationRecorder::current(), &inner);
+// The editor's drag fields stop at what json_reader::FieldRecorder saw the readers check. Every
+// number of the canonical document must be recorded, with exactly the reader's bounds: a value
+// just outside either bound is refused at that field with "must be in [lo, hi]", the bounds
+// themselves are not refused for their range (another field's rule may still refuse them).
+TEST(SceneIo, FieldRecorderRecordsEveryNumbersBounds) {
+  const json doc = json::parse(R"({
+    "kaskad_scene": 1, "render": {}, "shadow": {},
+    "entities": [
+      { "name": "mirror", "primitive": { "shape": "sphere" }, "material": { "roughness": 0.1 },
+        "reflector": { "map": "sphere", "center": [0, 1, 0], "box": { "min": [-1, -1, -1], "max": [1, 1, 1] } } },
+      { "name": "sun", "light": { "type": "directional" }, "shadow": { "filter": "bilinear" } },
+      { "name": "lamp", "light": { "type": "area" } },
+      { "name": "camera", "camera": {} } ] })");
+  auto scene = parse_scene(doc, temp_dir() / "ranges.json");
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  const json canonical = scene_to_json(*scene);
+  // As the editor records: its canonical document read once, every section present.
+  json_reader::FieldRecorder recorder;
+  ASSERT_TRUE(parse_scene(canonical, temp_dir() / "ranges.json").ok());
+  const auto& ranges = recorder.ranges();
+  // What the reader says of `value` at `pointer`: "" when it takes it (or refuses another field).
+  auto verdict = [&](const std::string& pointer, const json& value) {
+    json_reader::FieldRecorder scratch;
+    json d = canonical;
+    d[json::json_pointer(pointer)] = value;
+    auto r = parse_scene(d, temp_dir() / "ranges.json");
+    return !r.ok() && r.error().where == pointer ? r.error().message : std::string();
+  };
+  int checked = 0;
+  const json leaves = canonical.flatten();
+  for (const auto& [pointer, value] : leaves.items()) {
+    if (!value.is_number() || pointer == "/kaskad_scene") continue;
+    // An array's numbers share the array's bounds.
+    const std::string parent = pointer.substr(0, pointer.rfind('/'));
+    const bool element = !parent.empty() && canonical[json::json_pointer(parent)].is_array();
+    const auto it = ranges.find(element ? parent : pointer);
+    ASSERT_NE(it, ranges.end()) << pointer << " is a number whose bounds were not recorded";
+    ++checked;
+    const auto [lo, hi] = it->second;
+    const bool integer = value.is_number_integer();
+    const json below = integer ? json(std::int64_t(lo) - 1) : json(lo - std::max(std::abs(lo), 1.0) * 1e-6);
+    const json above = integer ? json(std::int64_t(hi) + 1) : json(hi + std::max(std::abs(hi), 1.0) * 1e-6);
+    EXPECT_EQ(verdict(pointer, below).rfind("must be in [", 0), 0u) << pointer << " = " << below;
+    EXPECT_EQ(verdict(pointer, above).rfind("must be in [", 0), 0u) << pointer << " = " << above;
+    for (const double bound : {lo, hi}) {
+      const json at = integer ? json(std::int64_t(bound)) : json(bound);
+      EXPECT_EQ(verdict(pointer, at).rfind("must be in [", 0), std::string::npos)
+          << pointer << " = " << at << ": " << verdict(pointer, at);
     }
-    EXPECT_EQ(json_reader::EnumerationRecorder::current(), &outer);
   }
-  EXPECT_EQ(json_reader::EnumerationRecorder::current(), nullptr);
+  EXPECT_GE(checked, 60);
+}
+
+TEST(SceneIo, FieldRecorderIsScoped) {
+  EXPECT_EQ(json_reader::FieldRecorder::current(), nullptr);
+  {
+    json_reader::FieldRecorder outer;
+    {
+      json_reader::FieldRecorder inner;
+      EXPECT_EQ(json_reader::FieldRecorder::current(), &inner);
+    }
+    EXPECT_EQ(json_reader::FieldRecorder::current(), &outer);
+  }
+  EXPECT_EQ(json_reader::FieldRecorder::current(), nullptr);
 }
 
 }  // namespace

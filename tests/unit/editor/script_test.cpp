@@ -42,10 +42,38 @@ TEST(EditorScript, EveryActionParses) {
   EXPECT_EQ((*r)[17].kind, ActionKind::input);
 }
 
+TEST(EditorScript, PanelInputParses) {
+  auto r = parse_script_text(
+      "click save as...\nctrl_click sun.light.intensity\ndouble_click entity:box resting\n"
+      "drag make root -40\ntype 0.25 m\nkey enter\nkey escape\n",
+      "s.txt");
+  ASSERT_TRUE(r.ok()) << r.error().to_string();
+  ASSERT_EQ(r->size(), 7u);
+  EXPECT_EQ((*r)[0].kind, ActionKind::click);
+  EXPECT_EQ((*r)[0].args, std::vector<std::string>{"save as..."});  // a label with a space
+  EXPECT_EQ((*r)[1].kind, ActionKind::ctrl_click);
+  EXPECT_EQ((*r)[2].kind, ActionKind::double_click);
+  EXPECT_EQ((*r)[2].args, std::vector<std::string>{"entity:box resting"});
+  EXPECT_EQ((*r)[3].kind, ActionKind::drag);
+  EXPECT_EQ((*r)[3].args, (std::vector<std::string>{"make root", "-40"}));
+  EXPECT_EQ((*r)[4].kind, ActionKind::type);
+  EXPECT_EQ((*r)[4].args, std::vector<std::string>{"0.25 m"});
+  EXPECT_EQ((*r)[5].args, std::vector<std::string>{"enter"});
+  EXPECT_NE(error_of("drag sun.light.intensity\n").find("expected 'drag WIDGET PIXELS'"),
+            std::string::npos);
+  EXPECT_NE(error_of("drag sun.light.intensity far\n").find("drag: expected pixels"),
+            std::string::npos);
+  EXPECT_NE(error_of("click\n").find("expected 'click WIDGET'"), std::string::npos);
+  // The keys a script presses, from the one table, in the message.
+  for (const char* key : kScriptKeys)
+    EXPECT_NE(error_of("key ctrl+q\n").find(key), std::string::npos) << key;
+}
+
 TEST(EditorScript, BadLinesNameTheFileAndLine) {
   EXPECT_EQ(error_of("frames 1\nsett a=1\n"),
             "s.txt: line 2: unknown action 'sett' (set, choices, choose, select, create, import, "
-            "delete, duplicate, rename, parent, camera, orbit, key, view, frames, screenshot, "
+            "delete, duplicate, rename, parent, camera, orbit, key, click, ctrl_click, "
+            "double_click, drag, type, view, frames, screenshot, "
             "window_screenshot, input, open, save, "
             "save_as, undo, redo, quit, quit!)");
   EXPECT_NE(error_of("orbit 10\n").find("line 1: expected 'orbit YAW_DEG PITCH_DEG'"),
