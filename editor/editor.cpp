@@ -34,6 +34,7 @@
 #include "components/light.h"
 #include "components/model.h"
 #include "components/name.h"
+#include "components/shadow_settings.h"
 #include "components/transform.h"
 #include "editor/file_dialog.h"
 #include "editor/script.h"
@@ -1082,8 +1083,13 @@ void Editor::field(const std::string& key, const std::string& label, const json&
   } else if (v.is_string()) {
     char buf[512];
     std::snprintf(buf, sizeof buf, "%s", v.get<std::string>().c_str());
-    if (ImGui::InputText(label.c_str(), buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue))
-      request(key + "=" + json(std::string(buf)).dump());
+    if (ImGui::InputText(label.c_str(), buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue)) {
+      // A word is the string; a JSON array or object typed over a word such as a reflector's
+      // "auto" centre or "none" box is that value ([0, 1, 0]).
+      const json typed = json::parse(buf, nullptr, /*allow_exceptions=*/false);
+      const bool structured = typed.is_array() || typed.is_object();
+      request(key + "=" + (structured ? std::string(buf) : json(std::string(buf)).dump()));
+    }
     name_item(key);
   } else if (v.is_array() && v.size() >= 2 && v.size() <= 4 &&
              std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); })) {
@@ -1263,7 +1269,12 @@ void Editor::inspector() {
         if (button("make root")) operations_.push_back([this] { return reparent_selected(""); });
       }
       ImGui::TextDisabled("drag an entity onto another to parent it");
-      for (auto it = ent->begin(); it != ent->end(); ++it) {
+      // A light's shadow settings with every field (the file holds those that differ from the
+      // scene's shadow block).
+      json sections = *ent;
+      if (const auto e = find(selected_); e && scene_.world.has<ShadowSettings>(*e))
+        sections["shadow"] = live_entity_sections(scene_, *e)["shadow"];
+      for (auto it = sections.begin(); it != sections.end(); ++it) {
         if (it.key() == "name" || !it.value().is_object()) continue;
         const bool open = ImGui::CollapsingHeader(it.key().c_str(), ImGuiTreeNodeFlags_DefaultOpen);
         name_item(selected_ + "." + it.key());

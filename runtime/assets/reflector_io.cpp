@@ -30,7 +30,12 @@ void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
   r.integer("every_n", out.every_n, 1, 1 << 20);
   r.integer("faces_per_frame", out.faces_per_frame, 1, 6);
   r.integer("resolution", out.resolution, 8, 2048);
-  if (r.has("center")) {
+  // center: [x, y, z], or "auto" (the centre of the entity's bounds; what a file without it gets).
+  if (r.has("center") && r.raw("center").is_string()) {
+    if (r.raw("center") != "auto")
+      fail(r.at("center"), "expected [x, y, z] or \"auto\", got " + r.raw("center").dump());
+    out.has_center = false;
+  } else if (r.has("center")) {
     r.vector<3>("center", out.center, -kBig, kBig);
     out.has_center = true;
   }
@@ -48,7 +53,13 @@ void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
       out.exclude_layers |= 1u << layer;
     }
   }
-  if (r.has("box")) {
+  // box: {"min": [x, y, z], "max": [x, y, z]}, or "none" (no box projection; a file without it).
+  if (r.has("box") && r.raw("box").is_string()) {
+    if (r.raw("box") != "none")
+      fail(r.at("box"), "expected {\"min\": [x, y, z], \"max\": [x, y, z]} or \"none\", got " +
+                            r.raw("box").dump());
+    out.box_projection = false;
+  } else if (r.has("box")) {
     json_reader::ObjectReader br(r.raw("box"), r.at("box"));
     if (!br.has("min") || !br.has("max")) fail(r.at("box"), "a box needs min and max");
     br.vector<3>("min", out.box_min, -kBig, kBig);
@@ -86,14 +97,14 @@ json reflector_to_json(const Reflector& r) {
             {"every_n", r.every_n},
             {"faces_per_frame", r.faces_per_frame},
             {"resolution", r.resolution}};
-  if (r.has_center) j["center"] = vec(r.center);
+  j["center"] = r.has_center ? vec(r.center) : json("auto");
   j["near"] = num(r.near);
   j["far"] = num(r.far);
   json layers = json::array();
   for (int i = 0; i < 32; ++i)
     if (r.exclude_layers & (1u << i)) layers.push_back(i);
   j["exclude_layers"] = layers;
-  if (r.box_projection) j["box"] = {{"min", vec(r.box_min)}, {"max", vec(r.box_max)}};
+  j["box"] = r.box_projection ? json{{"min", vec(r.box_min)}, {"max", vec(r.box_max)}} : json("none");
   j["amount"] = num(r.amount);
   j["file"] = r.file;
   j["layout"] = enum_name(r.layout, kLayouts);

@@ -592,6 +592,10 @@ save $tmp/combo.json
 click entity:sphere
 click duplicate
 save $tmp/duplicated.json
+select sun
+click sun.shadow.filter
+click sun.shadow.filter=bilinear
+save $tmp/light_shadow.json
 quit!" "$scene"
   [ "$rc" -eq 0 ] || { fail "clicks script exit $rc"; tail -5 "$tmp/out"; }
   is "while a number is typed, nothing is applied" "$(value typing.json box_resting material roughness)" 0.5
@@ -611,6 +615,21 @@ quit!" "$scene"
   is "a click on a checkbox toggles it" "$(value checkbox.json box_resting renderer cast_shadows)" False
   is "a click on a combo's item picks it" "$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["shadow"]["filter"])' "$tmp/combo.json")" none
   is "a click on an entity's row, then on duplicate" "$(value duplicated.json sphere_1 primitive shape)" sphere
+  # A light's own shadow section shows every field (the file held none for the sun).
+  is "a light's shadow field the file did not give" "$(value light_shadow.json sun shadow filter)" bilinear
+  # A reflector's "auto" centre, a text field, takes an array typed over it, and undo restores it.
+  edit "select mirror_sphere
+double_click mirror_sphere.reflector.center
+type [0, 1.5, 0]
+key enter
+frames 1
+save $tmp/centre.json
+undo
+save $tmp/centre_undone.json
+quit!" "$KASKAD_CONTENT/scenes/reflections.json"
+  [ "$rc" -eq 0 ] || { fail "reflector centre script exit $rc"; tail -5 "$tmp/out"; }
+  is "an array typed over a reflector's auto centre" "$(value centre.json mirror_sphere reflector center)" "[0.0, 1.5, 0.0]"
+  is "undo gives the auto centre back" "$(value centre_undone.json mirror_sphere reflector center)" auto
   edit "click no_such_widget
 quit!" "$scene"
   refused "line 1: no widget named 'no_such_widget' in the last frame; it showed: " "a click on a widget the panels do not show: exit 1, named"

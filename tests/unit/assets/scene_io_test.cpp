@@ -564,6 +564,34 @@ TEST(SceneIo, ReflectorsRoundTripAndOverride) {
   EXPECT_EQ(rb.exclude_layers, (1u << 3) | (1u << 31));
   EXPECT_TRUE(rb.box_projection);
   EXPECT_EQ(rb.box_max, glm::vec3(5, 4.5f, 1));
+  // The optional fields are in the canonical form as "auto" and "none", so that --set and the
+  // editor's inspector reach them: set, then set back.
+  const nlohmann::json plain = scene_to_json(*a)["entities"];
+  const auto sphere_doc = std::find_if(plain.begin(), plain.end(), [](const nlohmann::json& e) {
+    return e["name"] == "mirror_sphere";
+  });
+  ASSERT_NE(sphere_doc, plain.end());
+  EXPECT_EQ((*sphere_doc)["reflector"]["center"], "auto");
+  EXPECT_EQ((*sphere_doc)["reflector"]["box"], "none");
+  ASSERT_TRUE(apply_live_override(*b, "mirror_plane.reflector.center=auto").ok());
+  ASSERT_TRUE(apply_live_override(*b, "mirror_plane.reflector.box=none").ok());
+  EXPECT_FALSE(b->world.get<Reflector>(find(*b, "mirror_plane")).has_center);
+  EXPECT_FALSE(b->world.get<Reflector>(find(*b, "mirror_plane")).box_projection);
+  ASSERT_TRUE(apply_live_override(*b, "mirror_plane.reflector.center=[1,2,3]").ok());
+  ASSERT_TRUE(apply_live_override(
+                  *b, R"(mirror_plane.reflector.box={"min": [-4, 0, -4], "max": [4, 4, 4]})")
+                  .ok());
+  EXPECT_EQ(b->world.get<Reflector>(find(*b, "mirror_plane")).center, glm::vec3(1, 2, 3));
+  EXPECT_TRUE(b->world.get<Reflector>(find(*b, "mirror_plane")).box_projection);
+  EXPECT_EQ(b->world.get<Reflector>(find(*b, "mirror_plane")).box_min, glm::vec3(-4, 0, -4));
+  auto wrong = apply_live_override(*b, "mirror_plane.reflector.center=middle");
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_NE(wrong.error().to_string().find(R"(expected [x, y, z] or "auto")"), std::string::npos)
+      << wrong.error().to_string();
+  wrong = apply_live_override(*b, "mirror_plane.reflector.box=off");
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_NE(wrong.error().to_string().find(R"(or "none")"), std::string::npos)
+      << wrong.error().to_string();
 }
 
 TEST(SceneIo, BadReflectorsNameTheKey) {
