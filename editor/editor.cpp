@@ -147,11 +147,23 @@ struct Layout {
 constexpr float kMinPanel = 120.0f;
 float max_panel(int window_width) { return std::max(kMinPanel, 0.45f * float(window_width)); }
 
-/// `left` and `right` < 0: the first layout, a share of the window with limits in pixels.
-Layout layout_for(int w, int h, float left, float right) {
+/// `left` and `right` < 0: the first layout, a share of the window with limits in pixels, the
+/// two panels together at most 55% of it. `hidden`: no panels, the viewport is the window.
+Layout layout_for(int w, int h, float left, float right, bool hidden) {
   Layout l;
-  l.left = left < 0 ? std::clamp(0.2f * float(w), 160.0f, 300.0f) : left;
-  l.right = right < 0 ? std::clamp(0.32f * float(w), 260.0f, 460.0f) : right;
+  if (hidden) {
+    l.view_w = w;
+    l.view_h = h;
+    return l;
+  }
+  const float fw = float(w);
+  l.left = left < 0 ? std::clamp(0.2f * fw, 160.0f, 300.0f) : left;
+  l.right = right < 0 ? std::clamp(0.32f * fw, 200.0f, 460.0f) : right;
+  if (left < 0 && right < 0 && l.left + l.right > 0.55f * fw) {
+    const float shrink = 0.55f * fw / (l.left + l.right);
+    l.left *= shrink;
+    l.right *= shrink;
+  }
   l.left = std::clamp(l.left, kMinPanel, max_panel(w));
   l.right = std::clamp(l.right, kMinPanel, max_panel(w));
   l.view_x = int(l.left);
@@ -388,6 +400,7 @@ class Editor {
   /// the dialog staying with the error when that is refused.
   void accept_file_dialog();
   void interactive_input(float dt);
+  void entities_panel(int w, int h, const Layout& l);
   /// Records the last widget's place under `name` (its label without a "##..." part).
   void name_item(const std::string& name);
   bool button(const char* label) {
@@ -466,6 +479,7 @@ class Editor {
   FlyCamera camera_;
   float speed_ = 1.0f;            ///< fly speed, metres per second (from the scene's size)
   Aabb bounds_;                   ///< the scene's bounds when loaded (fly speed, auto near/far)
+  bool panels_hidden_ = false;    ///< H: the viewport takes the whole window
   bool planes_follow_ = false;    ///< the camera was auto_frame: its near and far follow it
   bool prewarm_ = true;           ///< compile the scene's programs before its first frame
   bool changed_since_frame_ = true;
@@ -815,6 +829,11 @@ Status Editor::save(const fs::path& file) {
 
 Status Editor::press(const std::string& key, float seconds) {
   if (key == "f") return frame_selection();
+  if (key == "h") {
+    panels_hidden_ = !panels_hidden_;
+    changed_since_frame_ = true;  // the viewport changes size
+    return {};
+  }
   if (key == "ctrl+z") return undo();
   if (key == "ctrl+y") return redo();
   if (key == "ctrl+s") return save(opt_.scene);
@@ -1416,13 +1435,9 @@ Status Editor::feed_ui_step() {
   return {};
 }
 
-void Editor::draw_ui(int w, int h) {
-  widgets_.clear();
-  const Layout l = layout_for(w, h, left_w_, right_w_);
+void Editor::entities_panel(int w, int h, const Layout& l) {
   const ImGuiWindowFlags panel = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse |
                                  ImGuiWindowFlags_NoSavedSettings;
-  const ImGuiWindowFlags fixed = panel | ImGuiWindowFlags_NoResize;
-  // Panels keep the window's height; only their inner edge moves.
   ImGui::SetNextWindowPos(ImVec2(0, 0));
   ImGui::SetNextWindowSize(ImVec2(l.left, float(h)));
   ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
@@ -1457,6 +1472,17 @@ void Editor::draw_ui(int w, int h) {
   entity_list();
   left_w_ = ImGui::GetWindowWidth();
   ImGui::End();
+}
+
+void Editor::draw_ui(int w, int h) {
+  widgets_.clear();
+  const Layout l = layout_for(w, h, left_w_, right_w_, panels_hidden_);
+  const ImGuiWindowFlags panel = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse |
+                                 ImGuiWindowFlags_NoSavedSettings;
+  const ImGuiWindowFlags fixed = panel | ImGuiWindowFlags_NoResize;
+  // Panels keep the window's height; only their inner edge moves. H hides them.
+  if (!panels_hidden_) entities_panel(w, h, l);
+
 
   ImGui::SetNextWindowPos(ImVec2(float(l.view_x), 0));
   ImGui::SetNextWindowSize(ImVec2(float(l.view_w), float(l.view_h)));
@@ -1470,20 +1496,26 @@ void Editor::draw_ui(int w, int h) {
     ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<std::uintptr_t>(view_texture_.id())),
                  ImVec2(float(texture_w_) * scale, float(texture_h_) * scale));
   }
+  if (panels_hidden_) {
+    ImGui::SetCursorPos(ImVec2(6, 4));
+    ImGui::TextDisabled("H: panels");
+  }
   viewport_hovered_ = ImGui::IsWindowHovered();
   ImGui::End();
   ImGui::PopStyleVar();
 
-  ImGui::SetNextWindowPos(ImVec2(float(w) - l.right, 0));
-  ImGui::SetNextWindowSize(ImVec2(l.right, float(h)));
-  ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
-  ImGui::Begin("Inspector", nullptr, panel);
-  right_w_ = ImGui::GetWindowWidth();
-  // Labels keep a fixed share of the panel, so long field names are not clipped.
-  ImGui::PushItemWidth(-std::max(120.0f, 0.42f * l.right));
-  inspector();
-  ImGui::PopItemWidth();
-  ImGui::End();
+  if (!panels_hidden_) {
+    ImGui::SetNextWindowPos(ImVec2(float(w) - l.right, 0));
+    ImGui::SetNextWindowSize(ImVec2(l.right, float(h)));
+    ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
+    ImGui::Begin("Inspector", nullptr, panel);
+    right_w_ = ImGui::GetWindowWidth();
+    // Labels keep a fixed share of the panel, so long field names are not clipped.
+    ImGui::PushItemWidth(-std::max(120.0f, 0.42f * l.right));
+    inspector();
+    ImGui::PopItemWidth();
+    ImGui::End();
+  }
 
   file_dialog(w, h);
 
@@ -1661,6 +1693,7 @@ void Editor::interactive_input(float dt) {
     if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Y, false)) shortcut = "ctrl+y";
     if (io.KeyCtrl && !io.KeyShift && ImGui::IsKeyPressed(GLFW_KEY_S, false)) shortcut = "ctrl+s";
     if (!io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_F, false)) shortcut = "f";
+    if (!io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_H, false)) shortcut = "h";
     if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_O, false))
       show_file_dialog(FileDialog::Purpose::open, file_line_);
     if (io.KeyCtrl && io.KeyShift && ImGui::IsKeyPressed(GLFW_KEY_S, false))
@@ -1882,7 +1915,7 @@ int Editor::run() {
     int w = 0, h = 0;
     glfwGetFramebufferSize(window, &w, &h);
     if (w <= 0 || h <= 0) continue;  // minimised
-    const Layout l = layout_for(w, h, left_w_, right_w_);
+    const Layout l = layout_for(w, h, left_w_, right_w_, panels_hidden_);
     if (l.view_w > 0 && l.view_h > 0) {
       if (Status st = render_viewport(l.view_w, l.view_h); !st) {
         if (!opt_.script.empty()) {

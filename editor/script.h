@@ -44,9 +44,9 @@ struct ScriptAction {
 };
 
 /// The names `key` takes (the same keys a user presses): w a s d q e (one fly step of 1/30 s),
-/// f (frame the selection), ctrl+z, ctrl+y, ctrl+s, and enter and escape (to the panels: they
-/// end the typing in a field).
-inline constexpr const char* kScriptKeys[] = {"w", "a", "s", "d", "q", "e", "f", "ctrl+z",
+/// f (frame the selection), h (hide or show the panels), ctrl+z, ctrl+y, ctrl+s, and enter and
+/// escape (to the panels: they end the typing in a field).
+inline constexpr const char* kScriptKeys[] = {"w", "a", "s", "d", "q", "e", "f", "h", "ctrl+z",
                                               "ctrl+y", "ctrl+s", "enter", "escape"};
 bool is_script_key(const std::string& name);
 

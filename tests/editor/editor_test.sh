@@ -630,6 +630,19 @@ quit!" "$KASKAD_CONTENT/scenes/reflections.json"
   [ "$rc" -eq 0 ] || { fail "reflector centre script exit $rc"; tail -5 "$tmp/out"; }
   is "an array typed over a reflector's auto centre" "$(value centre.json mirror_sphere reflector center)" "[0.0, 1.5, 0.0]"
   is "undo gives the auto centre back" "$(value centre_undone.json mirror_sphere reflector center)" auto
+  # The layout at 640x360: the viewport keeps at least 45% of the width; H hides the panels.
+  edit "screenshot $tmp/small_view.png
+key h
+screenshot $tmp/no_panels.png
+key h
+screenshot $tmp/small_again.png
+quit!" "$scene" --size 640x360
+  [ "$rc" -eq 0 ] || { fail "layout script exit $rc"; tail -5 "$tmp/out"; }
+  png_size() { od -An -tu1 -j16 -N8 "$tmp/$1" | awk '{ printf "%d %d", $3 * 256 + $4, $7 * 256 + $8 }'; }
+  read -r vw vh <<<"$(png_size small_view.png)"
+  if [ "$vw" -ge 288 ] && [ "$vh" -eq 360 ]; then ok "at 640x360 the viewport is ${vw}x${vh}"; else fail "at 640x360 the viewport is ${vw}x${vh}"; fi
+  is "H hides the panels: the viewport is the window" "$(png_size no_panels.png)" "640 360"
+  is "H again shows them" "$(png_size small_again.png)" "$vw $vh"
   edit "click no_such_widget
 quit!" "$scene"
   refused "line 1: no widget named 'no_such_widget' in the last frame; it showed: " "a click on a widget the panels do not show: exit 1, named"
