@@ -960,16 +960,17 @@ Status Editor::render_viewport(int w, int h) {
         std::snprintf(part, sizeof part, ", %s %.2f", name, ms);
         parts += part;
       }
-    // Three lines whatever their contents, so that the panel below does not move from frame to
-    // frame (a narrow panel cuts them).
+    // Four lines whatever their contents, so that the panel below does not move from frame to
+    // frame (a narrow panel cuts them; the tooltip has them whole).
     const auto& shaders = player_.renderer->shaders().stats();
     std::snprintf(line, sizeof line,
-                  "%.1f ms; GPU ms: shadow %.2f, probes %.2f, forward %.2f%s\n"
-                  "%d draws, %zu shadow triangles, %d probe faces%s\n"
-                  "%d programs compiled, %d from the binary cache",
-                  t->first_frame_ms, st.shadow_gpu_ms, st.probe_gpu_ms, st.forward_gpu_ms,
-                  parts.c_str(), st.draw_calls, st.shadow_triangles, st.probe_faces,
-                  st.visibility_reused ? ", visibility read back" : "", shaders.programs_compiled,
+                  "%.1f ms a frame%s\n"
+                  "GPU ms: shadow %.2f, probes %.2f, fwd %.2f%s\n"
+                  "%d draws, %zu shadow tris, %d probe faces\n"
+                  "programs: %d compiled, %d from cache",
+                  t->first_frame_ms, st.visibility_reused ? ", visibility read back" : "",
+                  st.shadow_gpu_ms, st.probe_gpu_ms, st.forward_gpu_ms, parts.c_str(),
+                  st.draw_calls, st.shadow_triangles, st.probe_faces, shaders.programs_compiled,
                   shaders.cache_hits);
     stats_ = line;
   }
@@ -1153,10 +1154,13 @@ void Editor::direction_helpers() {
   name_item(selected_ + ".aim");
   if (!aim_open) return;
   glm::vec3 d = glm::normalize(-glm::vec3(wt->matrix[2]));
-  if (ImGui::DragFloat3("direction", &d.x, 0.01f, -1.0f, 1.0f, "%.3f") && glm::length(d) > 1e-4f)
+  const bool turned = ImGui::DragFloat3("direction", &d.x, 0.01f, -1.0f, 1.0f, "%.3f");
+  name_item(selected_ + ".aim.direction");
+  if (turned && glm::length(d) > 1e-4f)
     request(selected_ + ".transform.direction=" +
             json::array({double(d.x), double(d.y), double(d.z)}).dump());
   ImGui::DragFloat3("look-at point", &look_at_.x, 0.05f, 0.0f, 0.0f, "%.3g");
+  name_item(selected_ + ".aim.look-at point");
   if (button("look at it"))
     requests_.emplace_back(selected_ + ".transform.look_at=" +
                                json::array({double(look_at_.x), double(look_at_.y), double(look_at_.z)}).dump(),
@@ -1220,6 +1224,7 @@ void Editor::entity_list() {
 void Editor::inspector() {
   ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
   ImGui::TextUnformatted(stats_.c_str());
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", stats_.c_str());
   ImGui::PopStyleColor();
   if (!frame_ms_.empty())
     ImGui::PlotLines("frame ms", frame_ms_.data(), int(frame_ms_.size()), 0, nullptr, 0.0f,
@@ -1288,6 +1293,10 @@ void Editor::inspector() {
         if (button("make root")) operations_.push_back([this] { return reparent_selected(""); });
       }
       ImGui::TextDisabled("drag an entity onto another to parent it");
+      if (const auto e = find(selected_); e && scene_.world.has<Camera>(*e))
+        ImGui::TextDisabled(active_camera() == e
+                                ? "the viewport's camera"
+                                : "not the viewport's camera (the first active one, else the first, is)");
       // A light's shadow settings with every field (the file holds those that differ from the
       // scene's shadow block).
       json sections = *ent;
@@ -1441,7 +1450,8 @@ void Editor::entities_panel(int w, int h, const Layout& l) {
   ImGui::SetNextWindowPos(ImVec2(0, 0));
   ImGui::SetNextWindowSize(ImVec2(l.left, float(h)));
   ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
-  ImGui::Begin("Entities", nullptr, panel);
+  // Deep glTF hierarchies scroll sideways rather than cut their names.
+  ImGui::Begin("Entities", nullptr, panel | ImGuiWindowFlags_HorizontalScrollbar);
   static const char* kShapes[] = {"box", "sphere", "cylinder", "cone", "plane"};
   ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
   ImGui::Combo("##shape", &create_shape_, kShapes, int(std::size(kShapes)));
