@@ -190,37 +190,65 @@ Image read_window(int w, int h) {
   return img;
 }
 
-// An AOV view as an RGB image; `aovs` has the channels of Renderer::read_aovs().
+// Linear radiance clamped to [0, 1] and encoded for display with a 2.2 gamma (an approximation
+// of sRGB is enough for a debug view).
+float display_gamma(float linear) { return std::pow(std::clamp(linear, 0.0f, 1.0f), 1.0f / 2.2f); }
+
+// An AOV view as an RGB image; `aovs` has the channels of Renderer::read_aovs(), found by the
+// names it gives them (README "AOV contract").
 Image aov_view(View view, const Image& aovs) {
   Image out;
   out.width = aovs.width;
   out.height = aovs.height;
   out.channels = 3;
   out.pixels.assign(std::size_t(aovs.width) * std::size_t(aovs.height) * 3, 0.0f);
+  auto channel = [&](const char* name) {
+    const auto it = std::find(aovs.channel_names.begin(), aovs.channel_names.end(), name);
+    KASKAD_CHECK(it != aovs.channel_names.end(), "the AOVs have a channel of every name read here");
+    return int(it - aovs.channel_names.begin());
+  };
+  const int px = channel("P.X"), nx = channel("N.X"), z = channel("Z"), vis = channel("visibility"),
+            mask = channel("mask"), cascade = channel("cascade"), rr = channel("reflection.R"),
+            reflector = channel("reflector");
   // Cascades 0..7 in distinct colours (outside every cascade: black).
   static const glm::vec3 kCascade[] = {{1, 0.2f, 0.2f}, {0.2f, 1, 0.2f}, {0.3f, 0.4f, 1},
                                        {1, 1, 0.2f},    {1, 0.3f, 1},    {0.2f, 1, 1},
                                        {1, 0.6f, 0.2f}, {0.7f, 0.7f, 0.7f}};
-  float far = 0.0f;  // the depth view spans the visible depths
-  if (view == View::depth)
-    for (int y = 0; y < aovs.height; ++y)
-      for (int x = 0; x < aovs.width; ++x)
-        if (aovs.at(x, y, 8) > 0.5f) far = std::max(far, aovs.at(x, y, 6));
+  // The depth and position views span what is visible.
+  float far = 0.0f;
+  Aabb seen;
+  auto vec3_at = [&](int x, int y, int first) {
+    return glm::vec3(aovs.at(x, y, first), aovs.at(x, y, first + 1), aovs.at(x, y, first + 2));
+  };
+  for (int y = 0; y < aovs.height; ++y)
+    for (int x = 0; x < aovs.width; ++x)
+      if (aovs.at(x, y, mask) > 0.5f) {
+        far = std::max(far, aovs.at(x, y, z));
+        seen.expand(vec3_at(x, y, px));
+      }
+  const glm::vec3 span = seen.empty() ? glm::vec3(1.0f) : glm::max(seen.max - seen.min, glm::vec3(1e-6f));
   for (int y = 0; y < aovs.height; ++y)
     for (int x = 0; x < aovs.width; ++x) {
       glm::vec3 c{0.0f};
-      if (aovs.at(x, y, 8) > 0.5f) {
+      if (aovs.at(x, y, mask) > 0.5f) {
         switch (view) {
-          case View::visibility: c = glm::vec3(aovs.at(x, y, 7)); break;
+          case View::visibility: c = glm::vec3(aovs.at(x, y, vis)); break;
           case View::cascade: {
-            const int k = int(std::lround(aovs.at(x, y, 9)));
-            if (k >= 0) c = kCascade[k % 8] * (0.4f + 0.6f * aovs.at(x, y, 7));
+            const int k = int(std::lround(aovs.at(x, y, cascade)));
+            if (k >= 0) c = kCascade[k % 8] * (0.4f + 0.6f * aovs.at(x, y, vis));
             break;
           }
-          case View::normal:
-            c = 0.5f * glm::vec3(aovs.at(x, y, 3), aovs.at(x, y, 4), aovs.at(x, y, 5)) + 0.5f;
+          case View::normal: c = 0.5f * vec3_at(x, y, nx) + 0.5f; break;
+          case View::depth: c = glm::vec3(far > 0.0f ? 1.0f - aovs.at(x, y, z) / far : 0.0f); break;
+          case View::position: c = (vec3_at(x, y, px) - seen.min) / span; break;
+          case View::reflection: {
+            // C_t where a reflection map shades the surface; other surfaces dark grey.
+            const glm::vec3 t = vec3_at(x, y, rr);
+            c = aovs.at(x, y, reflector) > 0.5f
+                    ? glm::vec3(display_gamma(t.r), display_gamma(t.g), display_gamma(t.b))
+                    : glm::vec3(0.08f);
             break;
-          case View::depth: c = glm::vec3(far > 0.0f ? 1.0f - aovs.at(x, y, 6) / far : 0.0f); break;
+          }
           default: break;
         }
       }
@@ -231,10 +259,6 @@ Image aov_view(View view, const Image& aovs) {
     }
   return out;
 }
-
-// Linear radiance clamped to [0, 1] and encoded for display with a 2.2 gamma (an approximation
-// of sRGB is enough for a debug view).
-float display_gamma(float linear) { return std::pow(std::clamp(linear, 0.0f, 1.0f), 1.0f / 2.2f); }
 
 // A cube map's faces side by side (+X -X +Y -Y +Z -Z), encoded by display_gamma().
 Image cube_strip(const CubeMap& cube) {
@@ -907,7 +931,7 @@ Status Editor::render_viewport(int w, int h) {
   run.width = w;
   run.height = h;
   // The AOV targets cost fill rate: only for the views that show them.
-  run.write_aovs = view_ != View::colour && view_ != View::shadow_map && view_ != View::soft_maps;
+  run.write_aovs = is_aov_view(view_);
   run.prewarm = prewarm_;
   auto t = render_frames(player_, scene_, run);
   if (!t) return t.error();

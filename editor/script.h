@@ -24,13 +24,21 @@ enum class ActionKind {
 /// (S3 eq. (2), made for the current camera; a probe of cube maps has none: the colour shows),
 /// or the soft-shadow technique's own maps (lom: each layer's occlusion factors of its first
 /// peel; vsm/evsm: the first moment, scaled to its largest value; other techniques have none:
-/// the colour shows).
+/// the colour shows). position and reflection are AOVs too: the world position spanning the
+/// visible positions, S3's C_t where a reflection map shades the surface.
 enum class View {
-  colour, visibility, cascade, normal, depth, shadow_map, probe_faces, sphere_map, soft_maps
+  colour, visibility, cascade, normal, depth, position, reflection, shadow_map, probe_faces,
+  sphere_map, soft_maps
 };
 /// The views' names, in View order: the viewport's combo and the script's `view NAME`.
-inline constexpr const char* kViewNames[] = {"colour", "visibility", "cascade", "normal", "depth",
-                                             "shadow_map", "probe_faces", "sphere_map", "soft_maps"};
+inline constexpr const char* kViewNames[] = {"colour",     "visibility", "cascade",    "normal",
+                                             "depth",      "position",   "reflection", "shadow_map",
+                                             "probe_faces", "sphere_map", "soft_maps"};
+/// Whether the view is made from the frame's AOVs (README "AOV contract").
+inline bool is_aov_view(View v) {
+  return v == View::visibility || v == View::cascade || v == View::normal || v == View::depth ||
+         v == View::position || v == View::reflection;
+}
 inline std::optional<View> view_named(const std::string& name) {
   for (std::size_t i = 0; i < std::size(kViewNames); ++i)
     if (name == kViewNames[i]) return View(i);

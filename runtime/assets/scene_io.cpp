@@ -1080,7 +1080,9 @@ Result<std::vector<ecs::Entity>> import_model(Scene& scene, ecs::Entity e, bool 
       const std::string name = w.has<Name>(e) ? w.get<Name>(e).value : std::string("?");
       return Error{scene.file.string(), "/" + name + "/model/path", report.error().to_string()};
     }
-    for (const auto& warning : report->warnings) log::warn("%s: %s", path.string().c_str(), warning.c_str());
+    // Once each: the editor reloads the scene on every undo.
+    for (const auto& warning : report->warnings)
+      log::warn_once("%s: %s", path.string().c_str(), warning.c_str());
     w.view<Imported>().each([&](ecs::Entity x, const Imported& imp) {
       if (imp.source == e) made.push_back(x);
     });
@@ -1124,7 +1126,7 @@ Status apply_node_overrides(Scene& scene, ecs::Entity e, const std::vector<ecs::
     for (ecs::Entity x : made)
       if (const auto* n = w.try_get<Name>(x); n && n->value == o.node) found.push_back(x);
     if (found.empty()) {
-      log::warn("%s: %s: %s has no node named '%s'; its settings are kept for saving",
+      log::warn_once("%s: %s: %s has no node named '%s'; its settings are kept for saving",
                 scene.file.string().c_str(), where.c_str(), path.string().c_str(), o.node.c_str());
       continue;
     }

@@ -114,6 +114,8 @@ view cascade
 screenshot $tmp/cascade.png
 view shadow_map
 screenshot $tmp/shadow_map.png
+view position
+screenshot $tmp/position.png
 view colour
 frames 1
 screenshot $tmp/6b.png
@@ -146,13 +148,14 @@ quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
   differ "view visibility (AOV)" 6.png visibility.png
   differ "view cascade (AOV)" visibility.png cascade.png
   differ "view shadow_map" cascade.png shadow_map.png
+  differ "view position (AOV)" shadow_map.png position.png
   same "debug views leave the colour as it was" 6.png 6b.png
   # Frames kept coming: one stats line per frame, seven `frames 2`, four `frames 1` and one
   # frame before each screenshot of a new view (after `frames` a screenshot needs none).
   n=$(grep -c '^frame [0-9]*:' "$tmp/out")
-  # 25, and the drag's 15: a frame to settle, 2 to scroll the aim block into view, one to move
+  # 26, and the drag's 15: a frame to settle, 2 to scroll the aim block into view, one to move
   # there, one to press, 8 moving, one to release, one to settle.
-  if [ "$n" -eq 40 ]; then ok "40 frames rendered"; else fail "expected 40 frame lines, got $n"; fi
+  if [ "$n" -eq 41 ]; then ok "41 frames rendered"; else fail "expected 41 frame lines, got $n"; fi
   # F on a glTF model's entity (no mesh of its own: its nodes' bounds), at a hundredth and a
   # hundred times the truck's size, with the camera far off: the truck fills the view, centred.
   truck="$KASKAD_CONTENT/models/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf"
@@ -436,6 +439,8 @@ select mirror_sphere
 screenshot $tmp/sphere_faces.png
 view sphere_map
 screenshot $tmp/sphere_map.png
+view reflection
+screenshot $tmp/reflection.png
 quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
     --set mirror_sphere.reflector.every_n=3 --set mirror_plane.reflector.every_n=3 \
     --set mirror_plane.reflector.faces_per_frame=6
@@ -450,6 +455,10 @@ quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
   differ "probe map cube -> sphere changes the reflection" cube.png sphere.png
   differ "the probe faces view shows the probe's faces" sphere.png plane_faces.png
   differ "the selected entity's probe is the one shown" plane_faces.png sphere_faces.png
+  # The reflection view (S3's C_t AOV): the mirrors show what their maps return, many colours;
+  # every other surface one dark grey.
+  colours=$(cd "$(dirname "$0")" && python3 -c 'import sys; from changed_within import read_png; w, h, c, rows = read_png(sys.argv[1]); print(len({bytes(r[x * c:x * c + 3]) for r in rows for x in range(w)}))' "$tmp/reflection.png")
+  if [ "$colours" -gt 100 ]; then ok "the reflection view shows the mirrors' maps ($colours colours)"; else fail "the reflection view has $colours colours"; fi
   # The views differ by shape, whatever the probes' maps hold: the faces view is a 6:1 strip,
   # the sphere map square (a PNG's width and height are bytes 16-23).
   png_size() { od -An -tu1 -j16 -N8 "$tmp/$1" | awk '{ printf "%dx%d", $3 * 256 + $4, $7 * 256 + $8 }'; }
