@@ -366,7 +366,9 @@ class Editor {
   // Edits: one --set assignment through scene IO's own override path.
   Status edit(const std::string& assignment, bool merge);
   void record(bool merge);  ///< a snapshot of the scene as it is now, after an edit
-  Status restore(std::size_t index);
+  /// The scene becomes history document `index`; the view stays where the user put it (or, with
+  /// `keep_view`, where it is), otherwise it is the document's camera.
+  Status restore(std::size_t index, bool keep_view = false);
   /// The scene becomes canonical document `doc` (read as a file of the scene's path would be),
   /// its programs compiled before its next frame; the scene is unchanged on an error.
   Status load_document(const json& doc);
@@ -388,6 +390,10 @@ class Editor {
   // The camera.
   std::optional<ecs::Entity> active_camera() const;
   void take_camera_from_scene();
+  /// The active camera takes the fly camera's pose (nothing else of it changes).
+  void place_camera();
+  /// A move by the user (fly, F, orbit, a script's camera): place_camera(), and an auto_frame
+  /// camera becomes a placed one whose near and far follow it.
   void write_camera();
   void update_bounds_speed();
   Status press(const std::string& key, float seconds);
@@ -550,7 +556,7 @@ void Editor::take_camera_from_scene() {
   camera_.look_along(-glm::vec3(wt->matrix[2]));
 }
 
-void Editor::write_camera() {
+void Editor::place_camera() {
   const auto cam = active_camera();
   if (!cam) return;
   Transform& t = scene_.world.get<Transform>(*cam);
@@ -570,31 +576,39 @@ void Editor::write_camera() {
   }
   // A glTF model's camera: the pose is kept in the model's nodes block when saved.
   note_node_override(scene_, *cam, "transform", {"translation", "rotation", "scale"});
+  doc_stale_ = true;
+  changed_since_frame_ = true;
+}
+
+void Editor::write_camera() {
+  place_camera();
+  const auto cam = active_camera();
+  if (!cam) return;
+  camera_.moved = true;
   // An auto_frame camera moved by the user is placed where they put it: saved and reloaded
   // there, not framed again. Its near and far planes had been fitted to the scene from where the
-  // load put it; they follow the camera, so that flying in (or F) does not clip what is close.
+  // load put it; they follow the camera (until near, far or auto_frame is edited), so that
+  // flying in (or F) does not clip what is close.
   Camera& c = scene_.world.get<Camera>(*cam);
   if (c.auto_frame) {
     c.auto_frame = false;
     planes_follow_ = true;
   }
   if (planes_follow_ && !bounds_.empty()) {
-    const glm::vec3 forward = camera_.forward();
+    // Far: the farthest corner of the scene's bounds; near: the nearest point of them (0 inside),
+    // so near < far wherever the camera looks.
     float far = 0.0f;
     for (int i = 0; i < 8; ++i) {
       const glm::vec3 corner{(i & 1) ? bounds_.max.x : bounds_.min.x,
                              (i & 2) ? bounds_.max.y : bounds_.min.y,
                              (i & 4) ? bounds_.max.z : bounds_.min.z};
-      far = std::max(far, glm::dot(corner - camera_.position, forward));
+      far = std::max(far, glm::length(corner - camera_.position));
     }
-    far = std::max(far * 1.01f, 1e-3f * glm::length(bounds_.extent()));
+    far = std::max(far * 1.01f, 1e-3f);
     const glm::vec3 nearest = glm::clamp(camera_.position, bounds_.min, bounds_.max);
-    c.near = std::max(0.9f * glm::length(nearest - camera_.position), 1e-3f * far);
+    c.near = std::clamp(0.9f * glm::length(nearest - camera_.position), 1e-3f * far, 0.5f * far);
     c.far = far;
   }
-  camera_.moved = true;
-  doc_stale_ = true;
-  changed_since_frame_ = true;
 }
 
 void Editor::update_bounds_speed() {
@@ -607,19 +621,16 @@ void Editor::update_bounds_speed() {
 
 Status Editor::edit(const std::string& assignment, bool merge) {
   // What the load makes on its own (the ground, a terrain's tiles) is not saved: an edit of it
-  // would be lost, so it is refused.
-  std::optional<std::string> made_at_load;
-  scene_.world.view<Imported>().each([&](ecs::Entity e, const Imported& imp) {
-    const auto* n = scene_.world.try_get<Name>(e);
-    if (n && !(imp.source.valid() && scene_.world.alive(imp.source) &&
-               scene_.world.has<ModelRef>(imp.source)) &&
-        assignment.starts_with(n->value + "."))
-      made_at_load = n->value;
-  });
-  if (made_at_load)
-    return Error{"--set", assignment.substr(0, assignment.find('=')),
-                 "'" + *made_at_load + "' is made when the scene loads and is not saved; change "
-                 "render.ground instead"};
+  // would be lost, so it is refused. The entity as scene IO resolves the key.
+  const std::string key = assignment.substr(0, assignment.find('='));
+  if (auto target = entity_for_key(scene_, key)) {
+    const auto* imp = scene_.world.try_get<Imported>(target.value());
+    if (imp && !(imp->source.valid() && scene_.world.alive(imp->source) &&
+                 scene_.world.has<ModelRef>(imp->source)))
+      return Error{"--set", key, "'" + scene_.world.get<Name>(target.value()).value +
+                                     "' is made when the scene loads and is not saved; change "
+                                     "render.ground instead"};
+  }
   Status live = apply_live_override(scene_, assignment);
   if (!live) {
     // Sections a loaded entity does not take live (material, primitive, model, name) are set on
@@ -627,6 +638,12 @@ Status Editor::edit(const std::string& assignment, bool merge) {
     json doc = scene_to_json(scene_);
     if (!apply_override(doc, assignment)) return live;
     KASKAD_TRY(load_document(doc));
+  }
+  // Near, far or auto_frame of the viewport's camera set by the user: theirs from now on.
+  if (const auto cam = active_camera(); cam && scene_.world.has<Name>(*cam)) {
+    const std::string prefix = scene_.world.get<Name>(*cam).value + ".camera.";
+    for (const char* field : {"near", "far", "auto_frame"})
+      if (key == prefix + field) planes_follow_ = false;
   }
   record(merge);
   return {};
@@ -636,6 +653,7 @@ void Editor::record(bool merge) {
   update_transforms(scene_.world, scene_.assets);
   doc_stale_ = true;
   changed_since_frame_ = true;
+  update_bounds_speed();  // what the fly speed and a placed camera's planes span
   json snapshot = scene_to_json(scene_);
   if (snapshot == history_[position_]) return;  // an edit that changed nothing is no undo step
   if (merge && position_ + 1 == history_.size() && position_ != saved_ && position_ > 0) {
@@ -769,13 +787,13 @@ Status Editor::load_document(const json& doc) {
   return {};
 }
 
-Status Editor::restore(std::size_t index) {
+Status Editor::restore(std::size_t index, bool keep_view) {
   KASKAD_TRY(load_document(history_[index]));
   position_ = index;
   doc_stale_ = true;
   changed_since_frame_ = true;
-  if (camera_.moved) {
-    write_camera();
+  if (camera_.moved || keep_view) {
+    place_camera();
     update_transforms(scene_.world, scene_.assets);
   } else {
     take_camera_from_scene();
@@ -810,19 +828,24 @@ Status Editor::save_as(const fs::path& file) {
   KASKAD_TRY(save(file));
   // From now on the scene is that file: Ctrl+S writes it and it is what "unsaved" refers to.
   // The undo history's paths (models, material files, maps) are relative to the scene's file:
-  // each document is rewritten relative to the new one, and the scene reloaded from its own.
-  const fs::path old_file = scene_.file;
-  const fs::path dir = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+  // each document is rewritten relative to the new one, and the scene loaded from its own, before
+  // anything changes (a failure leaves the editor as it was; the copy is written).
   std::vector<json> rebased;
   for (const json& doc : history_) {
-    auto parsed = parse_scene(doc, old_file);
+    auto parsed = parse_scene(doc, scene_.file);
     if (!parsed) return parsed.error();
-    rebased.push_back(scene_to_json(*parsed, dir));
+    rebased.push_back(scene_to_json(*parsed, folder_of(file)));
   }
+  auto scene = load_scene_document(rebased[position_], file);
+  if (!scene) return scene.error();
   history_ = std::move(rebased);
   opt_.scene = file;
-  camera_.moved = true;  // the reload keeps the view (an auto_frame camera is not framed again)
-  KASKAD_TRY(restore(position_));
+  scene_ = std::move(scene.value());
+  prewarm_ = true;
+  doc_stale_ = true;
+  changed_since_frame_ = true;
+  place_camera();  // the view stays; an auto_frame camera is not framed again
+  update_transforms(scene_.world, scene_.assets);
   saved_ = position_;
   glfwSetWindowTitle(player_.context->window(), ("Kaskad editor - " + file.string()).c_str());
   return {};
@@ -897,6 +920,10 @@ Status Editor::frame_selection() {
   const auto e = find(selected_);
   if (!e) return Error{"", "", "F frames the selection: select an entity first"};
   // The entity and everything below it: a model's entity, or a glTF node, has no mesh of its own.
+  std::map<std::uint32_t, std::vector<ecs::Entity>> children;  // by parent index, one pass
+  scene_.world.view<Transform>().each([&](ecs::Entity x, const Transform& t) {
+    if (t.parent.valid()) children[t.parent.index].push_back(x);
+  });
   Aabb box;
   std::vector<ecs::Entity> subtree{*e};
   for (std::size_t i = 0; i < subtree.size(); ++i) {
@@ -904,9 +931,9 @@ Status Editor::frame_selection() {
       box.expand(b->box.min);
       box.expand(b->box.max);
     }
-    scene_.world.view<Transform>().each([&](ecs::Entity x, const Transform& t) {
-      if (t.parent == subtree[i]) subtree.push_back(x);
-    });
+    if (const auto it = children.find(subtree[i].index); it != children.end())
+      for (ecs::Entity c : it->second)
+        if (scene_.world.get<Transform>(c).parent == subtree[i]) subtree.push_back(c);
   }
   if (box.empty()) {
     const auto* wt = scene_.world.try_get<WorldTransform>(*e);
@@ -1590,7 +1617,7 @@ void Editor::show_file_dialog(FileDialog::Purpose purpose, const std::string& ty
     dialog_.enter(fs::absolute(t, ec).parent_path());
     std::snprintf(dialog_.name, sizeof dialog_.name, "%s", t.filename().string().c_str());
   } else {
-    dialog_.enter(opt_.scene.parent_path().empty() ? fs::path(".") : opt_.scene.parent_path());
+    dialog_.enter(folder_of(opt_.scene));
     const std::string own =
         purpose == FileDialog::Purpose::save_as ? opt_.scene.filename().string() : "";
     std::snprintf(dialog_.name, sizeof dialog_.name, "%s", own.c_str());
@@ -1978,6 +2005,12 @@ int Editor::run() {
     last = now;
     if (opt_.script.empty() || input_until) interactive_input(dt);
     draw_ui(w, h);
+    // A number being typed whose field was not drawn again (a click on another entity's row
+    // changed the inspector): the click ended the typing, which applies it.
+    if (!typed_.first.empty() && !ImGui::IsAnyItemActive()) {
+      requests_.emplace_back(typed_.second, false);
+      typed_ = {};
+    }
     ImGui::Render();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, w, h);

@@ -125,7 +125,7 @@ void read_shadow(ObjectReader& r, ShadowSettings& s) {
                                std::to_string(s.vsm_blur));
   // [0, 1): 1 would shadow everything. The largest float under 1 is the bound (the editor's).
   if (r.has("vsm_bleed_reduction") && r.raw("vsm_bleed_reduction").is_number() &&
-      r.raw("vsm_bleed_reduction").get<double>() >= 1.0)
+      r.raw("vsm_bleed_reduction").get<double>() > double(std::nextafter(1.0f, 0.0f)))
     fail(r.at("vsm_bleed_reduction"), "must be in [0, 1) (1 would shadow everything), was " +
                                           r.raw("vsm_bleed_reduction").dump());
   r.number("vsm_bleed_reduction", s.vsm_bleed_reduction, 0.0f, std::nextafter(1.0f, 0.0f));
@@ -790,15 +790,16 @@ json write_node_overrides(const Scene& scene, ecs::Entity model) {
   json out = json::object();
   for (const NodeOverride& o : scene.world.get<ModelRef>(model).nodes) {
     const std::vector<ecs::Entity> found = nodes_named(scene.world, model, o.node);
-    if (found.size() != 1) {
-      out[o.node][o.section] = json::parse(o.block, nullptr, /*allow_exceptions=*/false);
-      continue;
+    json block = json::object();
+    if (found.size() == 1 && settable_sections(scene, found.front()).contains(o.section)) {
+      const json live = settable_sections(scene, found.front())[o.section];
+      for (const std::string& f : o.fields)
+        if (live.contains(f)) block[f] = live[f];
+    } else {
+      block = json::parse(o.block, nullptr, /*allow_exceptions=*/false);
     }
-    const json live = settable_sections(scene, found.front());
-    json& block = out[o.node][o.section];
-    block = json::object();
-    for (const std::string& f : o.fields)
-      if (live.contains(o.section) && live[o.section].contains(f)) block[f] = live[o.section][f];
+    // An empty block says nothing (and a section the node lacks would not load).
+    if (block.is_object() && !block.empty()) out[o.node][o.section] = block;
   }
   return out;
 }
@@ -810,7 +811,8 @@ void note_node_override(Scene& scene, ecs::Entity e, const std::string& section,
   ecs::World& w = scene.world;
   const ecs::Entity model = model_of(w, e);
   const auto* name = w.try_get<Name>(e);
-  if (!model.valid() || !name) return;
+  // A name two nodes of the model share could not be read back to one of them: not kept.
+  if (!model.valid() || !name || nodes_named(w, model, name->value).size() != 1) return;
   std::vector<NodeOverride>& nodes = w.get<ModelRef>(model).nodes;
   auto it = std::find_if(nodes.begin(), nodes.end(), [&](const NodeOverride& o) {
     return o.node == name->value && o.section == section;
@@ -890,12 +892,8 @@ Status apply_live_override(Scene& scene, const std::string& assignment) {
   return {};
 }
 
-Status apply_entity_override(Scene& scene, const std::string& assignment) {
-  const auto eq = assignment.find('=');
-  if (eq == std::string::npos || eq == 0)
-    return Error{"--set", assignment, "expected key=value, e.g. shadow.map_size=2048"};
-  const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
-  ecs::World& w = scene.world;
+Result<ecs::Entity> entity_for_key(const Scene& scene, const std::string& key) {
+  const ecs::World& w = scene.world;
   // The longest entity name followed by '.' that starts the key: glTF names may hold dots.
   std::vector<std::pair<ecs::Entity, std::string>> named;
   w.view<Name>().each([&](ecs::Entity e, const Name& n) { named.emplace_back(e, n.value); });
@@ -922,11 +920,23 @@ Status apply_entity_override(Scene& scene, const std::string& assignment) {
     return Error{"--set", key, "no setting section or entity named '" + key.substr(0, key.find('.')) +
                                    "'; sections: render, shadow; entities: " + join(names)};
   }
-  const std::string name = key.substr(0, best);
   if (matches.size() > 1)
-    return Error{"--set", key, std::to_string(matches.size()) + " entities are named '" + name +
-                                   "'; only a unique name can be set"};
-  const ecs::Entity e = matches.front();
+    return Error{"--set", key, std::to_string(matches.size()) + " entities are named '" +
+                                   key.substr(0, best) + "'; only a unique name can be set"};
+  return matches.front();
+}
+
+Status apply_entity_override(Scene& scene, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    return Error{"--set", assignment, "expected key=value, e.g. shadow.map_size=2048"};
+  const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  ecs::World& w = scene.world;
+  auto found = entity_for_key(scene, key);
+  if (!found) return found.error();
+  const ecs::Entity e = found.value();
+  const std::string name = w.get<Name>(e).value;
+  const std::size_t best = name.size();
   json ej = settable_sections(scene, e);
   const std::vector<std::string> parts = split_key(key.substr(best + 1));
   KASKAD_TRY(set_field(&ej, parts, key, text));
@@ -1404,7 +1414,7 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
 
 Status save_scene(const fs::path& file, const Scene& scene) {
   KASKAD_TRY(check_output_path(file));  // before the work, and with a clear word for a folder
-  const fs::path dir = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+  const fs::path dir = folder_of(file);
   return write_file_atomic(file, scene_to_json(scene, dir).dump(2) + "\n");
 }
 

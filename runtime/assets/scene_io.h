@@ -43,6 +43,11 @@ Result<Scene> read_scene(const std::filesystem::path& file,
                          const std::vector<std::string>& overrides = {},
                          std::vector<std::string>* deferred = nullptr);
 
+/// The entity an "ENTITY.SECTION.FIELD" key names: the longest entity name followed by '.' that
+/// starts the key (glTF names may hold dots), which only one entity may have. Errors list the
+/// names (or say how many share it).
+Result<ecs::Entity> entity_for_key(const Scene& scene, const std::string& key);
+
 /// Applies one "ENTITY.SECTION.FIELD=value" override to an entity of an instantiated scene by its
 /// Name (the longest name that starts the key, so glTF names with dots work): sections transform
 /// (rotation also as euler_deg, look_at or direction), light, shadow, camera and renderer, read

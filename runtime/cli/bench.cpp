@@ -19,6 +19,7 @@
 #include "runtime/cli/player.h"
 #include "runtime/assets/scene_io.h"
 #include "runtime/cli/stability.h"
+#include "runtime/core/file_io.h"
 #include "runtime/core/atomic_file.h"
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
@@ -233,7 +234,7 @@ Status run_bench(const BenchOptions& options) {
   // level only.
   std::error_code ec;
   const fs::path out_parent =
-      options.out_dir.parent_path().empty() ? fs::path(".") : options.out_dir.parent_path();
+      folder_of(options.out_dir);
   if (options.out_dir == BenchOptions{}.out_dir)
     fs::create_directories(options.out_dir, ec);  // the documented default, out/bench
   else if (!fs::exists(options.out_dir, ec) && fs::is_directory(out_parent, ec))

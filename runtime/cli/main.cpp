@@ -18,6 +18,7 @@
 #include "components/reflector.h"
 #include "components/shadow_settings.h"
 #include "components/transform.h"
+#include "runtime/core/file_io.h"
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
@@ -351,7 +352,7 @@ void print_layer_table(const render::FrameStats& st, const ShadowData& sh, bool 
 Status make_named_folder(const fs::path& dir) {
   std::error_code ec;
   if (!fs::exists(dir, ec)) {
-    const fs::path parent = dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
+    const fs::path parent = folder_of(dir);
     if (!fs::is_directory(parent, ec))
       return Error{dir.string(), "", "cannot make this folder: '" + parent.string() +
                                          "' does not exist (kaskad makes only the folder named)"};

@@ -9,15 +9,13 @@
 #include <cstring>
 #include <utility>
 
+#include "runtime/core/file_io.h"
+
 namespace kaskad {
 namespace fs = std::filesystem;
 namespace {
 
 std::string errno_text(int err) { return std::strerror(err); }
-
-fs::path folder_of(const fs::path& path) {
-  return path.parent_path().empty() ? fs::path(".") : path.parent_path();
-}
 
 /// mkstemps() in the target's folder: ".NAME.XXXXXX.EXT" (hidden, same extension). Returns the fd
 /// (or -1 with errno set) and fills `temp`.

@@ -299,6 +299,17 @@ quit" "$tmp/deep/er/truck.json"
   [ "$rc" -eq 0 ] || { fail "truck reload script exit $rc"; tail -5 "$tmp/out"; }
   same "the node's edit and the placed camera reload: save -> load -> save" deep/er/truck.json deep/er/truck_again.json
   same "the node's edit reloads: the same image" truck_edited.png truck_reloaded.png
+  # The camera placed looking away from the scene: its planes (an auto_frame camera's follow
+  # it) still make a file that loads.
+  edit "camera 30 30 30 60 60 60
+save_as $tmp/looking_away.json
+quit" "$truck"
+  [ "$rc" -eq 0 ] || { fail "looking-away script exit $rc"; tail -5 "$tmp/out"; }
+  if "$KASKAD" save "$tmp/looking_away.json" -o "$tmp/looking_away_again.json" >"$tmp/save_out" 2>&1; then
+    ok "a camera placed looking away from the scene saves a file that loads"
+  else
+    fail "looking_away.json does not load: $(cat "$tmp/save_out")"
+  fi
   edit "set sun.light.intensity=2
 save_as $tmp/deep/er/materials.json
 undo
@@ -602,7 +613,11 @@ click shadow
 click shadow.filter
 click shadow.filter=none
 save $tmp/combo.json
+ctrl_click box_resting.material.roughness
+type 0.375
 click entity:sphere
+frames 1
+save $tmp/typed_then_row.json
 click duplicate
 save $tmp/duplicated.json
 select sun
@@ -627,6 +642,7 @@ quit!" "$scene"
   fi
   is "a click on a checkbox toggles it" "$(value checkbox.json box_resting renderer cast_shadows)" False
   is "a click on a combo's item picks it" "$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["shadow"]["filter"])' "$tmp/combo.json")" none
+  is "a number typed, then a click on another entity's row: applied" "$(value typed_then_row.json box_resting material roughness)" 0.375
   is "a click on an entity's row, then on duplicate" "$(value duplicated.json sphere_1 primitive shape)" sphere
   # A light's own shadow section shows every field (the file held none for the sun).
   is "a light's shadow field the file did not give" "$(value light_shadow.json sun shadow filter)" bilinear

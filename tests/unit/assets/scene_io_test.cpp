@@ -790,6 +790,28 @@ TEST(SceneIo, ModelNodeSettingsApplyOverTheFileAndSaveWithTheModel) {
   ASSERT_TRUE(save_scene(resaved, *again).ok());
   EXPECT_EQ(read_file(saved), read_file(resaved));
 
+  // entity_for_key() resolves a key as the overrides do: the longest name, unique.
+  auto sun_key = entity_for_key(*s, "Sun.001.light.color");
+  ASSERT_TRUE(sun_key.ok()) << sun_key.error().to_string();
+  EXPECT_EQ(sun_key.value(), find(*s, "Sun.001"));
+  EXPECT_FALSE(entity_for_key(*s, "Sun.light.color").ok());
+
+  // Two nodes of one name in one model: a note of either is not kept (it could not be read back
+  // to one of them), and nothing empty is written.
+  write_file("twins.gltf", R"({"asset": {"version": "2.0"},
+    "nodes": [{"name": "twin"}, {"name": "twin"}], "scenes": [{"nodes": [0, 1]}], "scene": 0})");
+  auto twins = read_scene(write_file("twins_scene.json",
+                                     R"({"entities": [{"name": "t", "model": {"path": "twins.gltf"}}]})"));
+  ASSERT_TRUE(twins.ok());
+  ASSERT_TRUE(instantiate_scene(*twins).ok());
+  std::vector<ecs::Entity> twin_nodes;
+  twins->world.view<Name>().each([&](ecs::Entity e, const Name& n) {
+    if (n.value == "twin") twin_nodes.push_back(e);
+  });
+  ASSERT_EQ(twin_nodes.size(), 2u);
+  note_node_override(*twins, twin_nodes[0], "transform", {"translation"});
+  EXPECT_FALSE(scene_to_json(*twins)["entities"][0]["model"].contains("nodes"));
+
   // Bad blocks are errors naming the file and the place.
   auto error_of = [&](const std::string& nodes_block) {
     const fs::path bad = write_file("nodes_bad.json", R"({"entities": [{"name": "m", "model":
@@ -1147,6 +1169,21 @@ TEST(SceneIo, FieldRecorderRecordsEveryNumbersBounds) {
     }
   }
   EXPECT_GE(checked, 60);
+  // The editor finds a field's bounds by its object and name ("light.intensity", whichever
+  // entity; editor.cpp, enumeration_key): that pair must have one range wherever it is read.
+  std::map<std::string, std::pair<std::string, json_reader::FieldRecorder::Range>> by_pair;
+  for (const auto& [path, range] : ranges) {
+    const auto last = path.rfind('/');
+    const auto before = last == 0 || last == std::string::npos ? last : path.rfind('/', last - 1);
+    const std::string pair = before == std::string::npos ? path : path.substr(before + 1);
+    const auto [it, added] = by_pair.try_emplace(pair, path, range);
+    if (!added) {
+      EXPECT_EQ(range, it->second.second) << path << " and " << it->second.first << " differ";
+    }
+  }
+  // Just under 1, where the bound prints as 1: the message says the bound is open.
+  EXPECT_NE(verdict("/shadow/vsm_bleed_reduction", 0.99999997).find("[0, 1)"), std::string::npos)
+      << verdict("/shadow/vsm_bleed_reduction", 0.99999997);
 }
 
 TEST(SceneIo, FieldRecorderIsScoped) {
