@@ -366,9 +366,9 @@ class Editor {
   // Edits: one --set assignment through scene IO's own override path.
   Status edit(const std::string& assignment, bool merge);
   void record(bool merge);  ///< a snapshot of the scene as it is now, after an edit
-  /// The scene becomes history document `index`; the view stays where the user put it (or, with
-  /// `keep_view`, where it is), otherwise it is the document's camera.
-  Status restore(std::size_t index, bool keep_view = false);
+  /// The scene becomes history document `index`; the view stays where the user put it, otherwise
+  /// it is the document's camera.
+  Status restore(std::size_t index);
   /// The scene becomes canonical document `doc` (read as a file of the scene's path would be),
   /// its programs compiled before its next frame; the scene is unchanged on an error.
   Status load_document(const json& doc);
@@ -787,12 +787,12 @@ Status Editor::load_document(const json& doc) {
   return {};
 }
 
-Status Editor::restore(std::size_t index, bool keep_view) {
+Status Editor::restore(std::size_t index) {
   KASKAD_TRY(load_document(history_[index]));
   position_ = index;
   doc_stale_ = true;
   changed_since_frame_ = true;
-  if (camera_.moved || keep_view) {
+  if (camera_.moved) {
     place_camera();
     update_transforms(scene_.world, scene_.assets);
   } else {
