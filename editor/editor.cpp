@@ -242,11 +242,13 @@ Image aov_view(View view, const Image& aovs) {
           case View::depth: c = glm::vec3(far > 0.0f ? 1.0f - aovs.at(x, y, z) / far : 0.0f); break;
           case View::position: c = (vec3_at(x, y, px) - seen.min) / span; break;
           case View::reflection: {
-            // C_t where a reflection map shades the surface; other surfaces dark grey.
+            // C_t where a reflection map shades the surface; other surfaces dark grey (the
+            // editor test's reflector mask, tests/editor/changed_within.py, knows this grey).
+            constexpr float kNotReflecting = 0.08f;
             const glm::vec3 t = vec3_at(x, y, rr);
             c = aovs.at(x, y, reflector) > 0.5f
                     ? glm::vec3(display_gamma(t.r), display_gamma(t.g), display_gamma(t.b))
-                    : glm::vec3(0.08f);
+                    : glm::vec3(kNotReflecting);
             break;
           }
           default: break;

@@ -2,12 +2,15 @@
 """Whether the pixels that differ between two screenshots all lie inside a mask taken from a
 debug view of the frame before the change (editor_test.sh toggles):
 
-  changed_within.py BEFORE.png AFTER.png VIEW.png geometry|penumbra
+  changed_within.py BEFORE.png AFTER.png VIEW.png geometry|penumbra|reflector
 
   geometry  VIEW is the `normal` view: geometry is every pixel that is not black (a surface's
             colour there is n / 2 + 1/2, never black), the background is black.
   penumbra  VIEW is the `visibility` view: the mask is where the visibility lies strictly
             between 0 and 1 (partly lit by the filter's taps).
+  reflector VIEW is the `reflection` view: the mask is every pixel that is neither black (the
+            background) nor the grey the view paints surfaces without a reflection map
+            (kNotReflecting in editor/editor.cpp, 0.08: 20 in 8 bits).
 
 Prints the counts and exits 0 when some pixel changed and every changed pixel is in the mask,
 1 otherwise. The views are 8-bit: a visibility within 1/510 of 0 or 1 reads as 0 or 255 there,
@@ -67,7 +70,7 @@ def read_png(path):
 
 
 def main():
-    if len(sys.argv) != 5 or sys.argv[4] not in ("geometry", "penumbra"):
+    if len(sys.argv) != 5 or sys.argv[4] not in ("geometry", "penumbra", "reflector"):
         print(__doc__)
         return 2
     before, after, view = (read_png(p) for p in sys.argv[1:4])
@@ -82,7 +85,12 @@ def main():
             pb = rb[x * before[2]:x * before[2] + 3]
             pa = ra[x * after[2]:x * after[2] + 3]
             v = rv[x * view[2]:x * view[2] + 3]
-            mask = any(v) if sys.argv[4] == "geometry" else 0 < v[0] < 255
+            if sys.argv[4] == "geometry":
+                mask = any(v)
+            elif sys.argv[4] == "reflector":
+                mask = any(v) and tuple(v) != (20, 20, 20)
+            else:
+                mask = 0 < v[0] < 255
             in_mask += mask
             if pb != pa:
                 changed += 1

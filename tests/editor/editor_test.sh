@@ -12,7 +12,8 @@
 #   entities  duplicate, create, delete and rename show and are saved; five undos give the original;
 #             a glTF model imported shows, is saved, and undo removes it
 #   every_n   a reflector with update every_n = 3 captures on editor frames 0, 3, 6, 9 only; a
-#             probe's map type changed live changes the image
+#             probe's map type changed live changes the image, on the mirrors only (the
+#             reflection view of the frame before)
 #   soft_maps the soft-shadow technique's maps view: vsm's and evsm's moments and lom's factors
 #             per cascade; pcf has none (the colour shows)
 #   combos    an enumerated field's combo lists exactly the names the scene reader accepts (the
@@ -440,6 +441,9 @@ quit!" "$scene"
 every_n)
   edit "frames 10
 screenshot $tmp/cube.png
+view reflection
+screenshot $tmp/r0.png
+view colour
 set mirror_sphere.reflector.map=sphere
 frames 3
 screenshot $tmp/sphere.png
@@ -464,6 +468,12 @@ quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
     grep '^frame' "$tmp/out"
   fi
   differ "probe map cube -> sphere changes the reflection" cube.png sphere.png
+  # ... and only on the mirrors, from the reflection AOV of the frame before.
+  if python3 "$(dirname "$0")/changed_within.py" "$tmp/cube.png" "$tmp/sphere.png" "$tmp/r0.png" reflector >"$tmp/within" 2>&1; then
+    ok "probe map cube -> sphere changed mirror pixels only: $(cat "$tmp/within")"
+  else
+    fail "probe map cube -> sphere: $(cat "$tmp/within")"
+  fi
   differ "the probe faces view shows the probe's faces" sphere.png plane_faces.png
   differ "the selected entity's probe is the one shown" plane_faces.png sphere_faces.png
   # The reflection view (S3's C_t AOV): the mirrors show what their maps return, many colours;
