@@ -33,6 +33,9 @@ struct NodeOverride {
   /// The block as the scene file gave it (JSON text: components do not depend on the JSON
   /// library), applied when the model is imported; saved as it is while no node has the name.
   std::string block;
+  /// Where the block was read ("/entities/3/model/nodes/Wheels/transform"), for messages; empty
+  /// for a node set live (messages then name "/MODEL/model/nodes/NODE/SECTION").
+  std::string where;
 };
 
 /// A glTF file (.gltf or .glb) instanced under this entity; path relative to the scene file.

@@ -44,6 +44,7 @@
 #include "runtime/cli/player.h"
 #include "runtime/core/file_io.h"
 #include "runtime/core/json_reader.h"
+#include "runtime/core/log.h"
 #include "runtime/gpu/context.h"
 #include "runtime/gpu/gl_handles.h"
 #include "systems/transform_system.h"
@@ -512,6 +513,7 @@ class Editor {
   float speed_ = 1.0f;            ///< fly speed, metres per second (from the scene's size)
   Aabb bounds_;                   ///< the scene's bounds when loaded (fly speed, auto near/far)
   bool panels_hidden_ = false;    ///< H: the viewport takes the whole window
+  bool empty_view_ = false;       ///< the last frame drew nothing of a scene with meshes
   bool planes_follow_ = false;    ///< the camera was auto_frame: its near and far follow it
   bool prewarm_ = true;           ///< compile the scene's programs before its first frame
   bool changed_since_frame_ = true;
@@ -784,7 +786,9 @@ Status Editor::rename_selected(const std::string& name) {
 Status Editor::load_document(const json& doc) {
   auto scene = load_scene_document(doc, opt_.scene);
   if (!scene) return scene.error();
+  const auto frame = scene_.frames_rendered;
   scene_ = std::move(scene.value());
+  scene_.frames_rendered = frame;  // frame indices carry on (probes' every_n)
   prewarm_ = true;
   return {};
 }
@@ -838,16 +842,19 @@ Status Editor::save_as(const fs::path& file) {
     if (!parsed) return parsed.error();
     rebased.push_back(scene_to_json(*parsed, folder_of(file)));
   }
+  // The scene as it is now (the camera where the user put it, with its planes), as just saved.
+  rebased[position_] = scene_to_json(scene_, folder_of(file));
   auto scene = load_scene_document(rebased[position_], file);
   if (!scene) return scene.error();
+  const auto frame = scene_.frames_rendered;
   history_ = std::move(rebased);
   opt_.scene = file;
   scene_ = std::move(scene.value());
+  scene_.frames_rendered = frame;  // frame indices carry on (probes' every_n)
+  log::set_context(file.string());
   prewarm_ = true;
   doc_stale_ = true;
   changed_since_frame_ = true;
-  place_camera();  // the view stays; an auto_frame camera is not framed again
-  update_transforms(scene_.world, scene_.assets);
   saved_ = position_;
   glfwSetWindowTitle(player_.context->window(), ("Kaskad editor - " + file.string()).c_str());
   return {};
@@ -951,6 +958,25 @@ Status Editor::frame_selection() {
   const float distance = 1.2f * radius / std::sin(0.5f * fov);
   camera_.position = centre - camera_.forward() * distance;
   write_camera();
+  // F asked to see the selection: a camera whose own near and far planes leave it out (a small
+  // part of a model scaled up, seen from its framing distance) takes planes around it, and says so.
+  if (const auto cam = active_camera(); cam && !planes_follow_) {
+    Camera& c = scene_.world.get<Camera>(*cam);
+    const auto* wt = scene_.world.try_get<WorldTransform>(*cam);
+    // The camera system scales near and far by the camera's uniform world scale.
+    const float scale = wt ? std::cbrt(std::abs(glm::determinant(glm::mat3(wt->matrix)))) : 1.0f;
+    const float s = std::isfinite(scale) && scale > 0.0f ? scale : 1.0f;
+    const float far = std::max(c.far * s, (distance + radius) * 1.05f);
+    const float near = std::min(c.near * s, std::max((distance - radius) * 0.9f, far * 1e-4f));
+    if (near != c.near * s || far != c.far * s) {
+      c.near = near / s;
+      c.far = far / s;
+      message_ = "F: the camera's near and far are now " + json(json_reader::num(c.near)).dump() + " and " +
+                 json(json_reader::num(c.far)).dump() + ", so that they hold the selection";
+      message_is_error_ = false;
+      std::printf("kaskad edit: %s\n", message_.c_str());
+    }
+  }
   return {};
 }
 
@@ -964,6 +990,9 @@ Status Editor::render_viewport(int w, int h) {
   run.prewarm = prewarm_;
   auto t = render_frames(player_, scene_, run);
   if (!t) return t.error();
+  // Nothing drawn while the scene has meshes: the viewport says why it may be.
+  empty_view_ = t->last.stats.draw_calls == 0 && scene_.world.size() > 0 &&
+                !scene_bounds(scene_.world).empty();
   prewarm_ = false;
   changed_since_frame_ = false;
   if (view_ == View::colour) {
@@ -1117,7 +1146,21 @@ void Editor::field(const std::string& key, const std::string& label, const json&
     // Drag fields within the readers' own limits (one source of truth): a drag stops at them; a
     // typed value outside them is refused with the readers' message.
     const auto* range = limits(key);
-    if (v.is_number_integer() || v.is_number_unsigned()) {
+    if (range && range->power_of_two) {
+      // A map size: the powers of two in its bounds (a value outside them shown as it is).
+      const int current = v.get<int>();
+      const bool open = ImGui::BeginCombo(label.c_str(), std::to_string(current).c_str());
+      name_item(key);
+      if (open) {
+        for (double p = range->lo; p <= range->hi; p *= 2.0) {
+          const std::string item = std::to_string(int(p));
+          if (ImGui::Selectable(item.c_str(), int(p) == current) && int(p) != current)
+            request(key + "=" + item);
+          name_item(key + "=" + item);
+        }
+        ImGui::EndCombo();
+      }
+    } else if (v.is_number_integer() || v.is_number_unsigned()) {
       int i = v.get<int>();
       // An int drag computes max - min: only limits that cannot overflow it.
       const bool bounded = range && range->lo > -1e9 && range->hi < 1e9;
@@ -1156,7 +1199,9 @@ void Editor::field(const std::string& key, const std::string& label, const json&
   } else if (v.is_string()) {
     char buf[512];
     std::snprintf(buf, sizeof buf, "%s", v.get<std::string>().c_str());
-    if (ImGui::InputText(label.c_str(), buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue)) {
+    // A click selects the whole value: what is typed replaces it.
+    if (ImGui::InputText(label.c_str(), buf, sizeof buf,
+                         ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll)) {
       // A word is the string; a JSON array or object typed over a word such as a reflector's
       // "auto" centre or "none" box is that value ([0, 1, 0]).
       const json typed = json::parse(buf, nullptr, /*allow_exceptions=*/false);
@@ -1563,6 +1608,15 @@ void Editor::draw_ui(int w, int h) {
     ImGui::SetCursorPos(ImVec2(6, 4));
     ImGui::TextDisabled("H: panels");
   }
+  if (empty_view_ && view_ == View::colour) {
+    ImGui::SetCursorPos(ImVec2(6, 22));
+    if (const auto cam = active_camera()) {
+      const Camera& c = scene_.world.get<Camera>(*cam);
+      ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.4f, 1.0f),
+                         "nothing in view: the scene may lie outside the camera's near and far "
+                         "(%g, %g); F frames the selection", double(c.near), double(c.far));
+    }
+  }
   viewport_hovered_ = ImGui::IsWindowHovered();
   ImGui::End();
   ImGui::PopStyleVar();
@@ -1722,7 +1776,7 @@ void Editor::file_dialog(int w, int h) {
   if (enter) d.enter(*enter);
   if (ImGui::IsWindowAppearing()) ImGui::SetKeyboardFocusHere();
   ImGui::SetNextItemWidth(-160.0f);
-  ImGui::InputText("##name", d.name, sizeof d.name);
+  ImGui::InputText("##name", d.name, sizeof d.name, ImGuiInputTextFlags_AutoSelectAll);
   name_item("dialog name");
   // Enter anywhere in the dialog (the name field gives up the keyboard on Enter, so a second one,
   // to answer "replace it?", comes with no field active); as pressed, not its repeats: a held
@@ -1730,17 +1784,24 @@ void Editor::file_dialog(int w, int h) {
   if (ImGui::IsWindowFocused(ImGuiFocusedFlags_RootAndChildWindows) &&
       (ImGui::IsKeyPressed(GLFW_KEY_ENTER, false) || ImGui::IsKeyPressed(GLFW_KEY_KP_ENTER, false)))
     accept = true;
+  // Escape closes it (in the name field, the first Escape leaves the field).
+  const bool escape = ImGui::IsWindowFocused(ImGuiFocusedFlags_RootAndChildWindows) &&
+                      ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false) && !ImGui::IsAnyItemActive();
   ImGui::SameLine();
   const char* verb = d.purpose == FileDialog::Purpose::open      ? "open"
                      : d.purpose == FileDialog::Purpose::save_as ? "save"
                                                                  : "import";
   if (button(verb)) accept = true;
   ImGui::SameLine();
-  if (button("cancel")) {
+  if (button("cancel") || escape) {
     d.visible = false;
     ImGui::CloseCurrentPopup();
   }
-  if (!d.error.empty()) ImGui::TextColored(red, "%s", d.error.c_str());
+  if (!d.error.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, red);
+    ImGui::TextWrapped("%s", d.error.c_str());
+    ImGui::PopStyleColor();
+  }
   if (accept && d.visible) accept_file_dialog();
   ImGui::EndPopup();
 }
@@ -1815,6 +1876,8 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       return {};
     }
     case ActionKind::key:
+      if (dialog_.visible && a.args[0] != "enter" && a.args[0] != "escape")
+        return Error{"", "", "key " + a.args[0] + ": the file dialog is up and has the keys"};
       if (a.args[0] == "enter" || a.args[0] == "escape") {
         // To the panels: pressed for a frame, then released.
         const int key = a.args[0] == "enter" ? GLFW_KEY_ENTER : GLFW_KEY_ESCAPE;
@@ -2031,8 +2094,12 @@ int Editor::run() {
 
     // Edits from the panels, in the order made; a rejected one shows its error and changes nothing.
     for (const auto& [assignment, merge] : requests_) {
-      if (Status st = edit(assignment, merge); !st) report(st.error().to_string());
-      else message_.clear();
+      // A drag the readers refuse at every step says so once.
+      if (Status st = edit(assignment, merge); !st) {
+        if (st.error().to_string() != message_) report(st.error().to_string());
+      } else {
+        message_.clear();
+      }
     }
     requests_.clear();
     for (const auto& op : operations_) {

@@ -29,7 +29,7 @@ void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
   r.enumeration("update", out.update, kUpdates);
   r.integer("every_n", out.every_n, 1, 1 << 20);
   r.integer("faces_per_frame", out.faces_per_frame, 1, 6);
-  r.integer("resolution", out.resolution, 8, 2048);
+  r.power_of_two("resolution", out.resolution, 8, 2048);
   // center: [x, y, z], or "auto" (the centre of the entity's bounds; what a file without it gets).
   if (r.has("center") && r.raw("center").is_string()) {
     if (r.raw("center") != "auto")

@@ -94,7 +94,7 @@ const std::vector<std::pair<const char*, PointShadowMode>> kPointModes = {
 // Range checks here; combinations (fit_mode scene with several cascades) by
 // validate_shadow_settings(), whose message starts with the bad key.
 void read_shadow(ObjectReader& r, ShadowSettings& s) {
-  r.integer("map_size", s.map_size, 64, 16384);
+  r.power_of_two("map_size", s.map_size, 64, 16384);
   r.number("constant_bias", s.constant_bias, 0.0f, 1.0e4f);
   r.number("slope_bias", s.slope_bias, 0.0f, 100.0f);
   r.enumeration("cull", s.cull, kCullModes);
@@ -772,7 +772,7 @@ std::vector<NodeOverride> read_node_overrides(const json& nodes, const std::stri
       if (!s.value().is_object()) fail(sat, "expected an object, got " + type_name(s.value()));
       if (s.key() == "transform" && s.value().contains("parent"))
         fail(sat + "/parent", "an imported node keeps its parent from the model file");
-      NodeOverride o{n.key(), s.key(), {}, s.value().dump()};
+      NodeOverride o{n.key(), s.key(), {}, s.value().dump(), sat};
       for (auto f = s.value().begin(); f != s.value().end(); ++f) {
         const std::string field = recorded_field(s.key(), f.key());
         if (std::find(o.fields.begin(), o.fields.end(), field) == o.fields.end())
@@ -817,7 +817,7 @@ void note_node_override(Scene& scene, ecs::Entity e, const std::string& section,
   auto it = std::find_if(nodes.begin(), nodes.end(), [&](const NodeOverride& o) {
     return o.node == name->value && o.section == section;
   });
-  if (it == nodes.end()) it = nodes.insert(nodes.end(), NodeOverride{name->value, section, {}, "{}"});
+  if (it == nodes.end()) it = nodes.insert(nodes.end(), NodeOverride{name->value, section, {}, "{}", ""});
   for (const std::string& f : fields) {
     const std::string field = recorded_field(section, f);
     if (std::find(it->fields.begin(), it->fields.end(), field) == it->fields.end())
@@ -1131,7 +1131,8 @@ Status apply_node_overrides(Scene& scene, ecs::Entity e, const std::vector<ecs::
   const std::string model_name = w.has<Name>(e) ? w.get<Name>(e).value : std::string();
   const std::vector<NodeOverride> overrides = w.get<ModelRef>(e).nodes;  // a copy: pools move
   for (const NodeOverride& o : overrides) {
-    const std::string where = "/" + model_name + "/model/nodes/" + o.node + "/" + o.section;
+    const std::string where =
+        o.where.empty() ? "/" + model_name + "/model/nodes/" + o.node + "/" + o.section : o.where;
     std::vector<ecs::Entity> found;
     for (ecs::Entity x : made)
       if (const auto* n = w.try_get<Name>(x); n && n->value == o.node) found.push_back(x);

@@ -83,6 +83,7 @@ class FieldRecorder {
   /// The bounds a number (or each number of an array) must lie in, inclusive.
   struct Range {
     double lo = 0.0, hi = 0.0;
+    bool power_of_two = false;  ///< an integer that must also be a power of two (map sizes)
     bool operator==(const Range&) const = default;
   };
   void record(const std::string& path, std::vector<std::string> names) {
@@ -139,6 +140,15 @@ class ObjectReader {
       fail(at(key), "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
                         "], was " + std::to_string(d));
     out = int(d);
+  }
+  /// integer(), and a power of two (map sizes): `KEY must be a power of two in [lo, hi], was N`.
+  void power_of_two(const char* key, int& out, int lo, int hi) {
+    integer(key, out, lo, hi);
+    if (FieldRecorder* recorder = FieldRecorder::current())
+      recorder->record(at(key), {double(lo), double(hi), true});
+    if (has(key) && (out & (out - 1)) != 0)
+      fail(at(key), std::string(key) + " must be a power of two in [" + std::to_string(lo) + ", " +
+                        std::to_string(hi) + "], was " + std::to_string(out));
   }
   void boolean(const char* key, bool& out) {
     if (!has(key)) return;

@@ -160,12 +160,17 @@ quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
   # F on a glTF model's entity (no mesh of its own: its nodes' bounds), at a hundredth and a
   # hundred times the truck's size, with the camera far off: the truck fills the view, centred.
   truck="$KASKAD_CONTENT/models/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf"
-  for s in 0.01 100; do
+  # The camera: auto_frame (its planes follow it), or near 0.1 and far 100 of its own ("fixed":
+  # F then widens them, and says so).
+  for s in 0.01 100 100fixed; do
+    scale=${s%fixed}
+    camera='"auto_frame": true'
+    [ "$s" = 100fixed ] && camera='"near": 0.1, "far": 100'
     printf '{"render": {"ground": "none"}, "entities": [
       {"name": "truck", "transform": {"scale": [%s, %s, %s]}, "model": {"path": "%s"}},
-      {"name": "camera", "transform": {"translation": [0, 1, 5]}, "camera": {"auto_frame": true}},
+      {"name": "camera", "transform": {"translation": [0, 1, 5]}, "camera": {'"$camera"'}},
       {"name": "sun", "transform": {"direction": [-0.4, -1, -0.3]}, "light": {"type": "directional"}}]}\n' \
-      "$s" "$s" "$s" "$truck" >"$tmp/truck_$s.json"
+      "$scale" "$scale" "$scale" "$truck" >"$tmp/truck_$s.json"
     edit "camera 3000 1000 3000 0 0 0
 select truck
 key f
@@ -177,6 +182,10 @@ quit!" "$tmp/truck_$s.json"
     extent=$(python3 "$(dirname "$0")/geometry_extent.py" "$tmp/truck_framed_$s.png")
     if echo "$extent" | awk '{ exit !(($1 > 0.3 || $2 > 0.3) && $1 < 1 && $2 < 1 && $3 > 0.4 && $3 < 0.6 && $4 > 0.4 && $4 < 0.6) }'; then
       ok "F frames a model's entity at scale $s (extent and centre: $extent)"
+      if [ "$s" = 100fixed ]; then
+        grep -q "kaskad edit: F: the camera's near and far are now" "$tmp/out" &&
+          ok "F says it widened the camera's own planes" || fail "F widened the planes silently"
+      fi
     else
       fail "F on a model's entity at scale $s: the geometry's extent and centre are $extent"
     fi
@@ -272,16 +281,21 @@ quit!" "$scene"
   truck="$KASKAD_CONTENT/models/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf"
   mkdir -p "$tmp/deep/er"
   # The camera placed first: the wrapped glTF's auto_frame camera then stays where it was put.
+  # No ground: a load makes it from the models' bounds, which the raised wheels change.
   edit "camera 4 2 6 0 1 0
 set node_2.transform.translation=[0,2,0]
+key w
+key w
+screenshot $tmp/truck_before_save_as.png
 save_as $tmp/deep/er/truck.json
+screenshot $tmp/truck_after_save_as.png
 set sun.light.intensity=1.5
 undo
 redo
 undo
 save $tmp/deep/er/truck_undone.json
 screenshot $tmp/truck_edited.png
-quit" "$truck"
+quit" "$truck" --set render.ground=none
   [ "$rc" -eq 0 ] || { fail "glTF node edit script exit $rc"; tail -5 "$tmp/out"; }
   if tr -d ' \n' <"$tmp/deep/er/truck.json" | grep -q '"nodes":{"node_2":{"transform":{"translation":\[0.0,2.0,0.0\]}}}'; then
     ok "a glTF node's edit is saved in its model's nodes block"
@@ -294,6 +308,7 @@ quit" "$truck"
     if [ "$(model_block "$tmp/$2")" = "$(model_block "$tmp/$3")" ]; then ok "$1"; else fail "$1: $2 and $3 differ"; fi
   }
   same_model "an undo of a later edit keeps the node's edit" deep/er/truck.json deep/er/truck_undone.json
+  same "save as keeps the view (the camera flown, its planes following)" truck_before_save_as.png truck_after_save_as.png
   edit "screenshot $tmp/truck_reloaded.png
 save $tmp/deep/er/truck_again.json
 quit" "$tmp/deep/er/truck.json"
@@ -634,6 +649,14 @@ select sun
 click sun.shadow.filter
 click sun.shadow.filter=bilinear
 save $tmp/light_shadow.json
+click shadow.map_size
+click shadow.map_size=1024
+save $tmp/map_size.json
+click save as...
+key escape
+key escape
+key h
+key h
 quit!" "$scene"
   [ "$rc" -eq 0 ] || { fail "clicks script exit $rc"; tail -5 "$tmp/out"; }
   is "while a number is typed, nothing is applied" "$(value typing.json box_resting material roughness)" 0.5
@@ -656,6 +679,12 @@ quit!" "$scene"
   is "a click on an entity's row, then on duplicate" "$(value duplicated.json sphere_1 primitive shape)" sphere
   # A light's own shadow section shows every field (the file held none for the sun).
   is "a light's shadow field the file did not give" "$(value light_shadow.json sun shadow filter)" bilinear
+  is "a map size is picked from the powers of two in its bounds" "$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["shadow"]["map_size"])' "$tmp/map_size.json")" 1024
+  # (key h after two Escapes: the file dialog is closed, or the script would have failed below.)
+  edit "click save as...
+key h
+quit!" "$scene"
+  refused "line 2: key h: the file dialog is up and has the keys" "keys while the file dialog is up: refused, the dialog named"
   # A reflector's "auto" centre, a text field, takes an array typed over it, and undo restores it.
   edit "select mirror_sphere
 double_click mirror_sphere.reflector.center

@@ -729,7 +729,7 @@ TEST(SceneIo, ModelNodeSettingsApplyOverTheFileAndSaveWithTheModel) {
   // Sun.001 has no renderer: m2's block names a section the node lacks.
   auto lacking = instantiate_scene(*loaded);
   ASSERT_FALSE(lacking.ok());
-  EXPECT_NE(lacking.error().to_string().find("/m2/model/nodes/Sun.001/renderer"), std::string::npos)
+  EXPECT_NE(lacking.error().to_string().find("/entities/1/model/nodes/Sun.001/renderer"), std::string::npos)
       << lacking.error().to_string();
   std::string text = read_file(file);
   text.replace(text.find(R"("renderer": {}, )"), std::string(R"("renderer": {}, )").size(), "");
@@ -828,7 +828,7 @@ TEST(SceneIo, ModelNodeSettingsApplyOverTheFileAndSaveWithTheModel) {
   EXPECT_NE(e.find("transform, light, shadow, camera and renderer"), std::string::npos) << e;
   e = error_of(R"({"Sun.001": {"light": {"intensity": -1}}})");
   EXPECT_NE(e.find("nodes_bad.json"), std::string::npos) << e;
-  EXPECT_NE(e.find("/m/model/nodes/Sun.001/light/intensity"), std::string::npos) << e;
+  EXPECT_NE(e.find("/entities/0/model/nodes/Sun.001/light/intensity"), std::string::npos) << e;
   e = error_of(R"({"Sun.001": {"transform": {"parent": "m"}}})");
   EXPECT_NE(e.find("keeps its parent"), std::string::npos) << e;
   e = error_of(R"([1])");
@@ -1146,7 +1146,7 @@ TEST(SceneIo, FieldRecorderRecordsEveryNumbersBounds) {
     auto r = parse_scene(d, temp_dir() / "ranges.json");
     return !r.ok() && r.error().where == pointer ? r.error().message : std::string();
   };
-  int checked = 0;
+  int checked = 0, powers = 0;
   const json leaves = canonical.flatten();
   for (const auto& [pointer, value] : leaves.items()) {
     if (!value.is_number() || pointer == "/kaskad_scene") continue;
@@ -1156,7 +1156,13 @@ TEST(SceneIo, FieldRecorderRecordsEveryNumbersBounds) {
     const auto it = ranges.find(element ? parent : pointer);
     ASSERT_NE(it, ranges.end()) << pointer << " is a number whose bounds were not recorded";
     ++checked;
-    const auto [lo, hi] = it->second;
+    const auto [lo, hi, power_of_two] = it->second;
+    if (power_of_two) {
+      // A map size: offered as the powers of two in its bounds; a number between them refused.
+      ++powers;
+      EXPECT_NE(verdict(pointer, std::int64_t(lo) + 1).find("must be a power of two"), std::string::npos)
+          << pointer;
+    }
     const bool integer = value.is_number_integer();
     const json below = integer ? json(std::int64_t(lo) - 1) : json(lo - std::max(std::abs(lo), 1.0) * 1e-6);
     const json above = integer ? json(std::int64_t(hi) + 1) : json(hi + std::max(std::abs(hi), 1.0) * 1e-6);
@@ -1169,6 +1175,7 @@ TEST(SceneIo, FieldRecorderRecordsEveryNumbersBounds) {
     }
   }
   EXPECT_GE(checked, 60);
+  EXPECT_GE(powers, 2);  // the scene's map_size, the mirror's resolution
   // The editor finds a field's bounds by its object and name ("light.intensity", whichever
   // entity; editor.cpp, enumeration_key): that pair must have one range wherever it is read.
   std::map<std::string, std::pair<std::string, json_reader::FieldRecorder::Range>> by_pair;
