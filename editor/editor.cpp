@@ -991,8 +991,11 @@ Status Editor::render_viewport(int w, int h) {
   auto t = render_frames(player_, scene_, run);
   if (!t) return t.error();
   // Nothing drawn while the scene has meshes: the viewport says why it may be.
+  const bool was_empty = empty_view_;
   empty_view_ = t->last.stats.draw_calls == 0 && scene_.world.size() > 0 &&
                 !scene_bounds(scene_.world).empty();
+  if (empty_view_ && !was_empty && !opt_.script.empty())
+    std::printf("kaskad edit: nothing in view (the viewport says why it may be)\n");
   prewarm_ = false;
   changed_since_frame_ = false;
   if (view_ == View::colour) {
@@ -1609,12 +1612,23 @@ void Editor::draw_ui(int w, int h) {
     ImGui::TextDisabled("H: panels");
   }
   if (empty_view_ && view_ == View::colour) {
-    ImGui::SetCursorPos(ImVec2(6, 22));
     if (const auto cam = active_camera()) {
       const Camera& c = scene_.world.get<Camera>(*cam);
-      ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.4f, 1.0f),
-                         "nothing in view: the scene may lie outside the camera's near and far "
-                         "(%g, %g); F frames the selection", double(c.near), double(c.far));
+      char text[256];
+      std::snprintf(text, sizeof text,
+                    "Nothing in view: the scene may lie outside the camera's near and far planes "
+                    "(%g, %g). F frames the selection.", double(c.near), double(c.far));
+      // Wrapped to the viewport, on a dark band whatever the clear colour.
+      const float wrap = std::max(80.0f, float(l.view_w) - 24.0f);
+      const ImVec2 size = ImGui::CalcTextSize(text, nullptr, false, wrap);
+      const ImVec2 at = ImVec2(ImGui::GetWindowPos().x + 8.0f, ImGui::GetWindowPos().y + 24.0f);
+      ImGui::GetWindowDrawList()->AddRectFilled(ImVec2(at.x - 4.0f, at.y - 3.0f),
+                                                ImVec2(at.x + size.x + 4.0f, at.y + size.y + 3.0f),
+                                                IM_COL32(20, 20, 20, 210), 3.0f);
+      ImGui::SetCursorScreenPos(at);
+      ImGui::PushTextWrapPos(ImGui::GetCursorPos().x + wrap);
+      ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.4f, 1.0f), "%s", text);
+      ImGui::PopTextWrapPos();
     }
   }
   viewport_hovered_ = ImGui::IsWindowHovered();

@@ -698,6 +698,12 @@ quit!" "$KASKAD_CONTENT/scenes/reflections.json"
   [ "$rc" -eq 0 ] || { fail "reflector centre script exit $rc"; tail -5 "$tmp/out"; }
   is "an array typed over a reflector's auto centre" "$(value centre.json mirror_sphere reflector center)" "[0.0, 1.5, 0.0]"
   is "undo gives the auto centre back" "$(value centre_undone.json mirror_sphere reflector center)" auto
+  # A view of nothing (the camera looking up into the sky) says so.
+  edit "camera 0 500 0 0 600 0
+frames 1
+quit!" "$scene"
+  grep -q "kaskad edit: nothing in view" "$tmp/out" && ok "a view of nothing says so" ||
+    fail "no notice for a view of nothing"
   # The layout at 640x360: the viewport keeps at least 45% of the width; H hides the panels.
   edit "screenshot $tmp/small_view.png
 key h
