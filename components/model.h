@@ -27,8 +27,8 @@ struct PrimitiveMesh {
 /// the model's `nodes` block; the editor and --set on the node's name). Saved from the node's
 /// live component, so the values have one home: the entity.
 struct NodeOverride {
-  std::string node;     ///< the imported entity's name (unique among the model's nodes)
-  std::string section;  ///< transform, light, shadow, camera or renderer
+  std::string node;                 ///< the imported entity's name (unique among the model's nodes)
+  std::string section;              ///< transform, light, shadow, camera or renderer
   std::vector<std::string> fields;  ///< the section's fields that were set, in a stable order
   /// The block as the scene file gave it (JSON text: components do not depend on the JSON
   /// library), applied when the model is imported; saved as it is while no node has the name.

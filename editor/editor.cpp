@@ -3,16 +3,16 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
-#include <iterator>
 #include <chrono>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <deque>
-#include <array>
 #include <filesystem>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <string>
@@ -20,9 +20,9 @@
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
-#include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
 
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -193,7 +193,9 @@ Image read_window(int w, int h) {
 
 // Linear radiance clamped to [0, 1] and encoded for display with a 2.2 gamma (an approximation
 // of sRGB is enough for a debug view).
-float display_gamma(float linear) { return std::pow(std::clamp(linear, 0.0f, 1.0f), 1.0f / 2.2f); }
+float display_gamma(float linear) {
+  return std::pow(std::clamp(linear, 0.0f, 1.0f), 1.0f / 2.2f);
+}
 
 // An AOV view as an RGB image; `aovs` has the channels of Renderer::read_aovs(), found by the
 // names it gives them (README "AOV contract").
@@ -227,21 +229,30 @@ Image aov_view(View view, const Image& aovs) {
         far = std::max(far, aovs.at(x, y, z));
         seen.expand(vec3_at(x, y, px));
       }
-  const glm::vec3 span = seen.empty() ? glm::vec3(1.0f) : glm::max(seen.max - seen.min, glm::vec3(1e-6f));
+  const glm::vec3 span =
+      seen.empty() ? glm::vec3(1.0f) : glm::max(seen.max - seen.min, glm::vec3(1e-6f));
   for (int y = 0; y < aovs.height; ++y)
     for (int x = 0; x < aovs.width; ++x) {
       glm::vec3 c{0.0f};
       if (aovs.at(x, y, mask) > 0.5f) {
         switch (view) {
-          case View::visibility: c = glm::vec3(aovs.at(x, y, vis)); break;
+          case View::visibility:
+            c = glm::vec3(aovs.at(x, y, vis));
+            break;
           case View::cascade: {
             const int k = int(std::lround(aovs.at(x, y, cascade)));
             if (k >= 0) c = kCascade[k % 8] * (0.4f + 0.6f * aovs.at(x, y, vis));
             break;
           }
-          case View::normal: c = 0.5f * vec3_at(x, y, nx) + 0.5f; break;
-          case View::depth: c = glm::vec3(far > 0.0f ? 1.0f - aovs.at(x, y, z) / far : 0.0f); break;
-          case View::position: c = (vec3_at(x, y, px) - seen.min) / span; break;
+          case View::normal:
+            c = 0.5f * vec3_at(x, y, nx) + 0.5f;
+            break;
+          case View::depth:
+            c = glm::vec3(far > 0.0f ? 1.0f - aovs.at(x, y, z) / far : 0.0f);
+            break;
+          case View::position:
+            c = (vec3_at(x, y, px) - seen.min) / span;
+            break;
           case View::reflection: {
             // C_t where a reflection map shades the surface; other surfaces dark grey (the
             // editor test's reflector mask, tests/editor/changed_within.py, knows this grey).
@@ -468,7 +479,7 @@ class Editor {
   std::map<std::string, std::vector<std::string>> choices_;  ///< by enumeration_key()
   std::size_t choices_from_ = 0;  ///< how many recorded fields choices_ was made from
   std::map<std::string, json_reader::FieldRecorder::Range> limits_;  ///< by enumeration_key()
-  std::size_t limits_from_ = 0;   ///< how many recorded ranges limits_ was made from
+  std::size_t limits_from_ = 0;                ///< how many recorded ranges limits_ was made from
   std::pair<std::string, std::string> typed_;  ///< a number being typed: its key and edit
   /// The named widgets of the last UI frame and where they were (min x, min y, max x, max y):
   /// fields by their key, buttons and text fields by their label, entity rows "entity:NAME",
@@ -486,7 +497,7 @@ class Editor {
     std::string what;  ///< move: the widget; text: the characters
     bool ctrl = false;
     int key = 0;
-    int line = 0;      ///< the script line, for messages
+    int line = 0;  ///< the script line, for messages
   };
   std::deque<UiStep> ui_steps_;
   ImVec2 ui_mouse_{-FLT_MAX, -FLT_MAX};  ///< where the script's mouse is
@@ -567,15 +578,17 @@ void Editor::place_camera() {
   t.translation = camera_.position;
   t.rotation = look_rotation(camera_.forward());
   // A camera under a parent (a glTF model's camera) gets the pose in its parent's space.
-  if (const auto* parent = t.parent.valid() ? scene_.world.try_get<WorldTransform>(t.parent) : nullptr) {
+  if (const auto* parent =
+          t.parent.valid() ? scene_.world.try_get<WorldTransform>(t.parent) : nullptr) {
     const glm::mat4 local = glm::inverse(parent->matrix) *
-                            glm::translate(glm::mat4(1.0f), camera_.position) * glm::mat4_cast(t.rotation);
+                            glm::translate(glm::mat4(1.0f), camera_.position) *
+                            glm::mat4_cast(t.rotation);
     const glm::vec3 scale{glm::length(glm::vec3(local[0])), glm::length(glm::vec3(local[1])),
                           glm::length(glm::vec3(local[2]))};
     t.translation = glm::vec3(local[3]);
-    t.rotation = glm::normalize(glm::quat_cast(glm::mat3(glm::vec3(local[0]) / scale.x,
-                                                         glm::vec3(local[1]) / scale.y,
-                                                         glm::vec3(local[2]) / scale.z)));
+    t.rotation = glm::normalize(
+        glm::quat_cast(glm::mat3(glm::vec3(local[0]) / scale.x, glm::vec3(local[1]) / scale.y,
+                                 glm::vec3(local[2]) / scale.z)));
     t.scale = scale;
   }
   // A glTF model's camera: the pose is kept in the model's nodes block when saved.
@@ -631,9 +644,10 @@ Status Editor::edit(const std::string& assignment, bool merge) {
     const auto* imp = scene_.world.try_get<Imported>(target.value());
     if (imp && !(imp->source.valid() && scene_.world.alive(imp->source) &&
                  scene_.world.has<ModelRef>(imp->source)))
-      return Error{"--set", key, "'" + scene_.world.get<Name>(target.value()).value +
-                                     "' is made when the scene loads and is not saved; change "
-                                     "render.ground instead"};
+      return Error{"--set", key,
+                   "'" + scene_.world.get<Name>(target.value()).value +
+                       "' is made when the scene loads and is not saved; change "
+                       "render.ground instead"};
   }
   Status live = apply_live_override(scene_, assignment);
   if (!live) {
@@ -971,8 +985,9 @@ Status Editor::frame_selection() {
     if (near != c.near * s || far != c.far * s) {
       c.near = near / s;
       c.far = far / s;
-      message_ = "F: the camera's near and far are now " + json(json_reader::num(c.near)).dump() + " and " +
-                 json(json_reader::num(c.far)).dump() + ", so that they hold the selection";
+      message_ = "F: the camera's near and far are now " + json(json_reader::num(c.near)).dump() +
+                 " and " + json(json_reader::num(c.far)).dump() +
+                 ", so that they hold the selection";
       message_is_error_ = false;
       std::printf("kaskad edit: %s\n", message_.c_str());
     }
@@ -1103,7 +1118,8 @@ const std::vector<std::string>* Editor::choices(const std::string& key) {
 
 const json_reader::FieldRecorder::Range* Editor::limits(const std::string& key) {
   if (limits_from_ != recorded_.ranges().size()) {
-    for (const auto& [path, range] : recorded_.ranges()) limits_[enumeration_key(path, '/')] = range;
+    for (const auto& [path, range] : recorded_.ranges())
+      limits_[enumeration_key(path, '/')] = range;
     limits_from_ = recorded_.ranges().size();
   }
   const auto it = limits_.find(enumeration_key(key, '.'));
@@ -1176,8 +1192,9 @@ void Editor::field(const std::string& key, const std::string& label, const json&
       float speed = std::max(std::abs(f) * 0.01f, 0.001f);
       if (range && range->hi - range->lo <= 1000.0)
         speed = std::max(speed, float(range->hi - range->lo) * 0.002f);
-      const bool changed = ImGui::DragFloat(label.c_str(), &f, speed, range ? float(range->lo) : 0.0f,
-                                            range ? float(range->hi) : 0.0f, "%.5g");
+      const bool changed =
+          ImGui::DragFloat(label.c_str(), &f, speed, range ? float(range->lo) : 0.0f,
+                           range ? float(range->hi) : 0.0f, "%.5g");
       name_item(key);
       number_edit(key, changed, key + "=" + json(double(f)).dump());
     }
@@ -1203,8 +1220,9 @@ void Editor::field(const std::string& key, const std::string& label, const json&
     char buf[512];
     std::snprintf(buf, sizeof buf, "%s", v.get<std::string>().c_str());
     // A click selects the whole value: what is typed replaces it.
-    if (ImGui::InputText(label.c_str(), buf, sizeof buf,
-                         ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll)) {
+    if (ImGui::InputText(
+            label.c_str(), buf, sizeof buf,
+            ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll)) {
       // A word is the string; a JSON array or object typed over a word such as a reflector's
       // "auto" centre or "none" box is that value ([0, 1, 0]).
       const json typed = json::parse(buf, nullptr, /*allow_exceptions=*/false);
@@ -1222,8 +1240,9 @@ void Editor::field(const std::string& key, const std::string& label, const json&
     const auto* range = limits(key);
     const float lo = range ? float(range->lo) : 0.0f, hi = range ? float(range->hi) : 0.0f;
     if (range && range->hi - range->lo <= 1000.0) speed = std::max(speed, (hi - lo) * 0.002f);
-    const bool changed = ImGui::DragScalarN(label.c_str(), ImGuiDataType_Float, f, int(v.size()),
-                                            speed, range ? &lo : nullptr, range ? &hi : nullptr, "%.4g");
+    const bool changed =
+        ImGui::DragScalarN(label.c_str(), ImGuiDataType_Float, f, int(v.size()), speed,
+                           range ? &lo : nullptr, range ? &hi : nullptr, "%.4g");
     name_item(key);
     json a = json::array();
     for (std::size_t i = 0; i < v.size(); ++i) a.push_back(double(f[i]));
@@ -1367,7 +1386,8 @@ void Editor::inspector() {
   }
   char buf[512];
   std::snprintf(buf, sizeof buf, "%s", set_line_.c_str());
-  const bool set_entered = ImGui::InputText("--set", buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue);
+  const bool set_entered =
+      ImGui::InputText("--set", buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue);
   name_item("--set");
   set_line_ = buf;
   if (set_entered) requests_.emplace_back(set_line_, false);
@@ -1380,7 +1400,8 @@ void Editor::inspector() {
       ImGui::Separator();
       char name[256];
       std::snprintf(name, sizeof name, "%s", selected_.c_str());
-      const bool renamed = ImGui::InputText("name", name, sizeof name, ImGuiInputTextFlags_EnterReturnsTrue);
+      const bool renamed =
+          ImGui::InputText("name", name, sizeof name, ImGuiInputTextFlags_EnterReturnsTrue);
       name_item("name");
       if (renamed) {
         const std::string n = name;
@@ -1395,9 +1416,10 @@ void Editor::inspector() {
       }
       ImGui::TextDisabled("drag an entity onto another to parent it");
       if (const auto e = find(selected_); e && scene_.world.has<Camera>(*e))
-        ImGui::TextDisabled(active_camera() == e
-                                ? "the viewport's camera"
-                                : "not the viewport's camera (the first active one, else the first, is)");
+        ImGui::TextDisabled(
+            active_camera() == e
+                ? "the viewport's camera"
+                : "not the viewport's camera (the first active one, else the first, is)");
       // A light's shadow settings with every field (the file holds those that differ from the
       // scene's shadow block).
       json sections = *ent;
@@ -1418,13 +1440,18 @@ void Editor::inspector() {
       ImGui::Separator();
       const auto* imp = scene_.world.try_get<Imported>(*e);
       const auto* model = imp && scene_.world.alive(imp->source)
-                              ? scene_.world.try_get<Name>(imp->source) : nullptr;
+                              ? scene_.world.try_get<Name>(imp->source)
+                              : nullptr;
       if (!model || !scene_.world.has<ModelRef>(imp->source)) {
-        ImGui::TextWrapped("'%s' is made when the scene loads (render.ground, a terrain's tiles) "
-                           "and is not saved: it cannot be edited", selected_.c_str());
+        ImGui::TextWrapped(
+            "'%s' is made when the scene loads (render.ground, a terrain's tiles) "
+            "and is not saved: it cannot be edited",
+            selected_.c_str());
       } else {
-        ImGui::TextWrapped("'%s' is a node of model '%s': its edits are saved in that model's "
-                           "nodes block", selected_.c_str(), model->value.c_str());
+        ImGui::TextWrapped(
+            "'%s' is a node of model '%s': its edits are saved in that model's "
+            "nodes block",
+            selected_.c_str(), model->value.c_str());
         const json sections = live_entity_sections(scene_, *e);
         for (const char* section : {"transform", "light", "shadow", "camera", "renderer"}) {
           if (!sections.contains(section)) continue;
@@ -1503,8 +1530,8 @@ Status Editor::feed_ui_step() {
         if (widgets_.size() > shown.size())
           shown.push_back("... (" + std::to_string(widgets_.size()) + " in all)");
         return Error{opt_.script.string(), "line " + std::to_string(step.line),
-                     "no widget named '" + step.what + "' in the last frame; it showed: " +
-                         json_reader::join(shown)};
+                     "no widget named '" + step.what +
+                         "' in the last frame; it showed: " + json_reader::join(shown)};
       }
       if (!it->second.visible) {
         // Scrolled out of its panel: scrolled to as it is drawn, then looked for again.
@@ -1546,8 +1573,8 @@ Status Editor::feed_ui_step() {
 }
 
 void Editor::entities_panel(int w, int h, const Layout& l) {
-  const ImGuiWindowFlags panel = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse |
-                                 ImGuiWindowFlags_NoSavedSettings;
+  const ImGuiWindowFlags panel =
+      ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
   ImGui::SetNextWindowPos(ImVec2(0, 0));
   ImGui::SetNextWindowSize(ImVec2(l.left, float(h)));
   ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
@@ -1588,12 +1615,11 @@ void Editor::entities_panel(int w, int h, const Layout& l) {
 void Editor::draw_ui(int w, int h) {
   widgets_.clear();
   const Layout l = layout_for(w, h, left_w_, right_w_, panels_hidden_);
-  const ImGuiWindowFlags panel = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse |
-                                 ImGuiWindowFlags_NoSavedSettings;
+  const ImGuiWindowFlags panel =
+      ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
   const ImGuiWindowFlags fixed = panel | ImGuiWindowFlags_NoResize;
   // Panels keep the window's height; only their inner edge moves. H hides them.
   if (!panels_hidden_) entities_panel(w, h, l);
-
 
   ImGui::SetNextWindowPos(ImVec2(float(l.view_x), 0));
   ImGui::SetNextWindowSize(ImVec2(float(l.view_w), float(l.view_h)));
@@ -1617,7 +1643,8 @@ void Editor::draw_ui(int w, int h) {
       char text[256];
       std::snprintf(text, sizeof text,
                     "Nothing in view: the scene may lie outside the camera's near and far planes "
-                    "(%g, %g). F frames the selection.", double(c.near), double(c.far));
+                    "(%g, %g). F frames the selection.",
+                    double(c.near), double(c.far));
       // Wrapped to the viewport, on a dark band whatever the clear colour.
       const float wrap = std::max(80.0f, float(l.view_w) - 24.0f);
       const ImVec2 size = ImGui::CalcTextSize(text, nullptr, false, wrap);
@@ -1638,7 +1665,8 @@ void Editor::draw_ui(int w, int h) {
   if (!panels_hidden_) {
     ImGui::SetNextWindowPos(ImVec2(float(w) - l.right, 0));
     ImGui::SetNextWindowSize(ImVec2(l.right, float(h)));
-    ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
+    ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)),
+                                        ImVec2(max_panel(w), float(h)));
     ImGui::Begin("Inspector", nullptr, panel);
     right_w_ = ImGui::GetWindowWidth();
     // Labels keep a fixed share of the panel, so long field names are not clipped.
@@ -1771,7 +1799,8 @@ void Editor::file_dialog(int w, int h) {
   for (const FolderEntry& e : d.listing.entries) {
     const std::string label = e.folder ? e.label + "/" : e.label;
     const bool picked = !e.folder && e.path == d.picked;
-    const bool clicked = ImGui::Selectable(label.c_str(), picked, ImGuiSelectableFlags_AllowDoubleClick);
+    const bool clicked =
+        ImGui::Selectable(label.c_str(), picked, ImGuiSelectableFlags_AllowDoubleClick);
     name_item("dialog:" + label);
     if (clicked) {
       if (e.folder) {
@@ -1918,7 +1947,8 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       ui_steps_.push_back({K::move, a.args[0], false, 0, a.line});
       ui_steps_.push_back({K::press, a.args[0], false, 0, a.line});
       for (int i = 0; i < 8; ++i)
-        ui_steps_.push_back({K::move_by, "", false, (pixels * (i + 1)) / 8 - (pixels * i) / 8, a.line});
+        ui_steps_.push_back(
+            {K::move_by, "", false, (pixels * (i + 1)) / 8 - (pixels * i) / 8, a.line});
       ui_steps_.push_back({K::release, "", false, 0, a.line});
       ui_steps_.push_back({K::settle, "", false, 0, a.line});
       return {};
@@ -1927,7 +1957,9 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
       // A character a frame (UTF-8 sequences whole), as typed.
       for (std::size_t i = 0; i < a.args[0].size();) {
         std::size_t n = 1;
-        while (i + n < a.args[0].size() && (static_cast<unsigned char>(a.args[0][i + n]) & 0xC0) == 0x80) ++n;
+        while (i + n < a.args[0].size() &&
+               (static_cast<unsigned char>(a.args[0][i + n]) & 0xC0) == 0x80)
+          ++n;
         ui_steps_.push_back({UiStep::Kind::text, a.args[0].substr(i, n), false, 0, a.line});
         i += n;
       }

@@ -125,7 +125,8 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
         if (!keys.empty()) keys += ", ";
         keys += k;
       }
-      return Error{file.string(), where, "unknown key '" + a.args[0] + "'; expected one of " + keys};
+      return Error{file.string(), where,
+                   "unknown key '" + a.args[0] + "'; expected one of " + keys};
     }
     if (a.kind == ActionKind::view && !view_named(a.args[0])) {
       std::string views;  // from the one table
@@ -133,7 +134,8 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
         if (!views.empty()) views += '|';
         views += name;
       }
-      return Error{file.string(), where, "unknown view '" + a.args[0] + "'; expected view " + views};
+      return Error{file.string(), where,
+                   "unknown view '" + a.args[0] + "'; expected view " + views};
     }
     if (a.kind == ActionKind::drag && !whole_number_in(a.args[1], -100000, 100000))
       return Error{file.string(), where,

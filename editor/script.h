@@ -14,8 +14,8 @@ namespace kaskad::editor {
 
 enum class ActionKind {
   set, choices, choose, select, create, import, remove, duplicate, rename, parent, camera, orbit,
-  key, click, ctrl_click, double_click, drag, type, view, frames, screenshot, window_screenshot, input, open, save, save_as, undo,
-  redo, quit, force_quit
+  key, click, ctrl_click, double_click, drag, type, view, frames, screenshot, window_screenshot,
+  input, open, save, save_as, undo, redo, quit, force_quit
 };
 
 /// What the viewport shows: the colour, or as a debug view one of the frame's AOVs (README "AOV

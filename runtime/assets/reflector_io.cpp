@@ -104,7 +104,8 @@ json reflector_to_json(const Reflector& r) {
   for (int i = 0; i < 32; ++i)
     if (r.exclude_layers & (1u << i)) layers.push_back(i);
   j["exclude_layers"] = layers;
-  j["box"] = r.box_projection ? json{{"min", vec(r.box_min)}, {"max", vec(r.box_max)}} : json("none");
+  j["box"] =
+      r.box_projection ? json{{"min", vec(r.box_min)}, {"max", vec(r.box_max)}} : json("none");
   j["amount"] = num(r.amount);
   j["file"] = r.file;
   j["layout"] = enum_name(r.layout, kLayouts);

@@ -6,15 +6,14 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtx/euler_angles.hpp>
 #include <limits>
 #include <map>
 #include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
-
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/gtx/euler_angles.hpp>
 
 #include "components/camera.h"
 #include "components/light.h"
@@ -691,7 +690,8 @@ bool document_holds(const json& doc, const std::string& key) {
 // without its parent (kept as it is), shadow with every field, the rest as scene files hold them.
 json settable_sections(const Scene& scene, ecs::Entity e) {
   json ej = entity_to_json(scene, e, {});
-  if (const auto* s = scene.world.try_get<ShadowSettings>(e)) ej["shadow"] = write_shadow(*s, nullptr);
+  if (const auto* s = scene.world.try_get<ShadowSettings>(e))
+    ej["shadow"] = write_shadow(*s, nullptr);
   ej.erase("name");
   if (ej.contains("transform")) ej["transform"].erase("parent");
   return ej;
@@ -744,7 +744,8 @@ ecs::Entity model_of(const ecs::World& w, ecs::Entity e) {
 }
 
 // The entities imported for model entity `model` that are named `node`.
-std::vector<ecs::Entity> nodes_named(const ecs::World& w, ecs::Entity model, const std::string& node) {
+std::vector<ecs::Entity> nodes_named(const ecs::World& w, ecs::Entity model,
+                                     const std::string& node) {
   std::vector<ecs::Entity> found;
   w.view<Imported>().each([&](ecs::Entity x, const Imported& imp) {
     if (imp.source != model) return;
@@ -762,13 +763,15 @@ std::vector<NodeOverride> read_node_overrides(const json& nodes, const std::stri
   for (auto n = nodes.begin(); n != nodes.end(); ++n) {
     const std::string at = where + "/" + n.key();
     if (n.key().empty()) fail(at, "a node name may not be empty");
-    if (!n.value().is_object()) fail(at, "expected an object of sections, got " + type_name(n.value()));
+    if (!n.value().is_object())
+      fail(at, "expected an object of sections, got " + type_name(n.value()));
     for (auto s = n.value().begin(); s != n.value().end(); ++s) {
       const std::string sat = at + "/" + s.key();
       if (std::find_if(kNodeSections.begin(), kNodeSections.end(),
                        [&](const char* k) { return s.key() == k; }) == kNodeSections.end())
-        fail(sat, "unknown section '" + s.key() + "'; a node takes transform, light, shadow, "
-                  "camera and renderer");
+        fail(sat, "unknown section '" + s.key() +
+                      "'; a node takes transform, light, shadow, "
+                      "camera and renderer");
       if (!s.value().is_object()) fail(sat, "expected an object, got " + type_name(s.value()));
       if (s.key() == "transform" && s.value().contains("parent"))
         fail(sat + "/parent", "an imported node keeps its parent from the model file");
@@ -817,7 +820,8 @@ void note_node_override(Scene& scene, ecs::Entity e, const std::string& section,
   auto it = std::find_if(nodes.begin(), nodes.end(), [&](const NodeOverride& o) {
     return o.node == name->value && o.section == section;
   });
-  if (it == nodes.end()) it = nodes.insert(nodes.end(), NodeOverride{name->value, section, {}, "{}", ""});
+  if (it == nodes.end())
+    it = nodes.insert(nodes.end(), NodeOverride{name->value, section, {}, "{}", ""});
   for (const std::string& f : fields) {
     const std::string field = recorded_field(section, f);
     if (std::find(it->fields.begin(), it->fields.end(), field) == it->fields.end())
@@ -825,7 +829,9 @@ void note_node_override(Scene& scene, ecs::Entity e, const std::string& section,
   }
 }
 
-json live_entity_sections(const Scene& scene, ecs::Entity e) { return settable_sections(scene, e); }
+json live_entity_sections(const Scene& scene, ecs::Entity e) {
+  return settable_sections(scene, e);
+}
 
 Status apply_override(json& doc, const std::string& assignment) {
   const auto eq = assignment.find('=');
@@ -921,8 +927,9 @@ Result<ecs::Entity> entity_for_key(const Scene& scene, const std::string& key) {
                                    "'; sections: render, shadow; entities: " + join(names)};
   }
   if (matches.size() > 1)
-    return Error{"--set", key, std::to_string(matches.size()) + " entities are named '" +
-                                   key.substr(0, best) + "'; only a unique name can be set"};
+    return Error{"--set", key,
+                 std::to_string(matches.size()) + " entities are named '" + key.substr(0, best) +
+                     "'; only a unique name can be set"};
   return matches.front();
 }
 
@@ -944,9 +951,10 @@ Status apply_entity_override(Scene& scene, const std::string& assignment) {
   const std::string where = "/" + name + "/" + section;
   try {
     if (!read_section(w, e, section, ej[section], where))
-      return Error{"--set", key, "'" + section + "' of '" + name +
-                                     "' cannot be set on a loaded entity; it takes transform, "
-                                     "light, shadow, camera, renderer and reflector"};
+      return Error{"--set", key,
+                   "'" + section + "' of '" + name +
+                       "' cannot be set on a loaded entity; it takes transform, "
+                       "light, shadow, camera, renderer and reflector"};
   } catch (const ContentError& err) {
     return Error{"--set", err.where, err.message};
   }
@@ -1070,8 +1078,9 @@ std::vector<ecs::Entity> copy_import(ecs::World& w, const FirstImport& from, ecs
 // lights the scene's shadow settings. `imported` (file -> the first entity that imported it):
 // a file imported before is copied from that entity's import instead of read again.
 // Returns the entities it made.
-Result<std::vector<ecs::Entity>> import_model(Scene& scene, ecs::Entity e, bool activate_first_camera,
-                                              std::map<std::string, FirstImport>* imported = nullptr) {
+Result<std::vector<ecs::Entity>> import_model(
+    Scene& scene, ecs::Entity e, bool activate_first_camera,
+    std::map<std::string, FirstImport>* imported = nullptr) {
   ecs::World& w = scene.world;
   const fs::path path = scene.file.parent_path() / w.get<ModelRef>(e).path;
   std::error_code ec;
@@ -1138,7 +1147,8 @@ Status apply_node_overrides(Scene& scene, ecs::Entity e, const std::vector<ecs::
       if (const auto* n = w.try_get<Name>(x); n && n->value == o.node) found.push_back(x);
     if (found.empty()) {
       log::warn_once("%s: %s: %s has no node named '%s'; its settings are kept for saving",
-                scene.file.string().c_str(), where.c_str(), path.string().c_str(), o.node.c_str());
+                     scene.file.string().c_str(), where.c_str(), path.string().c_str(),
+                     o.node.c_str());
       continue;
     }
     if (found.size() > 1)

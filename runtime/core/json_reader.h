@@ -184,8 +184,7 @@ class ObjectReader {
   void enumeration(const char* key, E& out, const std::vector<std::pair<const char*, E>>& table) {
     std::vector<std::string> names;
     for (const auto& [n, e] : table) names.push_back(n);
-    if (FieldRecorder* recorder = FieldRecorder::current())
-      recorder->record(at(key), names);
+    if (FieldRecorder* recorder = FieldRecorder::current()) recorder->record(at(key), names);
     if (!has(key)) return;
     const json& v = j_.at(key);
     if (!v.is_string()) fail(at(key), "expected one of " + join(names) + ", got " + type_name(v));

@@ -729,7 +729,8 @@ TEST(SceneIo, ModelNodeSettingsApplyOverTheFileAndSaveWithTheModel) {
   // Sun.001 has no renderer: m2's block names a section the node lacks.
   auto lacking = instantiate_scene(*loaded);
   ASSERT_FALSE(lacking.ok());
-  EXPECT_NE(lacking.error().to_string().find("/entities/1/model/nodes/Sun.001/renderer"), std::string::npos)
+  EXPECT_NE(lacking.error().to_string().find("/entities/1/model/nodes/Sun.001/renderer"),
+            std::string::npos)
       << lacking.error().to_string();
   std::string text = read_file(file);
   text.replace(text.find(R"("renderer": {}, )"), std::string(R"("renderer": {}, )").size(), "");
@@ -741,7 +742,8 @@ TEST(SceneIo, ModelNodeSettingsApplyOverTheFileAndSaveWithTheModel) {
   std::vector<ecs::Entity> suns;
   s->world.view<Light>().each([&](ecs::Entity e, const Light&) { suns.push_back(e); });
   ASSERT_EQ(suns.size(), 2u);
-  std::sort(suns.begin(), suns.end(), [](ecs::Entity a, ecs::Entity b) { return a.index < b.index; });
+  std::sort(suns.begin(), suns.end(),
+            [](ecs::Entity a, ecs::Entity b) { return a.index < b.index; });
   const Light& first = s->world.get<Light>(suns[0]);
   const Light& second = s->world.get<Light>(suns[1]);
   EXPECT_FLOAT_EQ(first.intensity, 5.0f);
@@ -770,7 +772,8 @@ TEST(SceneIo, ModelNodeSettingsApplyOverTheFileAndSaveWithTheModel) {
   ASSERT_TRUE(apply_entity_override(*s, "Sun.001.transform.translation.1=7").ok());
   doc = scene_to_json(*s);
   const nlohmann::json& edited = doc["entities"][0]["model"]["nodes"]["Sun.001"];
-  EXPECT_EQ(edited["light"], nlohmann::json::parse(R"({"intensity": 5.0, "color": [1.0, 0.0, 0.0]})"));
+  EXPECT_EQ(edited["light"],
+            nlohmann::json::parse(R"({"intensity": 5.0, "color": [1.0, 0.0, 0.0]})"));
   EXPECT_EQ(edited["shadow"], nlohmann::json::parse(R"({"filter": "none"})"));
   EXPECT_EQ(edited["transform"]["translation"], nlohmann::json::parse("[0.0, 7.0, 0.0]"));
   EXPECT_TRUE(edited["transform"].contains("rotation"));
@@ -800,8 +803,8 @@ TEST(SceneIo, ModelNodeSettingsApplyOverTheFileAndSaveWithTheModel) {
   // to one of them), and nothing empty is written.
   write_file("twins.gltf", R"({"asset": {"version": "2.0"},
     "nodes": [{"name": "twin"}, {"name": "twin"}], "scenes": [{"nodes": [0, 1]}], "scene": 0})");
-  auto twins = read_scene(write_file("twins_scene.json",
-                                     R"({"entities": [{"name": "t", "model": {"path": "twins.gltf"}}]})"));
+  auto twins = read_scene(write_file(
+      "twins_scene.json", R"({"entities": [{"name": "t", "model": {"path": "twins.gltf"}}]})"));
   ASSERT_TRUE(twins.ok());
   ASSERT_TRUE(instantiate_scene(*twins).ok());
   std::vector<ecs::Entity> twin_nodes;
@@ -1160,12 +1163,15 @@ TEST(SceneIo, FieldRecorderRecordsEveryNumbersBounds) {
     if (power_of_two) {
       // A map size: offered as the powers of two in its bounds; a number between them refused.
       ++powers;
-      EXPECT_NE(verdict(pointer, std::int64_t(lo) + 1).find("must be a power of two"), std::string::npos)
+      EXPECT_NE(verdict(pointer, std::int64_t(lo) + 1).find("must be a power of two"),
+                std::string::npos)
           << pointer;
     }
     const bool integer = value.is_number_integer();
-    const json below = integer ? json(std::int64_t(lo) - 1) : json(lo - std::max(std::abs(lo), 1.0) * 1e-6);
-    const json above = integer ? json(std::int64_t(hi) + 1) : json(hi + std::max(std::abs(hi), 1.0) * 1e-6);
+    const json below =
+        integer ? json(std::int64_t(lo) - 1) : json(lo - std::max(std::abs(lo), 1.0) * 1e-6);
+    const json above =
+        integer ? json(std::int64_t(hi) + 1) : json(hi + std::max(std::abs(hi), 1.0) * 1e-6);
     EXPECT_EQ(verdict(pointer, below).rfind("must be in [", 0), 0u) << pointer << " = " << below;
     EXPECT_EQ(verdict(pointer, above).rfind("must be in [", 0), 0u) << pointer << " = " << above;
     for (const double bound : {lo, hi}) {
