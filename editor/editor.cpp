@@ -990,6 +990,7 @@ Status Editor::frame_selection() {
                  ", so that they hold the selection";
       message_is_error_ = false;
       std::printf("kaskad edit: %s\n", message_.c_str());
+      record(false);  // a change of the camera's settings: an undo step, and unsaved
     }
   }
   return {};

@@ -171,12 +171,17 @@ quit!" "$scene" --set shadow.cascade_count=1 --set shadow.fit_mode=stable
       {"name": "camera", "transform": {"translation": [0, 1, 5]}, "camera": {'"$camera"'}},
       {"name": "sun", "transform": {"direction": [-0.4, -1, -0.3]}, "light": {"type": "directional"}}]}\n' \
       "$scale" "$scale" "$scale" "$truck" >"$tmp/truck_$s.json"
+    undo_planes=""  # the camera's own planes widened by F: an undo step
+    [ "$s" = 100fixed ] && undo_planes="save $tmp/truck_framed_$s.json
+undo
+save $tmp/truck_f_undone_$s.json"
     edit "camera 3000 1000 3000 0 0 0
 select truck
 key f
 view normal
 frames 1
 screenshot $tmp/truck_framed_$s.png
+$undo_planes
 quit!" "$tmp/truck_$s.json"
     [ "$rc" -eq 0 ] || { fail "F on a model script exit $rc"; tail -5 "$tmp/out"; }
     extent=$(python3 "$(dirname "$0")/geometry_extent.py" "$tmp/truck_framed_$s.png")
@@ -185,6 +190,12 @@ quit!" "$tmp/truck_$s.json"
       if [ "$s" = 100fixed ]; then
         grep -q "kaskad edit: F: the camera's near and far are now" "$tmp/out" &&
           ok "F says it widened the camera's own planes" || fail "F widened the planes silently"
+        planes() { python3 -c 'import json,sys; c=[e for e in json.load(open(sys.argv[1]))["entities"] if e["name"]=="camera"][0]["camera"]; print(c["near"], c["far"])' "$tmp/$1"; }
+        if [ "$(planes truck_f_undone_$s.json)" = "0.1 100.0" ] && [ "$(planes truck_framed_$s.json)" != "0.1 100.0" ]; then
+          ok "the widened planes are saved, and undo gives the camera's own back"
+        else
+          fail "planes after F: $(planes truck_framed_$s.json), after undo: $(planes truck_f_undone_$s.json)"
+        fi
       fi
     else
       fail "F on a model's entity at scale $s: the geometry's extent and centre are $extent"
