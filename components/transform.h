@@ -6,6 +6,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "runtime/ecs/entity.h"
@@ -26,6 +27,25 @@ inline glm::quat look_rotation(const glm::vec3& direction) {
   const glm::vec3 up = std::abs(direction.y) > 0.999f ? glm::vec3(0, 0, -1) : glm::vec3(0, 1, 0);
   // lookAt builds world->view; its inverse rotation is the entity's orientation.
   return glm::quat_cast(glm::inverse(glm::mat3(glm::lookAt(glm::vec3(0), direction, up))));
+}
+
+/// Translation, rotation and scale of an affine matrix (its projective part ignored): a negative
+/// determinant goes into scale.x, a zero scale keeps the identity rotation, and shear, if any, is
+/// approximated by the rotation of the normalised axes. The parent is left null.
+inline Transform decompose(const glm::mat4& matrix) {
+  Transform t;
+  t.translation = glm::vec3(matrix[3]);
+  glm::vec3 axis[3] = {glm::vec3(matrix[0]), glm::vec3(matrix[1]), glm::vec3(matrix[2])};
+  t.scale = {glm::length(axis[0]), glm::length(axis[1]), glm::length(axis[2])};
+  if (glm::determinant(glm::mat3(axis[0], axis[1], axis[2])) < 0.0f) {
+    t.scale.x = -t.scale.x;
+    axis[0] = -axis[0];
+  }
+  const float smallest = std::min({std::abs(t.scale.x), std::abs(t.scale.y), std::abs(t.scale.z)});
+  if (!(smallest > 1e-12f)) return t;  // a zero scale has no recoverable rotation: keep identity
+  for (glm::vec3& a : axis) a = glm::normalize(a);
+  t.rotation = glm::normalize(glm::quat_cast(glm::mat3(axis[0], axis[1], axis[2])));
+  return t;
 }
 
 /// Derived by the TransformSystem: local-to-world matrix (parent chain applied).

@@ -47,6 +47,7 @@
 #include "runtime/core/log.h"
 #include "runtime/gpu/context.h"
 #include "runtime/gpu/gl_handles.h"
+#include "systems/camera_system.h"
 #include "systems/transform_system.h"
 
 namespace fs = std::filesystem;
@@ -146,6 +147,9 @@ struct Layout {
 };
 
 constexpr float kMinPanel = 120.0f;
+// The side panels: fixed in place, resizable at their inner edge.
+constexpr ImGuiWindowFlags kPanelFlags =
+    ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
 float max_panel(int window_width) { return std::max(kMinPanel, 0.45f * float(window_width)); }
 
 /// `left` and `right` < 0: the first layout, a share of the window with limits in pixels, the
@@ -316,16 +320,29 @@ Image grey(const Image& one) {
   return out;
 }
 
-// The last two parts of a field's path, "/" or "." separated ("/entities/2/light/type" and
-// "sun.light.type" give "light.type"; "/shadow/filter" and "shadow.filter" give "shadow.filter"):
-// the object and the field, which name one table of the readers whichever entity holds them.
-std::string enumeration_key(const std::string& path, char separator) {
-  const auto last = path.rfind(separator);
-  if (last == std::string::npos || last == 0) return path.substr(last == 0 ? 1 : 0);
-  const auto before = path.rfind(separator, last - 1);
-  std::string key = path.substr(before == std::string::npos ? 0 : before + 1);
-  std::replace(key.begin(), key.end(), separator, '.');
-  return key;
+// A float drag's change per pixel: 1% of the value's magnitude, at least 0.001, and within a
+// range of at most 1000 at least 1/500 of it (a 0..1 field crosses in 500 pixels).
+float drag_speed(float magnitude, const json_reader::FieldRecorder::Range* range) {
+  float speed = std::max(magnitude * 0.01f, 0.001f);
+  if (range && range->hi - range->lo <= 1000.0)
+    speed = std::max(speed, float(range->hi - range->lo) * 0.002f);
+  return speed;
+}
+
+// What the readers recorded (`recorded`, by field path) for the inspector field KEY, found by its
+// object and field (FieldRecorder::object_and_field()) in `by_pair`, which takes in the records
+// made since the last call (`from` of them were taken in before).
+template <class T>
+const T* recorded_for(const std::string& key, const std::map<std::string, T>& recorded,
+                      std::map<std::string, T>& by_pair, std::size_t& from) {
+  using json_reader::FieldRecorder;
+  if (from != recorded.size()) {
+    for (const auto& [path, value] : recorded)
+      by_pair[FieldRecorder::object_and_field(path, '/')] = value;
+    from = recorded.size();
+  }
+  const auto it = by_pair.find(FieldRecorder::object_and_field(key, '.'));
+  return it == by_pair.end() ? nullptr : &it->second;
 }
 
 // The file dialog's state: what it is for, the folder shown and the name typed.
@@ -423,6 +440,10 @@ class Editor {
   void entity_node(ecs::Entity e, const std::map<std::uint32_t, std::vector<ecs::Entity>>& children);
   void inspector();
   void field(const std::string& key, const std::string& label, const json& value);
+  /// A collapsing section named `label` (widget `key`) of the fields of object `fields`, each
+  /// field's key "KEY.FIELD".
+  void section(const std::string& key, const std::string& label, const json& fields,
+               bool open_at_first);
   void request(const std::string& assignment);
   /// The names the readers accept for the enumerated field KEY (an inspector key such as
   /// "shadow.filter" or "sun.light.type"); nullptr when KEY is not enumerated.
@@ -452,8 +473,9 @@ class Editor {
     name_item(label);
     return pressed;
   }
-  /// Queues a script's click (and Ctrl, or a second click) on the widget named `what`.
-  void queue_click(const std::string& what, bool ctrl, bool twice, int line);
+  /// Queues a script's mouse on the widget named `what`: `presses` clicks (with Ctrl held), the
+  /// mouse moved `drag_pixels` to the right over eight frames while the button is down.
+  void queue_pointer(const std::string& what, bool ctrl, int presses, int drag_pixels, int line);
   /// Feeds the next queued script step to Dear ImGui (between the backend's frame and its own);
   /// an error when the widget a click names was not drawn in the last frame.
   Status feed_ui_step();
@@ -476,9 +498,9 @@ class Editor {
   /// Every enumeration and range-checked number the scene readers are asked for while the
   /// editor runs: the combo boxes' items and the drag fields' limits are the readers' own.
   json_reader::FieldRecorder recorded_;
-  std::map<std::string, std::vector<std::string>> choices_;  ///< by enumeration_key()
+  std::map<std::string, std::vector<std::string>> choices_;  ///< by object_and_field()
   std::size_t choices_from_ = 0;  ///< how many recorded fields choices_ was made from
-  std::map<std::string, json_reader::FieldRecorder::Range> limits_;  ///< by enumeration_key()
+  std::map<std::string, json_reader::FieldRecorder::Range> limits_;  ///< by object_and_field()
   std::size_t limits_from_ = 0;                ///< how many recorded ranges limits_ was made from
   std::pair<std::string, std::string> typed_;  ///< a number being typed: its key and edit
   /// The named widgets of the last UI frame and where they were (min x, min y, max x, max y):
@@ -522,7 +544,7 @@ class Editor {
   bool doc_stale_ = true;
   FlyCamera camera_;
   float speed_ = 1.0f;            ///< fly speed, metres per second (from the scene's size)
-  Aabb bounds_;                   ///< the scene's bounds when loaded (fly speed, auto near/far)
+  Aabb bounds_;  ///< the scene's bounds, after each load and edit (fly speed, planes, notices)
   bool panels_hidden_ = false;    ///< H: the viewport takes the whole window
   bool empty_view_ = false;       ///< the last frame drew nothing of a scene with meshes
   bool planes_follow_ = false;    ///< the camera was auto_frame: its near and far follow it
@@ -580,16 +602,12 @@ void Editor::place_camera() {
   // A camera under a parent (a glTF model's camera) gets the pose in its parent's space.
   if (const auto* parent =
           t.parent.valid() ? scene_.world.try_get<WorldTransform>(t.parent) : nullptr) {
-    const glm::mat4 local = glm::inverse(parent->matrix) *
-                            glm::translate(glm::mat4(1.0f), camera_.position) *
-                            glm::mat4_cast(t.rotation);
-    const glm::vec3 scale{glm::length(glm::vec3(local[0])), glm::length(glm::vec3(local[1])),
-                          glm::length(glm::vec3(local[2]))};
-    t.translation = glm::vec3(local[3]);
-    t.rotation = glm::normalize(
-        glm::quat_cast(glm::mat3(glm::vec3(local[0]) / scale.x, glm::vec3(local[1]) / scale.y,
-                                 glm::vec3(local[2]) / scale.z)));
-    t.scale = scale;
+    const Transform local =
+        decompose(glm::inverse(parent->matrix) * glm::translate(glm::mat4(1.0f), camera_.position) *
+                  glm::mat4_cast(t.rotation));
+    t.translation = local.translation;
+    t.rotation = local.rotation;
+    t.scale = local.scale;
   }
   // A glTF model's camera: the pose is kept in the model's nodes block when saved.
   note_node_override(scene_, *cam, "transform", {"translation", "rotation", "scale"});
@@ -640,15 +658,13 @@ Status Editor::edit(const std::string& assignment, bool merge) {
   // What the load makes on its own (the ground, a terrain's tiles) is not saved: an edit of it
   // would be lost, so it is refused. The entity as scene IO resolves the key.
   const std::string key = assignment.substr(0, assignment.find('='));
-  if (auto target = entity_for_key(scene_, key)) {
-    const auto* imp = scene_.world.try_get<Imported>(target.value());
-    if (imp && !(imp->source.valid() && scene_.world.alive(imp->source) &&
-                 scene_.world.has<ModelRef>(imp->source)))
-      return Error{"--set", key,
-                   "'" + scene_.world.get<Name>(target.value()).value +
-                       "' is made when the scene loads and is not saved; change "
-                       "render.ground instead"};
-  }
+  const auto target = entity_for_key(scene_, key);
+  const ecs::Entity e = target ? target.value() : ecs::kNullEntity;
+  if (e.valid() && scene_.world.has<Imported>(e) && !model_of(scene_.world, e).valid())
+    return Error{"--set", key,
+                 "'" + scene_.world.get<Name>(e).value +
+                     "' is made when the scene loads and is not saved; change "
+                     "render.ground instead"};
   Status live = apply_live_override(scene_, assignment);
   if (!live) {
     // Sections a loaded entity does not take live (material, primitive, model, name) are set on
@@ -810,6 +826,7 @@ Status Editor::load_document(const json& doc) {
 Status Editor::restore(std::size_t index) {
   KASKAD_TRY(load_document(history_[index]));
   position_ = index;
+  update_bounds_speed();
   doc_stale_ = true;
   changed_since_frame_ = true;
   if (camera_.moved) {
@@ -976,10 +993,9 @@ Status Editor::frame_selection() {
   // part of a model scaled up, seen from its framing distance) takes planes around it, and says so.
   if (const auto cam = active_camera(); cam && !planes_follow_) {
     Camera& c = scene_.world.get<Camera>(*cam);
-    const auto* wt = scene_.world.try_get<WorldTransform>(*cam);
     // The camera system scales near and far by the camera's uniform world scale.
-    const float scale = wt ? std::cbrt(std::abs(glm::determinant(glm::mat3(wt->matrix)))) : 1.0f;
-    const float s = std::isfinite(scale) && scale > 0.0f ? scale : 1.0f;
+    const auto* wt = scene_.world.try_get<WorldTransform>(*cam);
+    const float s = wt ? camera_world_scale(wt->matrix) : 1.0f;
     const float far = std::max(c.far * s, (distance + radius) * 1.05f);
     const float near = std::min(c.near * s, std::max((distance - radius) * 0.9f, far * 1e-4f));
     if (near != c.near * s || far != c.far * s) {
@@ -1008,8 +1024,7 @@ Status Editor::render_viewport(int w, int h) {
   if (!t) return t.error();
   // Nothing drawn while the scene has meshes: the viewport says why it may be.
   const bool was_empty = empty_view_;
-  empty_view_ = t->last.stats.draw_calls == 0 && scene_.world.size() > 0 &&
-                !scene_bounds(scene_.world).empty();
+  empty_view_ = t->last.stats.draw_calls == 0 && !bounds_.empty();
   if (empty_view_ && !was_empty && !opt_.script.empty())
     std::printf("kaskad edit: nothing in view (the viewport says why it may be)\n");
   prewarm_ = false;
@@ -1108,23 +1123,11 @@ void Editor::request(const std::string& assignment) {
 }
 
 const std::vector<std::string>* Editor::choices(const std::string& key) {
-  if (choices_from_ != recorded_.enumerations().size()) {
-    for (const auto& [path, names] : recorded_.enumerations())
-      choices_[enumeration_key(path, '/')] = names;
-    choices_from_ = recorded_.enumerations().size();
-  }
-  const auto it = choices_.find(enumeration_key(key, '.'));
-  return it == choices_.end() ? nullptr : &it->second;
+  return recorded_for(key, recorded_.enumerations(), choices_, choices_from_);
 }
 
 const json_reader::FieldRecorder::Range* Editor::limits(const std::string& key) {
-  if (limits_from_ != recorded_.ranges().size()) {
-    for (const auto& [path, range] : recorded_.ranges())
-      limits_[enumeration_key(path, '/')] = range;
-    limits_from_ = recorded_.ranges().size();
-  }
-  const auto it = limits_.find(enumeration_key(key, '.'));
-  return it == limits_.end() ? nullptr : &it->second;
+  return recorded_for(key, recorded_.ranges(), limits_, limits_from_);
 }
 
 void Editor::number_edit(const std::string& key, bool changed, const std::string& assignment) {
@@ -1190,12 +1193,9 @@ void Editor::field(const std::string& key, const std::string& label, const json&
       number_edit(key, changed, key + "=" + std::to_string(i));
     } else {
       float f = v.get<float>();
-      float speed = std::max(std::abs(f) * 0.01f, 0.001f);
-      if (range && range->hi - range->lo <= 1000.0)
-        speed = std::max(speed, float(range->hi - range->lo) * 0.002f);
-      const bool changed =
-          ImGui::DragFloat(label.c_str(), &f, speed, range ? float(range->lo) : 0.0f,
-                           range ? float(range->hi) : 0.0f, "%.5g");
+      const bool changed = ImGui::DragFloat(label.c_str(), &f, drag_speed(std::abs(f), range),
+                                            range ? float(range->lo) : 0.0f,
+                                            range ? float(range->hi) : 0.0f, "%.5g");
       name_item(key);
       number_edit(key, changed, key + "=" + json(double(f)).dump());
     }
@@ -1237,13 +1237,11 @@ void Editor::field(const std::string& key, const std::string& label, const json&
     for (std::size_t i = 0; i < v.size(); ++i) f[i] = v[i].get<float>();
     float largest = 0.0f;
     for (float x : f) largest = std::max(largest, std::abs(x));
-    float speed = std::max(largest * 0.01f, 0.001f);
     const auto* range = limits(key);
     const float lo = range ? float(range->lo) : 0.0f, hi = range ? float(range->hi) : 0.0f;
-    if (range && range->hi - range->lo <= 1000.0) speed = std::max(speed, (hi - lo) * 0.002f);
-    const bool changed =
-        ImGui::DragScalarN(label.c_str(), ImGuiDataType_Float, f, int(v.size()), speed,
-                           range ? &lo : nullptr, range ? &hi : nullptr, "%.4g");
+    const bool changed = ImGui::DragScalarN(label.c_str(), ImGuiDataType_Float, f, int(v.size()),
+                                            drag_speed(largest, range), range ? &lo : nullptr,
+                                            range ? &hi : nullptr, "%.4g");
     name_item(key);
     json a = json::array();
     for (std::size_t i = 0; i < v.size(); ++i) a.push_back(double(f[i]));
@@ -1426,24 +1424,17 @@ void Editor::inspector() {
       json sections = *ent;
       if (const auto e = find(selected_); e && scene_.world.has<ShadowSettings>(*e))
         sections["shadow"] = live_entity_sections(scene_, *e)["shadow"];
-      for (auto it = sections.begin(); it != sections.end(); ++it) {
-        if (it.key() == "name" || !it.value().is_object()) continue;
-        const bool open = ImGui::CollapsingHeader(it.key().c_str(), ImGuiTreeNodeFlags_DefaultOpen);
-        name_item(selected_ + "." + it.key());
-        if (open)
-          for (auto f = it.value().begin(); f != it.value().end(); ++f)
-            field(selected_ + "." + it.key() + "." + f.key(), f.key(), f.value());
-      }
+      for (auto it = sections.begin(); it != sections.end(); ++it)
+        if (it.key() != "name" && it.value().is_object())
+          section(selected_ + "." + it.key(), it.key(), it.value(), true);
       direction_helpers();
     } else if (const auto e = find(selected_)) {
       // A glTF model's node: the sections a loaded entity takes, saved in its model's nodes
       // block. The ground and terrain tiles are remade at load: shown, not edited.
       ImGui::Separator();
-      const auto* imp = scene_.world.try_get<Imported>(*e);
-      const auto* model = imp && scene_.world.alive(imp->source)
-                              ? scene_.world.try_get<Name>(imp->source)
-                              : nullptr;
-      if (!model || !scene_.world.has<ModelRef>(imp->source)) {
+      const ecs::Entity source = model_of(scene_.world, *e);
+      const auto* model = source.valid() ? scene_.world.try_get<Name>(source) : nullptr;
+      if (!model) {
         ImGui::TextWrapped(
             "'%s' is made when the scene loads (render.ground, a terrain's tiles) "
             "and is not saved: it cannot be edited",
@@ -1454,26 +1445,24 @@ void Editor::inspector() {
             "nodes block",
             selected_.c_str(), model->value.c_str());
         const json sections = live_entity_sections(scene_, *e);
-        for (const char* section : {"transform", "light", "shadow", "camera", "renderer"}) {
-          if (!sections.contains(section)) continue;
-          const bool open = ImGui::CollapsingHeader(section, ImGuiTreeNodeFlags_DefaultOpen);
-          name_item(selected_ + "." + section);
-          if (open)
-            for (auto f = sections[section].begin(); f != sections[section].end(); ++f)
-              field(selected_ + "." + section + "." + f.key(), f.key(), f.value());
-        }
+        for (const char* name : {"transform", "light", "shadow", "camera", "renderer"})
+          if (sections.contains(name)) section(selected_ + "." + name, name, sections[name], true);
         direction_helpers();
       }
     }
   }
-  for (const char* section : {"render", "shadow"}) {
-    if (!doc.contains(section)) continue;
-    const bool open = ImGui::CollapsingHeader(section);
-    name_item(section);
-    if (open)
-      for (auto f = doc[section].begin(); f != doc[section].end(); ++f)
-        field(std::string(section) + "." + f.key(), f.key(), f.value());
-  }
+  for (const char* name : {"render", "shadow"})
+    if (doc.contains(name)) section(name, name, doc[name], false);
+}
+
+void Editor::section(const std::string& key, const std::string& label, const json& fields,
+                     bool open_at_first) {
+  const bool open = ImGui::CollapsingHeader(
+      label.c_str(), open_at_first ? ImGuiTreeNodeFlags_DefaultOpen : ImGuiTreeNodeFlags_None);
+  name_item(key);
+  if (open)
+    for (auto f = fields.begin(); f != fields.end(); ++f)
+      field(key + "." + f.key(), f.key(), f.value());
 }
 
 void Editor::name_item(const std::string& label) {
@@ -1486,14 +1475,18 @@ void Editor::name_item(const std::string& label) {
   }
 }
 
-void Editor::queue_click(const std::string& what, bool ctrl, bool twice, int line) {
+void Editor::queue_pointer(const std::string& what, bool ctrl, int presses, int drag_pixels,
+                           int line) {
   using K = UiStep::Kind;
   // A frame first, so that the panels show what the actions before changed (a selection's
-  // inspector); then the mouse goes there, and presses and releases, a frame each.
+  // inspector); then the mouse goes there, and presses (and drags) and releases, a frame each.
   ui_steps_.push_back({K::settle, "", false, 0, line});
   ui_steps_.push_back({K::move, what, ctrl, 0, line});
-  for (int i = 0; i < (twice ? 2 : 1); ++i) {
+  for (int i = 0; i < presses; ++i) {
     ui_steps_.push_back({K::press, what, ctrl, 0, line});
+    for (int k = 0; drag_pixels != 0 && k < 8; ++k)
+      ui_steps_.push_back(
+          {K::move_by, "", ctrl, (drag_pixels * (k + 1)) / 8 - (drag_pixels * k) / 8, line});
     ui_steps_.push_back({K::release, what, ctrl, 0, line});
   }
   ui_steps_.push_back({K::settle, "", false, 0, line});
@@ -1574,13 +1567,11 @@ Status Editor::feed_ui_step() {
 }
 
 void Editor::entities_panel(int w, int h, const Layout& l) {
-  const ImGuiWindowFlags panel =
-      ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
   ImGui::SetNextWindowPos(ImVec2(0, 0));
   ImGui::SetNextWindowSize(ImVec2(l.left, float(h)));
   ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)), ImVec2(max_panel(w), float(h)));
   // Deep glTF hierarchies scroll sideways rather than cut their names.
-  ImGui::Begin("Entities", nullptr, panel | ImGuiWindowFlags_HorizontalScrollbar);
+  ImGui::Begin("Entities", nullptr, kPanelFlags | ImGuiWindowFlags_HorizontalScrollbar);
   static const char* kShapes[] = {"box", "sphere", "cylinder", "cone", "plane"};
   ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x * 0.5f);
   ImGui::Combo("##shape", &create_shape_, kShapes, int(std::size(kShapes)));
@@ -1616,9 +1607,7 @@ void Editor::entities_panel(int w, int h, const Layout& l) {
 void Editor::draw_ui(int w, int h) {
   widgets_.clear();
   const Layout l = layout_for(w, h, left_w_, right_w_, panels_hidden_);
-  const ImGuiWindowFlags panel =
-      ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
-  const ImGuiWindowFlags fixed = panel | ImGuiWindowFlags_NoResize;
+  const ImGuiWindowFlags fixed = kPanelFlags | ImGuiWindowFlags_NoResize;
   // Panels keep the window's height; only their inner edge moves. H hides them.
   if (!panels_hidden_) entities_panel(w, h, l);
 
@@ -1668,7 +1657,7 @@ void Editor::draw_ui(int w, int h) {
     ImGui::SetNextWindowSize(ImVec2(l.right, float(h)));
     ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)),
                                         ImVec2(max_panel(w), float(h)));
-    ImGui::Begin("Inspector", nullptr, panel);
+    ImGui::Begin("Inspector", nullptr, kPanelFlags);
     right_w_ = ImGui::GetWindowWidth();
     // Labels keep a fixed share of the panel, so long field names are not clipped.
     ImGui::PushItemWidth(-std::max(120.0f, 0.42f * l.right));
@@ -1936,24 +1925,12 @@ Status Editor::run_action(const ScriptAction& a, bool& quit) {
     case ActionKind::click:
     case ActionKind::ctrl_click:
     case ActionKind::double_click:
-      queue_click(a.args[0], a.kind == ActionKind::ctrl_click, a.kind == ActionKind::double_click,
-                  a.line);
+      queue_pointer(a.args[0], a.kind == ActionKind::ctrl_click,
+                    a.kind == ActionKind::double_click ? 2 : 1, 0, a.line);
       return {};
-    case ActionKind::drag: {
-      // Press on the widget, move the mouse PIXELS to the right (left if negative) over eight
-      // frames, release.
-      using K = UiStep::Kind;
-      const int pixels = std::stoi(a.args[1]);
-      ui_steps_.push_back({K::settle, "", false, 0, a.line});
-      ui_steps_.push_back({K::move, a.args[0], false, 0, a.line});
-      ui_steps_.push_back({K::press, a.args[0], false, 0, a.line});
-      for (int i = 0; i < 8; ++i)
-        ui_steps_.push_back(
-            {K::move_by, "", false, (pixels * (i + 1)) / 8 - (pixels * i) / 8, a.line});
-      ui_steps_.push_back({K::release, "", false, 0, a.line});
-      ui_steps_.push_back({K::settle, "", false, 0, a.line});
+    case ActionKind::drag:  // PIXELS to the right (left if negative)
+      queue_pointer(a.args[0], false, 1, std::stoi(a.args[1]), a.line);
       return {};
-    }
     case ActionKind::type:
       // A character a frame (UTF-8 sequences whole), as typed.
       for (std::size_t i = 0; i < a.args[0].size();) {

@@ -22,6 +22,20 @@ bool whole_number_in(const std::string& s, int lo, int hi) {
   return ec == std::errc() && ptr == s.data() + s.size() && v >= lo && v <= hi;
 }
 
+// A table's names joined by `separator`: messages list what the one table holds.
+template <class Table, class NameOf>
+std::string names_of(const Table& table, const char* separator, NameOf name_of) {
+  std::string out;
+  for (const auto& entry : table) {
+    if (!out.empty()) out += separator;
+    out += name_of(entry);
+  }
+  return out;
+}
+const char* itself(const char* name) {
+  return name;
+}
+
 struct Verb {
   const char* name;
   ActionKind kind;
@@ -85,8 +99,7 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
     for (const Verb& candidate : kVerbs)
       if (verb == candidate.name) v = &candidate;
     if (!v) {
-      std::string known;  // the verbs, from the one table
-      for (const Verb& candidate : kVerbs) known += (known.empty() ? "" : ", ") + std::string(candidate.name);
+      const std::string known = names_of(kVerbs, ", ", [](const Verb& v) { return v.name; });
       return Error{file.string(), where, "unknown action '" + verb + "' (" + known + ")"};
     }
     ScriptAction a;
@@ -119,24 +132,14 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
       for (const std::string& c : a.args)
         if (!is_number(c))
           return Error{file.string(), where, verb + ": '" + c + "' is not a number"};
-    if (a.kind == ActionKind::key && !is_script_key(a.args[0])) {
-      std::string keys;  // from the one table
-      for (const char* k : kScriptKeys) {
-        if (!keys.empty()) keys += ", ";
-        keys += k;
-      }
+    if (a.kind == ActionKind::key && !is_script_key(a.args[0]))
       return Error{file.string(), where,
-                   "unknown key '" + a.args[0] + "'; expected one of " + keys};
-    }
-    if (a.kind == ActionKind::view && !view_named(a.args[0])) {
-      std::string views;  // from the one table
-      for (const char* name : kViewNames) {
-        if (!views.empty()) views += '|';
-        views += name;
-      }
-      return Error{file.string(), where,
-                   "unknown view '" + a.args[0] + "'; expected view " + views};
-    }
+                   "unknown key '" + a.args[0] + "'; expected one of " +
+                       names_of(kScriptKeys, ", ", itself)};
+    if (a.kind == ActionKind::view && !view_named(a.args[0]))
+      return Error{
+          file.string(), where,
+          "unknown view '" + a.args[0] + "'; expected view " + names_of(kViewNames, "|", itself)};
     if (a.kind == ActionKind::drag && !whole_number_in(a.args[1], -100000, 100000))
       return Error{file.string(), where,
                    "drag: expected pixels in [-100000, 100000], got '" + a.args[1] + "'"};

@@ -23,6 +23,11 @@ glm::mat4 rigid(const glm::mat4& m) {
 
 }  // namespace
 
+float camera_world_scale(const glm::mat4& world_matrix) {
+  const float scale = std::cbrt(std::abs(glm::determinant(glm::mat3(world_matrix))));
+  return std::isfinite(scale) && scale > 0.0f ? scale : 1.0f;
+}
+
 CameraState select_camera(const ecs::World& world, float output_aspect) {
   CameraState out;
   glm::mat4 world_matrix(1.0f);
@@ -38,11 +43,10 @@ CameraState select_camera(const ecs::World& world, float output_aspect) {
         }
       });
   if (!out.entity.valid()) return out;
-  // A camera inside a scaled hierarchy (a glTF model scaled to the scene's units) sees what it
-  // saw before scaling: its uniform world scale (the cube root of the basis' volume) scales its
-  // near, far and ortho height; its view drops the scale.
-  const float scale = std::cbrt(std::abs(glm::determinant(glm::mat3(world_matrix))));
-  if (std::isfinite(scale) && scale > 0.0f && scale != 1.0f) {
+  // A camera inside a scaled hierarchy sees what it saw before scaling (camera_world_scale());
+  // its view drops the scale.
+  const float scale = camera_world_scale(world_matrix);
+  if (scale != 1.0f) {
     out.camera.near *= scale;
     out.camera.far *= scale;
     out.camera.ortho_height *= scale;

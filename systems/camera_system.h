@@ -18,6 +18,12 @@ struct CameraState {
   float aspect = 1.0f;
 };
 
+/// A camera's uniform world scale, the cube root of its world basis' volume (1 where that is not
+/// a positive finite number): a camera inside a scaled hierarchy (a glTF model scaled to the
+/// scene's units) has its near, far and ortho height scaled by it, so it sees what it saw
+/// before the scaling.
+float camera_world_scale(const glm::mat4& world_matrix);
+
 /// The first Camera with active = true, else the first Camera; needs WorldTransform.
 /// `output_aspect` is used when the camera's own aspect is 0.
 CameraState select_camera(const ecs::World& world, float output_aspect);

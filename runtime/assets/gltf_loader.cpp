@@ -1166,30 +1166,23 @@ Result<Material> read_material(Importer& im, int index) {
   return m;
 }
 
-/// Rotation and scale of a matrix's upper 3x3 (glTF requires matrices to be TRS-decomposable,
-/// 5.25; shear, if any, is lost with a warning). A negative determinant goes into scale.x.
-Transform decompose(const glm::mat4& matrix, std::vector<std::string>& warnings,
-                    const std::string& where) {
-  Transform t;
-  t.translation = glm::vec3(matrix[3]);
-  glm::vec3 axis[3] = {glm::vec3(matrix[0]), glm::vec3(matrix[1]), glm::vec3(matrix[2])};
-  t.scale = {glm::length(axis[0]), glm::length(axis[1]), glm::length(axis[2])};
-  if (glm::determinant(glm::mat3(axis[0], axis[1], axis[2])) < 0.0f) {
-    t.scale.x = -t.scale.x;
-    axis[0] = -axis[0];
-  }
+/// A node's matrix as TRS (components/transform.h decompose(); glTF requires matrices to be
+/// TRS-decomposable, 5.25), with warnings for what that loses: a projective part, shear.
+Transform decompose_node_matrix(const glm::mat4& matrix, std::vector<std::string>& warnings,
+                                const std::string& where) {
+  const Transform t = decompose(matrix);
   if (matrix[0][3] != 0.0f || matrix[1][3] != 0.0f || matrix[2][3] != 0.0f ||
       matrix[3][3] != 1.0f) {
     warnings.push_back(where + ": matrix is not affine; its projective part is ignored");
   }
-  const float smallest = std::min({std::abs(t.scale.x), std::abs(t.scale.y), std::abs(t.scale.z)});
-  if (!(smallest > 1e-12f)) return t;  // a zero scale has no recoverable rotation: keep identity
+  if (!(std::min({std::abs(t.scale.x), std::abs(t.scale.y), std::abs(t.scale.z)}) > 1e-12f))
+    return t;  // a zero scale: no rotation recovered, no shear to speak of
+  glm::vec3 axis[3] = {glm::vec3(matrix[0]), glm::vec3(matrix[1]), glm::vec3(matrix[2])};
   for (glm::vec3& a : axis) a = glm::normalize(a);
   const float shear =
       std::max({std::abs(glm::dot(axis[0], axis[1])), std::abs(glm::dot(axis[1], axis[2])),
                 std::abs(glm::dot(axis[0], axis[2]))});
   if (shear > 1e-3f) warnings.push_back(where + ": matrix has shear; it is approximated");
-  t.rotation = glm::normalize(glm::quat_cast(glm::mat3(axis[0], axis[1], axis[2])));
   return t;
 }
 
@@ -1213,7 +1206,7 @@ Result<Transform> node_transform(const Importer& im, int index,
     glm::mat4 matrix;
     for (int c = 0; c < 4; ++c)
       for (int row = 0; row < 4; ++row) matrix[c][row] = float(m[std::size_t(c * 4 + row)]);
-    return decompose(matrix, warnings, where);
+    return decompose_node_matrix(matrix, warnings, where);
   }
   Transform out;
   if (t.size() == 3) out.translation = {float(t[0]), float(t[1]), float(t[2])};

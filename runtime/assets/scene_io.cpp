@@ -6,14 +6,15 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/gtx/euler_angles.hpp>
 #include <limits>
 #include <map>
 #include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtx/euler_angles.hpp>
 
 #include "components/camera.h"
 #include "components/light.h"
@@ -735,12 +736,11 @@ std::string recorded_field(const std::string& section, const std::string& field)
   return field;
 }
 
-// The model entity that imported e, when e is one of a glTF model's nodes; else none.
-ecs::Entity model_of(const ecs::World& w, ecs::Entity e) {
-  const auto* imp = w.try_get<Imported>(e);
-  if (!imp || !imp->source.valid() || !w.alive(imp->source) || !w.has<ModelRef>(imp->source))
-    return ecs::kNullEntity;
-  return imp->source;
+// Adds `field` of the override's section to the fields it records (once; any rotation form as
+// the rotation).
+void record_field(NodeOverride& o, const std::string& field) {
+  const std::string f = recorded_field(o.section, field);
+  if (std::find(o.fields.begin(), o.fields.end(), f) == o.fields.end()) o.fields.push_back(f);
 }
 
 // The entities imported for model entity `model` that are named `node`.
@@ -776,11 +776,7 @@ std::vector<NodeOverride> read_node_overrides(const json& nodes, const std::stri
       if (s.key() == "transform" && s.value().contains("parent"))
         fail(sat + "/parent", "an imported node keeps its parent from the model file");
       NodeOverride o{n.key(), s.key(), {}, s.value().dump(), sat};
-      for (auto f = s.value().begin(); f != s.value().end(); ++f) {
-        const std::string field = recorded_field(s.key(), f.key());
-        if (std::find(o.fields.begin(), o.fields.end(), field) == o.fields.end())
-          o.fields.push_back(field);
-      }
+      for (auto f = s.value().begin(); f != s.value().end(); ++f) record_field(o, f.key());
       out.push_back(std::move(o));
     }
   }
@@ -793,11 +789,11 @@ json write_node_overrides(const Scene& scene, ecs::Entity model) {
   json out = json::object();
   for (const NodeOverride& o : scene.world.get<ModelRef>(model).nodes) {
     const std::vector<ecs::Entity> found = nodes_named(scene.world, model, o.node);
+    const json live = found.size() == 1 ? settable_sections(scene, found.front()) : json();
     json block = json::object();
-    if (found.size() == 1 && settable_sections(scene, found.front()).contains(o.section)) {
-      const json live = settable_sections(scene, found.front())[o.section];
+    if (live.contains(o.section)) {
       for (const std::string& f : o.fields)
-        if (live.contains(f)) block[f] = live[f];
+        if (live[o.section].contains(f)) block[f] = live[o.section][f];
     } else {
       block = json::parse(o.block, nullptr, /*allow_exceptions=*/false);
     }
@@ -808,6 +804,13 @@ json write_node_overrides(const Scene& scene, ecs::Entity model) {
 }
 
 }  // namespace
+
+ecs::Entity model_of(const ecs::World& w, ecs::Entity e) {
+  const auto* imp = w.try_get<Imported>(e);
+  if (!imp || !imp->source.valid() || !w.alive(imp->source) || !w.has<ModelRef>(imp->source))
+    return ecs::kNullEntity;
+  return imp->source;
+}
 
 void note_node_override(Scene& scene, ecs::Entity e, const std::string& section,
                         const std::vector<std::string>& fields) {
@@ -822,11 +825,7 @@ void note_node_override(Scene& scene, ecs::Entity e, const std::string& section,
   });
   if (it == nodes.end())
     it = nodes.insert(nodes.end(), NodeOverride{name->value, section, {}, "{}", ""});
-  for (const std::string& f : fields) {
-    const std::string field = recorded_field(section, f);
-    if (std::find(it->fields.begin(), it->fields.end(), field) == it->fields.end())
-      it->fields.push_back(field);
-  }
+  for (const std::string& f : fields) record_field(*it, f);
 }
 
 json live_entity_sections(const Scene& scene, ecs::Entity e) {
@@ -1093,8 +1092,7 @@ Result<std::vector<ecs::Entity>> import_model(
     auto report = import_gltf(path, w, scene.assets, e, e, activate_first_camera);
     if (!report) {
       // A scene file's model: the scene and the entity come first, then the model's own error.
-      if (fs::path(w.get<ModelRef>(e).path).filename() == scene.file.filename() &&
-          lowercase_extension(scene.file) != ".json")
+      if (lowercase_extension(scene.file) != ".json")
         return report.error();  // a glTF opened directly: its own error says it all
       const std::string name = w.has<Name>(e) ? w.get<Name>(e).value : std::string("?");
       return Error{scene.file.string(), "/" + name + "/model/path", report.error().to_string()};

@@ -54,6 +54,10 @@ Result<ecs::Entity> entity_for_key(const Scene& scene, const std::string& key);
 /// and validated as in scene files. Unknown or ambiguous names are errors that list the names.
 Status apply_entity_override(Scene& scene, const std::string& assignment);
 
+/// The model entity that imported e, when e is one of a glTF model's nodes; else the null entity
+/// (authored entities, and what the load makes on its own: the ground, a terrain's tiles).
+ecs::Entity model_of(const ecs::World& world, ecs::Entity e);
+
 /// Records that `fields` of `section` were set on entity e, when e is a node a glTF model entity
 /// imported: scene_to_json() then writes their values, as e has them, in that model's
 /// `nodes` block (apply_entity_override() records its own edits; the editor's fly camera, which

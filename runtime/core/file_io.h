@@ -12,13 +12,13 @@
 
 namespace kaskad {
 
-/// A file's extension as path::extension() gives it (".glb": with the dot; empty without one),
-/// in ASCII lower case: how file types are told apart by name.
 /// The folder a file is in: its parent path, or "." for a bare name.
 inline std::filesystem::path folder_of(const std::filesystem::path& path) {
   return path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
 }
 
+/// A file's extension as path::extension() gives it (".glb": with the dot; empty without one),
+/// in ASCII lower case: how file types are told apart by name.
 inline std::string lowercase_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));

@@ -3,6 +3,7 @@
 // locations. Parsers throw ContentError internally and convert it to kaskad::Error at their API.
 #pragma once
 
+#include <algorithm>
 #include <charconv>
 #include <filesystem>
 #include <fstream>
@@ -98,6 +99,19 @@ class FieldRecorder {
   /// The bounds of each range-checked number or array of numbers, by field path.
   const std::map<std::string, Range>& ranges() const { return ranges_; }
 
+  /// The last two parts of a field's path, "/" or "." separated ("/entities/2/light/type" and
+  /// "sun.light.type" give "light.type"; "/shadow/filter" and "shadow.filter" give
+  /// "shadow.filter"): the object and the field, which name one table and one range of the
+  /// readers whichever entity holds them (how the editor finds a field's).
+  static std::string object_and_field(const std::string& path, char separator) {
+    const auto last = path.rfind(separator);
+    if (last == std::string::npos || last == 0) return path.substr(last == 0 ? 1 : 0);
+    const auto before = path.rfind(separator, last - 1);
+    std::string key = path.substr(before == std::string::npos ? 0 : before + 1);
+    std::replace(key.begin(), key.end(), separator, '.');
+    return key;
+  }
+
  private:
   static inline thread_local FieldRecorder* current_ = nullptr;
   FieldRecorder* previous_;
@@ -144,8 +158,7 @@ class ObjectReader {
   /// integer(), and a power of two (map sizes): `KEY must be a power of two in [lo, hi], was N`.
   void power_of_two(const char* key, int& out, int lo, int hi) {
     integer(key, out, lo, hi);
-    if (FieldRecorder* recorder = FieldRecorder::current())
-      recorder->record(at(key), {double(lo), double(hi), true});
+    record_range(key, lo, hi, /*power_of_two=*/true);
     if (has(key) && (out & (out - 1)) != 0)
       fail(at(key), std::string(key) + " must be a power of two in [" + std::to_string(lo) + ", " +
                         std::to_string(hi) + "], was " + std::to_string(out));
@@ -205,8 +218,9 @@ class ObjectReader {
   }
 
  private:
-  void record_range(const char* key, double lo, double hi) const {
-    if (FieldRecorder* recorder = FieldRecorder::current()) recorder->record(at(key), {lo, hi});
+  void record_range(const char* key, double lo, double hi, bool power_of_two = false) const {
+    if (FieldRecorder* recorder = FieldRecorder::current())
+      recorder->record(at(key), {lo, hi, power_of_two});
   }
   static std::string fmt(double d) {
     std::ostringstream s;

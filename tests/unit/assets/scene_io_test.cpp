@@ -1041,6 +1041,20 @@ namespace {
 
 using json = nlohmann::json;
 
+// The editor finds what the readers recorded for a field by its object and field
+// (FieldRecorder::object_and_field()): every path of one pair must hold the same record.
+template <class T>
+void expect_one_per_object_and_field(const std::map<std::string, T>& recorded) {
+  std::map<std::string, std::pair<std::string, T>> by_pair;
+  for (const auto& [path, value] : recorded) {
+    const auto [it, added] =
+        by_pair.try_emplace(json_reader::FieldRecorder::object_and_field(path, '/'), path, value);
+    if (!added) {
+      EXPECT_EQ(value, it->second.second) << path << " and " << it->second.first << " differ";
+    }
+  }
+}
+
 // The editor's combo boxes list what json_reader::FieldRecorder saw the readers ask for.
 // Every string field of the canonical document that the reader checks against a table must be
 // recorded, with exactly the names that table accepts.
@@ -1104,17 +1118,8 @@ TEST(SceneIo, FieldRecorderSeesEveryEnumeratedField) {
   }
   EXPECT_GE(enumerated, 11);
   // The editor finds a combo's names by the field's object and name ("light.type", whichever
-  // entity; editor.cpp, enumeration_key): that pair must name one table wherever it is read.
-  std::map<std::string, std::pair<std::string, std::vector<std::string>>> by_pair;
-  for (const auto& [path, names] : fields) {
-    const auto last = path.rfind('/');
-    const auto before = last == 0 || last == std::string::npos ? last : path.rfind('/', last - 1);
-    const std::string pair = before == std::string::npos ? path : path.substr(before + 1);
-    const auto [it, added] = by_pair.try_emplace(pair, path, names);
-    if (!added) {
-      EXPECT_EQ(names, it->second.second) << path << " and " << it->second.first << " differ";
-    }
-  }
+  // entity): that pair must name one table wherever it is read.
+  expect_one_per_object_and_field(fields);
   // The shadow filter's names are the table's, in its order, each once.
   const auto& filters = fields.at("/shadow/filter");
   EXPECT_EQ(std::set<std::string>(filters.begin(), filters.end()).size(), filters.size());
@@ -1183,17 +1188,8 @@ TEST(SceneIo, FieldRecorderRecordsEveryNumbersBounds) {
   EXPECT_GE(checked, 60);
   EXPECT_GE(powers, 2);  // the scene's map_size, the mirror's resolution
   // The editor finds a field's bounds by its object and name ("light.intensity", whichever
-  // entity; editor.cpp, enumeration_key): that pair must have one range wherever it is read.
-  std::map<std::string, std::pair<std::string, json_reader::FieldRecorder::Range>> by_pair;
-  for (const auto& [path, range] : ranges) {
-    const auto last = path.rfind('/');
-    const auto before = last == 0 || last == std::string::npos ? last : path.rfind('/', last - 1);
-    const std::string pair = before == std::string::npos ? path : path.substr(before + 1);
-    const auto [it, added] = by_pair.try_emplace(pair, path, range);
-    if (!added) {
-      EXPECT_EQ(range, it->second.second) << path << " and " << it->second.first << " differ";
-    }
-  }
+  // entity): that pair must have one range wherever it is read.
+  expect_one_per_object_and_field(ranges);
   // Just under 1, where the bound prints as 1: the message says the bound is open.
   EXPECT_NE(verdict("/shadow/vsm_bleed_reduction", 0.99999997).find("[0, 1)"), std::string::npos)
       << verdict("/shadow/vsm_bleed_reduction", 0.99999997);

@@ -34,6 +34,29 @@ TEST(TransformSystem, ParentChainsCompose) {
   EXPECT_NEAR(p.z, 0.0f, 1e-5f);
 }
 
+// decompose() (components/transform.h): what the glTF loader makes of node matrices and the
+// editor of a parented camera's pose. T * R * S recomposes to the matrix, a mirror goes into
+// scale.x, a zero scale keeps the identity rotation.
+TEST(TransformSystem, DecomposeRecomposesTranslationRotationAndScale) {
+  auto compose = [](const Transform& t) {
+    return glm::translate(glm::mat4(1.0f), t.translation) * glm::mat4_cast(t.rotation) *
+           glm::scale(glm::mat4(1.0f), t.scale);
+  };
+  const glm::quat r = glm::normalize(glm::quat(0.8f, 0.1f, -0.5f, 0.3f));
+  for (const glm::vec3 scale : {glm::vec3(2.0f, 0.5f, 3.0f), glm::vec3(-1.5f, 1.0f, 2.0f)}) {
+    const glm::mat4 m = compose(Transform{{1, -2, 3}, r, scale});
+    const Transform t = decompose(m);
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 4; ++k) EXPECT_NEAR(compose(t)[c][k], m[c][k], 1e-5f) << c << k;
+    EXPECT_EQ(t.scale.x < 0.0f, scale.x < 0.0f);  // the mirror is in scale.x
+    EXPECT_GT(t.scale.y, 0.0f);
+  }
+  const Transform flat = decompose(glm::scale(glm::mat4(1.0f), glm::vec3(1.0f, 0.0f, 1.0f)));
+  EXPECT_EQ(flat.rotation, glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
+  EXPECT_EQ(camera_world_scale(glm::scale(glm::mat4(1.0f), glm::vec3(8.0f))), 8.0f);
+  EXPECT_EQ(camera_world_scale(glm::mat4(0.0f)), 1.0f);
+}
+
 TEST(TransformSystem, CyclesAndStaleParentsBecomeRoots) {
   ecs::World w;
   AssetStore assets;
