@@ -63,6 +63,8 @@ edit() {
   if [ "$rc" -ge 128 ]; then fail "crashed (exit $rc)"; tail -20 "$tmp/out"; fi
 }
 
+# png_size FILE: WIDTH x HEIGHT of $tmp/FILE, a PNG (its width and height are bytes 16-23).
+png_size() { od -An -tu1 -j16 -N8 "$tmp/$1" | awk '{ printf "%dx%d", $3 * 256 + $4, $7 * 256 + $8 }'; }
 same() { if cmp -s "$tmp/$2" "$tmp/$3"; then ok "$1"; else fail "$1: $2 and $3 differ"; fi; }
 differ() { if cmp -s "$tmp/$2" "$tmp/$3"; then fail "$1: $2 and $3 are identical"; else ok "$1"; fi; }
 
@@ -507,8 +509,7 @@ quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
   colours=$(cd "$(dirname "$0")" && python3 -c 'import sys; from changed_within import read_png; w, h, c, rows = read_png(sys.argv[1]); print(len({bytes(r[x * c:x * c + 3]) for r in rows for x in range(w)}))' "$tmp/reflection.png")
   if [ "$colours" -gt 100 ]; then ok "the reflection view shows the mirrors' maps ($colours colours)"; else fail "the reflection view has $colours colours"; fi
   # The views differ by shape, whatever the probes' maps hold: the faces view is a 6:1 strip,
-  # the sphere map square (a PNG's width and height are bytes 16-23).
-  png_size() { od -An -tu1 -j16 -N8 "$tmp/$1" | awk '{ printf "%dx%d", $3 * 256 + $4, $7 * 256 + $8 }'; }
+  # the sphere map square.
   if [ "$(png_size sphere_faces.png)" = "768x128" ] && [ "$(png_size sphere_map.png)" = "128x128" ]; then
     ok "the sphere map view shows the probe's 128^2 sphere map, the faces view its six faces"
   else
@@ -518,7 +519,6 @@ quit!" "$KASKAD_CONTENT/scenes/reflections.json" \
 soft_maps)
   # The soft-shadow technique's maps: none for pcf (the colour shows, at the viewport's size);
   # vsm's first moment and lom's first-peel factors, one 256^2 slice per cascade stacked.
-  png_size() { od -An -tu1 -j16 -N8 "$tmp/$1" | awk '{ printf "%dx%d", $3 * 256 + $4, $7 * 256 + $8 }'; }
   edit "frames 1
 view soft_maps
 screenshot $tmp/pcf.png
@@ -723,11 +723,10 @@ key h
 screenshot $tmp/small_again.png
 quit!" "$scene" --size 640x360
   [ "$rc" -eq 0 ] || { fail "layout script exit $rc"; tail -5 "$tmp/out"; }
-  png_size() { od -An -tu1 -j16 -N8 "$tmp/$1" | awk '{ printf "%d %d", $3 * 256 + $4, $7 * 256 + $8 }'; }
-  read -r vw vh <<<"$(png_size small_view.png)"
+  IFS=x read -r vw vh <<<"$(png_size small_view.png)"
   if [ "$vw" -ge 288 ] && [ "$vh" -eq 360 ]; then ok "at 640x360 the viewport is ${vw}x${vh}"; else fail "at 640x360 the viewport is ${vw}x${vh}"; fi
-  is "H hides the panels: the viewport is the window" "$(png_size no_panels.png)" "640 360"
-  is "H again shows them" "$(png_size small_again.png)" "$vw $vh"
+  is "H hides the panels: the viewport is the window" "$(png_size no_panels.png)" "640x360"
+  is "H again shows them" "$(png_size small_again.png)" "${vw}x$vh"
   edit "click no_such_widget
 quit!" "$scene"
   refused "line 1: no widget named 'no_such_widget' in the last frame; it showed: " "a click on a widget the panels do not show: exit 1, named"
