@@ -93,6 +93,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.msaa = scene.render.msaa;
   in.shadow_cache = scene.render.shadow_cache;
   in.shadow_scroll = scene.render.shadow_scroll;
+  in.multi_draw = scene.render.multi_draw;
   in.visibility_cache = scene.render.visibility_cache;
   if (!shadows.empty()) {
     const ShadowSettings& s = shadows.front().settings;  // shared by every view (ShadowData)

@@ -66,6 +66,10 @@ struct RenderSettings {
   /// shadow maps) reads each pixel's shadow visibility back instead of looking the maps up.
   /// Images are identical either way; off, every frame looks up (for measurements).
   bool visibility_cache = true;
+  /// Multi-draw: draws with the same program, material and winding but different meshes are one
+  /// glMultiDrawElementsIndirect (one instanced draw per mesh in it). Off, one call per mesh.
+  /// Images are identical either way (for measurements, and drivers that mishandle it).
+  bool multi_draw = true;
   /// Capture rounds on a frame where reflection probes make their first capture, in
   /// [kMinProbeBounces, kMaxProbeBounces] (components/reflector.h): each round reads the other
   /// probes' maps of the round before, so round k shows mirrors seen in mirrors k - 1 deep.

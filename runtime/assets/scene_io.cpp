@@ -274,6 +274,7 @@ void read_render(ObjectReader& r, RenderSettings& s) {
   r.boolean("shadow_cache", s.shadow_cache);
   r.boolean("shadow_scroll", s.shadow_scroll);
   r.boolean("visibility_cache", s.visibility_cache);
+  r.boolean("multi_draw", s.multi_draw);
   r.integer("probe_bounces", s.probe_bounces, kMinProbeBounces, kMaxProbeBounces);
   r.finish();
 }
@@ -1408,6 +1409,7 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
                    {"shadow_cache", r.shadow_cache},
                    {"shadow_scroll", r.shadow_scroll},
                    {"visibility_cache", r.visibility_cache},
+                   {"multi_draw", r.multi_draw},
                    {"probe_bounces", r.probe_bounces}};
   doc["shadow"] = write_shadow(scene.shadow_defaults, nullptr);
   std::vector<ecs::Entity> authored;

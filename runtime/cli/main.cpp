@@ -434,12 +434,14 @@ int run_render(Args a) {
   std::printf("frames    %d at %dx%d%s: first %.1f ms, median %.2f ms (frames 2..%d)\n", a.frames,
               scene->render.width, scene->render.height, msaa.c_str(), timings->first_frame_ms,
               timings->median_ms(), a.frames);
-  std::printf("last      %d objects in %d draw calls (%d outside the view, culled), %zu "
-              "triangles; shadow pass %d caster instances in %d draw calls, %zu triangles; GPU "
-              "shadow %.2f ms, forward %.2f ms; %d program and %d material switches\n",
-              st.instances, st.draw_calls, st.frustum_culled, st.triangles, st.shadow_instances,
-              st.shadow_draw_calls, st.shadow_triangles, st.shadow_gpu_ms, st.forward_gpu_ms,
-              st.program_switches, st.material_switches);
+  std::printf(
+      "last      %d objects in %d draw calls of %d meshes (%d outside the view, "
+      "culled), %zu triangles; shadow pass %d caster instances in %d draw calls of %d "
+      "meshes, %zu triangles; GPU shadow %.2f ms, forward %.2f ms; %d program and %d "
+      "material switches\n",
+      st.instances, st.draw_calls, st.mesh_draws, st.frustum_culled, st.triangles,
+      st.shadow_instances, st.shadow_draw_calls, st.shadow_mesh_draws, st.shadow_triangles,
+      st.shadow_gpu_ms, st.forward_gpu_ms, st.program_switches, st.material_switches);
   if (st.probe_gpu_ms > 0 || st.lom_gpu_ms > 0 || st.moments_gpu_ms > 0)
     std::printf("          GPU parts: probe captures %.2f ms (prefiltering %.2f ms of it), lom "
                 "%.2f ms and moments %.2f ms (of the shadow pass's)\n",

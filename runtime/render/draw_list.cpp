@@ -203,29 +203,33 @@ std::vector<std::uint32_t> material_ranks(const FrameInput& frame) {
   return id;
 }
 
-// Draw indices sorted by `by[i]` as pass `pass` sees it, then by material, then by mesh: draws
-// that may share one instanced draw (same program, material and mesh) end up next to each other.
-// The depth pass reads a material only to discard alpha-masked texels: without that, draws of
-// one mesh share a draw whatever their materials, so there mesh comes before material.
+// Draw indices sorted by `by[i]` as pass `pass` sees it, then by winding, material and mesh: draws
+// that may share one call (same program, winding and material) end up next to each other, and
+// within them draws of one mesh (one instanced draw of the call). The depth pass reads a material
+// only to discard alpha-masked texels: without that, draws of one mesh share a draw whatever
+// their materials, so there mesh comes before material.
 std::vector<std::uint32_t> sorted_by(const FrameInput& frame, Pass pass,
                                      const std::vector<VariantKey>& by,
                                      const std::vector<std::uint32_t>& material_rank) {
   struct SortKey {
     VariantKey key;
+    bool mirrored;
     bool mesh_first;
     std::uint32_t material;
     MeshId mesh;
   };
   std::vector<SortKey> k(frame.draws.size());
   for (std::size_t i = 0; i < k.size(); ++i)
-    k[i] = {by[i].filtered_for(pass), pass == Pass::depth && !by[i].has(VariantKey::kAlphaMask),
-            material_rank[i], frame.draws[i].mesh};
+    k[i] = {by[i].filtered_for(pass), mirrors(frame.draws[i].model),
+            pass == Pass::depth && !by[i].has(VariantKey::kAlphaMask), material_rank[i],
+            frame.draws[i].mesh};
   std::vector<std::uint32_t> order(frame.draws.size());
   for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
     const SortKey& ka = k[a];
     const SortKey& kb = k[b];
     if (ka.key != kb.key) return ka.key < kb.key;
+    if (ka.mirrored != kb.mirrored) return kb.mirrored;
     if (ka.mesh_first && ka.mesh != kb.mesh) return ka.mesh < kb.mesh;
     if (ka.material != kb.material) return ka.material < kb.material;
     return ka.mesh < kb.mesh;

@@ -30,6 +30,12 @@ VariantKey material_variant(const DrawItem& draw);
 /// (the costliest binds), then the factors. Materials that compare equal (operator==) are
 /// neither before the other.
 bool material_sorts_before(const Material& a, const Material& b);
+/// Whether `model` mirrors (negative determinant): its triangles wind the other way on screen, so
+/// the front face is the clockwise one (glTF 2.0, "Transformations"). Draws that mirror and draws
+/// that do not are never one call.
+inline bool mirrors(const glm::mat4& model) {
+  return glm::determinant(glm::mat3(model)) < 0.0f;
+}
 
 /// Every (pass, key) a frame draws with, sorted and unique: what prewarm compiles and what
 /// `kaskad variants` lists. Pure: no GL.
@@ -42,8 +48,9 @@ struct DrawList {
   /// FrameInput::msaa > 1). forward_order serves both: two draws have equal keys exactly when
   /// they have equal msaa_keys, so its runs of one program and material are the same.
   std::vector<VariantKey> keys, capture_keys, msaa_keys;
-  /// Draw indices in submission order: sorted by the pass's program key, then by material, so
-  /// program and material state change as rarely as possible (stable: ties keep draw order).
+  /// Draw indices in submission order: sorted by the pass's program key, then by winding
+  /// (mirrors()), material and mesh, so program and material state change as rarely as possible
+  /// and draws that may be one call are neighbours (stable: ties keep draw order).
   std::vector<std::uint32_t> depth_order, forward_order, capture_order;
 
   /// The depth-pass key of draw i in shadow view `view`: views after the first are cascades and

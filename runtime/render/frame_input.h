@@ -210,6 +210,8 @@ struct FrameInput {
   bool shadow_cache = true;
   /// render.shadow_scroll: with shadow_cache, scroll a moved stable cascade (ShadowMapPass).
   bool shadow_scroll = true;
+  /// render.multi_draw: a batch of meshes sharing program, material and winding is one call.
+  bool multi_draw = true;
   /// render.visibility_cache: the main view keeps each pixel's shadow visibility, and a frame
   /// whose visibility inputs equal the frame before's reads it back instead of looking the
   /// shadow maps up (Renderer::render()). Not with AOVs, MSAA or the cascade tint.

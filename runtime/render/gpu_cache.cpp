@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 
 #include <glm/glm.hpp>
@@ -16,10 +17,18 @@
 namespace kaskad::render {
 namespace {
 
-// The vertex array's instanced attributes (InstanceRecord, divisor 1) read from binding 3.
-// Vertex buffer bindings: 0-2 positions, normals and uvs, 3 the instance records, 4 tangents.
-constexpr GLuint kInstanceBinding = 3;
-constexpr GLuint kTangentBinding = 4;
+// The vertex array's buffer bindings: 0 the shared vertices, 1 the instance records
+// (InstanceRecord, divisor 1).
+constexpr GLuint kVertexBinding = 0;
+constexpr GLuint kInstanceBinding = 1;
+
+// One vertex of the shared geometry.
+struct Vertex {
+  glm::vec3 position{0.0f}, normal{0.0f};
+  glm::vec2 uv{0.0f};
+  glm::vec4 tangent{0.0f};
+};
+static_assert(sizeof(Vertex) == 48);
 
 void add_instance_attributes(GLuint vao, GLuint buffer) {
   for (GLuint i = 0; i < 4; ++i) {
@@ -68,9 +77,45 @@ void GpuCache::use(const AssetStore& assets) {
   assets_ = &assets;
   if (assets.uid == assets_uid_) return;
   meshes_.clear();
+  vertices_used_ = indices_used_ = 0;  // the buffers stay, for the next store's meshes
   textures_.clear();
   probes_->clear();
   assets_uid_ = assets.uid;
+}
+
+void GpuCache::reserve_geometry(std::size_t vertices, std::size_t indices) {
+  if (!vao_) {
+    vao_ = gpu::make_vertex_array();
+    const GLuint vao = vao_.id();
+    const GLuint attrs[4] = {kAttrPosition, kAttrNormal, kAttrUv, kAttrTangent};
+    const GLuint offsets[4] = {offsetof(Vertex, position), offsetof(Vertex, normal),
+                               offsetof(Vertex, uv), offsetof(Vertex, tangent)};
+    const GLint sizes[4] = {3, 3, 2, 4};
+    for (int i = 0; i < 4; ++i) {
+      glEnableVertexArrayAttrib(vao, attrs[i]);
+      glVertexArrayAttribFormat(vao, attrs[i], sizes[i], GL_FLOAT, GL_FALSE, offsets[i]);
+      glVertexArrayAttribBinding(vao, attrs[i], kVertexBinding);
+    }
+    add_instance_attributes(vao, instances_ ? instances_.id() : 0);
+  }
+  // A full buffer is replaced by one twice as large holding a copy (draws recorded earlier keep
+  // reading the old one, which GL holds until they are done).
+  auto grow = [](gpu::Buffer& buffer, std::size_t& capacity, std::size_t used, std::size_t need,
+                 std::size_t element) {
+    if (need <= capacity) return false;
+    const std::size_t grown = std::max<std::size_t>({std::size_t(1) << 12, 2 * capacity, need});
+    gpu::Buffer bigger = gpu::make_buffer();
+    glNamedBufferStorage(bigger.id(), GLsizeiptr(grown * element), nullptr, GL_DYNAMIC_STORAGE_BIT);
+    if (used > 0)
+      glCopyNamedBufferSubData(buffer.id(), bigger.id(), 0, 0, GLsizeiptr(used * element));
+    buffer = std::move(bigger);
+    capacity = grown;
+    return true;
+  };
+  if (grow(vertices_, vertices_capacity_, vertices_used_, vertices, sizeof(Vertex)))
+    glVertexArrayVertexBuffer(vao_.id(), kVertexBinding, vertices_.id(), 0, sizeof(Vertex));
+  if (grow(indices_, indices_capacity_, indices_used_, indices, sizeof(std::uint32_t)))
+    glVertexArrayElementBuffer(vao_.id(), indices_.id());
 }
 
 const GpuMesh& GpuCache::mesh(MeshId id) {
@@ -78,47 +123,76 @@ const GpuMesh& GpuCache::mesh(MeshId id) {
   KASKAD_CHECK(assets_ && at < assets_->meshes.size(), "mesh id out of range");
   if (at >= meshes_.size()) meshes_.resize(at + 1);
   GpuMesh& m = meshes_[at];
-  if (m.vao) return m;
+  if (m.uploaded) return m;
   const MeshData& src = assets_->meshes[at];
   const std::size_t n = src.positions.size();
-  // One buffer, four streams: positions | normals | uvs | tangents (uvs zero when the mesh has
-  // none; tangents the mesh's own, else generated (MikkTSpace's rule), zero without uvs).
-  const std::size_t pos_bytes = n * sizeof(glm::vec3), uv_bytes = n * sizeof(glm::vec2),
-                    tangent_bytes = n * sizeof(glm::vec4);
-  std::vector<std::uint8_t> data(2 * pos_bytes + uv_bytes + tangent_bytes, 0);
-  std::memcpy(data.data(), src.positions.data(), pos_bytes);
-  if (src.normals.size() == n) std::memcpy(data.data() + pos_bytes, src.normals.data(), pos_bytes);
-  if (src.uvs.size() == n) std::memcpy(data.data() + 2 * pos_bytes, src.uvs.data(), uv_bytes);
+  // Uvs are zero when the mesh has none; tangents are the mesh's own, else generated
+  // (MikkTSpace's rule), zero without uvs.
   const std::vector<glm::vec4> generated = src.tangents.size() == n ? std::vector<glm::vec4>()
                                                                       : generate_tangents(src);
   const std::vector<glm::vec4>& tangents = generated.empty() ? src.tangents : generated;
-  if (tangents.size() == n)
-    std::memcpy(data.data() + 2 * pos_bytes + uv_bytes, tangents.data(), tangent_bytes);
-  m.vertices = gpu::make_buffer();
-  glNamedBufferStorage(m.vertices.id(), GLsizeiptr(std::max<std::size_t>(data.size(), 1)),
-                       data.data(), 0);
-  m.indices = gpu::make_buffer();
-  glNamedBufferStorage(m.indices.id(), GLsizeiptr(std::max<std::size_t>(src.indices.size() * 4, 4)),
-                       src.indices.empty() ? nullptr : src.indices.data(), 0);
-  m.index_count = GLsizei(src.indices.size());
-  m.vao = gpu::make_vertex_array();
-  const GLuint vao = m.vao.id();
-  glVertexArrayVertexBuffer(vao, 0, m.vertices.id(), 0, sizeof(glm::vec3));
-  glVertexArrayVertexBuffer(vao, 1, m.vertices.id(), GLintptr(pos_bytes), sizeof(glm::vec3));
-  glVertexArrayVertexBuffer(vao, 2, m.vertices.id(), GLintptr(2 * pos_bytes), sizeof(glm::vec2));
-  glVertexArrayVertexBuffer(vao, kTangentBinding, m.vertices.id(),
-                            GLintptr(2 * pos_bytes + uv_bytes), sizeof(glm::vec4));
-  const GLuint attrs[4] = {kAttrPosition, kAttrNormal, kAttrUv, kAttrTangent};
-  const GLuint bindings[4] = {0, 1, 2, kTangentBinding};
-  const GLint sizes[4] = {3, 3, 2, 4};
-  for (int i = 0; i < 4; ++i) {
-    glEnableVertexArrayAttrib(vao, attrs[i]);
-    glVertexArrayAttribFormat(vao, attrs[i], sizes[i], GL_FLOAT, GL_FALSE, 0);
-    glVertexArrayAttribBinding(vao, attrs[i], bindings[i]);
+  std::vector<Vertex> vertices(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    vertices[i].position = src.positions[i];
+    if (src.normals.size() == n) vertices[i].normal = src.normals[i];
+    if (src.uvs.size() == n) vertices[i].uv = src.uvs[i];
+    if (tangents.size() == n) vertices[i].tangent = tangents[i];
   }
-  glVertexArrayElementBuffer(vao, m.indices.id());
-  add_instance_attributes(vao, instances_ ? instances_.id() : 0);
+  reserve_geometry(vertices_used_ + n, indices_used_ + src.indices.size());
+  if (n > 0)
+    glNamedBufferSubData(vertices_.id(), GLintptr(vertices_used_ * sizeof(Vertex)),
+                         GLsizeiptr(n * sizeof(Vertex)), vertices.data());
+  if (!src.indices.empty())
+    glNamedBufferSubData(indices_.id(), GLintptr(indices_used_ * sizeof(std::uint32_t)),
+                         GLsizeiptr(src.indices.size() * sizeof(std::uint32_t)),
+                         src.indices.data());
+  m.index_count = GLsizei(src.indices.size());
+  m.first_index = GLuint(indices_used_);
+  m.base_vertex = GLint(vertices_used_);
+  m.uploaded = true;
+  vertices_used_ += n;
+  indices_used_ += src.indices.size();
   return m;
+}
+
+void GpuCache::draw_batch(std::span<const MeshDraw> draws) {
+  if (draws.empty()) return;
+  glBindVertexArray(vao_.id());
+  if (draws.size() == 1) {
+    const MeshDraw& d = draws[0];
+    glDrawElementsInstancedBaseVertexBaseInstance(
+        GL_TRIANGLES, d.mesh.index_count, GL_UNSIGNED_INT,
+        reinterpret_cast<const void*>(std::uintptr_t(d.mesh.first_index) * sizeof(std::uint32_t)),
+        GLsizei(d.count), d.mesh.base_vertex, d.first_instance);
+    return;
+  }
+  // glMultiDrawElementsIndirect's command layout (GL 4.6 core, 10.4).
+  struct Command {
+    GLuint count, instance_count, first_index;
+    GLint base_vertex;
+    GLuint base_instance;
+  };
+  std::vector<Command> commands;
+  commands.reserve(draws.size());
+  for (const MeshDraw& d : draws)
+    commands.push_back({GLuint(d.mesh.index_count), d.count, d.mesh.first_index, d.mesh.base_vertex,
+                        d.first_instance});
+  const std::size_t first = commands_used_;
+  if (first + commands.size() > commands_capacity_) {
+    commands_capacity_ =
+        std::max<std::size_t>({256, 2 * commands_capacity_, first + commands.size()});
+    commands_ = gpu::make_buffer();
+    glNamedBufferStorage(commands_.id(), GLsizeiptr(commands_capacity_ * sizeof(Command)), nullptr,
+                         GL_DYNAMIC_STORAGE_BIT);
+  }
+  glNamedBufferSubData(commands_.id(), GLintptr(first * sizeof(Command)),
+                       GLsizeiptr(commands.size() * sizeof(Command)), commands.data());
+  commands_used_ = first + commands.size();
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands_.id());
+  glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT,
+                              reinterpret_cast<const void*>(first * sizeof(Command)),
+                              GLsizei(commands.size()), 0);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
 }
 
 std::uint32_t GpuCache::upload(std::span<const InstanceRecord> records) {
@@ -130,10 +204,9 @@ std::uint32_t GpuCache::upload(std::span<const InstanceRecord> records) {
     instances_ = gpu::make_buffer();
     glNamedBufferStorage(instances_.id(), GLsizeiptr(instances_capacity_ * sizeof(InstanceRecord)),
                          nullptr, GL_DYNAMIC_STORAGE_BIT);
-    for (GpuMesh& m : meshes_)
-      if (m.vao)
-        glVertexArrayVertexBuffer(m.vao.id(), kInstanceBinding, instances_.id(), 0,
-                                  sizeof(InstanceRecord));
+    if (vao_)
+      glVertexArrayVertexBuffer(vao_.id(), kInstanceBinding, instances_.id(), 0,
+                                sizeof(InstanceRecord));
   }
   if (!records.empty())
     glNamedBufferSubData(instances_.id(), GLintptr(first * sizeof(InstanceRecord)),

@@ -18,12 +18,22 @@
 
 namespace kaskad::render {
 
-/// One mesh on the GPU: positions | normals | uvs in one buffer, 32-bit indices.
+/// Where one mesh lies in the cache's shared geometry. Every mesh's vertices (position, normal,
+/// uv, tangent: one Vertex each) share one buffer and its 32-bit indices another, read through one
+/// vertex array, so that draws of different meshes with the same program and material can be one
+/// multi-draw (draw_batch()).
 struct GpuMesh {
-  gpu::VertexArray vao;
-  gpu::Buffer vertices;
-  gpu::Buffer indices;
   GLsizei index_count = 0;
+  GLuint first_index = 0;  ///< in the shared index buffer
+  GLint base_vertex = 0;   ///< added to each of its indices
+  bool uploaded = false;
+};
+
+/// One draw of a batch: `count` instances of `mesh` (a copy: mesh() may move the cache's
+/// records) from instance record `first_instance` on (upload()'s index plus the draw's first).
+struct MeshDraw {
+  GpuMesh mesh;
+  std::uint32_t first_instance, count;
 };
 
 class GpuCache {
@@ -37,6 +47,10 @@ class GpuCache {
 
   /// Mesh `id` of the store given to use(), uploaded on first use. Precondition: a valid id.
   const GpuMesh& mesh(MeshId id);
+  /// Draws `draws` (triangles, instanced) with the bound program and state: one
+  /// glDrawElementsInstancedBaseVertexBaseInstance for one draw, else one
+  /// glMultiDrawElementsIndirect whose commands go to the frame's indirect buffer.
+  void draw_batch(std::span<const MeshDraw> draws);
   /// Material texture `id` (sRGB colour, or linear for a normal map), uploaded with mips on
   /// first use; a 1x1 white (or flat normal) texture for kNoTexture or an unknown id.
   gpu::TextureRef texture(TextureId id, bool is_normal_map);
@@ -46,14 +60,22 @@ class GpuCache {
   /// `records` after the ones stored earlier in the frame and returns the index of the first,
   /// the base instance of the draws that read them (every mesh's vertex array reads instanced
   /// attributes from this buffer).
-  void begin_frame() { instances_used_ = 0; }
+  void begin_frame() { instances_used_ = commands_used_ = 0; }
   std::uint32_t upload(std::span<const InstanceRecord> records);
 
  private:
   GpuCache() = default;
   const AssetStore* assets_ = nullptr;
   std::uint64_t assets_uid_ = 0;
+  void reserve_geometry(std::size_t vertices, std::size_t indices);
+
   std::vector<GpuMesh> meshes_;                        // indexed by MeshId
+  gpu::VertexArray vao_;  // every mesh's vertices and indices, and the instance records
+  gpu::Buffer vertices_, indices_;
+  std::size_t vertices_used_ = 0, vertices_capacity_ = 0;  // in Vertex
+  std::size_t indices_used_ = 0, indices_capacity_ = 0;    // in indices
+  gpu::Buffer commands_;  // the frame's multi-draw commands, from commands_used_ on free
+  std::size_t commands_used_ = 0, commands_capacity_ = 0;
   std::vector<std::unique_ptr<gpu::Texture>> textures_;  // indexed by TextureId
   gpu::Texture white_, flat_normal_;
   gpu::Buffer instances_;

@@ -184,14 +184,6 @@ bool DrawState::depth_reads_material(VariantKey key) const {
   return key.has(VariantKey::kAlphaMask) || features_by_uniform_;
 }
 
-namespace {
-
-// Whether `model` mirrors (negative determinant): its triangles wind the other way on screen, so
-// the front face is the clockwise one (glTF 2.0, "Transformations").
-bool mirrors(const glm::mat4& model) { return glm::determinant(glm::mat3(model)) < 0.0f; }
-
-}  // namespace
-
 // ---- ShadowMapPass ------------------------------------------------------------------------------
 
 void ShadowMapPass::ensure_storage(int size, int layers, DepthFormat format, ShadowFilter filter) {
@@ -386,7 +378,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   stats.shadow_rect_culled = 0;
   stats.shadow_layers_scrolled = 0;
   stats.shadow_texels_drawn = 0;
-  stats.shadow_draw_calls = 0;
+  stats.shadow_draw_calls = stats.shadow_mesh_draws = 0;
   stats.shadow_instances = 0;
   stats.shadow_triangles = 0;
   redraw_ = 0;
@@ -608,16 +600,33 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
 
 namespace {
 
+// Draws `batch` (draws of one program, material and winding) as one multi-draw, or with
+// render.multi_draw off one call per mesh, counting both.
+void draw_batch(const FrameInput& frame, GpuCache& cache, std::span<const MeshDraw> batch,
+                int& calls, int& mesh_draws) {
+  mesh_draws += int(batch.size());
+  if (frame.multi_draw) {
+    cache.draw_batch(batch);
+    calls += batch.empty() ? 0 : 1;
+    return;
+  }
+  for (const MeshDraw& d : batch) cache.draw_batch({&d, 1});
+  calls += int(batch.size());
+}
+
 // Casters of one shadow view drawn by one instanced draw: draw list entry `draw` gives the mesh,
-// program and material; records first .. first + count - 1 the instances.
+// program and material; records first .. first + count - 1 the instances. Consecutive runs with
+// the same program, material (where it reads one) and winding are one batch (one multi-draw).
 struct CasterRun {
   std::uint32_t draw;
   std::size_t first, count;
-  bool mirrored;  ///< the casters' transforms mirror (negative determinant): reversed winding
+  bool mirrored;      ///< the casters' transforms mirror (negative determinant): reversed winding
+  bool starts_batch;  ///< its program, material or winding differs from the run before's
 };
 
 // Draws of view `view` as instanced runs that share a draw (same mesh and depth program, and
-// the same material where the depth program reads it), in depth order. `mask_of(i)`: the layers
+// the same material where the depth program reads it), in depth order, marked where a batch
+// starts. `mask_of(i)`: the layers
 // of the view (bit c) draw i goes to; `record_of(i, c)`: its instance record in layer c. The
 // records go to `records`, one per draw and layer.
 // The depth program's key of draw i in view `view`; `peel`: a LomPass depth peel (one layer per
@@ -637,7 +646,7 @@ std::vector<CasterRun> depth_runs(const FrameInput& frame, const DrawList& list,
   auto same_batch = [&](std::uint32_t i, std::uint32_t j) {
     const DrawItem& a = frame.draws[i];
     const DrawItem& b = frame.draws[j];
-    if (a.mesh != b.mesh || mirrors(a.model) != mirrors(b.model) ||
+    if (mirrors(a.model) != mirrors(b.model) ||
         depth_program_key(list, view, i, peel).filtered_for(Pass::depth) !=
             depth_program_key(list, view, j, peel).filtered_for(Pass::depth))
       return false;
@@ -650,8 +659,9 @@ std::vector<CasterRun> depth_runs(const FrameInput& frame, const DrawList& list,
   for (std::uint32_t i : list.depth_order) {
     const std::uint32_t mask = mask_of(i);
     if (mask == 0 || cache.mesh(frame.draws[i].mesh).index_count == 0) continue;
-    if (runs.empty() || !same_batch(previous, i))
-      runs.push_back({i, records.size(), 0, mirrors(frame.draws[i].model)});
+    const bool starts_batch = runs.empty() || !same_batch(previous, i);
+    if (starts_batch || frame.draws[previous].mesh != frame.draws[i].mesh)
+      runs.push_back({i, records.size(), 0, mirrors(frame.draws[i].model), starts_batch});
     previous = i;
     for (int c = 0; c < v.layer_count; ++c)
       if (mask & (1u << c)) records.push_back(record_of(i, c));
@@ -715,9 +725,16 @@ Status draw_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache,
                  bool peel = false) {
   const std::uint32_t base = cache.upload(records);
   const ShadowView& v = frame.shadow_views[view];
-  for (const CasterRun& run : runs) {
+  std::vector<MeshDraw> batch;
+  for (std::size_t first = 0; first < runs.size();) {
+    const CasterRun& run = runs[first];
     const DrawItem& d = frame.draws[run.draw];
-    const GpuMesh& m = cache.mesh(d.mesh);
+    std::size_t end = first + 1;
+    while (end < runs.size() && !runs[end].starts_batch) ++end;
+    batch.clear();
+    for (std::size_t r = first; r < end; ++r)
+      batch.push_back({cache.mesh(frame.draws[runs[r].draw].mesh),
+                       base + std::uint32_t(runs[r].first), std::uint32_t(runs[r].count)});
     KASKAD_TRY(state.use_program(Pass::depth, depth_program_key(list, view, run.draw, peel)));
     const GLuint prog = state.program().id();
     // The material as the depth program sees it: uniforms of features it lacks (occlusion, ...)
@@ -732,10 +749,8 @@ Status draw_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache,
                                 &v.view_proj[0][0][0]);
     }
     glFrontFace(run.mirrored ? GL_CW : GL_CCW);
-    glBindVertexArray(m.vao.id());
-    glDrawElementsInstancedBaseInstance(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
-                                        GLsizei(run.count), GLuint(base + run.first));
-    ++stats.shadow_draw_calls;
+    draw_batch(frame, cache, batch, stats.shadow_draw_calls, stats.shadow_mesh_draws);
+    first = end;
   }
   glFrontFace(GL_CCW);
   return {};
@@ -1292,19 +1307,30 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
   auto reflective = [&](std::uint32_t i) {
     return keys[i].has(VariantKey::kReflectionCube) || keys[i].has(VariantKey::kReflectionSphere);
   };
-  // Runs of visible draws with the same mesh, program, material and winding become one
-  // instanced draw; a reflective draw (its own probe map and k_s * p_r) stays alone.
+  // Runs of visible draws with the same program, material and winding become one batch: one
+  // instanced draw per mesh, all in one multi-draw; a reflective draw (its own probe map and
+  // k_s * p_r) stays alone. The draw list orders a batch's draws by mesh.
+  std::vector<MeshDraw> batch;
   for (std::size_t first = 0; first < visible.size();) {
     const std::uint32_t i = visible[first];
     const DrawItem& d = frame.draws[i];
     const bool mirrored = mirrors(d.model);
     std::size_t end = first + 1;
     if (!reflective(i))
-      while (end < visible.size() && frame.draws[visible[end]].mesh == d.mesh &&
-             keys[visible[end]] == keys[i] && frame.draws[visible[end]].material == d.material &&
+      while (end < visible.size() && keys[visible[end]] == keys[i] &&
+             frame.draws[visible[end]].material == d.material &&
              mirrors(frame.draws[visible[end]].model) == mirrored)
         ++end;
-    const GpuMesh& m = cache.mesh(d.mesh);
+    batch.clear();
+    for (std::size_t k = first; k < end; ++k) {
+      const MeshId mesh = frame.draws[visible[k]].mesh;
+      if (k > first && frame.draws[visible[k - 1]].mesh == mesh) {
+        ++batch.back().count;
+      } else {
+        batch.push_back({cache.mesh(mesh), base + std::uint32_t(k), 1});
+      }
+      stats.triangles += std::size_t(batch.back().mesh.index_count / 3);
+    }
     KASKAD_TRY(state.use_program(Pass::forward, keys[i]));
     const GLuint prog = state.program().id();
     if (d.material.double_sided) {
@@ -1341,12 +1367,8 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
         break;
       }
     }
-    glBindVertexArray(m.vao.id());
-    glDrawElementsInstancedBaseInstance(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr,
-                                        GLsizei(end - first), GLuint(base + first));
-    ++stats.draw_calls;
+    draw_batch(frame, cache, batch, stats.draw_calls, stats.mesh_draws);
     stats.instances += int(end - first);
-    stats.triangles += (end - first) * std::size_t(m.index_count / 3);
     first = end;
   }
   glFrontFace(GL_CCW);
@@ -1409,7 +1431,8 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
         const FrameBlock face = probe_face_block(main, job, f);
         glNamedBufferSubData(ubo.id(), 0, sizeof face, &face);
         cache.probes().begin_face(job.handle, buffer, f, frame.clear_color);
-        const int before = stats.draw_calls, instances_before = stats.instances;
+        const int before = stats.draw_calls, mesh_draws_before = stats.mesh_draws,
+                  instances_before = stats.instances;
         const std::size_t triangles_before = stats.triangles;
         status = draw_forward(frame, list.capture_order, list.capture_keys, &job, round,
                               face.view_proj, cache, state, stats);
@@ -1417,6 +1440,7 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
         stats.probe_draw_calls += stats.draw_calls - before;
         stats.probe_instances += stats.instances - instances_before;
         stats.draw_calls = before;
+        stats.mesh_draws = mesh_draws_before;
         stats.instances = instances_before;
         stats.triangles = triangles_before;
         ++stats.probe_faces;

@@ -269,7 +269,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   if (int(frame.lights.size()) > kMaxLights)
     log::warn_once("%zu lights; only the first %d are shaded", frame.lights.size(), kMaxLights);
   read_timers();
-  stats_.draw_calls = stats_.instances = 0;
+  stats_.draw_calls = stats_.mesh_draws = stats_.instances = 0;
   stats_.triangles = 0;
   stats_.frustum_culled = 0;
   stats_.program_switches = stats_.material_switches = 0;

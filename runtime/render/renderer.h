@@ -28,17 +28,20 @@
 
 namespace kaskad::render {
 
-/// Draw calls are GL draw calls: draws that share mesh, program and material are one instanced
-/// draw. Instances are the objects those calls draw.
+/// Draw calls are GL draw calls: draws that share program, material and winding are one call, a
+/// multi-draw of one instanced draw per mesh among them (mesh draws; a call of one mesh is a plain
+/// instanced draw). Instances are the objects those calls draw.
 struct FrameStats {
   /// Forward pass of the main view; with render.msaa > 1 and AOVs, its multisampled colour
   /// and single-sample AOV draws together (each object twice).
   int draw_calls = 0;
+  int mesh_draws = 0;                 ///< the instanced draws within them (one per mesh)
   int instances = 0;                  ///< objects drawn by them
   int frustum_culled = 0;             ///< draws outside the main view's frustum, not drawn
   std::size_t triangles = 0;          ///< submitted in the forward pass (both, as draw_calls)
   /// Shadow pass draw calls recorded this frame (0 when every layer kept its depth).
   int shadow_draw_calls = 0;
+  int shadow_mesh_draws = 0;  ///< the instanced draws within them (one per mesh)
   /// Caster instances in the shadow map's layers (one per caster and layer) and their
   /// triangles, whether drawn this frame or kept from an earlier one (shadow_layers_rendered
   /// says which layers were drawn).

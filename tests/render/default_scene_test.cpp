@@ -286,8 +286,8 @@ TEST_F(DefaultSceneTest, StableCascadesDoNotShimmerUnderSubTexelCameraMoves) {
 // Crop fits: the stable fit's spheres are wide enough here for every cascade to see every caster
 // once the range starts at the nearest receiver.
 TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
-  // One pass per layer: the casters of each cascade, one instanced draw call per mesh among
-  // them (the depth program does not read materials; the layered pass is below).
+  // One pass per layer: the casters of each cascade, one instanced draw per mesh among them, all
+  // in one call (the depth program does not read materials; the layered pass is below).
   auto scene = load_scene(
       content_dir() / "scenes" / "default.json",
       {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=false",
@@ -298,7 +298,7 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
   const render::FrameStats& st = t->last.stats;
   const ShadowData& sh = t->last.shadow();
   ASSERT_EQ(st.shadow_layers, 8);
-  int casters = 0, culled = 0, meshes_per_layer = 0;
+  int casters = 0, culled = 0, meshes_per_layer = 0, layers_drawn = 0;
   std::size_t triangles = 0;
   std::set<MeshId> all_meshes;
   for (std::size_t i = 0; i < 8; ++i) {
@@ -306,6 +306,7 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
     std::set<MeshId> meshes;
     for (ecs::Entity e : sh.casters[i]) meshes.insert(scene->world.get<MeshRenderer>(e).mesh);
     if (!sh.skipped[i]) meshes_per_layer += int(meshes.size());
+    if (!sh.skipped[i] && !meshes.empty()) ++layers_drawn;
     all_meshes.insert(meshes.begin(), meshes.end());
     if (sh.skipped[i]) {
       EXPECT_EQ(st.layer_casters[i], 0) << "cascade " << i;
@@ -315,8 +316,9 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
     culled += 8 - st.layer_casters[i];  // the default scene has 8 casters
   }
   EXPECT_EQ(casters, st.shadow_instances);
-  EXPECT_EQ(st.shadow_draw_calls, meshes_per_layer);
-  EXPECT_LT(st.shadow_draw_calls, st.shadow_instances);  // the boxes share a draw
+  EXPECT_EQ(st.shadow_mesh_draws, meshes_per_layer);
+  EXPECT_LT(st.shadow_mesh_draws, st.shadow_instances);  // the boxes share a draw
+  EXPECT_EQ(st.shadow_draw_calls, layers_drawn);         // every mesh of a layer in one call
   EXPECT_EQ(triangles, st.shadow_triangles);
   EXPECT_GT(culled, 0);  // the nearest and farthest cascades do not see every caster
   EXPECT_FLOAT_EQ(sh.far_requested, 100.0f);
@@ -325,8 +327,8 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
   std::printf("[ 8 cascades ] last split pulled in from %.1f to %.1f m; %d of 64 caster draws culled\n",
               double(sh.far_requested), double(sh.far_used), culled);
 
-  // Layered: the same casters per cascade and the same triangles, but one instanced draw call
-  // per mesh for all cascades at once.
+  // Layered: the same casters per cascade and the same triangles, but one instanced draw per
+  // mesh for all cascades at once, in one call.
   auto layered_scene = load_scene(
       content_dir() / "scenes" / "default.json",
       {"render.width=160", "render.height=90", "shadow.cascade_count=8", "shadow.layered=true",
@@ -340,8 +342,9 @@ TEST_F(DefaultSceneTest, EachCascadeDrawsOnlyItsCulledCasters) {
     EXPECT_EQ(ls.layer_triangles[i], st.layer_triangles[i]) << "cascade " << i;
   }
   EXPECT_EQ(ls.shadow_instances, st.shadow_instances);
-  EXPECT_EQ(ls.shadow_draw_calls, int(all_meshes.size()));
-  EXPECT_LT(ls.shadow_draw_calls, st.shadow_draw_calls);
+  EXPECT_EQ(ls.shadow_mesh_draws, int(all_meshes.size()));
+  EXPECT_LT(ls.shadow_mesh_draws, st.shadow_mesh_draws);
+  EXPECT_EQ(ls.shadow_draw_calls, 1);
   EXPECT_EQ(ls.shadow_triangles, st.shadow_triangles);
 }
 

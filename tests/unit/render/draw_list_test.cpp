@@ -41,6 +41,7 @@ FrameInput shuffled_draws(int count, unsigned seed) {
     d.material = mats[gen() % mats.size()];
     d.receive_shadows = gen() % 4 != 0;
     d.model[3] = glm::vec4(float(i), 0.0f, 0.0f, 1.0f);
+    if (gen() % 5 == 0) d.model[0].x = -1.0f;  // a mirroring transform: the other winding
     frame.draws.push_back(d);
   }
   frame.shadow_views.push_back(ShadowView{});
@@ -74,20 +75,28 @@ void expect_runs(const std::vector<std::uint32_t>& order, std::size_t draws, Sam
   }
 }
 
-// Each order is sorted by its keys (materials by material_sorts_before()), and every class of
-// draws that may share one instanced draw is one run of it.
+// Each order is sorted by its keys (materials by material_sorts_before()), every class of draws
+// that may share one call (a multi-draw) is one run of it, and within that every class that may
+// share one instanced draw.
 TEST(DrawList, EveryOrderIsSortedAndDrawsThatMayShareADrawAreNeighbours) {
   for (unsigned seed : {1u, 2u, 3u}) {
     const FrameInput frame = shuffled_draws(3000, seed);
     const DrawList list = build_draw_list(frame, frame_variant(frame));
     const auto& d = frame.draws;
     auto fwd = [&](std::uint32_t a) { return list.keys[a].filtered_for(Pass::forward); };
-    expect_runs(list.forward_order, d.size(), [&](std::uint32_t a, std::uint32_t b) {
-      return fwd(a) == fwd(b) && d[a].material == d[b].material && d[a].mesh == d[b].mesh;
-    }, "forward");
-    // Sorted by (key, material, mesh): no draw sorts before the one ahead of it.
+    auto same_call = [&](std::uint32_t a, std::uint32_t b) {
+      return fwd(a) == fwd(b) && d[a].material == d[b].material &&
+             mirrors(d[a].model) == mirrors(d[b].model);
+    };
+    expect_runs(list.forward_order, d.size(), same_call, "forward calls", false);
+    expect_runs(
+        list.forward_order, d.size(),
+        [&](std::uint32_t a, std::uint32_t b) { return same_call(a, b) && d[a].mesh == d[b].mesh; },
+        "forward");
+    // Sorted by (key, winding, material, mesh): no draw sorts before the one ahead of it.
     auto forward_less = [&](std::uint32_t a, std::uint32_t b) {
       if (fwd(a) != fwd(b)) return fwd(a) < fwd(b);
+      if (mirrors(d[a].model) != mirrors(d[b].model)) return mirrors(d[b].model);
       if (material_sorts_before(d[a].material, d[b].material)) return true;
       if (material_sorts_before(d[b].material, d[a].material)) return false;
       return d[a].mesh < d[b].mesh;
@@ -96,13 +105,22 @@ TEST(DrawList, EveryOrderIsSortedAndDrawsThatMayShareADrawAreNeighbours) {
       EXPECT_FALSE(forward_less(list.forward_order[k], list.forward_order[k - 1])) << k;
     // The depth pass: one draw per mesh whatever the material, unless alpha-masked.
     auto depth = [&](std::uint32_t a) { return list.keys[a].filtered_for(Pass::depth); };
-    expect_runs(list.depth_order, d.size(), [&](std::uint32_t a, std::uint32_t b) {
-      if (depth(a) != depth(b) || d[a].mesh != d[b].mesh) return false;
+    auto same_depth_call = [&](std::uint32_t a, std::uint32_t b) {
+      if (depth(a) != depth(b) || mirrors(d[a].model) != mirrors(d[b].model)) return false;
       return !list.keys[a].has(VariantKey::kAlphaMask) || d[a].material == d[b].material;
-    }, "depth", false);
-    // Sorted by (key, mesh, material) where the key has no alpha mask, else (key, material, mesh).
+    };
+    expect_runs(list.depth_order, d.size(), same_depth_call, "depth calls", false);
+    expect_runs(
+        list.depth_order, d.size(),
+        [&](std::uint32_t a, std::uint32_t b) {
+          return same_depth_call(a, b) && d[a].mesh == d[b].mesh;
+        },
+        "depth", false);
+    // Sorted by (key, winding, mesh, material) where the key has no alpha mask, else (key,
+    // winding, material, mesh).
     auto depth_less = [&](std::uint32_t a, std::uint32_t b) {
       if (depth(a) != depth(b)) return depth(a) < depth(b);
+      if (mirrors(d[a].model) != mirrors(d[b].model)) return mirrors(d[b].model);
       if (!list.keys[a].has(VariantKey::kAlphaMask) && d[a].mesh != d[b].mesh) return d[a].mesh < d[b].mesh;
       if (material_sorts_before(d[a].material, d[b].material)) return true;
       if (material_sorts_before(d[b].material, d[a].material)) return false;
@@ -121,11 +139,12 @@ TEST(DrawList, TheOrderOfClassesIsTheSameWhateverOrderDrawsArriveIn) {
   std::reverse(b.draws.begin(), b.draws.end());
   auto classes = [](const FrameInput& f) {
     const DrawList list = build_draw_list(f, frame_variant(f));
-    std::vector<std::tuple<std::uint64_t, std::uint32_t, bool, float, float, float>> out;
+    std::vector<std::tuple<std::uint64_t, bool, std::uint32_t, bool, float, float, float>> out;
     for (std::uint32_t i : list.forward_order) {
       const DrawItem& d = f.draws[i];
-      out.emplace_back(list.keys[i].bits(), std::uint32_t(d.mesh), d.material.alpha_mask, d.material.roughness,
-                       d.material.base_color.r, d.material.metallic == 0.0f ? 0.0f : d.material.metallic);
+      out.emplace_back(list.keys[i].bits(), mirrors(d.model), std::uint32_t(d.mesh),
+                       d.material.alpha_mask, d.material.roughness, d.material.base_color.r,
+                       d.material.metallic == 0.0f ? 0.0f : d.material.metallic);
     }
     return out;
   };
