@@ -1199,12 +1199,22 @@ Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest) 
   ecs::World& w = scene.world;
   std::vector<std::pair<ecs::Entity, MaterialRef>> material_refs;
   w.view<MaterialRef>().each([&](ecs::Entity e, MaterialRef& r) { material_refs.emplace_back(e, r); });
+  // Each material file is read once: the entities that name it share its textures (and so
+  // can share draws), where reading it per entity made a copy of every texture for each.
+  std::map<std::filesystem::path, Material> loaded;
   for (auto& [e, ref] : material_refs) {
     if (!manifest)
       return Error{scene.file.string(), "", "material files need the feature manifest"};
-    auto m = load_material_file(scene.file.parent_path() / ref.path, *manifest, scene.assets);
-    if (!m) return m.error();
-    w.emplace<Material>(e, *m);
+    const std::filesystem::path file = scene.file.parent_path() / ref.path;
+    std::error_code ec;
+    const std::filesystem::path key = std::filesystem::weakly_canonical(file, ec);
+    auto it = loaded.find(ec ? file : key);
+    if (it == loaded.end()) {
+      auto m = load_material_file(file, *manifest, scene.assets);
+      if (!m) return m.error();
+      it = loaded.emplace(ec ? file : key, *m).first;
+    }
+    w.emplace<Material>(e, it->second);
   }
   KASKAD_TRY(load_environment(scene));
   // Static reflection maps (S3 (a)): loaded once here; the probe system uploads them once.

@@ -206,7 +206,8 @@ std::vector<std::string> bench_csv_columns() {
           "receiver_pixels", "misclassified_pct", "false_shadow_pct", "false_light_pct", "rmse",
           "mae", "misclassified_pct_noedge", "false_shadow_pct_noedge", "false_light_pct_noedge",
           "rmse_noedge", "mae_noedge", "reference_mrays_per_s", "stability_points",
-          "stability_frames", "stability_step_m", "flicker", "flicker_changed_pct"};
+          "stability_frames", "stability_step_m", "flicker", "flicker_changed_pct", "mesh_draws",
+          "shadow_mesh_draws"};
 }
 
 Status run_bench(const BenchOptions& options) {
@@ -216,20 +217,23 @@ Status run_bench(const BenchOptions& options) {
   if (!configs) return configs.error();
   std::vector<fs::path> scenes = options.scenes;
   if (scenes.empty()) scenes.push_back(content_dir() / "scenes" / "default.json");
-  // Every scene x configuration is read and its --set values validated before the first frame
-  // (cheap: no models are imported), so a bad value in the sweep fails at once.
-  for (const fs::path& scene_path : scenes)
+  // Before the first frame: each scene is loaded as it is (its models and textures imported, so
+  // a missing or broken asset fails at once), then read with every configuration of the sweep,
+  // so a bad value in the sweep fails at once too, named as the sweep's.
+  for (const fs::path& scene_path : scenes) {
+    const std::vector<std::string> size = {"render.width=" + std::to_string(options.width),
+                                           "render.height=" + std::to_string(options.height)};
+    if (auto loaded = load_scene(scene_path, size); !loaded) return loaded.error();
     for (const BenchConfig& config : *configs) {
       std::vector<std::string> sets = config.sets;
-      sets.push_back("render.width=" + std::to_string(options.width));
-      sets.push_back("render.height=" + std::to_string(options.height));
-      auto checked = read_scene(scene_path, sets);
-      if (!checked) {
+      sets.insert(sets.end(), size.begin(), size.end());
+      if (auto checked = read_scene(scene_path, sets); !checked) {
         Error e = checked.error();
         e.message += " (--sweep configuration " + config.label + ")";
         return e;
       }
     }
+  }
   // The output folder is the one the user named (--out, or out/bench): made when missing, one
   // level only.
   std::error_code ec;
@@ -242,12 +246,13 @@ Status run_bench(const BenchOptions& options) {
   KASKAD_TRY(check_output_folder(options.out_dir));
   const fs::path csv_path = options.out_dir / "bench.csv";
   // The CSV is rewritten atomically after every row (atomic_file.h): rows survive Ctrl-C and
-  // crashes, and the file is never half-written.
+  // crashes, and the file is never half-written. A run that fails before its first row leaves
+  // the folder's previous bench.csv as it was.
+  KASKAD_TRY(check_output_path(csv_path));
   std::string csv;
   const auto columns = bench_csv_columns();
   for (std::size_t i = 0; i < columns.size(); ++i) csv += (i ? "," : "") + columns[i];
   csv += "\n";
-  KASKAD_TRY(write_file_atomic(csv_path, csv));
 
   gpu::ContextOptions copt;
   copt.headless = true;
@@ -401,7 +406,8 @@ Status run_bench(const BenchOptions& options) {
           std::to_string(has_stability ? options.stability_frames : 0),
           has_stability ? fmt(stab_run.step) : fmt(nan),
           has_stability ? fmt(stability.flicker) : fmt(nan),
-          has_stability ? fmt(stability.changed_pct) : fmt(nan)};
+          has_stability ? fmt(stability.changed_pct) : fmt(nan),
+          std::to_string(st.mesh_draws), std::to_string(st.shadow_mesh_draws)};
       for (std::size_t i = 0; i < row.size(); ++i) csv += (i ? "," : "") + csv_quote(row[i]);
       csv += "\n";
       if (auto st = write_file_atomic(csv_path, csv); !st) {
@@ -416,11 +422,17 @@ Status run_bench(const BenchOptions& options) {
   progress_line(done, total, std::chrono::duration<double>(Clock::now() - t0).count(),
            g_interrupted ? "interrupted" : "done");
   std::fprintf(stderr, "\n");
-  if (!result.ok()) return result;
-  std::printf("wrote     %s (%zu rows%s)\n", fs::absolute(csv_path).string().c_str(), done,
-              g_interrupted ? ", interrupted" : "");
-  if (options.chart && done > 0) KASKAD_TRY(draw_charts(csv_path, options.out_dir));
-  return {};
+  if (done > 0) {
+    std::printf("wrote     %s (%zu row%s%s)\n", fs::absolute(csv_path).string().c_str(), done,
+                done == 1 ? "" : "s",
+                !result.ok() ? ", then failed" : g_interrupted ? ", interrupted" : "");
+    // The runs that finished are charted even when a later one failed.
+    if (options.chart) {
+      const Status charted = draw_charts(csv_path, options.out_dir);
+      if (result.ok()) KASKAD_TRY(charted);
+    }
+  }
+  return result;
 }
 
 Status merge_bench(const std::vector<fs::path>& dirs, const fs::path& out_dir, bool chart) {

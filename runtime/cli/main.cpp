@@ -1,6 +1,7 @@
 // The `kaskad` command line: render scenes headless (or in a window), write images and AOVs,
 // and save canonical scene files. Run `kaskad --help`.
 #include <algorithm>
+#include <cctype>
 #include <bit>
 #include <chrono>
 #include <csignal>
@@ -8,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "components/camera.h"
@@ -151,6 +153,11 @@ Args parse_args(int argc, char** argv) {
     const std::string arg = argv[i];
     auto value = [&]() -> std::string {
       if (i + 1 >= argc) usage_error(arg + " needs a value");
+      // `--set -o x.png`: the option's value is missing, not "-o" (a negative number is left to
+      // the value's own check; a file named -x is ./-x).
+      const std::string v = argv[i + 1];
+      if (v.size() > 1 && v[0] == '-' && !std::isdigit(static_cast<unsigned char>(v[1])))
+        usage_error(arg + " needs a value, got the option '" + v + "'");
       return argv[++i];
     };
     if (arg == "-h" || arg == "--help") {
@@ -174,6 +181,9 @@ Args parse_args(int argc, char** argv) {
       a.shadow_reference = value();
     } else if (arg == "--sweep" && a.command == "bench") {
       a.sweep = value();
+      if (a.sweep.empty())
+        usage_error("--sweep needs a sweep (e.g. shadow.map_size=1024,2048, or soft); without "
+                    "--sweep, bench runs the default one");
     } else if (arg == "--out" && a.command == "bench") {
       a.out_dir = value();
     } else if ((arg == "--out" || arg == "--sweep") && a.command == "render") {
@@ -267,6 +277,8 @@ int run_info(const Args& a) {
 int run_save(const Args& a) {
   if (a.scene.empty()) usage_error("save needs a SCENE");
   if (a.output.empty()) usage_error("save needs -o OUT.json");
+  if (lowercase_extension(a.output) != ".json")
+    usage_error("save writes a scene file: -o needs a .json path, got '" + a.output + "'");
   auto scene = read_scene(a.scene, a.sets);
   if (!scene) return fail(scene.error());
   if (auto st = save_scene(a.output, *scene); !st) return fail(st.error());
@@ -373,9 +385,31 @@ Status check_render_outputs(const Args& a, const fs::path& out) {
   } else {
     KASKAD_TRY(check_image_output(out));
   }
-  for (const std::string* extra :
-       {&a.aov, &a.shadow_map, &a.reflection_reference, &a.shadow_reference})
-    if (!extra->empty()) KASKAD_TRY(check_image_output(*extra));
+  // The data outputs hold named float channels (AOVs, references' errors, depths): OpenEXR only,
+  // where another format would drop channels or clip them to 8 bits.
+  const std::pair<const char*, const std::string*> data_outputs[] = {
+      {"--aov", &a.aov},
+      {"--shadow-map", &a.shadow_map},
+      {"--reflection-reference", &a.reflection_reference},
+      {"--shadow-reference", &a.shadow_reference}};
+  std::vector<std::pair<std::string, fs::path>> named = {{"-o", out}};
+  for (const auto& [flag, file] : data_outputs) {
+    if (file->empty()) continue;
+    KASKAD_TRY(check_image_output(*file));
+    if (lowercase_extension(*file) != ".exr")
+      return Error{*file, "", std::string(flag) +
+                                  " writes named float channels: it needs an OpenEXR file "
+                                  "(.exr), which other formats would cut to 8 bits or fewer "
+                                  "channels"};
+    named.emplace_back(flag, *file);
+  }
+  // Two outputs of one path: the second would replace the first.
+  for (std::size_t i = 0; i < named.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (fs::weakly_canonical(named[i].second, ec) == fs::weakly_canonical(named[j].second, ec))
+        return Error{named[i].second.string(), "",
+                     named[j].first + " and " + named[i].first +
+                         " name the same file: one would replace the other"};
   if (!a.probe_maps.empty()) KASKAD_TRY(make_named_folder(a.probe_maps));
   return {};
 }
@@ -431,16 +465,24 @@ int run_render(Args a) {
   const auto& st = timings->last.stats;
   const std::string msaa =
       st.msaa_samples > 1 ? ", " + std::to_string(st.msaa_samples) + "x MSAA" : std::string();
-  std::printf("frames    %d at %dx%d%s: first %.1f ms, median %.2f ms (frames 2..%d)\n", a.frames,
-              scene->render.width, scene->render.height, msaa.c_str(), timings->first_frame_ms,
-              timings->median_ms(), a.frames);
+  if (a.frames > 1) {
+    std::printf("frames    %d at %dx%d%s: first %.1f ms, median %.2f ms (frames 2..%d)\n",
+                a.frames, scene->render.width, scene->render.height, msaa.c_str(),
+                timings->first_frame_ms, timings->median_ms(), a.frames);
+  } else {  // the first frame alone (it compiles programs and uploads assets): no median
+    std::printf("frames    1 at %dx%d%s: %.1f ms\n", scene->render.width, scene->render.height,
+                msaa.c_str(), timings->first_frame_ms);
+  }
   std::printf(
       "last      %d objects in %d draw calls of %d meshes (%d outside the view, "
       "culled), %zu triangles; shadow pass %d caster instances in %d draw calls of %d "
-      "meshes, %zu triangles; GPU shadow %.2f ms, forward %.2f ms; %d program and %d "
+      "meshes%s, %zu triangles; GPU shadow %.2f ms, forward %.2f ms; %d program and %d "
       "material switches\n",
       st.instances, st.draw_calls, st.mesh_draws, st.frustum_culled, st.triangles,
-      st.shadow_instances, st.shadow_draw_calls, st.shadow_mesh_draws, st.shadow_triangles,
+      st.shadow_instances, st.shadow_draw_calls, st.shadow_mesh_draws,
+      st.shadow_layers > 0 && st.shadow_layers_rendered == 0 ? " (every layer kept its depth)"
+                                                             : "",
+      st.shadow_triangles,
       st.shadow_gpu_ms, st.forward_gpu_ms, st.program_switches, st.material_switches);
   if (st.probe_gpu_ms > 0 || st.lom_gpu_ms > 0 || st.moments_gpu_ms > 0)
     std::printf("          GPU parts: probe captures %.2f ms (prefiltering %.2f ms of it), lom "

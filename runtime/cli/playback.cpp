@@ -599,7 +599,7 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
   csv << "frame,t,frame_ms,cpu_transforms_ms,cpu_camera_ms,cpu_shadows_ms,cpu_probes_ms,"
          "cpu_draw_list_ms,cpu_render_ms,gpu_shadow_ms,gpu_forward_ms,gpu_probe_ms,draw_calls,"
          "shadow_draw_calls,shadow_triangles,probe_faces,probe_captures,compiles_after_prewarm,"
-         "misclassified_pct,rss_mib,gl_objects\n";
+         "misclassified_pct,rss_mib,gl_objects,mesh_draws,shadow_mesh_draws\n";
   double rss_warm = 0.0, rss_max_after = 0.0, rss_end = 0.0;
   long gl_warm = 0, gl_max_after = 0;
   std::vector<double> frame_ms;
@@ -772,13 +772,13 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
     const auto& st = report.stats;
     char line[640];
     std::snprintf(line, sizeof line,
-                  "%d,%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%d,%zu,%d,%d,%d,%s,%.2f,%ld\n", f,
+                  "%d,%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%d,%zu,%d,%d,%d,%s,%.2f,%ld,%d,%d\n", f,
                   t, ms, report.transforms_ms, report.camera_ms, report.shadows_ms, report.probes_ms,
                   report.draw_list_ms, report.render_ms, st.shadow_gpu_ms, st.forward_gpu_ms,
                   st.probe_gpu_ms, st.draw_calls, st.shadow_draw_calls, st.shadow_triangles,
                   st.probe_faces, report.probes.captures_this_frame, row.compiles,
                   row.misclassified_pct < 0 ? "" : std::to_string(row.misclassified_pct).c_str(),
-                  rss, gl_objects);
+                  rss, gl_objects, st.mesh_draws, st.shadow_mesh_draws);
     csv << line;
     print_progress(std::size_t(f + 1), std::size_t(pb.frames),
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count(),

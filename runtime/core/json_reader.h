@@ -140,9 +140,12 @@ class ObjectReader {
     const json& v = j_.at(key);
     if (!v.is_number()) fail(at(key), "expected a number, got " + type_name(v));
     const double d = v.get<double>();
-    if (!(d >= lo && d <= hi))
+    // Compared as the float it is stored as: a bound written in the file (1e-7) is a double a
+    // little off the float bound, and must be accepted.
+    const float f = float(d);
+    if (!(f >= lo && f <= hi))
       fail(at(key), "must be in [" + fmt(lo) + ", " + fmt(hi) + "], was " + fmt(d));
-    out = float(d);
+    out = f;
   }
   void integer(const char* key, int& out, int lo, int hi) {
     record_range(key, lo, hi);
@@ -187,10 +190,11 @@ class ObjectReader {
       if (!v[std::size_t(i)].is_number())
         fail(at(key) + "/" + std::to_string(i), "expected a number, got " + type_name(v[std::size_t(i)]));
       const double d = v[std::size_t(i)].get<double>();
-      if (!(d >= lo && d <= hi))
+      const float f = float(d);  // compared as stored, as number() does
+      if (!(f >= lo && f <= hi))
         fail(at(key) + "/" + std::to_string(i),
              "must be in [" + fmt(lo) + ", " + fmt(hi) + "], was " + fmt(d));
-      out[i] = float(d);
+      out[i] = f;
     }
   }
   template <class E>

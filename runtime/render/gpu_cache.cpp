@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 
 #include <glm/glm.hpp>
 
@@ -103,7 +102,7 @@ void GpuCache::reserve_geometry(std::size_t vertices, std::size_t indices) {
   auto grow = [](gpu::Buffer& buffer, std::size_t& capacity, std::size_t used, std::size_t need,
                  std::size_t element) {
     if (need <= capacity) return false;
-    const std::size_t grown = std::max<std::size_t>({std::size_t(1) << 12, 2 * capacity, need});
+    const std::size_t grown = std::max<std::size_t>({kGeometryFirstCapacity, 2 * capacity, need});
     gpu::Buffer bigger = gpu::make_buffer();
     glNamedBufferStorage(bigger.id(), GLsizeiptr(grown * element), nullptr, GL_DYNAMIC_STORAGE_BIT);
     if (used > 0)
@@ -138,6 +137,10 @@ const GpuMesh& GpuCache::mesh(MeshId id) {
     if (src.uvs.size() == n) vertices[i].uv = src.uvs[i];
     if (tangents.size() == n) vertices[i].tangent = tangents[i];
   }
+  // The draws' base vertex is a GLint, their first index a GLuint.
+  KASKAD_CHECK(vertices_used_ + n <= std::size_t(INT32_MAX) &&
+                   indices_used_ + src.indices.size() <= std::size_t(UINT32_MAX),
+               "the scene's meshes hold more vertices or indices than one buffer can address");
   reserve_geometry(vertices_used_ + n, indices_used_ + src.indices.size());
   if (n > 0)
     glNamedBufferSubData(vertices_.id(), GLintptr(vertices_used_ * sizeof(Vertex)),
@@ -166,14 +169,8 @@ void GpuCache::draw_batch(std::span<const MeshDraw> draws) {
         GLsizei(d.count), d.mesh.base_vertex, d.first_instance);
     return;
   }
-  // glMultiDrawElementsIndirect's command layout (GL 4.6 core, 10.4).
-  struct Command {
-    GLuint count, instance_count, first_index;
-    GLint base_vertex;
-    GLuint base_instance;
-  };
-  std::vector<Command> commands;
-  commands.reserve(draws.size());
+  std::vector<IndirectCommand>& commands = commands_scratch_;
+  commands.clear();
   for (const MeshDraw& d : draws)
     commands.push_back({GLuint(d.mesh.index_count), d.count, d.mesh.first_index, d.mesh.base_vertex,
                         d.first_instance});
@@ -182,15 +179,15 @@ void GpuCache::draw_batch(std::span<const MeshDraw> draws) {
     commands_capacity_ =
         std::max<std::size_t>({256, 2 * commands_capacity_, first + commands.size()});
     commands_ = gpu::make_buffer();
-    glNamedBufferStorage(commands_.id(), GLsizeiptr(commands_capacity_ * sizeof(Command)), nullptr,
+    glNamedBufferStorage(commands_.id(), GLsizeiptr(commands_capacity_ * sizeof(IndirectCommand)), nullptr,
                          GL_DYNAMIC_STORAGE_BIT);
   }
-  glNamedBufferSubData(commands_.id(), GLintptr(first * sizeof(Command)),
-                       GLsizeiptr(commands.size() * sizeof(Command)), commands.data());
+  glNamedBufferSubData(commands_.id(), GLintptr(first * sizeof(IndirectCommand)),
+                       GLsizeiptr(commands.size() * sizeof(IndirectCommand)), commands.data());
   commands_used_ = first + commands.size();
   glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands_.id());
   glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT,
-                              reinterpret_cast<const void*>(first * sizeof(Command)),
+                              reinterpret_cast<const void*>(first * sizeof(IndirectCommand)),
                               GLsizei(commands.size()), 0);
   glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
 }

@@ -29,6 +29,9 @@ struct GpuMesh {
   bool uploaded = false;
 };
 
+/// Vertices (and indices) the shared geometry's buffers first hold; each growth doubles them.
+inline constexpr std::size_t kGeometryFirstCapacity = 4096;
+
 /// One draw of a batch: `count` instances of `mesh` (a copy: mesh() may move the cache's
 /// records) from instance record `first_instance` on (upload()'s index plus the draw's first).
 struct MeshDraw {
@@ -58,7 +61,7 @@ class GpuCache {
 
   /// Instance records for this frame's draws: begin_frame() starts the frame; upload() stores
   /// `records` after the ones stored earlier in the frame and returns the index of the first,
-  /// the base instance of the draws that read them (every mesh's vertex array reads instanced
+  /// the base instance of the draws that read them (the shared vertex array reads instanced
   /// attributes from this buffer).
   void begin_frame() { instances_used_ = commands_used_ = 0; }
   std::uint32_t upload(std::span<const InstanceRecord> records);
@@ -74,7 +77,14 @@ class GpuCache {
   gpu::Buffer vertices_, indices_;
   std::size_t vertices_used_ = 0, vertices_capacity_ = 0;  // in Vertex
   std::size_t indices_used_ = 0, indices_capacity_ = 0;    // in indices
+  // glMultiDrawElementsIndirect's command layout (GL 4.6 core, 10.4).
+  struct IndirectCommand {
+    GLuint count, instance_count, first_index;
+    GLint base_vertex;
+    GLuint base_instance;
+  };
   gpu::Buffer commands_;  // the frame's multi-draw commands, from commands_used_ on free
+  std::vector<IndirectCommand> commands_scratch_;  // draw_batch()'s, kept for its capacity
   std::size_t commands_used_ = 0, commands_capacity_ = 0;
   std::vector<std::unique_ptr<gpu::Texture>> textures_;  // indexed by TextureId
   gpu::Texture white_, flat_normal_;

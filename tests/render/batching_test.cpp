@@ -7,6 +7,7 @@
 #include <string>
 
 #include "runtime/cli/player.h"
+#include "runtime/render/gpu_cache.h"
 #include "tests/render/headless_gl.h"
 #include "tests/test_tmp.h"
 
@@ -15,11 +16,13 @@ namespace {
 
 class BatchingTest : public HeadlessGlTest {};
 
-// Six meshes of one material (box, cylinder, cone, spheres of 12, 48 and 64 segments: more
-// vertices than the shared geometry's first buffer holds, so it grows during the frame), two
+
+// Seven meshes of one material (box, cylinder, cone, spheres of 12, 48, 64 and 128 segments:
+// more vertices and indices than the shared geometry's buffers first hold, so they grow), two
 // instances of one of them (one instanced draw within the call), a mirrored instance (the other
-// winding: a call of its own), a floor and the glTF Box (materials of their own), under a sun
-// with four cascades.
+// winding: a call of its own), two meshes of one alpha-masked material (their own call, in the
+// depth pass too), a floor and the glTF Box (materials of their own), under a sun with four
+// cascades.
 std::filesystem::path write_scene() {
   const std::filesystem::path file = testing_util::test_tmp() / "batching.json";
   std::ofstream out(file);
@@ -39,17 +42,25 @@ std::filesystem::path write_scene() {
                           R"("shape": "sphere", "segments": 12)",
                           R"("shape": "sphere", "segments": 48)",
                           R"("shape": "sphere", "segments": 64)",
+                          R"("shape": "sphere", "segments": 128)",
                           R"("shape": "box")"};
-  for (int i = 0; i < 7; ++i) {
+  for (int i = 0; i < 8; ++i) {
     out << ",\n    { \"name\": \"s" << i << "\", \"transform\": { \"translation\": ["
-        << -4.5 + 1.5 * i << ", 0.6, " << (i % 2 ? -1 : 1) << "], \"euler_deg\": [0, " << 25 * i
+        << -4.5 + 1.3 * i << ", 0.6, " << (i % 2 ? -1 : 1) << "], \"euler_deg\": [0, " << 25 * i
         << ", 0] }, \"primitive\": { " << shapes[i]
         << " }, \"material\": { \"base_color\": [0.8, 0.4, 0.2, 1], \"roughness\": 0.5 } }";
   }
+  const std::string foliage = (content_dir() / "materials" / "foliage_card.json").string();
   out << R"(,
     { "name": "mirrored", "transform": { "translation": [2, 0.6, 2.5], "scale": [-1, 1, 1],
       "euler_deg": [0, 30, 0] }, "primitive": { "shape": "cone" },
       "material": { "base_color": [0.8, 0.4, 0.2, 1], "roughness": 0.5 } },
+    { "name": "card", "transform": { "translation": [0, 1.2, 3], "euler_deg": [70, 20, 0] },
+      "primitive": { "shape": "plane" }, "material": { "file": ")"
+      << foliage << R"(" } },
+    { "name": "cut_box", "transform": { "translation": [3.5, 0.7, 2] },
+      "primitive": { "shape": "box" }, "material": { "file": ")"
+      << foliage << R"(" } },
     { "name": "model", "transform": { "translation": [-2, 0.5, 2.5] },
       "model": { "path": ")"
       << (content_dir() / "models/Box/glTF-Binary/Box.glb").string() << R"(" } }
@@ -58,50 +69,90 @@ std::filesystem::path write_scene() {
   return file;
 }
 
-TEST_F(BatchingTest, MultiDrawsGiveTheFrameOfOneCallPerMesh) {
-  auto scene = load_scene(write_scene());
-  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
-  FrameContext ctx;
-  ctx.width = 320;
-  ctx.height = 180;
-  render::FrameInput frame = plan_frame(*scene, ctx);
-  struct Run {
-    render::FrameStats stats;
-    Image color, aovs;
-  };
-  auto render_with = [&](bool multi_draw) {
-    // A renderer of its own: nothing kept from the other run (shadow layers, shared geometry).
-    auto renderer = render::Renderer::create(content_dir() / "shaders");
-    EXPECT_TRUE(renderer.ok()) << renderer.error().to_string();
-    Run r;
-    if (!renderer.ok()) return r;
-    frame.multi_draw = multi_draw;
-    const Status status = (*renderer)->render(frame, scene->assets);
+struct Frame {
+  render::FrameStats stats;
+  Image color, aovs, shadow_map;
+};
+
+// `frame` with multi-draw on or off, by a renderer of its own (nothing kept from another run:
+// shadow layers, shared geometry). With `first`, that renderer draws `first` before: its meshes
+// are uploaded first, so `frame`'s meshes lie elsewhere in the shared buffers.
+Frame render_with(const Scene& scene, render::FrameInput frame, bool multi_draw,
+                const render::FrameInput* first = nullptr) {
+  auto renderer = render::Renderer::create(content_dir() / "shaders");
+  EXPECT_TRUE(renderer.ok()) << renderer.error().to_string();
+  Frame r;
+  if (!renderer.ok()) return r;
+  if (first) {
+    const Status status = (*renderer)->render(*first, scene.assets);
     EXPECT_TRUE(status.ok()) << status.error().to_string();
-    r.stats = (*renderer)->stats();
-    r.color = (*renderer)->read_color();
-    r.aovs = (*renderer)->read_aovs();
-    return r;
-  };
-  const Run multi = render_with(true), single = render_with(false);
-  std::printf("[ multi-draw ] forward: %d calls for %d meshes; shadow: %d calls for %d meshes\n",
-              multi.stats.draw_calls, multi.stats.mesh_draws, multi.stats.shadow_draw_calls,
-              multi.stats.shadow_mesh_draws);
-  // One call per mesh without it; fewer calls, the same meshes and instances with it.
-  EXPECT_EQ(single.stats.draw_calls, single.stats.mesh_draws);
-  EXPECT_EQ(single.stats.shadow_draw_calls, single.stats.shadow_mesh_draws);
-  EXPECT_EQ(multi.stats.mesh_draws, single.stats.mesh_draws);
-  EXPECT_EQ(multi.stats.shadow_mesh_draws, single.stats.shadow_mesh_draws);
-  EXPECT_EQ(multi.stats.instances, single.stats.instances);
-  EXPECT_EQ(multi.stats.shadow_instances, single.stats.shadow_instances);
-  // Forward: the seven shapes (six meshes, the two boxes one instanced draw) are one call; the
-  // mirrored cone, the floor and the model (materials of their own) one each.
-  EXPECT_EQ(multi.stats.draw_calls, 4);
-  EXPECT_EQ(multi.stats.mesh_draws, 9);
-  EXPECT_LT(multi.stats.shadow_draw_calls, multi.stats.shadow_mesh_draws / 2);
-  ASSERT_FALSE(multi.color.pixels.empty());
-  EXPECT_EQ(multi.color.pixels, single.color.pixels);
-  EXPECT_EQ(multi.aovs.pixels, single.aovs.pixels);
+  }
+  frame.multi_draw = multi_draw;
+  const Status status = (*renderer)->render(frame, scene.assets);
+  EXPECT_TRUE(status.ok()) << status.error().to_string();
+  r.stats = (*renderer)->stats();
+  r.color = (*renderer)->read_color();
+  r.aovs = (*renderer)->read_aovs();
+  r.shadow_map = (*renderer)->read_shadow_map();
+  return r;
+}
+
+TEST_F(BatchingTest, MultiDrawsGiveTheFrameOfOneCallPerMesh) {
+  for (const char* layered : {"shadow.layered=false", "shadow.layered=true"}) {
+    SCOPED_TRACE(layered);
+    auto scene = load_scene(write_scene(), {layered});
+    ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+    std::size_t vertices = 0, indices = 0;
+    for (const MeshData& m : scene->assets.meshes) {
+      vertices += m.positions.size();
+      indices += m.indices.size();
+    }
+    ASSERT_GT(vertices, render::kGeometryFirstCapacity);  // the buffers grow
+    ASSERT_GT(indices, 2 * render::kGeometryFirstCapacity);
+    FrameContext ctx;
+    ctx.width = 320;
+    ctx.height = 180;
+    const render::FrameInput frame = plan_frame(*scene, ctx);
+    // The largest sphere and the card alone, uploaded before the rest.
+    render::FrameInput first = frame;
+    std::erase_if(first.draws, [&](const render::DrawItem& d) {
+      return scene->assets.meshes[index(d.mesh)].positions.size() < 8000 &&
+             !d.material.alpha_mask;
+    });
+    ASSERT_EQ(first.draws.size(), 3u);
+
+    const Frame multi = render_with(*scene, frame, true), single = render_with(*scene, frame, false),
+              moved = render_with(*scene, frame, true, &first);
+    std::printf("[ %s ] forward: %d calls for %d meshes; shadow: %d calls for %d meshes\n",
+                layered, multi.stats.draw_calls, multi.stats.mesh_draws,
+                multi.stats.shadow_draw_calls, multi.stats.shadow_mesh_draws);
+    // One call per mesh without it; fewer calls, the same meshes and instances with it.
+    EXPECT_EQ(single.stats.draw_calls, single.stats.mesh_draws);
+    EXPECT_EQ(single.stats.shadow_draw_calls, single.stats.shadow_mesh_draws);
+    EXPECT_EQ(multi.stats.mesh_draws, single.stats.mesh_draws);
+    EXPECT_EQ(multi.stats.shadow_mesh_draws, single.stats.shadow_mesh_draws);
+    EXPECT_EQ(multi.stats.instances, single.stats.instances);
+    EXPECT_EQ(multi.stats.shadow_instances, single.stats.shadow_instances);
+    // Forward: the eight shapes (seven meshes, the two boxes one instanced draw) are one call;
+    // the card and the cut box one; the mirrored cone, the floor and the model one each.
+    EXPECT_EQ(multi.stats.draw_calls, 5);
+    EXPECT_EQ(multi.stats.mesh_draws, 12);
+    // Depth: per layer (or once, layered) one call for the opaque casters of each winding and
+    // one for the alpha-masked ones.
+    const int passes = std::string(layered) == "shadow.layered=true" ? 1 : 4;
+    EXPECT_LE(multi.stats.shadow_draw_calls, 3 * passes);
+    EXPECT_LT(multi.stats.shadow_draw_calls, multi.stats.shadow_mesh_draws / 2);
+    EXPECT_EQ(moved.stats.draw_calls, multi.stats.draw_calls);
+    ASSERT_FALSE(multi.color.pixels.empty());
+    ASSERT_FALSE(multi.shadow_map.pixels.empty());
+    // The same maps and frames, pixel for pixel.
+    EXPECT_EQ(multi.shadow_map.pixels, single.shadow_map.pixels);
+    EXPECT_EQ(multi.color.pixels, single.color.pixels);
+    EXPECT_EQ(multi.aovs.pixels, single.aovs.pixels);
+    EXPECT_EQ(moved.shadow_map.pixels, multi.shadow_map.pixels);
+    EXPECT_EQ(moved.color.pixels, multi.color.pixels);
+    EXPECT_EQ(moved.aovs.pixels, multi.aovs.pixels);
+  }
 }
 
 }  // namespace
