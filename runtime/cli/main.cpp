@@ -239,6 +239,8 @@ int fail(const Error& e) {
 }
 
 int run_info(const Args& a) {
+  if (a.scene.empty() && !a.sets.empty())
+    usage_error("info --set needs a SCENE (without one, info prints the OpenGL context)");
   if (!a.scene.empty()) {
     auto scene = load_scene(a.scene, a.sets);
     if (!scene) return fail(scene.error());
@@ -419,6 +421,9 @@ int run_render(Args a) {
       a.scene.empty() ? content_dir() / "scenes" / "default.json" : fs::path(a.scene);
   const fs::path out = a.output.empty() ? fs::path("out") / (scene_path.stem().string() + ".png")
                                         : fs::path(a.output);
+  if (!a.env.empty() && a.reflection_reference.empty())
+    usage_error("--env is the environment of --reflection-reference; a scene's own is "
+                "render.environment (--set render.environment=FILE)");
   if (auto st = check_render_outputs(a, out); !st) return fail(st.error());
   if (!a.env.empty()) {
     // An input read only after the frames: checked before them, so a bad map fails before any

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <mutex>
 #include <set>
+#include <string>
+#include <string_view>
 
 namespace kaskad::log {
 namespace {
@@ -61,7 +63,10 @@ void warn_once(const char* fmt, ...) {
   std::string message;
   {
     const std::lock_guard<std::mutex> lock(g_once_mutex);
-    message = g_context.empty() ? std::string(buf) : g_context + ": " + buf;
+    // A message that already names the context (a glTF opened directly is its own scene file)
+    // is not prefixed twice.
+    const bool named = std::string_view(buf).starts_with(g_context + ":");
+    message = g_context.empty() || named ? std::string(buf) : g_context + ": " + buf;
     if (!g_said.insert(message).second) return;
   }
   warn("%s", message.c_str());

@@ -274,6 +274,9 @@ check set_missing_value 2 "--set needs a value, got the option '-o'" -- "$KASKAD
   --headless --set -o "$tmp/x.png"
 check save_not_json 2 "-o needs a .json path" -- "$KASKAD" save \
   "$KASKAD_CONTENT/scenes/default.json" -o "$tmp/scene.png"
+check info_set_alone 2 "info --set needs a SCENE" -- "$KASKAD" info --set sun.light.intensity=3
+check env_alone 2 "--env is the environment of --reflection-reference" -- "$KASKAD" render \
+  --headless --frames 1 -o "$tmp/env_alone.png" --env "$KASKAD_CONTENT/env/sky.hdr"
 # A bound written in the file is accepted (compared as the float it is stored as).
 check near_at_bound 0 "wrote" -- "$KASKAD" render --headless --size 96x64 --frames 1 \
   -o "$tmp/near.png" --set camera.camera.near=1e-7 --set camera.camera.far=1e7
