@@ -22,8 +22,12 @@ passed=0 failed=0 n=0
 rows="" atomic_summary=""
 
 # Previous outputs every case starts from (a real PNG and EXR, so byte changes are meaningful).
-"$KASKAD" render --headless --size 24x16 --frames 1 -o "$tmp/prev.png" --aov "$tmp/prev.exr" >/dev/null 2>&1 ||
-  { echo "FAIL setup: cannot render the previous outputs"; exit 1; }
+if ! setup_log="$("$KASKAD" render --headless --size 24x16 --frames 1 -o "$tmp/prev.png" \
+      --aov "$tmp/prev.exr" 2>&1)"; then
+  echo "FAIL setup: cannot render the previous outputs"
+  echo "$setup_log" | tail -20
+  exit 1
+fi
 "$KASKAD" save "$content/scenes/default.json" -o "$tmp/prev.json" >/dev/null 2>&1 || { echo "FAIL setup: save"; exit 1; }
 
 snapshot() { (cd "$1" && find . -print0 | sort -z | xargs -0 md5sum 2>/dev/null; find . | sort); }
