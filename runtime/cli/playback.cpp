@@ -514,7 +514,11 @@ Result<Scene> load_checked(const Playback& pb, render::Renderer* prewarm = nullp
   sets.push_back("render.width=" + std::to_string(pb.width));
   sets.push_back("render.height=" + std::to_string(pb.height));
   auto scene = load_scene(pb.scene, sets);
-  if (!scene) return scene.error();
+  if (!scene) {
+    Error e = scene.error();
+    e.message += " (the scene of " + pb.file.string() + ", /scene)";
+    return e;
+  }
   auto trial = load_scene(pb.scene, sets);
   if (!trial) return trial.error();
   const bool points = bool(pb.flicker);  // the flicker gate reads the points pass

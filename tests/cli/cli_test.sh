@@ -277,6 +277,9 @@ check save_not_json 2 "-o needs a .json path" -- "$KASKAD" save \
 check info_set_alone 2 "info --set needs a SCENE" -- "$KASKAD" info --set sun.light.intensity=3
 check env_alone 2 "--env is the environment of --reflection-reference" -- "$KASKAD" render \
   --headless --frames 1 -o "$tmp/env_alone.png" --env "$KASKAD_CONTENT/env/sky.hdr"
+printf '{ "kaskad_playback": 1, "scene": "nope.gltf", "frames": 2 }\n' >"$tmp/missing_scene_play.json"
+check play_missing_scene nonzero "nope.gltf: file not found \(the scene of .*missing_scene_play.json, /scene\)" \
+  -- "$KASKAD" play "$tmp/missing_scene_play.json" --out "$tmp/play_missing"
 # A bound written in the file is accepted (compared as the float it is stored as).
 check near_at_bound 0 "wrote" -- "$KASKAD" render --headless --size 96x64 --frames 1 \
   -o "$tmp/near.png" --set camera.camera.near=1e-7 --set camera.camera.far=1e7
