@@ -975,12 +975,13 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
   try {
     ObjectReader root(doc, "");
     int version = kFormatVersion;
-    if (root.has("kaskad_scene") && root.raw("kaskad_scene").is_number_integer() &&
-        root.raw("kaskad_scene").get<long long>() > kFormatVersion)
-      fail(root.at("kaskad_scene"),
-           "format version " + std::to_string(root.raw("kaskad_scene").get<long long>()) +
-               " is newer than this build reads (" + std::to_string(kFormatVersion) +
-               "): written by a later Kaskad?");
+    if (root.has("kaskad_scene") && root.raw("kaskad_scene").is_number_integer()) {
+      const long long written = root.raw("kaskad_scene").get<long long>();
+      if (written > kFormatVersion)
+        fail(root.at("kaskad_scene"),
+             "format version " + std::to_string(written) + " is newer than this build reads (" +
+                 std::to_string(kFormatVersion) + "): written by a later Kaskad?");
+    }
     root.integer("kaskad_scene", version, 1, kFormatVersion);
     if (root.has("render")) {
       ObjectReader r(root.raw("render"), "/render");

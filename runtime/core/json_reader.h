@@ -139,13 +139,7 @@ class ObjectReader {
     if (!has(key)) return;
     const json& v = j_.at(key);
     if (!v.is_number()) fail(at(key), "expected a number, got " + type_name(v));
-    const double d = v.get<double>();
-    // Compared as the float it is stored as: a bound written in the file (1e-7) is a double a
-    // little off the float bound, and must be accepted.
-    const float f = float(d);
-    if (!(f >= lo && f <= hi))
-      fail(at(key), "must be in [" + fmt(lo) + ", " + fmt(hi) + "], was " + fmt(d));
-    out = f;
+    out = float_in_range(v.get<double>(), lo, hi, at(key));
   }
   void integer(const char* key, int& out, int lo, int hi) {
     record_range(key, lo, hi);
@@ -189,12 +183,8 @@ class ObjectReader {
     for (int i = 0; i < N; ++i) {
       if (!v[std::size_t(i)].is_number())
         fail(at(key) + "/" + std::to_string(i), "expected a number, got " + type_name(v[std::size_t(i)]));
-      const double d = v[std::size_t(i)].get<double>();
-      const float f = float(d);  // compared as stored, as number() does
-      if (!(f >= lo && f <= hi))
-        fail(at(key) + "/" + std::to_string(i),
-             "must be in [" + fmt(lo) + ", " + fmt(hi) + "], was " + fmt(d));
-      out[i] = f;
+      out[i] = float_in_range(v[std::size_t(i)].get<double>(), lo, hi,
+                              at(key) + "/" + std::to_string(i));
     }
   }
   template <class E>
@@ -230,6 +220,15 @@ class ObjectReader {
     std::ostringstream s;
     s << d;
     return s.str();
+  }
+  // `d` as the float it is stored as, which must lie in [lo, hi] (else an error at `where`).
+  // Compared as that float: a bound written in a file (1e-7) is a double a little off the float
+  // bound, and must be accepted.
+  static float float_in_range(double d, float lo, float hi, const std::string& where) {
+    const float f = float(d);
+    if (!(f >= lo && f <= hi))
+      fail(where, "must be in [" + fmt(lo) + ", " + fmt(hi) + "], was " + fmt(d));
+    return f;
   }
   const json& j_;
   std::string path_;

@@ -50,6 +50,26 @@ void add_instance_attributes(GLuint vao, GLuint buffer) {
   if (buffer) glVertexArrayVertexBuffer(vao, kInstanceBinding, buffer, 0, sizeof(InstanceRecord));
 }
 
+// Stores `count` elements of `element` bytes from `data` at element `first` of a buffer the frame
+// fills from its start on, replacing the buffer by a larger one (at least `min_capacity`) first
+// when they do not fit: draws already recorded this frame keep reading the old one (GL holds it
+// until they are done), so the new one is filled from the same index on. Returns whether the
+// buffer was replaced.
+bool store_in_frame_buffer(gpu::Buffer& buffer, std::size_t& capacity, std::size_t first,
+                           std::size_t count, std::size_t element, std::size_t min_capacity,
+                           const void* data) {
+  const bool replaced = first + count > capacity;
+  if (replaced) {
+    capacity = std::max<std::size_t>({min_capacity, 2 * capacity, first + count});
+    buffer = gpu::make_buffer();
+    glNamedBufferStorage(buffer.id(), GLsizeiptr(capacity * element), nullptr,
+                         GL_DYNAMIC_STORAGE_BIT);
+  }
+  if (count > 0)
+    glNamedBufferSubData(buffer.id(), GLintptr(first * element), GLsizeiptr(count * element), data);
+  return replaced;
+}
+
 // A 1x1 texture standing in for a missing material texture.
 gpu::Texture make_solid_texture(const std::array<float, 4>& rgba, GLenum internal_format) {
   gpu::Texture t = gpu::make_texture(GL_TEXTURE_2D);
@@ -175,15 +195,8 @@ void GpuCache::draw_batch(std::span<const MeshDraw> draws) {
     commands.push_back({GLuint(d.mesh.index_count), d.count, d.mesh.first_index, d.mesh.base_vertex,
                         d.first_instance});
   const std::size_t first = commands_used_;
-  if (first + commands.size() > commands_capacity_) {
-    commands_capacity_ =
-        std::max<std::size_t>({256, 2 * commands_capacity_, first + commands.size()});
-    commands_ = gpu::make_buffer();
-    glNamedBufferStorage(commands_.id(), GLsizeiptr(commands_capacity_ * sizeof(IndirectCommand)), nullptr,
-                         GL_DYNAMIC_STORAGE_BIT);
-  }
-  glNamedBufferSubData(commands_.id(), GLintptr(first * sizeof(IndirectCommand)),
-                       GLsizeiptr(commands.size() * sizeof(IndirectCommand)), commands.data());
+  store_in_frame_buffer(commands_, commands_capacity_, first, commands.size(),
+                        sizeof(IndirectCommand), 256, commands.data());
   commands_used_ = first + commands.size();
   glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands_.id());
   glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT,
@@ -194,20 +207,11 @@ void GpuCache::draw_batch(std::span<const MeshDraw> draws) {
 
 std::uint32_t GpuCache::upload(std::span<const InstanceRecord> records) {
   const std::size_t first = instances_used_;
-  if (first + records.size() > instances_capacity_) {
-    // A larger buffer; draws already recorded this frame keep reading the old one (GL holds it
-    // until they are done), so the new one is filled from the same index on.
-    instances_capacity_ = std::max<std::size_t>({1024, 2 * instances_capacity_, first + records.size()});
-    instances_ = gpu::make_buffer();
-    glNamedBufferStorage(instances_.id(), GLsizeiptr(instances_capacity_ * sizeof(InstanceRecord)),
-                         nullptr, GL_DYNAMIC_STORAGE_BIT);
-    if (vao_)
-      glVertexArrayVertexBuffer(vao_.id(), kInstanceBinding, instances_.id(), 0,
-                                sizeof(InstanceRecord));
-  }
-  if (!records.empty())
-    glNamedBufferSubData(instances_.id(), GLintptr(first * sizeof(InstanceRecord)),
-                         GLsizeiptr(records.size() * sizeof(InstanceRecord)), records.data());
+  if (store_in_frame_buffer(instances_, instances_capacity_, first, records.size(),
+                            sizeof(InstanceRecord), 1024, records.data()) &&
+      vao_)
+    glVertexArrayVertexBuffer(vao_.id(), kInstanceBinding, instances_.id(), 0,
+                              sizeof(InstanceRecord));
   instances_used_ = first + records.size();
   return std::uint32_t(first);
 }

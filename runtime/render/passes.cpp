@@ -626,9 +626,8 @@ struct CasterRun {
 
 // Draws of view `view` as instanced runs that share a draw (same mesh and depth program, and
 // the same material where the depth program reads it), in depth order, marked where a batch
-// starts. `mask_of(i)`: the layers
-// of the view (bit c) draw i goes to; `record_of(i, c)`: its instance record in layer c. The
-// records go to `records`, one per draw and layer.
+// starts. `mask_of(i)`: the layers of the view (bit c) draw i goes to; `record_of(i, c)`: its
+// instance record in layer c. The records go to `records`, one per draw and layer.
 // The depth program's key of draw i in view `view`; `peel`: a LomPass depth peel (one layer per
 // pass, never the layered program).
 VariantKey depth_program_key(const DrawList& list, std::size_t view, std::uint32_t i, bool peel) {

@@ -146,12 +146,13 @@ TEST_F(BatchingTest, MultiDrawsGiveTheFrameOfOneCallPerMesh) {
     ASSERT_FALSE(multi.color.pixels.empty());
     ASSERT_FALSE(multi.shadow_map.pixels.empty());
     // The same maps and frames, pixel for pixel.
-    EXPECT_EQ(multi.shadow_map.pixels, single.shadow_map.pixels);
-    EXPECT_EQ(multi.color.pixels, single.color.pixels);
-    EXPECT_EQ(multi.aovs.pixels, single.aovs.pixels);
-    EXPECT_EQ(moved.shadow_map.pixels, multi.shadow_map.pixels);
-    EXPECT_EQ(moved.color.pixels, multi.color.pixels);
-    EXPECT_EQ(moved.aovs.pixels, multi.aovs.pixels);
+    auto expect_same = [](const Frame& a, const Frame& b, const char* what) {
+      EXPECT_EQ(a.shadow_map.pixels, b.shadow_map.pixels) << what;
+      EXPECT_EQ(a.color.pixels, b.color.pixels) << what;
+      EXPECT_EQ(a.aovs.pixels, b.aovs.pixels) << what;
+    };
+    expect_same(multi, single, "one call per mesh");
+    expect_same(moved, multi, "meshes uploaded in another order");
   }
 }
 
