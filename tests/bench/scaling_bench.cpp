@@ -1,5 +1,6 @@
 // Frame cost against object count, and what a still camera saves (issue 13's benchmark).
-//   scaling_bench [frames=8] [max_instances=100000]   (build/release/tests/scaling_bench)
+//   scaling_bench [frames=8] [max_instances=100000] [scenes=default,terrain]
+//   (build/release/tests/scaling_bench; max_instances 0 runs part 2 alone, scenes "" part 1 alone)
 // 1. Scaling: generated scenes of 100, 1,000, 10,000 and 100,000 instances of three meshes
 //    (box, sphere, the glTF Box model) with three materials on a ground plane, under a sun with 4
 //    stable cascades, 640x360, the camera orbiting slowly (every frame is a new view, so no
@@ -187,8 +188,15 @@ int main(int argc, char** argv) {
   std::printf("\n2. still camera against moving camera (own size; medians of %d frames)\n", frames);
   std::printf("%-9s %-19s %9s %14s %14s %9s\n", "scene", "camera", "frame ms", "GPU shadow 1st",
               "GPU shadow med", "layers");
-  for (const char* name : {"default", "terrain"}) {
-    const fs::path file = content_dir() / "scenes" / (std::string(name) + ".json");
+  std::vector<std::string> names;
+  for (std::string list = argc > 3 ? argv[3] : "default,terrain"; !list.empty();) {
+    const size_t comma = list.find(',');
+    if (comma != 0) names.push_back(list.substr(0, comma));
+    list = comma == std::string::npos ? "" : list.substr(comma + 1);
+  }
+  for (const std::string& name : names) {
+    const fs::path file = content_dir() / "scenes" / (name + ".json");
+    if (!fs::exists(file)) die("no scene " + file.string());
     double off = 0.0, moving = 0.0, still = 0.0;
     for (const char* mode : {"still", "still, no vis. cache", "moving", "shadows off"}) {
       const bool shadows = std::string(mode) != "shadows off";
@@ -199,7 +207,7 @@ int main(int argc, char** argv) {
       if (!scene && uncached) continue;  // a tree from before render.visibility_cache
       if (!scene) die(scene.error().to_string());
       const RunResult r = run(*player, *scene, frames, std::string(mode) == "moving");
-      std::printf("%-9s %-20s %8.1f %14.2f %14.2f %6d/%d\n", name, mode, r.frame_ms,
+      std::printf("%-9s %-20s %8.1f %14.2f %14.2f %6d/%d\n", name.c_str(), mode, r.frame_ms,
                   r.first_shadow_gpu_ms, r.shadow_gpu_ms, r.layers_rendered, r.layers);
       if (std::string(mode) == "still") still = r.frame_ms;
       if (std::string(mode) == "moving") moving = r.frame_ms;
@@ -208,7 +216,7 @@ int main(int argc, char** argv) {
     }
     std::printf("          %s: moving / shadows off %.2fx (asked: at most 2x), still / shadows "
                 "off %.2fx (asked: at most 1.2x)\n",
-                name, moving / off, still / off);
+                name.c_str(), moving / off, still / off);
   }
   return 0;
 }
