@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "components/name.h"
 #include "components/transform.h"
 #include "runtime/core/log.h"
 
@@ -75,6 +77,79 @@ glm::ivec2 fit_output_to_camera(const ecs::World& world, int width, int height) 
     out.y = std::max(1, int(std::lround(float(width) / a)));
   else
     out.x = std::max(1, int(std::lround(float(height) * a)));
+  return out;
+}
+
+std::vector<std::string> camera_warnings(const ecs::World& world, float output_aspect,
+                                         int output_height) {
+  std::vector<std::string> out;
+  auto name_of = [&](ecs::Entity e) {
+    const Name* n = world.try_get<Name>(e);
+    return n && !n->value.empty() ? "'" + n->value + "'" : "entity " + std::to_string(e.index);
+  };
+  std::vector<ecs::Entity> active;
+  world.view<Camera>().each([&](ecs::Entity e, const Camera& c) {
+    if (c.active) active.push_back(e);
+  });
+  if (active.size() > 1) {
+    std::string names;
+    for (ecs::Entity e : active) names += (names.empty() ? "" : ", ") + name_of(e);
+    out.push_back(std::to_string(active.size()) + " cameras are active (" + names + "); " +
+                  name_of(active.front()) + ", the first, renders");
+  }
+  const CameraState cam = select_camera(world, output_aspect);
+  if (!cam.entity.valid()) return out;
+  const Camera& c = cam.camera;
+  const bool perspective = c.projection == Projection::perspective;
+  // Metres a pixel spans at distance d.
+  const float tan_half = std::tan(glm::radians(c.fov_y_deg) * 0.5f);
+  auto pixel_at = [&](float d) {
+    return (perspective ? 2.0f * tan_half * d : c.ortho_height) / float(std::max(output_height, 1));
+  };
+  const glm::mat4 view_proj = cam.proj * cam.view;
+  float farthest = 0.0f;  // the farthest centre of what the camera sees
+  float worst_jitter = 0.0f, worst_spacing = 0.0f, worst_from_origin = 0.0f;
+  ecs::Entity worst = ecs::kNullEntity;
+  world.view<WorldBounds>().each([&](ecs::Entity e, const WorldBounds& b) {
+    if (b.box.empty() || outside_clip_volume(view_proj, b.box)) return;
+    const glm::vec3 nearest = glm::clamp(cam.position, b.box.min, b.box.max);
+    const float d = std::clamp(glm::distance(cam.position, nearest), c.near, c.far);
+    farthest = std::max(farthest, std::min(glm::distance(cam.position, b.box.center()), c.far));
+    // Float spacing at the box's point nearest the camera (or at the camera: the view's
+    // translation), where the box looks largest.
+    const glm::vec3 m = glm::max(glm::abs(nearest), glm::abs(cam.position));
+    const float from_origin = std::max({m.x, m.y, m.z});
+    const float spacing = std::nextafter(from_origin, INFINITY) - from_origin;
+    const float jitter = spacing / pixel_at(d);
+    if (jitter > worst_jitter) {
+      worst_jitter = jitter;
+      worst_spacing = spacing;
+      worst_from_origin = from_origin;
+      worst = e;
+    }
+  });
+  char line[512];
+  if (perspective && farthest > 0.0f) {
+    const double d = farthest, n = c.near, f = c.far;
+    const double step = d * d * (f - n) / (n * f * 16777216.0);
+    if (step > 0.01 * d) {
+      std::snprintf(line, sizeof line,
+                    "camera %s: with near %g and far %g the depth buffer tells surfaces %g m from "
+                    "the camera apart only when they are %.3g m apart (%.0f%% of the distance): "
+                    "they will fight or vanish; raise near (or lower far)",
+                    name_of(cam.entity).c_str(), n, f, d, step, 100.0 * step / d);
+      out.push_back(line);
+    }
+  }
+  if (worst_jitter > 0.5f) {
+    std::snprintf(line, sizeof line,
+                  "what camera %s sees lies %g m from the origin, where 32-bit float positions "
+                  "are %.3g m apart: %.2g pixels at %s; its edges and shadows will jitter as "
+                  "the camera moves. Move the scene nearer the origin",
+                  name_of(cam.entity).c_str(), double(worst_from_origin), double(worst_spacing),
+                  double(worst_jitter), name_of(worst).c_str());
+    out.push_back(line);
+  }
   return out;
 }
 

@@ -1,6 +1,9 @@
 // Camera selection and framing.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include <glm/glm.hpp>
 
 #include "components/bounds.h"
@@ -33,6 +36,18 @@ CameraState select_camera(const ecs::World& world, float output_aspect);
 /// aspect inside the request, so the image is never stretched. The request when the camera
 /// takes its aspect from the output.
 glm::ivec2 fit_output_to_camera(const ecs::World& world, int width, int height);
+
+/// What a user should hear about the rendering camera of `world` (WorldBounds needed), as
+/// sentences; empty when all is well. Checked once, after a scene is loaded:
+/// - more than one camera is active (the first renders);
+/// - the depth buffer cannot tell surfaces apart at the distance of what the camera sees: the
+///   depth step there (window depth has 24 bits of precision near 1: d^2 (far - near) /
+///   (near far 2^24) metres at distance d) is over 1% of the distance (near far too small);
+/// - what it sees lies so far from the origin that 32-bit float positions there are over half
+///   a pixel apart at their distance from the camera (vertices and shadows jitter).
+/// `output_height` is the image's height in pixels.
+std::vector<std::string> camera_warnings(const ecs::World& world, float output_aspect,
+                                         int output_height);
 
 /// Moves every auto_frame camera back along its view axis until `bounds` fits its field of view,
 /// and sets near/far to enclose the bounds, far also the farthest corner of `depth_bounds` in

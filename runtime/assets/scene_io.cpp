@@ -323,8 +323,10 @@ bool read_light(ObjectReader& lr, Light& l) {
   if (l.type == LightType::area && l.outer_cone_deg > 80.0f)
     fail(lr.at("outer_cone_deg"), "of an area light must be at most 80 (its shadow map is one "
                                   "perspective map over the cone), was " + json(num(l.outer_cone_deg)).dump());
-  if (l.inner_cone_deg > l.outer_cone_deg)
-    fail(lr.at("inner_cone_deg"), "must not exceed outer_cone_deg");
+  if (l.inner_cone_deg > l.outer_cone_deg)  // both values: a --set of one names the other
+    fail(lr.at("inner_cone_deg"), "must not exceed outer_cone_deg (" +
+                                      json(num(l.outer_cone_deg)).dump() + "), was " +
+                                      json(num(l.inner_cone_deg)).dump());
   return cast_given;
 }
 

@@ -87,6 +87,10 @@ Result<Scene> finish_load(Result<Scene> scene, const std::filesystem::path& file
     scene->render.width = fitted.x;
     scene->render.height = fitted.y;
   }
+  for (const std::string& w :
+       camera_warnings(scene->world, float(scene->render.width) / float(scene->render.height),
+                       scene->render.height))
+    log::warn_once("%s", w.c_str());
   return scene;
 }
 

@@ -4,6 +4,7 @@
 
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "components/camera.h"
@@ -309,6 +310,78 @@ TEST(TransformSystem, IncrementalMatchesAFullRecompute) {
     }
   }
   ::testing::internal::GetCapturedStderr();
+}
+
+// A camera `offset` + (0, 2, 10) looking at a 2 m box at `offset`, with `near` and `far`.
+struct CameraSetup {
+  ecs::World w;
+  AssetStore assets;
+  ecs::Entity camera, box;
+  CameraSetup(glm::vec3 offset, float near, float far) {
+    camera = w.create();
+    Transform t;
+    t.translation = offset + glm::vec3(0, 2, 10);
+    t.rotation = glm::quat_cast(glm::inverse(
+        glm::mat3(glm::lookAt(t.translation, offset, glm::vec3(0, 1, 0)))));
+    w.emplace<Transform>(camera, t);
+    Camera c;
+    c.near = near;
+    c.far = far;
+    c.active = true;
+    w.emplace<Camera>(camera, c);
+    w.emplace<Name>(camera, Name{"eye"});
+    box = w.create();
+    w.emplace<Transform>(box);
+    w.emplace<Name>(box, Name{"crate"});
+    update_transforms(w, assets);
+    w.emplace<WorldBounds>(box, WorldBounds{Aabb::from_corners(offset - 1.0f, offset + 1.0f)});
+  }
+  std::vector<std::string> warnings() { return camera_warnings(w, 16.0f / 9.0f, 720); }
+};
+
+std::string joined(const std::vector<std::string>& lines) {
+  std::string all;
+  for (const auto& l : lines) all += l + "\n";
+  return all;
+}
+
+TEST(CameraSystem, AWellSetCameraHasNothingToSay) {
+  EXPECT_EQ(joined(CameraSetup(glm::vec3(0), 0.1f, 100.0f).warnings()), "");
+  EXPECT_EQ(joined(CameraSetup(glm::vec3(0), 1e-3f, 1e3f).warnings()), "");  // step 0.6 mm at 10 m
+  EXPECT_EQ(joined(CameraSetup(glm::vec3(1e3f, 0, -1e3f), 0.1f, 100.0f).warnings()), "");
+}
+
+TEST(CameraSystem, SeveralActiveCamerasAreNamedAndTheFirstRenders) {
+  CameraSetup s(glm::vec3(0), 0.1f, 100.0f);
+  const ecs::Entity other = s.w.create();
+  s.w.emplace<Transform>(other);
+  Camera c;
+  c.active = true;
+  s.w.emplace<Camera>(other, c);
+  s.w.emplace<Name>(other, Name{"spare"});
+  update_transforms(s.w, s.assets);
+  const std::string all = joined(s.warnings());
+  EXPECT_NE(all.find("2 cameras are active ('eye', 'spare'); 'eye', the first, renders"),
+            std::string::npos)
+      << all;
+  EXPECT_EQ(select_camera(s.w, 1.0f).entity, s.camera);
+}
+
+TEST(CameraSystem, ANearPlaneTooCloseForTheContentIsReported) {
+  const std::string all = joined(CameraSetup(glm::vec3(0), 1e-6f, 1e7f).warnings());
+  EXPECT_NE(all.find("camera 'eye': with near 1e-06 and far 1e+07"), std::string::npos) << all;
+  EXPECT_NE(all.find("raise near"), std::string::npos) << all;
+}
+
+TEST(CameraSystem, ContentFarFromTheOriginIsReportedWithItsJitter) {
+  // At 1e5 m floats are 1/128 m apart; a pixel at the box's near face (about 9 m, 45 degrees,
+  // 720 rows) is about 1 cm.
+  const std::string all = joined(CameraSetup(glm::vec3(1e5f, 0, 0), 0.1f, 100.0f).warnings());
+  EXPECT_NE(all.find("lies 100000 m from the origin, where 32-bit float positions are 0.00781 m "
+                     "apart"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("at 'crate'"), std::string::npos) << all;
 }
 
 TEST(CameraSystem, ActiveCameraWinsAndAutoFrameFitsTheBounds) {
