@@ -63,6 +63,21 @@ Status publish(int fd, const fs::path& temp, const fs::path& target) {
   return {};
 }
 
+/// The file a write to `path` lands in: through symbolic links (relative ones from the link's
+/// folder), so an output named by a link replaces the file it points to and the link stays.
+/// A dangling link's target is created; a loop is left to the checks to report.
+fs::path through_links(const fs::path& path) {
+  fs::path p = path;
+  for (int hops = 0; hops < 40; ++hops) {  // the kernel's own limit (ELOOP)
+    std::error_code ec;
+    if (!fs::is_symlink(fs::symlink_status(p, ec))) return p;
+    const fs::path to = fs::read_symlink(p, ec);
+    if (ec) return p;
+    p = to.is_absolute() ? to : folder_of(p) / to;
+  }
+  return p;
+}
+
 /// Why files cannot be made in `dir` (empty when they can).
 std::string folder_problem(const fs::path& dir) {
   std::error_code ec;
@@ -105,7 +120,8 @@ Status check_output_path(const fs::path& path) {
   return {};
 }
 
-Status write_file_atomic(const fs::path& path, const void* data, std::size_t size) {
+Status write_file_atomic(const fs::path& named, const void* data, std::size_t size) {
+  const fs::path path = through_links(named);
   const std::string name = path.string();
   KASKAD_TRY(check_output_path(path));
   fs::path temp;
@@ -129,7 +145,8 @@ Status write_file_atomic(const fs::path& path, const void* data, std::size_t siz
   return publish(fd, temp, path);
 }
 
-Result<TempFile> TempFile::create(const fs::path& target) {
+Result<TempFile> TempFile::create(const fs::path& named) {
+  const fs::path target = through_links(named);
   KASKAD_TRY(check_output_path(target));
   fs::path temp;
   const int fd = make_temp(target, temp);

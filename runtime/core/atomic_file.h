@@ -1,7 +1,8 @@
 // Outputs are written atomically: every file Kaskad writes (images, AOVs, CSV, charts, scene
 // saves, probe dumps, the shader cache) goes to a temporary file in the target's own folder,
 // is checked (every write() complete, fsync), and only then renamed over the target. On any
-// failure the temporary file is removed and the previous file is left byte-identical.
+// failure the temporary file is removed and the previous file is left byte-identical. An output
+// named by a symbolic link replaces the file the link points to; the link stays.
 // No folder is ever created here: callers that create one do it because the user named it.
 #pragma once
 

@@ -22,6 +22,29 @@ TEST(AtomicFile, WritesAndReplacesLeavingNoTemporaryFile) {
   EXPECT_EQ(files_in(dir), 1u);
 }
 
+TEST(AtomicFile, AnOutputNamedByALinkReplacesTheFileItPointsTo) {
+  const fs::path dir = fresh_dir("link");
+  fs::create_directories(dir / "real");
+  ASSERT_TRUE(write_file_atomic(dir / "real" / "a.png", std::string("old")).ok());
+  fs::create_symlink("real/a.png", dir / "latest.png");  // relative, from the link's folder
+  fs::create_symlink(dir / "latest.png", dir / "chain.png");  // a link to a link
+  ASSERT_TRUE(write_file_atomic(dir / "chain.png", std::string("new")).ok());
+  EXPECT_TRUE(fs::is_symlink(dir / "chain.png"));
+  EXPECT_TRUE(fs::is_symlink(dir / "latest.png"));
+  EXPECT_EQ(read_text(dir / "real" / "a.png"), "new");
+  EXPECT_EQ(files_in(dir / "real"), 1u) << "a temporary file was left behind";
+
+  // A library's writer (TempFile) too, and a dangling link's target is created.
+  fs::create_symlink("real/b.exr", dir / "b.exr");
+  auto temp = TempFile::create(dir / "b.exr");
+  ASSERT_TRUE(temp.ok()) << temp.error().to_string();
+  EXPECT_EQ(temp->path().parent_path(), dir / "real");
+  ASSERT_TRUE(write_file_atomic(temp->path(), std::string("exr")).ok());
+  ASSERT_TRUE(temp->commit().ok());
+  EXPECT_TRUE(fs::is_symlink(dir / "b.exr"));
+  EXPECT_EQ(read_text(dir / "real" / "b.exr"), "exr");
+}
+
 TEST(AtomicFile, FailedWriteUnderFileSizeLimitKeepsThePreviousFile) {
   const fs::path dir = fresh_dir("limit");
   const std::string previous(3000, 'p');
