@@ -1087,9 +1087,12 @@ std::vector<ecs::Entity> copy_import(ecs::World& w, const FirstImport& from, ecs
 // lights the scene's shadow settings. `imported` (file -> the first entity that imported it):
 // a file imported before is copied from that entity's import instead of read again.
 // Returns the entities it made.
+// `blame` (file and place) is named first when the model cannot be imported; by default the
+// scene file's entity.
 Result<std::vector<ecs::Entity>> import_model(
     Scene& scene, ecs::Entity e, bool activate_first_camera,
-    std::map<std::string, FirstImport>* imported = nullptr) {
+    std::map<std::string, FirstImport>* imported = nullptr,
+    const std::optional<Error>& blame = std::nullopt) {
   ecs::World& w = scene.world;
   const fs::path path = scene.file.parent_path() / w.get<ModelRef>(e).path;
   std::error_code ec;
@@ -1101,6 +1104,7 @@ Result<std::vector<ecs::Entity>> import_model(
   } else {
     auto report = import_gltf(path, w, scene.assets, e, e, activate_first_camera);
     if (!report) {
+      if (blame) return Error{blame->file, blame->where, report.error().to_string()};
       // A scene file's model: the scene and the entity come first, then the model's own error.
       if (lowercase_extension(scene.file) != ".json")
         return report.error();  // a glTF opened directly: its own error says it all
@@ -1341,8 +1345,22 @@ ecs::Entity add_ground(Scene& scene, const Aabb& extent) {
   return e;
 }
 
-Result<ecs::Entity> add_entity(Scene& scene, const json& block, const std::string& where) {
+Result<ecs::Entity> add_entity(Scene& scene, const json& given, const std::string& where,
+                               const fs::path& source_file) {
   ecs::World& w = scene.world;
+  const fs::path source = source_file.empty() ? scene.file : source_file;
+  // A model path is relative to the file the block comes from; the entity keeps it relative
+  // to the scene's folder, as a scene file's own models are.
+  json block = given;
+  if (source != scene.file && block.is_object() && block.contains("model") &&
+      block["model"].is_object() && block["model"].contains("path") &&
+      block["model"]["path"].is_string()) {
+    const fs::path model =
+        fs::absolute(source.parent_path() / block["model"]["path"].get<std::string>());
+    const fs::path rel =
+        model.lexically_normal().lexically_relative(fs::absolute(scene.file.parent_path()));
+    block["model"]["path"] = (rel.empty() ? model.lexically_normal() : rel).generic_string();
+  }
   std::map<std::string, ecs::Entity> by_name;
   w.view<Name>().each([&](ecs::Entity e, const Name& n) { by_name.emplace(n.value, e); });
   try {
@@ -1367,7 +1385,7 @@ Result<ecs::Entity> add_entity(Scene& scene, const json& block, const std::strin
         [&](ecs::Entity, const PrimitiveMesh& pm) { tiled = tiled || pm.tiles > 1; });
     if (tiled) fail(where + "/primitive/tiles", "an added terrain cannot be tiled");
   } catch (const ContentError& e) {
-    return Error{scene.file.string(), e.where, e.message};
+    return Error{source.string(), e.where, e.message};
   }
   std::vector<Pending> parents;
   FirstSun sun;
@@ -1378,7 +1396,8 @@ Result<ecs::Entity> add_entity(Scene& scene, const json& block, const std::strin
     w.get<MeshRenderer>(e).mesh = scene.assets.add_mesh(make_primitive(pm->shape, pm->segments));
   if (w.has<ModelRef>(e)) {
     // A model that cannot be imported, or a nodes block its file refuses, leaves no entity.
-    auto made = import_model(scene, e, /*activate_first_camera=*/false);
+    auto made = import_model(scene, e, /*activate_first_camera=*/false, nullptr,
+                             Error{source.string(), where + "/model/path", ""});
     Status st = made ? apply_node_overrides(scene, e, made.value()) : Status(made.error());
     if (!st) {
       (void)remove_entity(scene, block.at("name").get<std::string>());

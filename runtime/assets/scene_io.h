@@ -92,8 +92,11 @@ Status apply_live_override(Scene& scene, const std::string& assignment);
 /// Adds an entity from a scene file's entity block (`where` is its JSON path for messages) to a
 /// loaded scene between frames: validated as in scene files (a bad block leaves the scene
 /// unchanged), its primitive meshed, its model imported. It needs a unique name; material files
-/// and tiled terrains are not taken (inline materials are).
-Result<ecs::Entity> add_entity(Scene& scene, const nlohmann::json& block, const std::string& where);
+/// and tiled terrains are not taken (inline materials are). `source` is the file the block comes
+/// from (a playback file): errors name it, and a model path is relative to its folder; empty
+/// means the scene file.
+Result<ecs::Entity> add_entity(Scene& scene, const nlohmann::json& block, const std::string& where,
+                               const std::filesystem::path& source = {});
 
 /// Removes the entity named `name`, everything parented below it and everything imported for it.
 Status remove_entity(Scene& scene, const std::string& name);

@@ -1,5 +1,7 @@
 #include "runtime/cli/bench.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -12,15 +14,15 @@
 #include <sstream>
 
 #include "components/light.h"
-#include "components/shadow_settings.h"
-#include "components/transform.h"
 #include "components/material.h"
 #include "components/mesh_renderer.h"
-#include "runtime/cli/player.h"
+#include "components/shadow_settings.h"
+#include "components/transform.h"
 #include "runtime/assets/scene_io.h"
+#include "runtime/cli/player.h"
 #include "runtime/cli/stability.h"
-#include "runtime/core/file_io.h"
 #include "runtime/core/atomic_file.h"
+#include "runtime/core/file_io.h"
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
 
@@ -68,13 +70,29 @@ std::string clock_text(double seconds) {
   return buf;
 }
 
+// A terminal gets one line rewritten in place; a log (CI) a plain line every 10 s and at the end.
+bool g_progress_open = false;  // a bar on the terminal waits for its newline
+double g_progress_logged_s = -1.0;
+
 void progress_line(std::size_t done, std::size_t total, double elapsed_s, const std::string& what) {
   const int width = 28;
   const int filled = total ? int(double(done) / double(total) * width) : width;
   const double eta = done ? elapsed_s / double(done) * double(total - done) : 0.0;
-  std::fprintf(stderr, "\r[%s%s] %zu/%zu  elapsed %s  ETA %s  %-40.40s", std::string(std::size_t(filled), '#').c_str(),
+  const bool terminal = isatty(STDERR_FILENO);
+  if (!terminal) {
+    if (elapsed_s < g_progress_logged_s) g_progress_logged_s = -1.0;  // a new run
+    if (done < total && g_progress_logged_s >= 0.0 && elapsed_s - g_progress_logged_s < 10.0)
+      return;
+    g_progress_logged_s = elapsed_s;
+  }
+  std::fprintf(stderr,
+               terminal ? "\r[%s%s] %zu/%zu  elapsed %s  ETA %s  %-40.40s"
+                        : "[%s%s] %zu/%zu  elapsed %s  ETA %s  %s\n",
+               std::string(std::size_t(filled), '#').c_str(),
                std::string(std::size_t(width - filled), '-').c_str(), done, total,
-               clock_text(elapsed_s).c_str(), done ? clock_text(eta).c_str() : "--:--", what.c_str());
+               clock_text(elapsed_s).c_str(), done ? clock_text(eta).c_str() : "--:--",
+               what.c_str());
+  g_progress_open = terminal;
   std::fflush(stderr);
 }
 
@@ -123,6 +141,11 @@ static Status draw_charts(const fs::path& csv_path, const fs::path& out_dir) {
 void print_progress(std::size_t done, std::size_t total, double elapsed_s,
                     const std::string& what) {
   progress_line(done, total, elapsed_s, what);
+}
+
+void end_progress() {
+  if (g_progress_open) std::fprintf(stderr, "\n");
+  g_progress_open = false;
 }
 
 std::string default_sweep() {
@@ -421,7 +444,7 @@ Status run_bench(const BenchOptions& options) {
   std::signal(SIGINT, previous);
   progress_line(done, total, std::chrono::duration<double>(Clock::now() - t0).count(),
            g_interrupted ? "interrupted" : "done");
-  std::fprintf(stderr, "\n");
+  end_progress();
   if (done > 0) {
     std::printf("wrote     %s (%zu row%s%s)\n", fs::absolute(csv_path).string().c_str(), done,
                 done == 1 ? "" : "s",

@@ -37,8 +37,12 @@ struct BenchConfig {
   std::vector<std::string> sets;
 };
 
-/// One progress line on stderr (bar, done/total, elapsed, ETA, what), rewritten in place.
+/// One progress line on stderr (bar, done/total, elapsed, ETA, what): rewritten in place on a
+/// terminal; into a log, a line every 10 s and the last one.
 void print_progress(std::size_t done, std::size_t total, double elapsed_s, const std::string& what);
+
+/// Ends a progress line left on the terminal (nothing when there is none).
+void end_progress();
 
 /// The sweep used when none is given: the settings whose speed/accuracy trade-off matters.
 std::string default_sweep();

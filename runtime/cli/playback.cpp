@@ -1,5 +1,8 @@
-#include "runtime/core/median.h"
 #include "runtime/cli/playback.h"
+
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -7,12 +10,11 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <set>
 #include <sstream>
 
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
+#include "runtime/core/median.h"
 
 extern char** environ;
 
@@ -492,10 +494,10 @@ std::string frame_name(const char* prefix, int f, const char* ext) {
   return buf;
 }
 
-// One timeline event on a loaded scene.
-Status apply_event(Scene& scene, const SetEvent& ev) {
+// One timeline event of playback file `file` on a loaded scene.
+Status apply_event(Scene& scene, const SetEvent& ev, const fs::path& file) {
   if (ev.add) {
-    auto e = add_entity(scene, *ev.add, ev.where + "/add");
+    auto e = add_entity(scene, *ev.add, ev.where + "/add", file);
     if (!e) return e.error();
     update_transforms(scene.world, scene.assets);
     return {};
@@ -524,10 +526,10 @@ Result<Scene> load_checked(const Playback& pb, render::Renderer* prewarm = nullp
   const bool points = bool(pb.flicker);  // the flicker gate reads the points pass
   if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx, {}, points));
   for (const SetEvent& ev : pb.events) {
-    if (auto st = apply_event(*trial, ev); !st) {
+    if (auto st = apply_event(*trial, ev, pb.file); !st) {
       Error e = st.error();
-      e.message += " (timeline event at frame " + std::to_string(ev.frame) + " of " +
-                   pb.file.string() + ")";
+      e.message += " (timeline event at frame " + std::to_string(ev.frame) +
+                   (e.file == pb.file.string() ? "" : " of " + pb.file.string()) + ")";
       return e;
     }
     if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx, {}, points));
@@ -571,6 +573,11 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) return Error{out.string(), "", "cannot create the output folder: " + ec.message()};
+  // Captures and diff images of an earlier run of this file would pass for this run's.
+  static const std::regex earlier(R"((frame|diff)_\d{4}\.png|aov_\d{4}\.exr)");
+  for (const auto& entry : fs::directory_iterator(out, ec))
+    if (entry.is_regular_file(ec) && std::regex_match(entry.path().filename().string(), earlier))
+      fs::remove(entry.path(), ec);
 
   // The output size the camera allows (an own aspect fits inside the playback's size).
   ctx.width = scene->render.width;
@@ -621,7 +628,7 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
     const double t = f * pb.dt;
     // 1. Timeline: events due now, then the tracks' poses.
     for (; next_event < pb.events.size() && pb.events[next_event].frame <= f; ++next_event)
-      KASKAD_TRY(apply_event(*scene, pb.events[next_event]));
+      KASKAD_TRY(apply_event(*scene, pb.events[next_event], pb.file));
     if (pb.camera)
       apply_pose(scene->world, camera, *pb.camera, sample_track(*pb.camera, t), camera_start);
     for (const Moved& m : moved)
@@ -788,7 +795,7 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count(),
                    pb.file.filename().string());
   }
-  std::fprintf(stderr, "\n");
+  end_progress();
   KASKAD_TRY(write_file_atomic(out / "frames.csv", csv.str()));
 
   // 4. Whole-run expectations.
@@ -861,25 +868,48 @@ Result<std::vector<PlayFailure>> run_playbacks(const std::vector<fs::path>& file
     return Error{"--shard", "", "expected i/n with 0 <= i < n"};
   std::vector<fs::path> sorted = files;
   std::sort(sorted.begin(), sorted.end());
+  std::vector<PlayFailure> failures;
+  json summary = {
+      {"kaskad_play_summary", 1},
+      {"shard", std::to_string(options.shard_index) + "/" + std::to_string(options.shard_count)},
+      {"files", json::array()}};
+  // A file that cannot be read or run fails on its own: it is reported at once and recorded in
+  // the summary, and the other files still run.
+  auto fail_file = [&](const fs::path& file, const Error& error) {
+    end_progress();
+    std::fprintf(stderr, "kaskad: error: %s\n", error.to_string().c_str());
+    std::printf("play      %-40s %6d frames %8.1f s  FAILED (cannot run)\n",
+                file.filename().string().c_str(), 0, 0.0);
+    failures.push_back({file.string(), -1, error.to_string()});
+    summary["files"].push_back(
+        {{"file", file.string()},
+         {"frames", 0},
+         {"captured", 0},
+         {"wall_s", 0.0},
+         {"ok", false},
+         {"failures", json::array({{{"frame", -1}, {"message", error.to_string()}}})}});
+  };
   // Every file of the shard is read before anything renders: a bad file fails at once.
   std::vector<Playback> playbacks;
   for (std::size_t i : shard_files(sorted.size(), options.shard_index, options.shard_count)) {
     auto pb = read_playback(sorted[i]);
-    if (!pb) return pb.error();
-    playbacks.push_back(std::move(pb.value()));
+    if (pb)
+      playbacks.push_back(std::move(pb.value()));
+    else
+      fail_file(sorted[i], pb.error());
   }
   std::error_code ec;
   fs::create_directories(options.out_dir, ec);
   if (ec) return Error{options.out_dir.string(), "", "cannot create the output folder: " + ec.message()};
-  gpu::ContextOptions opt;
-  opt.headless = options.headless;
-  auto player = Player::create(opt);
-  if (!player) return player.error();
+  std::optional<Player> player;
+  if (!playbacks.empty()) {
+    gpu::ContextOptions opt;
+    opt.headless = options.headless;
+    auto made = Player::create(opt);
+    if (!made) return made.error();
+    player.emplace(std::move(made.value()));
+  }
 
-  std::vector<PlayFailure> failures;
-  json summary = {{"kaskad_play_summary", 1},
-                  {"shard", std::to_string(options.shard_index) + "/" + std::to_string(options.shard_count)},
-                  {"files", json::array()}};
   for (const Playback& pb : playbacks) {
     // Output folders by file name; files of the same name from different folders get their
     // folder's name in front.
@@ -890,7 +920,10 @@ Result<std::vector<PlayFailure>> run_playbacks(const std::vector<fs::path>& file
         break;
       }
     auto r = play_one(*player, pb, options, options.out_dir / name);
-    if (!r) return r.error();
+    if (!r) {
+      fail_file(pb.file, r.error());
+      continue;
+    }
     json failed = json::array();
     for (const PlayFailure& f : r->failures) {
       failed.push_back({{"frame", f.frame}, {"message", f.message}});
@@ -956,7 +989,8 @@ int run_play_command(int argc, char** argv) {
   };
   PlayOptions options;
   options.headless = !gpu::display_available();
-  std::vector<fs::path> files;
+  std::vector<fs::path> inputs;  // files and folders as given
+  bool out_given = false;
   bool merge = false;
   int jobs = 1;
   for (int i = 2; i < argc; ++i) {
@@ -978,6 +1012,7 @@ int run_play_command(int argc, char** argv) {
       const std::string v = argv[++i];
       if (arg == "--out") {
         options.out_dir = v;
+        out_given = true;
         continue;
       }
       int idx = -1, n = 0;
@@ -995,28 +1030,53 @@ int run_play_command(int argc, char** argv) {
     } else if (!arg.empty() && arg[0] == '-') {
       return usage("unknown option '" + arg + "'");
     } else {
-      std::error_code ec;
-      if (fs::is_directory(arg, ec)) {
-        for (const auto& entry : fs::directory_iterator(arg, ec))
-          if (entry.path().extension() == ".json") files.push_back(entry.path());
-      } else {
-        files.push_back(arg);
-      }
+      inputs.push_back(arg);
+    }
+  }
+  // Like every output folder Kaskad makes: one level, in a folder that exists (the default
+  // out/play is made whole).
+  if (out_given) {
+    const fs::path parent = options.out_dir.has_parent_path() ? options.out_dir.parent_path() : ".";
+    std::error_code ec;
+    if (!fs::is_directory(parent, ec)) {
+      std::fprintf(
+          stderr,
+          "kaskad: error: %s: the folder it goes in does not exist (--out makes one level)\n",
+          options.out_dir.string().c_str());
+      return 1;
     }
   }
   if (merge) {
-    if (files.empty()) return usage("--merge needs the output folders of the shards");
-    auto failed = merge_summaries(files, options.out_dir);
+    if (inputs.empty()) return usage("--merge needs the output folders of the shards");
+    auto failed = merge_summaries(inputs, options.out_dir);
     if (!failed) {
       std::fprintf(stderr, "kaskad: error: %s\n", failed.error().to_string().c_str());
       return 1;
     }
     return *failed == 0 ? 0 : 1;
   }
+  // A folder stands for its *.json files.
+  std::vector<fs::path> files;
+  for (const fs::path& in : inputs) {
+    std::error_code ec;
+    if (fs::is_directory(in, ec)) {
+      for (const auto& entry : fs::directory_iterator(in, ec))
+        if (entry.path().extension() == ".json") files.push_back(entry.path());
+    } else {
+      files.push_back(in);
+    }
+  }
   if (files.empty()) return usage("name playback files or folders of them");
   if (jobs > 1) {
     if (options.shard_count > 1) return usage("give --jobs or --shard, not both");
     // One process per shard (one GL context each), then one merged summary.
+    std::error_code ec;
+    fs::create_directories(options.out_dir, ec);
+    if (ec) {
+      std::fprintf(stderr, "kaskad: error: %s: cannot create the output folder: %s\n",
+                   options.out_dir.string().c_str(), ec.message().c_str());
+      return 1;
+    }
     std::vector<pid_t> children;
     std::vector<fs::path> dirs;
     for (int j = 0; j < jobs; ++j) {
@@ -1037,11 +1097,33 @@ int run_play_command(int argc, char** argv) {
       children.push_back(pid);
     }
     bool crashed = false;
-    for (pid_t pid : children) {
+    for (std::size_t j = 0; j < children.size(); ++j) {
       int status = 0;
-      waitpid(pid, &status, 0);
-      // 0 and 1 are results; anything else (a signal, a usage error) is a broken run.
-      crashed = crashed || !WIFEXITED(status) || WEXITSTATUS(status) > 1;
+      waitpid(children[j], &status, 0);
+      // 0 and 1 are results with a summary; anything else (a signal, a usage error), or no
+      // summary, is a broken run.
+      std::error_code ec;
+      const bool summary = fs::exists(dirs[j] / "summary.json", ec);
+      if (WIFEXITED(status) && WEXITSTATUS(status) <= 1 && summary) continue;
+      crashed = true;
+      const std::string how = WIFSIGNALED(status)
+                                  ? "was killed by signal " + std::to_string(WTERMSIG(status))
+                                  : "exited with status " + std::to_string(WEXITSTATUS(status));
+      std::fprintf(stderr, "kaskad: error: the process of shard %zu/%d %s\n", j, jobs, how.c_str());
+      // A shard that left no summary is recorded as failed, so the merge still reports the rest.
+      if (!summary) {
+        fs::create_directory(dirs[j], ec);
+        const std::string message = "the shard process " + how + " before writing its summary";
+        const json stub = {
+            {"kaskad_play_summary", 1},
+            {"shard", std::to_string(j) + "/" + std::to_string(jobs)},
+            {"files",
+             json::array({{{"file", dirs[j].string()},
+                           {"ok", false},
+                           {"failures", json::array({{{"frame", -1}, {"message", message}}})}}})}};
+        if (auto st = write_file_atomic(dirs[j] / "summary.json", stub.dump(2) + "\n"); !st)
+          std::fprintf(stderr, "kaskad: error: %s\n", st.error().to_string().c_str());
+      }
     }
     auto failed = merge_summaries(dirs, options.out_dir);
     if (!failed) {

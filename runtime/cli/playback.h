@@ -152,8 +152,9 @@ struct PlayFailure {
 
 /// Runs the playback files (this shard's), writes OUT/<stem>/frame_NNNN.png (captures),
 /// OUT/<stem>/frames.csv, OUT/<stem>/diff_NNNN.png for failing goldens and OUT/summary.json;
-/// prints a line per file. Returns the failures (empty: all expectations held); an error for
-/// files that cannot be read or run.
+/// prints a line per file. Returns the failures (empty: all expectations held). A file that
+/// cannot be read or run is one failure (frame -1, in the summary too) and the others still run;
+/// an error only when the output folder or the GL context cannot be made.
 Result<std::vector<PlayFailure>> run_playbacks(const std::vector<std::filesystem::path>& files,
                                                const PlayOptions& options);
 

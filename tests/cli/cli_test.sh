@@ -280,6 +280,40 @@ check env_alone 2 "--env is the environment of --reflection-reference" -- "$KASK
 printf '{ "kaskad_playback": 1, "scene": "nope.gltf", "frames": 2 }\n' >"$tmp/missing_scene_play.json"
 check play_missing_scene nonzero "nope.gltf: file not found \(the scene of .*missing_scene_play.json, /scene\)" \
   -- "$KASKAD" play "$tmp/missing_scene_play.json" --out "$tmp/play_missing"
+# Playback suites as CI runs them: three shards of a folder merged by their folders; a file that
+# cannot run is a failure in the summary and the others still run; --out makes one level.
+mkdir -p "$tmp/suite/models"
+cp "$KASKAD_CONTENT/models/Box/glTF-Binary/Box.glb" "$tmp/suite/models/"
+for n in a b c; do
+  printf '{ "kaskad_playback": 1, "scene": "%s/scenes/default.json", "size": [64, 36], "frames": 2,
+    "capture": { "frames": [1] } }\n' "$KASKAD_CONTENT" >"$tmp/suite/$n.json"
+done
+# An added model's path is relative to the playback file, not to the scene.
+printf '{ "kaskad_playback": 1, "scene": "%s/scenes/default.json", "size": [64, 36], "frames": 2,
+  "timeline": [ { "frame": 1, "add": { "name": "bx", "model": { "path": "models/Box.glb" } } } ] }\n' \
+  "$KASKAD_CONTENT" >"$tmp/suite/d_add.json"
+for i in 0 1 2; do
+  check "play_shard_$i" 0 "summary .*shard$i/summary.json: 0 failed" -- "$KASKAD" play "$tmp/suite" --headless \
+    --shard "$i/3" --out "$tmp/shard$i"
+done
+check play_merge_folders 0 "merged +3 summaries, 4 files, 0 failed" -- "$KASKAD" play --merge \
+  "$tmp/shard0" "$tmp/shard1" "$tmp/shard2" --out "$tmp/merged"
+# A capture of an earlier run does not stay beside this run's.
+touch "$tmp/shard0/a/frame_0007.png" "$tmp/shard0/a/diff_0001.png" "$tmp/shard0/a/mine.png"
+check play_rerun 0 "0 failed" -- "$KASKAD" play "$tmp/suite/a.json" --headless --out "$tmp/shard0"
+[ "$(ls "$tmp/shard0/a" | grep png | tr '\n' ' ')" = "frame_0001.png mine.png " ] && passed=$((passed + 1)) ||
+  { echo "FAIL play_rerun_outputs: $(ls "$tmp/shard0/a" | tr '\n' ' ')"; failed=$((failed + 1)); }
+printf '{ "kaskad_playback": 1, "scene": 3 }\n' >"$tmp/suite/bad.json"
+check play_bad_file_recorded 1 "bad.json: /scene: expected a string" -- "$KASKAD" play "$tmp/suite" --headless \
+  --out "$tmp/with_bad"
+grep -q '"ok": true' "$tmp/with_bad/summary.json" && [ -s "$tmp/with_bad/c/frame_0001.png" ] &&
+  [ "$(grep -c '"ok": false' "$tmp/with_bad/summary.json")" = 1 ] && passed=$((passed + 1)) ||
+  { echo "FAIL play_bad_file_summary"; failed=$((failed + 1)); }
+check play_jobs_bad_file 1 "merged +2 summaries, 5 files, 1 failed" -- "$KASKAD" play "$tmp/suite" --headless \
+  --jobs 2 --out "$tmp/jobs"
+check play_out_deep 1 "deep/er: the folder it goes in does not exist" -- "$KASKAD" play "$tmp/suite/a.json" \
+  --headless --out "$tmp/deep/er"
+[ ! -e "$tmp/deep" ] && passed=$((passed + 1)) || { echo "FAIL play_out_deep_made"; failed=$((failed + 1)); }
 # A bound written in the file is accepted (compared as the float it is stored as).
 check near_at_bound 0 "wrote" -- "$KASKAD" render --headless --size 96x64 --frames 1 \
   -o "$tmp/near.png" --set camera.camera.near=1e-7 --set camera.camera.far=1e7
