@@ -25,7 +25,8 @@ layout(std140, binding = 0) uniform FrameBlock {
   vec4 u_environment_sh[9];         // rgb: the environment map's SH coefficients
   vec4 u_frame;                     // x exposure, y shadow map size (texels a side), z lom layers,
                                     // w vsm_bleed_reduction
-  ivec4 u_counts;                   // x lights, y shadow views, z the view the AOV shows
+  ivec4 u_counts;                   // x lights, y shadow views, z the view the AOV shows,
+                                    // w vsm_blur (texels a side)
   vec4 u_light_color[MAX_LIGHTS];   // rgb: colour * intensity
   ivec4 u_light_info[MAX_LIGHTS];   // x type (LIGHT_*), y its shadow view (-1: none)
   vec4 u_light_dir[MAX_LIGHTS];     // xyz: direction the light travels, w: range (0 = infinite)

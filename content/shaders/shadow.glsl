@@ -21,7 +21,7 @@ layout(binding = UNIT_SHADOW_LINEAR) uniform sampler2DArrayShadow u_shadow_linea
 #if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_VSM || \
     VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_EVSM
 #define SHADOW_MOMENTS 1  // variance shadow maps (MomentsPass, vsm() below)
-// The moments of every layer (MomentsPass): blurred, mipmapped, trilinear and anisotropic.
+// The moments of every layer (MomentsPass): blurred, mipmapped, read trilinear.
 layout(binding = UNIT_VSM_MOMENTS) uniform sampler2DArray u_vsm_moments;
 #endif
 #if defined(SHADOW_SIZED) || defined(SHADOW_MOMENTS)
@@ -529,6 +529,39 @@ vec4 vsm_warp(float d) { return vec4(d, d * d, 0.0, 0.0); }
 // deviation 3.5e-4 of the map's depth range.
 const float VSM_MIN_VARIANCE = 1.1920929e-7;
 
+// The moments of `layer` filtered over the footprint spanned by the gradients dx, dy (texture
+// units) around uv. The blur already averages vsm_blur texels (u_counts.w), so a footprint
+// within that reads one bilinear tap of level 0; a longer one takes N = min(ceil(P_max /
+// max(P_min, blur)), VSM_MAX_ANISOTROPY) trilinear taps spread evenly along its longer axis,
+// at the level where each tap's share of it, P_max / N, is one blur wide. Anisotropic filtering
+// done here so that it follows these gradients on every driver, costs at most
+// VSM_MAX_ANISOTROPY taps, and keeps to level 0 (whole-texel shifts of a stable cascade change
+// nothing) while the blur covers the footprint. The sampler's own anisotropy was tried:
+// llvmpipe's takes the ellipse from the coordinates' screen derivatives, not from textureGrad's,
+// and in non-uniform control flow or at a spot map's near plane scanned thousands of texels per
+// pixel (seconds a frame).
+const int VSM_MAX_ANISOTROPY = 8;
+
+vec4 moments_filtered(int layer, vec2 uv, vec2 dx, vec2 dy) {
+  vec2 size = vec2(textureSize(u_vsm_moments, 0).xy);
+  vec2 a = dx * size, b = dy * size;  // texels
+  float la = dot(a, a), lb = dot(b, b);
+  vec2 axis = la >= lb ? dx : dy;
+  float major = sqrt(max(la, lb)), minor = sqrt(min(la, lb));
+  float blur = float(u_counts.w);
+  // Non-finite gradients (a receiver at the light's plane) read the coarsest level, one tap.
+  if (!(major < 1e30)) return textureLod(u_vsm_moments, vec3(uv, float(layer)), 64.0);
+  int n = clamp(int(ceil(major / max(minor, blur))), 1, VSM_MAX_ANISOTROPY);
+  float lod = max(log2(major / (float(n) * blur)), 0.0);
+  vec4 sum = vec4(0.0);
+  for (int j = 0; j < VSM_MAX_ANISOTROPY; ++j) {
+    if (j >= n) break;
+    vec2 at = uv + axis * ((float(j) + 0.5) / float(n) - 0.5);
+    sum += textureLod(u_vsm_moments, vec3(at, float(layer)), lod);
+  }
+  return sum / float(n);
+}
+
 // Chebyshev's one-tailed bound (Donnelly, Lauritzen 2006, eq. 5) on the fraction of the filter
 // region whose depth is at least t: p_max = s^2 / (s^2 + (t - mu)^2), with mu = m.x, s^2 =
 // m.y - m.x^2 (at least min_variance); 1 when t <= mu.
@@ -549,19 +582,18 @@ float pixel_footprint(vec3 q) {
 
 // Visibility from the moments of layer i of view k at map coordinates c (receiver q, normal n).
 // The filter region is the pixel's footprint on the receiver's plane, mapped into the layer:
-// two tangents of the plane, a pixel long, as texture gradients, so the hardware picks the mip
-// level and the anisotropy (no screen derivatives: the points pass has none, and lookups sit in
-// non-uniform control flow). Then Chebyshev's bound and the light-bleeding reduction
-// (Lauritzen, GPU Gems 3 ch. 8): p -> linstep(a, 1, p), a = vsm_bleed_reduction (u_frame.w):
-// bounds below a, the light that bleeds where a second occluder lies between the receiver and
-// the nearest one, become shadow.
+// two tangents of the plane, a pixel long, as the gradients of moments_filtered() (no screen
+// derivatives: the points pass has none, and lookups sit in non-uniform control flow). Then
+// Chebyshev's bound and the light-bleeding reduction (Lauritzen, GPU Gems 3 ch. 8):
+// p -> linstep(a, 1, p), a = vsm_bleed_reduction (u_frame.w): bounds below a, the light that
+// bleeds where a second occluder lies between the receiver and the nearest one, become shadow.
 float vsm(int k, int i, int layer, vec3 c, vec3 q, vec3 n) {
   float f = pixel_footprint(q);
   vec3 t1 = normalize(cross(n, abs(n.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0)));
   vec3 t2 = cross(n, t1);
   vec2 dx = map_coords(k, i, q + f * t1).xy - c.xy;
   vec2 dy = map_coords(k, i, q + f * t2).xy - c.xy;
-  vec4 m = textureGrad(u_vsm_moments, vec3(c.xy, float(layer)), dx, dy);
+  vec4 m = moments_filtered(layer, c.xy, dx, dy);
   float d = vsm_depth(k, c.z);
   vec4 w = vsm_warp(d);
 #if VARIANT_SHADOW_TECHNIQUE == VARIANT_SHADOW_TECHNIQUE_EVSM

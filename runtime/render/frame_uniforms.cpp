@@ -76,7 +76,8 @@ FrameBlock pack_frame_block(const FrameInput& frame) {
                               frame.shadow_map.vsm_bleed_reduction);
   const int lights = shaded_lights(frame);
   const int views = int(frame.shadow_views.size());
-  fb.counts = glm::ivec4(lights, views, views > 0 ? frame.aov_shadow_view : -1, 0);
+  fb.counts =
+      glm::ivec4(lights, views, views > 0 ? frame.aov_shadow_view : -1, frame.shadow_map.vsm_blur);
   for (int i = 0; i < lights; ++i) {
     const LightItem& l = frame.lights[std::size_t(i)];
     fb.light_color[i] = glm::vec4(l.color, 0.0f);

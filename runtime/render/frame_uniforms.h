@@ -38,7 +38,8 @@ struct alignas(16) FrameBlock {
   glm::vec4 environment_sh[9];  ///< rgb: the environment map's SH coefficients (project_sh9)
   /// x exposure, y shadow map size (texels a side), z lom layers, w vsm_bleed_reduction
   glm::vec4 frame_params;
-  glm::ivec4 counts;       ///< x lights shaded, y shadow views, z the view the AOV shows
+  /// x lights shaded, y shadow views, z the view the AOV shows, w vsm_blur (texels a side)
+  glm::ivec4 counts;
   glm::vec4 light_color[kMaxLights];  ///< rgb: colour * intensity
   glm::ivec4 light_info[kMaxLights];  ///< x LightType, y its shadow view (-1: none)
   glm::vec4 light_dir[kMaxLights];    ///< xyz: direction the light travels, w: range (0 = inf)

@@ -201,7 +201,7 @@ class MomentsPass {
   /// layer's moments match its depth.
   Status record(const FrameInput& frame, const DrawList& list, ShadowMapPass& shadow,
                 DrawState& state);
-  /// Binds the moments (UNIT_VSM_MOMENTS: trilinear, anisotropic where the driver has it).
+  /// Binds the moments (UNIT_VSM_MOMENTS: trilinear).
   void bind();
   /// Level 0 of every layer, stacked as ShadowMapPass::read(), channels as stored (tests).
   Image read() const;
@@ -213,7 +213,7 @@ class MomentsPass {
   gpu::Texture moments_;         ///< 2D array, mipmapped
   gpu::Texture along_x_;         ///< 2D: one layer's moments blurred along x
   gpu::Framebuffer fbo_;
-  gpu::Sampler filtered_;        ///< trilinear (+ anisotropic), clamp to edge
+  gpu::Sampler filtered_;  ///< trilinear, clamp to edge
   gpu::VertexArray empty_vao_;
   std::vector<std::uint64_t> drawn_from_;  // per shadow-map layer, as LomPass
   std::vector<glm::ivec4> drawn_rect_;
