@@ -629,21 +629,7 @@ void Editor::write_camera() {
     c.auto_frame = false;
     planes_follow_ = true;
   }
-  if (planes_follow_ && !bounds_.empty()) {
-    // Far: the farthest corner of the scene's bounds; near: the nearest point of them (0 inside),
-    // so near < far wherever the camera looks.
-    float far = 0.0f;
-    for (int i = 0; i < 8; ++i) {
-      const glm::vec3 corner{(i & 1) ? bounds_.max.x : bounds_.min.x,
-                             (i & 2) ? bounds_.max.y : bounds_.min.y,
-                             (i & 4) ? bounds_.max.z : bounds_.min.z};
-      far = std::max(far, glm::length(corner - camera_.position));
-    }
-    far = std::max(far * 1.01f, 1e-3f);
-    const glm::vec3 nearest = glm::clamp(camera_.position, bounds_.min, bounds_.max);
-    c.near = std::clamp(0.9f * glm::length(nearest - camera_.position), 1e-3f * far, 0.5f * far);
-    c.far = far;
-  }
+  if (planes_follow_ && !bounds_.empty()) fit_planes_to_bounds(c, camera_.position, bounds_);
 }
 
 void Editor::update_bounds_speed() {

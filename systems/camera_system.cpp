@@ -153,6 +153,20 @@ std::vector<std::string> camera_warnings(const ecs::World& world, float output_a
   return out;
 }
 
+void fit_planes_to_bounds(Camera& camera, const glm::vec3& position, const Aabb& bounds) {
+  float far = 0.0f;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 corner{(i & 1) ? bounds.max.x : bounds.min.x,
+                           (i & 2) ? bounds.max.y : bounds.min.y,
+                           (i & 4) ? bounds.max.z : bounds.min.z};
+    far = std::max(far, glm::length(corner - position));
+  }
+  far = std::max(far * 1.01f, 1e-3f);
+  const glm::vec3 nearest = glm::clamp(position, bounds.min, bounds.max);
+  camera.near = std::clamp(0.9f * glm::length(nearest - position), 1e-3f * far, 0.5f * far);
+  camera.far = far;
+}
+
 void frame_auto_cameras(ecs::World& world, const Aabb& bounds, const Aabb& depth_bounds,
                         float output_aspect) {
   if (bounds.empty()) return;

@@ -49,6 +49,13 @@ glm::ivec2 fit_output_to_camera(const ecs::World& world, int width, int height);
 std::vector<std::string> camera_warnings(const ecs::World& world, float output_aspect,
                                          int output_height);
 
+/// Near and far of a camera at `position` fitted to `bounds` (not empty): far just past the
+/// farthest corner, near 0.9x the distance to the nearest point of the box (0 inside it), kept
+/// between far / 1000 and far / 2, so near < far wherever the camera looks. For an auto_frame
+/// camera moved after the load (the editor's fly camera, a playback's camera keys): the planes
+/// framing fitted from where the load put it would clip what the camera flies up to.
+void fit_planes_to_bounds(Camera& camera, const glm::vec3& position, const Aabb& bounds);
+
 /// Moves every auto_frame camera back along its view axis until `bounds` fits its field of view,
 /// and sets near/far to enclose the bounds, far also the farthest corner of `depth_bounds` in
 /// front of the camera (a ground wider than the models). Updates Transform (root cameras only; a

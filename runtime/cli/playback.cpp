@@ -629,8 +629,15 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
     // 1. Timeline: events due now, then the tracks' poses.
     for (; next_event < pb.events.size() && pb.events[next_event].frame <= f; ++next_event)
       KASKAD_TRY(apply_event(*scene, pb.events[next_event], pb.file));
-    if (pb.camera)
+    if (pb.camera) {
       apply_pose(scene->world, camera, *pb.camera, sample_track(*pb.camera, t), camera_start);
+      // An auto_frame camera's planes were fitted from where the load put it; as in the
+      // editor, they follow the keys, or a camera moved in would clip what it moves up to.
+      Camera& c = scene->world.get<Camera>(camera);
+      const Aabb bounds = scene_bounds(scene->world);
+      if (c.auto_frame && !bounds.empty())
+        fit_planes_to_bounds(c, scene->world.get<Transform>(camera).translation, bounds);
+    }
     for (const Moved& m : moved)
       apply_pose(scene->world, m.entity, *m.track, sample_track(*m.track, t), m.start);
     // 2. The frame, timed with the GPU waited on.

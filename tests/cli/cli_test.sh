@@ -314,6 +314,21 @@ check play_jobs_bad_file 1 "merged +2 summaries, 5 files, 1 failed" -- "$KASKAD"
 check play_out_deep 1 "deep/er: the folder it goes in does not exist" -- "$KASKAD" play "$tmp/suite/a.json" \
   --headless --out "$tmp/deep/er"
 [ ! -e "$tmp/deep" ] && passed=$((passed + 1)) || { echo "FAIL play_out_deep_made"; failed=$((failed + 1)); }
+# Camera keys moving a glTF's auto_frame camera in: its near and far follow it (as in the
+# editor), so the box it moves up to is not cut by the near plane framing fitted at load.
+cat >"$tmp/box_in.json" <<EOF
+{ "kaskad_playback": 1, "scene": "$KASKAD_CONTENT/models/Box/glTF-Binary/Box.glb",
+  "size": [160, 90], "frames": 3, "dt": 0.1,
+  "camera": { "keys": [ { "t": 0, "move": [0, 0, 0] }, { "t": 0.2, "move": [0, 0, 0.4] } ] },
+  "capture": { "frames": [2] }, "expect": { "gl_errors": 0 } }
+EOF
+check play_camera_planes_follow 0 "0 failed" -- "$KASKAD" play "$tmp/box_in.json" --headless \
+  --out "$tmp/play_box_in"
+check play_camera_planes_image 0 "box centre red" -- /usr/bin/python3 -c '
+import sys, matplotlib.image as m
+px = m.imread(sys.argv[1])[45, 80]
+print("box centre red" if px[0] > 2 * px[1] and px[0] > 2 * px[2] else "centre pixel %s" % px)
+' "$tmp/play_box_in/box_in/frame_0002.png"
 # A bound written in the file is accepted (compared as the float it is stored as).
 check near_at_bound 0 "wrote" -- "$KASKAD" render --headless --size 96x64 --frames 1 \
   -o "$tmp/near.png" --set camera.camera.near=1e-7 --set camera.camera.far=1e7

@@ -415,5 +415,25 @@ TEST(CameraSystem, ActiveCameraWinsAndAutoFrameFitsTheBounds) {
   }
 }
 
+TEST(CameraPlanes, FollowACameraMovedInsideAndOutsideTheBounds) {
+  Aabb bounds;
+  bounds.expand(glm::vec3(-1, 0, -1));
+  bounds.expand(glm::vec3(1, 2, 1));
+  Camera c;
+  // Outside: near just short of the box's nearest point, far past its farthest corner.
+  fit_planes_to_bounds(c, glm::vec3(0, 1, 3), bounds);
+  EXPECT_NEAR(c.near, 0.9f * 2.0f, 1e-4f);
+  EXPECT_GE(c.far, glm::length(glm::vec3(1, 1, 4)));
+  EXPECT_LT(c.far, 1.02f * glm::length(glm::vec3(1, 1, 4)));
+  // Inside: near at its floor, far / 1000, never 0.
+  fit_planes_to_bounds(c, glm::vec3(0, 1, 0), bounds);
+  EXPECT_NEAR(c.near, 1e-3f * c.far, 1e-7f);
+  EXPECT_GE(c.far, glm::length(glm::vec3(1, 1, 1)));
+  // Far away: near at most far / 2.
+  fit_planes_to_bounds(c, glm::vec3(0, 1, 1000), bounds);
+  EXPECT_LE(c.near, 0.5f * c.far);
+  EXPECT_LT(c.near, 999.0f);
+}
+
 }  // namespace
 }  // namespace kaskad
