@@ -522,6 +522,7 @@ Status save_image(const std::filesystem::path& path, const Image& image) {
                "channel_names must be empty or one per channel, was " +
                    std::to_string(image.channel_names.size()));
 
+  KASKAD_TRY(check_output_path(path));  // a folder or a missing folder named as such
   const std::string name = path.string();
   const std::string ext = extension_format(path);
   // Declared before the writer, which may still use it while it is destroyed.

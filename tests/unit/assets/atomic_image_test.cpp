@@ -41,5 +41,16 @@ TEST(AtomicFile, FailedImageWritesKeepThePreviousImage) {
   EXPECT_EQ(files_in(dir), 4u) << "a temporary file was left behind";
 }
 
+TEST(AtomicFile, AnImageNamedByAFolderSaysSo) {
+  // The editor's `screenshot FOLDER` was told "cannot write this image format".
+  const fs::path dir = fresh_dir("image_folder");
+  fs::create_directories(dir / "shots");
+  const Status st = save_image(dir / "shots", gradient(4, 4));
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().to_string().find("is a folder"), std::string::npos)
+      << st.error().to_string();
+  EXPECT_TRUE(fs::is_directory(dir / "shots"));
+}
+
 }  // namespace
 }  // namespace kaskad
