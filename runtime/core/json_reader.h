@@ -304,9 +304,78 @@ struct ErrorLocator {
 
 /// Parses JSON text read from `file` (used in messages). Every error nlohmann can raise (syntax,
 /// number overflow, invalid UTF-8, ...) becomes a content error with line and column.
+/// A SAX consumer that finds the first key given twice in one object (the parser would keep the
+/// last and drop the other without a word), as the JSON pointer of the second one.
+struct DuplicateKeyFinder {
+  struct Level {
+    bool object = false;
+    std::vector<std::string> keys;  // objects: keys so far
+    std::size_t index = 0;          // arrays: elements so far
+  };
+  std::vector<Level> levels;
+  std::string duplicate, pointer;
+
+  void element() {
+    if (!levels.empty() && !levels.back().object) ++levels.back().index;
+  }
+  bool scalar() {
+    element();
+    return true;
+  }
+  bool null() { return scalar(); }
+  bool boolean(bool) { return scalar(); }
+  bool number_integer(json::number_integer_t) { return scalar(); }
+  bool number_unsigned(json::number_unsigned_t) { return scalar(); }
+  bool number_float(json::number_float_t, const json::string_t&) { return scalar(); }
+  bool string(json::string_t&) { return scalar(); }
+  bool binary(json::binary_t&) { return scalar(); }
+  bool start_object(std::size_t) {
+    element();
+    levels.push_back({true, {}, 0});
+    return true;
+  }
+  bool start_array(std::size_t) {
+    element();
+    levels.push_back({false, {}, 0});
+    return true;
+  }
+  bool end_object() { return end(); }
+  bool end_array() { return end(); }
+  bool end() {
+    levels.pop_back();
+    return true;
+  }
+  bool key(json::string_t& k) {
+    std::vector<std::string>& keys = levels.back().keys;
+    if (std::find(keys.begin(), keys.end(), k) == keys.end()) {
+      keys.push_back(k);
+      return true;
+    }
+    duplicate = k;
+    keys.push_back(k);  // the last key of each object level names it in the pointer
+    for (const Level& l : levels) {
+      pointer += '/';
+      if (!l.object) {
+        pointer += std::to_string(l.index - 1);
+        continue;
+      }
+      for (char c : l.keys.back()) pointer += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+    }
+    return false;  // the first one is enough
+  }
+  bool parse_error(std::size_t, const std::string&, const json::exception&) { return false; }
+};
+
 inline Result<json> parse_json_text(const std::string& text, const std::string& file) {
   try {
-    return json::parse(text, nullptr, true, /*ignore_comments=*/false);
+    json doc = json::parse(text, nullptr, true, /*ignore_comments=*/false);
+    DuplicateKeyFinder keys;
+    json::sax_parse(text, &keys);
+    if (!keys.duplicate.empty())
+      return Error{file, keys.pointer,
+                   "the key '" + keys.duplicate +
+                       "' is given twice in this object (only one would count); give it once"};
+    return doc;
   } catch (const json::parse_error& e) {
     return Error{file, line_column(text, e.byte), "malformed JSON: " + json_message(e)};
   } catch (const json::exception& e) {

@@ -51,5 +51,22 @@ TEST(JsonReader, FoldersMissingAndEmptyFiles) {
   EXPECT_EQ(empty.error().where, "line 1, column 1");
 }
 
+TEST(JsonParse, AKeyGivenTwiceInOneObjectIsAnErrorAtItsPointer) {
+  // nlohmann keeps the last of two equal keys without a word: a scene saying "shadow" twice
+  // lost the first block's settings silently.
+  auto top = parse_json_text(R"({"a": 1, "b": 2, "a": 3})", "x.json");
+  ASSERT_FALSE(top.ok());
+  EXPECT_EQ(top.error().where, "/a");
+  EXPECT_NE(top.error().message.find("'a' is given twice"), std::string::npos);
+  auto deep = parse_json_text(R"({"t": [{"k": 1}, {"k": 1, "m/~": {}, "m/~": 2}]})", "x.json");
+  ASSERT_FALSE(deep.ok());
+  EXPECT_EQ(deep.error().where, "/t/1/m~1~0");
+  // Equal keys in different objects, and equal values, are fine.
+  auto fine =
+      parse_json_text(R"({"a": {"a": 1}, "b": [{"a": 1}, {"a": 1}], "c": ["a", "a"]})", "x.json");
+  ASSERT_TRUE(fine.ok()) << fine.error().to_string();
+  EXPECT_EQ((*fine)["b"][1]["a"], 1);
+}
+
 }  // namespace
 }  // namespace kaskad

@@ -406,6 +406,7 @@ TEST(FrameUniforms, PackPutsEveryViewAndLightInItsPlace) {
   frame.lights[2].type = LightType::spot;
   frame.exposure = 2.5f;
   frame.shadow_map.vsm_bleed_reduction = 0.3f;
+  frame.shadow_map.vsm_blur = 7;
   frame.height = 200;
   frame.camera.proj = glm::perspective(glm::radians(90.0f), 2.0f, 0.1f, 100.0f);
   ShadowView a;
@@ -428,7 +429,7 @@ TEST(FrameUniforms, PackPutsEveryViewAndLightInItsPlace) {
   frame.aov_shadow_view = 1;
   ASSERT_EQ(shadow_views_error(frame), "");
   const FrameBlock fb = pack_frame_block(frame);
-  EXPECT_EQ(fb.counts, glm::ivec4(3, 2, 1, 0));
+  EXPECT_EQ(fb.counts, glm::ivec4(3, 2, 1, 7));  // w: vsm_blur
   EXPECT_EQ(fb.frame_params.x, 2.5f);
   EXPECT_EQ(fb.frame_params.w, 0.3f);
   // Metres per pixel at 1 m of view depth: 2 tan(45 deg) / 200.
