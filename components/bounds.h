@@ -33,14 +33,15 @@ struct Aabb {
     expand(b.min);
     expand(b.max);
   }
+  /// Corner i of 8: bit 0 picks max.x, bit 1 max.y, bit 2 max.z.
+  glm::vec3 corner(int i) const {
+    return {(i & 1) ? max.x : min.x, (i & 2) ? max.y : min.y, (i & 4) ? max.z : min.z};
+  }
   /// The box of the 8 corners of this box transformed by m (empty stays empty).
   Aabb transformed(const glm::mat4& m) const {
     Aabb out;
     if (empty()) return out;
-    for (int i = 0; i < 8; ++i) {
-      glm::vec3 c{(i & 1) ? max.x : min.x, (i & 2) ? max.y : min.y, (i & 4) ? max.z : min.z};
-      out.expand(glm::vec3(m * glm::vec4(c, 1.0f)));
-    }
+    for (int i = 0; i < 8; ++i) out.expand(glm::vec3(m * glm::vec4(corner(i), 1.0f)));
     return out;
   }
 };
@@ -53,9 +54,7 @@ inline bool outside_clip_volume(const glm::mat4& view_proj, const Aabb& box) {
   if (box.empty()) return false;
   int out[6] = {0, 0, 0, 0, 0, 0};
   for (int i = 0; i < 8; ++i) {
-    const glm::vec4 c = view_proj * glm::vec4((i & 1) ? box.max.x : box.min.x,
-                                              (i & 2) ? box.max.y : box.min.y,
-                                              (i & 4) ? box.max.z : box.min.z, 1.0f);
+    const glm::vec4 c = view_proj * glm::vec4(box.corner(i), 1.0f);
     out[0] += c.x < -c.w;
     out[1] += c.x > c.w;
     out[2] += c.y < -c.w;

@@ -155,12 +155,7 @@ std::vector<std::string> camera_warnings(const ecs::World& world, float output_a
 
 void fit_planes_to_bounds(Camera& camera, const glm::vec3& position, const Aabb& bounds) {
   float far = 0.0f;
-  for (int i = 0; i < 8; ++i) {
-    const glm::vec3 corner{(i & 1) ? bounds.max.x : bounds.min.x,
-                           (i & 2) ? bounds.max.y : bounds.min.y,
-                           (i & 4) ? bounds.max.z : bounds.min.z};
-    far = std::max(far, glm::length(corner - position));
-  }
+  for (int i = 0; i < 8; ++i) far = std::max(far, glm::length(bounds.corner(i) - position));
   far = std::max(far * 1.01f, 1e-3f);
   const glm::vec3 nearest = glm::clamp(position, bounds.min, bounds.max);
   camera.near = std::clamp(0.9f * glm::length(nearest - position), 1e-3f * far, 0.5f * far);
@@ -193,12 +188,9 @@ void frame_auto_cameras(ecs::World& world, const Aabb& bounds, const Aabb& depth
     t.translation = center - forward * distance;
     cam.near = std::max(distance - radius, distance * 1e-3f) * 0.9f;
     cam.far = (distance + radius) * 1.1f;
-    for (int i = 0; i < 8 && !depth_bounds.empty(); ++i) {
-      const glm::vec3 c{(i & 1) ? depth_bounds.max.x : depth_bounds.min.x,
-                        (i & 2) ? depth_bounds.max.y : depth_bounds.min.y,
-                        (i & 4) ? depth_bounds.max.z : depth_bounds.min.z};
-      cam.far = std::max(cam.far, glm::dot(c - t.translation, forward) * 1.01f);
-    }
+    for (int i = 0; i < 8 && !depth_bounds.empty(); ++i)
+      cam.far =
+          std::max(cam.far, glm::dot(depth_bounds.corner(i) - t.translation, forward) * 1.01f);
   });
 }
 

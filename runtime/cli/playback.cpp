@@ -633,10 +633,11 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
       apply_pose(scene->world, camera, *pb.camera, sample_track(*pb.camera, t), camera_start);
       // An auto_frame camera's planes were fitted from where the load put it; as in the
       // editor, they follow the keys, or a camera moved in would clip what it moves up to.
-      Camera& c = scene->world.get<Camera>(camera);
-      const Aabb bounds = scene_bounds(scene->world);
-      if (c.auto_frame && !bounds.empty())
-        fit_planes_to_bounds(c, scene->world.get<Transform>(camera).translation, bounds);
+      if (Camera& c = scene->world.get<Camera>(camera); c.auto_frame) {
+        const Aabb bounds = scene_bounds(scene->world);
+        if (!bounds.empty())
+          fit_planes_to_bounds(c, scene->world.get<Transform>(camera).translation, bounds);
+      }
     }
     for (const Moved& m : moved)
       apply_pose(scene->world, m.entity, *m.track, sample_track(*m.track, t), m.start);

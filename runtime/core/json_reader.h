@@ -302,8 +302,6 @@ struct ErrorLocator {
   }
 };
 
-/// Parses JSON text read from `file` (used in messages). Every error nlohmann can raise (syntax,
-/// number overflow, invalid UTF-8, ...) becomes a content error with line and column.
 /// A SAX consumer that finds the first key given twice in one object (the parser would keep the
 /// last and drop the other without a word), as the JSON pointer of the second one.
 struct DuplicateKeyFinder {
@@ -366,6 +364,9 @@ struct DuplicateKeyFinder {
   bool parse_error(std::size_t, const std::string&, const json::exception&) { return false; }
 };
 
+/// Parses JSON text read from `file` (used in messages). Every error nlohmann can raise (syntax,
+/// number overflow, invalid UTF-8, ...) becomes a content error with line and column; a key
+/// given twice in one object, an error at its JSON pointer.
 inline Result<json> parse_json_text(const std::string& text, const std::string& file) {
   try {
     json doc = json::parse(text, nullptr, true, /*ignore_comments=*/false);

@@ -1164,9 +1164,9 @@ void MomentsPass::ensure_storage(int size, int layers, bool four) {
     glSamplerParameteri(filtered_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glSamplerParameteri(filtered_.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glSamplerParameteri(filtered_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    // Trilinear only. 8x anisotropic filtering was tried: on llvmpipe it made the default
-    // scene's first vsm frame 40x slower (a spot map's, 15 s at 640x360) and misclassified more
-    // pixels (0.16% against 0.065%); the footprint is the receiver plane's already.
+    // Trilinear only: moments_filtered() (shadow.glsl) filters anisotropically along the
+    // footprint itself. The sampler's 8x anisotropy made a spot's vsm frame take 15 s at 640x360
+    // on llvmpipe and misclassified 0.16% of the default scene's pixels (0.059% now).
     empty_vao_ = gpu::make_vertex_array();
   }
   drawn_from_.assign(std::size_t(layers), 0);
