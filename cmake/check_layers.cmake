@@ -12,8 +12,9 @@
 
 cmake_minimum_required(VERSION 3.25)
 
-# Layers, lowest first; kaskad_<layer> is the CMake target.
-set(layers result core ecs components math gpu features assets reference render systems app)
+# Layers, lowest first; kaskad_<layer> is the CMake target (cli: the `kaskad` executable). A file's
+# layer is its folder: runtime/<layer>/, components/ or systems/.
+set(layers result core ecs components math gpu features assets reference render systems app cli)
 # What each layer may use, directly or through another layer (so: closed under "uses").
 set(uses_result     "")
 set(uses_core       result)
@@ -27,24 +28,15 @@ set(uses_reference  assets features math components ecs core result)
 set(uses_render     assets features math gpu components ecs core result)
 set(uses_systems    render math assets features gpu components ecs core result)
 set(uses_app        systems render reference math assets features gpu components ecs core result)
+set(uses_cli        app systems render reference math assets features gpu components ecs core result)
 
 # The layer of a source file, from its path relative to the repository ("" when none).
 function(layer_of path out)
   set(layer "")
-  if(path STREQUAL "runtime/core/result.h")
-    set(layer result)
-  elseif(path MATCHES "^runtime/render/(feature_manifest\\.(h|cpp)|variant_key\\.h|shader_interface\\.h)$")
-    set(layer features)
-  elseif(path MATCHES "^runtime/(core|ecs|gpu|assets|reference|render)/")
+  if(path MATCHES "^runtime/([a-z]+)/")
     set(layer ${CMAKE_MATCH_1})
-  elseif(path MATCHES "^runtime/cli/")
-    set(layer app)
-  elseif(path MATCHES "^components/")
-    set(layer components)
-  elseif(path MATCHES "^systems/[a-z_]+_math\\.(h|cpp)$")
-    set(layer math)
-  elseif(path MATCHES "^systems/")
-    set(layer systems)
+  elseif(path MATCHES "^(components|systems)/")
+    set(layer ${CMAKE_MATCH_1})
   endif()
   set(${out} "${layer}" PARENT_SCOPE)
 endfunction()

@@ -1,7 +1,7 @@
 // Shadow parameters of one shadowed light, kept apart from Light (Bevy's CascadeShadowConfig
 // beside DirectionalLight): the map and its bias/filter, and the cascades of a directional light
 // (S0, with S2's stabilisation). Plain data; validate_shadow_settings() names the first bad value.
-// Each default says where it comes from. The maths lives in systems/cascade_math.h.
+// Each default says where it comes from. The maths lives in runtime/math/cascade_math.h.
 #pragma once
 
 #include <cmath>

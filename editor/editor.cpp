@@ -41,7 +41,7 @@
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/core/file_io.h"
 #include "runtime/core/json_reader.h"
 #include "runtime/core/log.h"

@@ -13,7 +13,7 @@
 #include "components/model.h"
 #include "components/transform.h"
 #include "runtime/core/log.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 namespace kaskad {
 namespace {

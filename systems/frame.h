@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "runtime/assets/scene.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/render/renderer.h"
 #include "systems/camera_system.h"
 #include "systems/environment_probe_system.h"

@@ -9,7 +9,7 @@
 #include "components/name.h"
 #include "components/transform.h"
 #include "runtime/core/log.h"
-#include "systems/local_light_math.h"
+#include "runtime/math/local_light_math.h"
 
 namespace kaskad {
 namespace {

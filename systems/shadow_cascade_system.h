@@ -21,7 +21,7 @@
 #include "components/limits.h"
 #include "runtime/render/frame_input.h"
 #include "systems/camera_system.h"
-#include "systems/cascade_math.h"
+#include "runtime/math/cascade_math.h"
 #include "systems/shadow_map_system.h"
 
 namespace kaskad {

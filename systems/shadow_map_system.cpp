@@ -7,7 +7,7 @@
 #include "components/light.h"
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
-#include "systems/cascade_math.h"
+#include "runtime/math/cascade_math.h"
 
 namespace kaskad {
 

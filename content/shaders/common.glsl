@@ -1,7 +1,7 @@
 // Shared declarations. FrameBlock is FrameBlock in runtime/render/frame_uniforms.h (std140; its
 // offsets are tested against this block). MAX_LIGHTS, MAX_CASCADES and MAX_SHADOW_VIEWS are
 // defined in every program from components/limits.h (FeatureManifest::defines), and LIGHT_*
-// (LightType's values) from runtime/render/shader_interface.h.
+// (LightType's values) from runtime/features/shader_interface.h.
 
 // One shadowed light's maps: its layers of the shadow map array (ShadowViewBlock).
 struct ShadowView {
@@ -39,7 +39,7 @@ float view_split(int k, int i) { return u_shadow_views[k].splits[i >> 2][i & 3];
 float view_texel(int k, int i) { return u_shadow_views[k].texel[i >> 2][i & 3]; }
 
 // Per-material uniforms (set when the material changes; draws are sorted by material). Locations,
-// attributes and texture units are defined from runtime/render/shader_interface.h.
+// attributes and texture units are defined from runtime/features/shader_interface.h.
 layout(location = LOC_BASE_COLOR) uniform vec4 u_base_color;
 layout(location = LOC_MATERIAL) uniform vec4 u_material;  // x metallic, y roughness, z normal scale, w alpha cutoff
 layout(location = LOC_EMISSIVE) uniform vec3 u_emissive;

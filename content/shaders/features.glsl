@@ -10,7 +10,7 @@ layout(location = LOC_FEATURE_BITS) uniform uint u_oracle_features;  // VariantK
 #endif
 
 // BIT_BASE_COLOR_TEXTURE, BIT_NORMAL_MAP, ...: the material features' key bits, defined in every
-// program by FeatureManifest::defines() from kFeatureTable (runtime/render/variant_key.h).
+// program by FeatureManifest::defines() from kFeatureTable (runtime/features/variant_key.h).
 
 // KHR_texture_transform: the uv a texture slot (UV_SLOT_*) reads. Two rows of the slot's affine
 // map per slot (uv_transform_rows() in components/material.h), declared here after ENABLED().

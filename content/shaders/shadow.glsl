@@ -54,9 +54,9 @@ float lom_depth(ivec2 t, int layer, int j) {
 // (u_shadow_views[k]); its layers are first_layer .. first_layer + layer count - 1 of the array.
 // Clamp-to-border with border depth 1 and the z > 1 test keep everything outside a layer's light
 // frustum lit. Cascade selection and blending: select_cascade_by_depth / select_cascade_by_map /
-// cascade_blend_weight* in systems/cascade_math.h, tested against this code in
+// cascade_blend_weight* in runtime/math/cascade_math.h, tested against this code in
 // tests/render/cascade_selection_test.cpp. View 0 may be a spot or point light
-// (VARIANT_SHADOW_PROJECTION != ORTHO; systems/local_light_math.h): its layers are the spot map,
+// (VARIANT_SHADOW_PROJECTION != ORTHO; runtime/math/local_light_math.h): its layers are the spot map,
 // cube faces or paraboloid hemispheres, view_split(0, 0..1) hold near and far (metres from the
 // light), and view_texel(0, i) is metres per texel at 1 m from the light.
 #if VARIANT_HAS_SHADOW
@@ -683,7 +683,7 @@ float perspective_visibility(int k, int layer, vec3 p, vec3 n) {
 
 #if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_CUBE
 // The face of direction d (+X, -X, +Y, -Y, +Z, -Z): its major axis, ties prefer x then y.
-// Mirrors cube_face_of() in systems/local_light_math.cpp.
+// Mirrors cube_face_of() in runtime/math/local_light_math.cpp.
 int cube_face(vec3 d) {
   vec3 a = abs(d);
   if (a.x >= a.y && a.x >= a.z) return d.x >= 0.0 ? 0 : 1;
@@ -695,7 +695,7 @@ int cube_face(vec3 d) {
 #if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_DUAL_PARABOLOID
 // Dual-paraboloid lookup (S0's earlier work): hemisphere 0 is z <= 0 of the view in
 // view_proj[0], hemisphere 1 the rest, seen from the same view turned 180 degrees about y.
-// Mirrors paraboloid_views() / paraboloid_project() (systems/local_light_math.h) and
+// Mirrors paraboloid_views() / paraboloid_project() (runtime/math/local_light_math.h) and
 // shadow_depth.vert.
 float paraboloid_visibility(int k, vec3 p, vec3 n, out int hemisphere) {
   vec3 q = local_offset_point(k, 0, p, n);

@@ -38,7 +38,7 @@ void main() {
 #endif
 #if VARIANT_SHADOW_PROJECTION == VARIANT_SHADOW_PROJECTION_DUAL_PARABOLOID
   // u_light_view_proj is the hemisphere's view; the paraboloid is not a matrix. xy as
-  // paraboloid_project() (systems/local_light_math.h), written with w = 1 - u.z so that
+  // paraboloid_project() (runtime/math/local_light_math.h), written with w = 1 - u.z so that
   // vertices behind the light (w -> 0) are clipped in clip space instead of divided by ~0. Depth
   // is the distance, linear in [near, far]. Rasterisation interpolates all of this linearly
   // between vertices: the tessellation error of paraboloid maps. The clip distance draws the

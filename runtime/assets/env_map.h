@@ -28,8 +28,8 @@
 
 #include <glm/glm.hpp>
 
-#include "runtime/core/result.h"
-#include "systems/sphere_map_math.h"
+#include "runtime/result/result.h"
+#include "runtime/math/sphere_map_math.h"
 
 namespace kaskad {
 

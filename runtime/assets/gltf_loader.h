@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "runtime/assets/asset_store.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/ecs/world.h"
 
 namespace kaskad {

@@ -7,8 +7,8 @@
 
 #include "components/material.h"
 #include "runtime/assets/asset_store.h"
-#include "runtime/core/result.h"
-#include "runtime/render/feature_manifest.h"
+#include "runtime/result/result.h"
+#include "runtime/features/feature_manifest.h"
 
 namespace kaskad {
 

@@ -15,7 +15,7 @@
 #include <numbers>
 #include <string>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 namespace kaskad {
 namespace {

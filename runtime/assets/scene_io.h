@@ -5,7 +5,7 @@
 //   read_scene_document  file -> JSON (a .gltf/.glb is wrapped into a one-entity scene)
 //   parse_scene          JSON -> Scene with the authored entities only (validated, no file I/O)
 //   instantiate_scene    primitives -> meshes, glTF references -> imported entities
-// load_scene (runtime/cli/player.h) runs all three plus the load phase (transforms, auto cameras).
+// load_scene (runtime/app/player.h) runs all three plus the load phase (transforms, auto cameras).
 // The format is documented in README.md ("Scene files").
 #pragma once
 
@@ -17,8 +17,8 @@
 
 #include "components/bounds.h"
 #include "runtime/assets/scene.h"
-#include "runtime/core/result.h"
-#include "runtime/render/feature_manifest.h"
+#include "runtime/result/result.h"
+#include "runtime/features/feature_manifest.h"
 
 namespace kaskad {
 
@@ -72,7 +72,7 @@ nlohmann::json live_entity_sections(const Scene& scene, ecs::Entity e);
 
 /// Loads material files (validated against `manifest`; required when the scene has any), creates
 /// meshes for primitives and imports glTF references (paths relative to scene.file). Cameras with
-/// auto_frame are framed by the load phase (load_scene in runtime/cli/player.h).
+/// auto_frame are framed by the load phase (load_scene in runtime/app/player.h).
 Status instantiate_scene(Scene& scene, const render::FeatureManifest* manifest = nullptr);
 
 /// render.environment's faces, texels a side (any layout is resampled to this).

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 namespace kaskad {
 

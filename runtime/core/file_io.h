@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 namespace kaskad {
 

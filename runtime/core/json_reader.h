@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "runtime/core/file_io.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 namespace kaskad::json_reader {
 

@@ -59,7 +59,7 @@
 #include <utility>
 #include <vector>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/ecs/entity.h"
 
 namespace kaskad::ecs {

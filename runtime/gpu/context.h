@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 struct GLFWwindow;
 

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/gpu/gl_handles.h"
 
 namespace kaskad::gpu {

@@ -18,7 +18,7 @@
 #include "components/light.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/ecs/entity.h"
 
 namespace kaskad::reference {

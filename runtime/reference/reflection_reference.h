@@ -29,7 +29,7 @@
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/reference/ray_tracer.h"
 
 namespace kaskad::reference {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "runtime/assets/image_io.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 namespace kaskad::reference {
 

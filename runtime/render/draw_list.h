@@ -10,7 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "runtime/render/frame_input.h"
-#include "runtime/render/variant_key.h"
+#include "runtime/features/variant_key.h"
 
 namespace kaskad::render {
 

@@ -11,10 +11,10 @@
 
 #include "components/mesh_renderer.h"
 #include "runtime/assets/asset_store.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/render/probe_capture.h"
-#include "runtime/render/shader_interface.h"
+#include "runtime/features/shader_interface.h"
 
 namespace kaskad::render {
 

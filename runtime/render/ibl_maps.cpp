@@ -9,7 +9,7 @@
 #include "components/ibl.h"
 #include "runtime/gpu/shader.h"
 #include "runtime/render/gpu_timers.h"
-#include "runtime/render/shader_interface.h"
+#include "runtime/features/shader_interface.h"
 
 namespace kaskad::render {
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "runtime/assets/env_map.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/gpu/gl_handles.h"
 
 namespace kaskad::render {

@@ -16,13 +16,13 @@
 #include <glm/glm.hpp>
 
 #include "runtime/assets/image_io.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/render/draw_list.h"
 #include "runtime/render/frame_input.h"
 #include "runtime/render/frame_uniforms.h"
 #include "runtime/render/gpu_cache.h"
-#include "runtime/render/shader_interface.h"
+#include "runtime/features/shader_interface.h"
 #include "runtime/render/shader_library.h"
 
 namespace kaskad::render {

@@ -16,7 +16,7 @@
 
 #include "components/probe_state.h"
 #include "runtime/assets/env_map.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/render/ibl_maps.h"
 

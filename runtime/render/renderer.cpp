@@ -25,7 +25,7 @@
 #include "runtime/render/input_hash.h"
 #include "runtime/render/passes.h"
 #include "runtime/render/probe_capture.h"
-#include "runtime/render/shader_interface.h"
+#include "runtime/features/shader_interface.h"
 
 namespace kaskad::render {
 struct Renderer::Impl {

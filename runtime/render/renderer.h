@@ -19,12 +19,12 @@
 #include "runtime/assets/asset_store.h"
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/render/shader_library.h"
 #include "runtime/render/draw_list.h"
 #include "runtime/render/frame_input.h"
-#include "runtime/render/variant_key.h"
+#include "runtime/features/variant_key.h"
 
 namespace kaskad::render {
 

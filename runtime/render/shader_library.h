@@ -12,10 +12,10 @@
 #include <unordered_map>
 #include <vector>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/gpu/gl_handles.h"
-#include "runtime/render/feature_manifest.h"
-#include "runtime/render/variant_key.h"
+#include "runtime/features/feature_manifest.h"
+#include "runtime/features/variant_key.h"
 
 namespace kaskad::render {
 

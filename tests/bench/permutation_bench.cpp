@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "runtime/core/median.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/gpu/context.h"
 #include "systems/frame.h"
 

@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "runtime/core/median.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/gpu/context.h"
 #include "runtime/reference/reflection_reference.h"
 #include "systems/frame.h"

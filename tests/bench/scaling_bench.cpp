@@ -29,7 +29,7 @@
 #include "runtime/core/memory.h"
 #define SCALING_BENCH_KEEPS_MEMORY 1
 #endif
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/gpu/context.h"
 #include "systems/frame.h"
 

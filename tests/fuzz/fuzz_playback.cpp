@@ -1,4 +1,4 @@
-// Fuzz target for playback files (runtime/cli/playback.h): parse the bytes as a playback file,
+// Fuzz target for playback files (runtime/app/playback.h): parse the bytes as a playback file,
 // then sample every track it accepted at a few times (interpolation with whatever keys got
 // through). Any outcome but a crash, a sanitizer report or a hang is fine.
 //
@@ -11,7 +11,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "runtime/cli/playback.h"
+#include "runtime/app/playback.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/render/gpu_cache.h"
 #include "tests/render/headless_gl.h"
 #include "tests/test_tmp.h"

@@ -1,5 +1,5 @@
 // The shader's cascade selection (select_cascade() in content/shaders/shadow.glsl) against the CPU
-// helpers of systems/cascade_math.h, through the shadow-points pass (the forward pass's own
+// helpers of runtime/math/cascade_math.h, through the shadow-points pass (the forward pass's own
 // lookup): for points spread through and around the camera's view, the cascade the shader picks
 // is the one select_cascade_by_depth() or select_cascade_by_map() picks. Points within a hair of
 // a split distance or a map border are left out (rounding may go either way there). The blend
@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "runtime/cli/player.h"
-#include "systems/cascade_math.h"
+#include "runtime/app/player.h"
+#include "runtime/math/cascade_math.h"
 #include "tests/render/player_fixture.h"
 
 namespace kaskad {

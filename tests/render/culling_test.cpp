@@ -2,7 +2,7 @@
 // image is the same, pixel for pixel, as drawing everything (the culled draws were not visible).
 #include <gtest/gtest.h>
 
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "tests/render/headless_gl.h"
 
 namespace kaskad {

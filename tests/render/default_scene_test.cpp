@@ -13,7 +13,7 @@
 #include "components/transform.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "tests/render/player_fixture.h"
 #include "runtime/gpu/context.h"
 #include "systems/shadow_map_system.h"

@@ -5,7 +5,7 @@
 
 #include <fstream>
 
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/core/log.h"
 #include "runtime/gpu/context.h"
 #include "runtime/gpu/gl_handles.h"

@@ -17,7 +17,7 @@
 #include "components/probe_state.h"
 #include "runtime/assets/env_lighting.h"
 #include "runtime/assets/image_io.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "systems/frame.h"
 #include "tests/render/player_fixture.h"
 #include "tests/test_tmp.h"

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "runtime/assets/image_io.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "tests/render/player_fixture.h"
 
 namespace kaskad {

@@ -18,7 +18,7 @@
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/mesh_tangents.h"
 #include "runtime/assets/primitives.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "tests/render/player_fixture.h"
 
 namespace kaskad {

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <set>
 
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/gpu/context.h"
 #include "systems/frame.h"
 #include "tests/render/headless_gl.h"

@@ -15,7 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "components/limits.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/gpu/context.h"
 #include "tests/test_tmp.h"
 

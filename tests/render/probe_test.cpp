@@ -16,7 +16,7 @@
 #include "components/probe_state.h"
 #include "components/reflector.h"
 #include "runtime/assets/env_map.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "tests/render/player_fixture.h"
 #include "runtime/gpu/context.h"
 #include "tests/test_tmp.h"

@@ -11,7 +11,7 @@
 #include "components/material.h"
 #include "components/name.h"
 #include "runtime/assets/image_io.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/gpu/context.h"
 #include "runtime/reference/reflection_reference.h"
 

@@ -20,7 +20,7 @@
 #include "components/mesh_renderer.h"
 #include "components/name.h"
 #include "components/transform.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "tests/render/player_fixture.h"
 #include "tests/test_tmp.h"
 

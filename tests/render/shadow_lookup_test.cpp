@@ -21,10 +21,10 @@
 #include <vector>
 
 #include "components/shadow_settings.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/gpu/gl_handles.h"
 #include "runtime/gpu/shader.h"
-#include "runtime/render/feature_manifest.h"
+#include "runtime/features/feature_manifest.h"
 #include "tests/render/headless_gl.h"
 #include "tests/render/player_fixture.h"
 #include "tests/test_tmp.h"

@@ -16,8 +16,8 @@
 
 #include "components/light.h"
 #include "components/transform.h"
-#include "runtime/cli/player.h"
-#include "runtime/cli/stability.h"
+#include "runtime/app/player.h"
+#include "runtime/app/stability.h"
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
 #include "tests/render/player_fixture.h"
@@ -172,7 +172,7 @@ class SoftShadowTest : public PlayerTest {
 
   // The penumbra's 10-90% width on the ground across the slab's edge (metres), averaged over
   // three lines along x. The lookup runs in the points pass: the forward pass's own code at
-  // exact world points (runtime/cli/stability.h).
+  // exact world points (runtime/app/stability.h).
   static float measured_width(Scene& scene, float spacing, float* texel = nullptr) {
     auto t = render_frames(*player_, scene, {});
     EXPECT_TRUE(t.ok()) << t.error().to_string();

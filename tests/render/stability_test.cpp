@@ -1,12 +1,12 @@
-// World-space stability (runtime/cli/stability.h): the shadow-points pass evaluates the forward
+// World-space stability (runtime/app/stability.h): the shadow-points pass evaluates the forward
 // pass's own shadow lookup at fixed world points, and a camera path measures flicker there.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "tests/render/player_fixture.h"
-#include "runtime/cli/stability.h"
+#include "runtime/app/stability.h"
 #include "runtime/gpu/context.h"
 
 namespace kaskad {

@@ -11,7 +11,7 @@
 #include "components/light.h"
 #include "components/name.h"
 #include "components/transform.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
 #include "tests/render/player_fixture.h"

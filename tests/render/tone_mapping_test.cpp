@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "components/tone_mapping.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "tests/render/player_fixture.h"
 #include "tests/test_tmp.h"
 

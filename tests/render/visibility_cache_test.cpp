@@ -18,7 +18,7 @@
 #include "components/light.h"
 #include "components/name.h"
 #include "components/transform.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "tests/render/player_fixture.h"
 
 namespace kaskad {

@@ -22,7 +22,7 @@
 #include "components/shadow_settings.h"
 #include "components/transform.h"
 #include "runtime/assets/image_io.h"
-#include "runtime/render/variant_key.h"
+#include "runtime/features/variant_key.h"
 #include "tests/unit/assets/asset_test_util.h"
 
 namespace kaskad {

@@ -10,7 +10,7 @@
 #include <iterator>
 #include <string>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "tests/test_tmp.h"
 
 #ifndef KASKAD_TEST_TMP

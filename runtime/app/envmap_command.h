@@ -9,7 +9,7 @@
 
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 namespace kaskad {
 

@@ -1,4 +1,4 @@
-#include "runtime/cli/bench.h"
+#include "runtime/app/bench.h"
 
 #include <unistd.h>
 
@@ -19,8 +19,8 @@
 #include "components/shadow_settings.h"
 #include "components/transform.h"
 #include "runtime/assets/scene_io.h"
-#include "runtime/cli/player.h"
-#include "runtime/cli/stability.h"
+#include "runtime/app/player.h"
+#include "runtime/app/stability.h"
 #include "runtime/core/atomic_file.h"
 #include "runtime/core/file_io.h"
 #include "runtime/reference/ray_tracer.h"

@@ -1,10 +1,10 @@
-#include "runtime/render/feature_manifest.h"
+#include "runtime/features/feature_manifest.h"
 
 #include <algorithm>
 #include <cctype>
 
 #include "components/limits.h"
-#include "runtime/render/shader_interface.h"
+#include "runtime/features/shader_interface.h"
 #include "runtime/core/json_reader.h"
 
 namespace kaskad::render {
@@ -61,7 +61,7 @@ Result<FeatureManifest> FeatureManifest::load(const std::filesystem::path& file)
     std::string comment;
     root.string("comment", comment);
     if (root.has("features"))
-      fail("/features", "features are declared in kFeatureTable (runtime/render/variant_key.h), "
+      fail("/features", "features are declared in kFeatureTable (runtime/features/variant_key.h), "
                         "not in the manifest");
     if (root.has("parameters")) {
       const auto& params = root.raw("parameters");
@@ -178,7 +178,7 @@ std::vector<std::pair<std::string, std::string>> FeatureManifest::defines(Varian
   out.emplace_back("MAX_CASCADES", std::to_string(kMaxCascades));
   out.emplace_back("MAX_SHADOW_VIEWS", std::to_string(kMaxShadowedLights));
   out.emplace_back("PCSS_MAX_RADIUS", std::to_string(kPcssMaxRadiusTexels) + ".0");
-  // Attribute and uniform locations and texture units, from runtime/render/shader_interface.h.
+  // Attribute and uniform locations and texture units, from runtime/features/shader_interface.h.
   for (const auto& [name, value] : shader_interface_defines()) out.emplace_back(name, std::to_string(value));
   return out;
 }

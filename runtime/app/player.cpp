@@ -1,5 +1,5 @@
 #include "runtime/core/median.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 
 #include <algorithm>
 #include <chrono>

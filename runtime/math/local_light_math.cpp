@@ -1,4 +1,4 @@
-#include "systems/local_light_math.h"
+#include "runtime/math/local_light_math.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <string>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 namespace kaskad {
 

@@ -1,4 +1,4 @@
-// Cascaded shadow map maths (systems/cascade_math.h): invariants first (STYLE.md 12). Splits
+// Cascaded shadow map maths (runtime/math/cascade_math.h): invariants first (STYLE.md 12). Splits
 // cover [near, far] and increase; every slice corner lies inside its cascade's light clip
 // volume; casters outside the view are kept; a stable cascade moves in whole texels and keeps its
 // size; ComputeNearAndFar matches a brute-force reference.
@@ -18,7 +18,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "components/shadow_settings.h"
-#include "systems/cascade_math.h"
+#include "runtime/math/cascade_math.h"
 
 namespace kaskad {
 namespace {

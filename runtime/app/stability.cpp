@@ -1,4 +1,4 @@
-#include "runtime/cli/stability.h"
+#include "runtime/app/stability.h"
 
 #include <algorithm>
 #include <cmath>

@@ -9,7 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "runtime/assets/image_io.h"
-#include "runtime/cli/player.h"
+#include "runtime/app/player.h"
 #include "runtime/reference/shadow_metrics.h"
 
 namespace kaskad {

@@ -11,10 +11,10 @@
 #include <string>
 
 #include "runtime/assets/material_file.h"
-#include "runtime/render/feature_manifest.h"
+#include "runtime/features/feature_manifest.h"
 #include "runtime/render/frame_uniforms.h"
 #include "runtime/render/renderer.h"
-#include "runtime/render/variant_key.h"
+#include "runtime/features/variant_key.h"
 #include "tests/test_tmp.h"
 
 namespace kaskad::render {

@@ -1,4 +1,4 @@
-#include "systems/sphere_map_math.h"
+#include "runtime/math/sphere_map_math.h"
 
 #include <algorithm>
 #include <cmath>

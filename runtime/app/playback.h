@@ -19,7 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 namespace kaskad {
 

@@ -1,4 +1,4 @@
-// The feature manifest: the shader features of kFeatureTable (runtime/render/variant_key.h, the
+// The feature manifest: the shader features of kFeatureTable (runtime/features/variant_key.h, the
 // one place they are declared) as runtime values, plus the typed material parameters and textures
 // of content/shaders/features.json, with defaults, ranges and the feature each one belongs to.
 // The manifest turns a VariantKey into defines (the one function that produces both MATERIAL_*
@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "runtime/core/result.h"
-#include "runtime/render/variant_key.h"
+#include "runtime/result/result.h"
+#include "runtime/features/variant_key.h"
 
 namespace kaskad::render {
 

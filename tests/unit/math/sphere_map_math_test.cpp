@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "systems/sphere_map_math.h"
+#include "runtime/math/sphere_map_math.h"
 
 namespace kaskad {
 namespace {

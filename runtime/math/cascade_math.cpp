@@ -1,6 +1,6 @@
 // Cascaded shadow map maths: see cascade_math.h for the contracts; the fit is written as a
 // numbered procedure above fit_cascade().
-#include "systems/cascade_math.h"
+#include "runtime/math/cascade_math.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 namespace kaskad {
 namespace {

@@ -1,4 +1,4 @@
-#include "runtime/cli/envmap_command.h"
+#include "runtime/app/envmap_command.h"
 
 #include <chrono>
 #include <cstdio>

@@ -5,7 +5,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "components/transform.h"
-#include "runtime/cli/playback.h"
+#include "runtime/app/playback.h"
 
 namespace kaskad {
 namespace {

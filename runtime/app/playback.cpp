@@ -1,4 +1,4 @@
-#include "runtime/cli/playback.h"
+#include "runtime/app/playback.h"
 
 #include <spawn.h>
 #include <sys/wait.h>
@@ -26,9 +26,9 @@ extern char** environ;
 #include "components/transform.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
-#include "runtime/cli/bench.h"
-#include "runtime/cli/player.h"
-#include "runtime/cli/stability.h"
+#include "runtime/app/bench.h"
+#include "runtime/app/player.h"
+#include "runtime/app/stability.h"
 #include "runtime/core/atomic_file.h"
 #include "runtime/core/json_reader.h"
 #include "runtime/gpu/context.h"

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "runtime/assets/scene.h"
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 #include "runtime/gpu/context.h"
 #include "runtime/render/renderer.h"
 #include "systems/frame.h"

@@ -1,8 +1,8 @@
-// Spot and point light shadow maths (systems/local_light_math.h), without GL: depth ranges, the
+// Spot and point light shadow maths (runtime/math/local_light_math.h), without GL: depth ranges, the
 // near plane that keeps every box inside the frustum, the spot frustum around its cone, cube face
 // selection against each face's frustum, and the dual-paraboloid projection; plus the system's
 // output for a spot and a point light.
-#include "systems/local_light_math.h"
+#include "runtime/math/local_light_math.h"
 
 #include <gtest/gtest.h>
 

@@ -12,7 +12,7 @@
 #include <span>
 
 #include "components/bounds.h"
-#include "systems/cascade_math.h"  // NearFar
+#include "runtime/math/cascade_math.h"  // NearFar
 
 namespace kaskad {
 

@@ -2,7 +2,7 @@
 // For every scene x configuration: frame time (median of N frames after warm-up, AOVs off), CPU
 // time per phase, GPU time per pass, counters, and shadow accuracy against the Embree reference
 // (runtime/reference) on the AOVs of one more frame, and world-space flicker at fixed receiver
-// points while the camera moves (runtime/cli/stability.h). Rows go to a CSV as they finish (Ctrl-C keeps
+// points while the camera moves (runtime/app/stability.h). Rows go to a CSV as they finish (Ctrl-C keeps
 // them); a matplotlib script (scripts/bench_chart.py, run with /usr/bin/python3) draws one chart per
 // scene: frame ms on x, error on y, the Pareto front highlighted.
 #pragma once
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "runtime/core/result.h"
+#include "runtime/result/result.h"
 
 namespace kaskad {
 
@@ -23,7 +23,7 @@ struct BenchOptions {
   int width = 640;
   int height = 360;
   bool chart = true;  ///< run scripts/bench_chart.py after the sweep
-  /// Stability: frames of the camera path (runtime/cli/stability.h); 0 or 1 = skip.
+  /// Stability: frames of the camera path (runtime/app/stability.h); 0 or 1 = skip.
   int stability_frames = 16;
   int stability_points = 4096;  ///< at most this many fixed receiver points
   /// --shard i/n: this process runs runs i, i + n, ... of the scene x configuration list (in
