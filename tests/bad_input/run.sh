@@ -102,9 +102,9 @@ fi
 
 if [ -n "$table" ]; then
   {
-    echo "# Bad input: what kaskad says"
+    echo "# Bad input: what kaskad says, case by case"
     echo
-    echo "Written by \`bash tests/bad_input/run.sh --table docs/bad_input.md\` (with \`KASKAD\` and"
+    echo "Written by \`bash tests/bad_input/run.sh --table docs/guide/bad_input_messages.md\` (with \`KASKAD\` and"
     echo "\`KASKAD_CONTENT\` set). One row per case of \`tests/bad_input/cases.txt\`: the arguments"
     echo "(\`{DIR}\` = \`tests/bad_input\`, \`{OUT}\` = a folder of previous outputs that must stay"
     echo "unchanged, \`{R}\` = \`--headless --size 32x32 --frames 1 -o {OUT}/out.png\`), the exit code and"
