@@ -77,7 +77,7 @@ def chart(rows, column, out_dir, suffix):
         ax.grid(True, alpha=0.3)
         ax.legend()
         out = os.path.join(out_dir, f"{scene}{suffix}.png")
-        # Atomic, as every output of Kaskad (README "Outputs"): a temporary file in the same
+        # Atomic, as every output of Kaskad (docs/guide/bad_input.md, "Outputs"): a temporary file in the same
         # folder, synced, then renamed over the previous chart.
         tmp = os.path.join(out_dir, f".{scene}{suffix}.tmp.png")
         try:

@@ -55,7 +55,7 @@ check render_two_suns 0 "view 1: light 'moon' \(entity [0-9]+\), layers 4\.\.5 o
   --headless --size 96x64 --frames 1 -o "$tmp/two.png"
 check cascade_table 0 "layer +m/texel +casters +triangles +drawn +receiver px" -- "$KASKAD" render --headless \
   --size 96x64 --frames 1 -o "$tmp/t.png" --aov "$tmp/t.exr"
-# The ray-traced shadow reference beside the AOV (issue 14): a file with its four channels and the
+# The ray-traced shadow reference beside the AOV: a file with its four channels and the
 # RMSE printed; refused without a shadowed light. Bench options are refused by render.
 check shadow_reference 0 "shadow reference: reference visibility error receiver; [0-9]+ receiver pixels, RMSE 0\.[0-9]+, MAE" -- \
   "$KASKAD" render "$KASKAD_CONTENT/scenes/soft/sun_5deg.json" --headless --size 96x64 --frames 1 \
@@ -149,7 +149,7 @@ assert int(rows["stable"]["stability_points"]) > 1000 and rows["stable"]["stabil
 assert s == 0.0 and c > 0.0, (s, c)
 print("flicker stable %g crop %g" % (s, c))
 ' "$tmp/flicker/bench.csv"
-# Soft shadows (issue 14): `--sweep soft` runs the techniques and kernels on the 5-degree sun;
+# Soft shadows: `--sweep soft` runs the techniques and kernels on the 5-degree sun;
 # pcss and lom are closer to the area-light reference (rmse) than hard 3x3 pcf. vsm and evsm
 # filter a hard shadow; at this small size they score 1.8 and 1.7 x hard pcf's rmse (the tilted
 # box's contact line reads lit over a whole pixel row, VSM's known weakness where the occluder

@@ -22,7 +22,7 @@
 #   clicks    the panels driven by clicks, drags and typing: a typed number applies on Enter (not
 #             at each keystroke), Escape cancels it; drags stop at the readers' limits; a
 #             checkbox, a combo item, an entity row and a button act
-#   docs      the README's screenshots (docs/editor/screenshots.txt) are what this run takes
+#   docs      the editor guide's screenshots (docs/editor/screenshots.txt) are what this run takes
 #   input     unknown flags, bad script lines, rejected values and unsaved quits fail clearly
 #   real_input  real X events (xdotool) during the script's `input` phases: right mouse + W flies
 #             forward, F frames the selection, Ctrl+Z undoes an edit, Ctrl+O's file dialog opens
@@ -732,11 +732,11 @@ quit!" "$scene"
   refused "line 1: no widget named 'no_such_widget' in the last frame; it showed: " "a click on a widget the panels do not show: exit 1, named"
   ;;
 docs)
-  # The README's editor screenshots are what this run takes: docs/editor/screenshots.txt, run
-  # from a folder with the content and an empty docs/editor, gives images that match the committed
-  # ones loosely (the stats' times differ from run to run: at most 3% of the pixels may differ by
-  # more than 0.25). A change that moves what they show fails here until the images are remade
-  # with the command the README gives.
+  # The editor guide's screenshots (docs/guide/editor.md) are what this run takes:
+  # docs/editor/screenshots.txt, run from a folder with the content and an empty docs/editor,
+  # gives images that match the committed ones loosely (the stats' times differ from run to run:
+  # at most 3% of the pixels may differ by more than 0.25). A change that moves what they show fails here until the images are remade
+  # with the command docs/editor/screenshots.txt gives.
   docs="$(cd "$(dirname "$0")/../../docs/editor" && pwd)"
   mkdir -p "$tmp/root/docs/editor"
   ln -s "$KASKAD_CONTENT" "$tmp/root/content"
