@@ -7,7 +7,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include <array>
+#include <string_view>
+#include <tuple>
+
 #include <glm/glm.hpp>
+
+#include "components/limits.h"
+#include "runtime/fields/fields.h"
 
 namespace kaskad {
 
@@ -22,6 +29,10 @@ enum class LightType {
   /// whose axes are the rectangle's, soft shadows from its size.
   area,
 };
+constexpr std::array<std::string_view, 4> enum_names(LightType) {
+  return {"directional", "spot", "point", "area"};
+}
+static_assert(enum_names(LightType{}).size() == std::size_t(LightType::area) + 1);
 
 struct Light {
   LightType type = LightType::directional;
@@ -46,6 +57,29 @@ struct Light {
   /// 2 x 2: S1's experiments.
   glm::vec2 size{2.0f, 2.0f};
 };
+
+/// The fields of Light, once (runtime/fields/fields.h); which type each size is for is a rule
+/// across fields (the scene reader's).
+constexpr auto field_table(fields::Of<Light>) {
+  using L = Light;
+  using namespace fields;
+  return std::tuple{
+      choice("type", &L::type, "Directional, spot, point or rectangular area light"),
+      vector("color", &L::color, 0, 1.0e4, "Linear RGB colour"),
+      number("intensity", &L::intensity, 0, 1.0e9,
+             "Directional: illuminance-like scale; spot, point, area: candela-like"),
+      number("range", &L::range, 0, kMaxCoordinate, "Spot and point: range in metres; 0 = infinite"),
+      number("inner_cone_deg", &L::inner_cone_deg, 0, 90,
+             "Spot: full intensity inside this half-angle, degrees"),
+      number("outer_cone_deg", &L::outer_cone_deg, 0, 90,
+             "Spot, area: no light outside this half-angle, degrees"),
+      flag("cast_shadows", &L::cast_shadows, "Gets shadow maps (a scene's first sun: on unless false)"),
+      number("angular_size_deg", &L::angular_size_deg, 0, 45,
+             "Directional: apex angle of the cone the light arrives from, degrees; 0 = punctual"),
+      number("radius", &L::radius, 0, 100, "Spot and point: emitter radius, metres; 0 = punctual"),
+      vector("size", &L::size, 1e-3, 100, "Area: width and height of the rectangle, metres"),
+  };
+}
 
 /// World-space direction a light shines along: its world matrix applied to local (0, 0, -1),
 /// normalised (straight down when the matrix collapses the axis). The one definition of the

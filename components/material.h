@@ -5,12 +5,14 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <utility>
-#include <vector>
+#include <string_view>
+#include <tuple>
+
 
 #include <glm/glm.hpp>
 
 #include "components/mesh_renderer.h"
+#include "runtime/fields/fields.h"
 
 namespace kaskad {
 
@@ -37,12 +39,8 @@ inline std::array<glm::vec3, 2> uv_transform_rows(const TextureTransform& t) {
 /// irradiance and GGX-prefiltered radiance, components/ibl.h), blended with the scene's
 /// environment by p_r; k_s is not used.
 enum class ReflectionModel : std::uint8_t { s3, pbr };
-/// The names scene and material files use (`reflection_model`).
-inline const std::vector<std::pair<const char*, ReflectionModel>>& reflection_model_names() {
-  static const std::vector<std::pair<const char*, ReflectionModel>> names = {
-      {"s3", ReflectionModel::s3}, {"pbr", ReflectionModel::pbr}};
-  return names;
-}
+constexpr std::array<std::string_view, 2> enum_names(ReflectionModel) { return {"s3", "pbr"}; }
+static_assert(enum_names(ReflectionModel{}).size() == std::size_t(ReflectionModel::pbr) + 1);
 
 struct Material {
   glm::vec4 base_color{1.0f};                  ///< linear RGBA factor (glTF baseColorFactor)
@@ -74,5 +72,22 @@ struct Material {
 
   bool operator==(const Material&) const = default;
 };
+
+/// The fields of Material a scene file's inline material block gives, once
+/// (runtime/fields/fields.h); textures come from glTF and material files.
+constexpr auto field_table(fields::Of<Material>) {
+  using M = Material;
+  using namespace fields;
+  return std::tuple{
+      vector("base_color", &M::base_color, 0, 1.0e4, "Linear RGBA factor"),
+      number("metallic", &M::metallic, 0, 1, "Metallic factor"),
+      number("roughness", &M::roughness, 0, 1, "Perceptual roughness"),
+      vector("emissive", &M::emissive, 0, 1.0e6, "Linear emitted radiance"),
+      flag("double_sided", &M::double_sided, "Lights both faces"),
+      number("k_s", &M::k_s, 0, 1, "Specular level scaling a reflection map's colour (S3's k_s)"),
+      choice("reflection_model", &M::reflection_model,
+             "How a reflector's probe reaches the surface: S3's mirror term or the PBR BRDF"),
+  };
+}
 
 }  // namespace kaskad

@@ -3,7 +3,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <tuple>
 #include <type_traits>
+
+#include "runtime/fields/fields.h"
 
 namespace kaskad {
 
@@ -28,5 +31,16 @@ struct MeshRenderer {
   bool receive_shadows = true;  ///< shadow maps are sampled when shading it
   int layer = 0;                ///< render layer in [0, 31]; Reflector::exclude_layers masks it
 };
+
+/// The authored fields of MeshRenderer, once (runtime/fields/fields.h).
+constexpr auto field_table(fields::Of<MeshRenderer>) {
+  using M = MeshRenderer;
+  using namespace fields;
+  return std::tuple{
+      flag("cast_shadows", &M::cast_shadows, "Drawn into shadow maps"),
+      flag("receive_shadows", &M::receive_shadows, "Shadow maps are sampled when shading it"),
+      integer("layer", &M::layer, 0, 31, "Render layer; a reflector's exclude_layers masks it"),
+  };
+}
 
 }  // namespace kaskad

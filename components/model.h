@@ -2,10 +2,14 @@
 // the scene loader turns them into meshes in the AssetStore and MeshRenderer components.
 #pragma once
 
+#include <array>
 #include <string>
+#include <string_view>
+#include <tuple>
 #include <vector>
 
 #include "runtime/ecs/entity.h"
+#include "runtime/fields/fields.h"
 
 namespace kaskad {
 
@@ -14,6 +18,10 @@ namespace kaskad {
 /// height 1 along Y; terrain: a 1 x 1 heightfield in XZ with heights in [0, 1] (deterministic
 /// fractal noise; `segments` x `segments` cells, 2 triangles each).
 enum class PrimitiveShape { plane, box, sphere, cylinder, cone, terrain };
+constexpr std::array<std::string_view, 6> enum_names(PrimitiveShape) {
+  return {"plane", "box", "sphere", "cylinder", "cone", "terrain"};
+}
+static_assert(enum_names(PrimitiveShape{}).size() == std::size_t(PrimitiveShape::terrain) + 1);
 
 struct PrimitiveMesh {
   PrimitiveShape shape = PrimitiveShape::box;
@@ -22,6 +30,18 @@ struct PrimitiveMesh {
   /// cascade culling can keep parts of it; segments must be a multiple. 1 = one mesh.
   int tiles = 1;
 };
+
+/// The fields of PrimitiveMesh, once (runtime/fields/fields.h); tiles' rules across fields are
+/// the scene reader's.
+constexpr auto field_table(fields::Of<PrimitiveMesh>) {
+  using P = PrimitiveMesh;
+  using namespace fields;
+  return std::tuple{
+      choice("shape", &P::shape, "The built-in unit primitive"),
+      integer("segments", &P::segments, 3, 1024, "Tessellation (around the axis; terrain: cells a side)"),
+      integer("tiles", &P::tiles, 1, 64, "Terrain: split into tiles x tiles meshes; segments a multiple"),
+  };
+}
 
 /// Fields of one section of one imported glTF node set over what the file gives (scene files:
 /// the model's `nodes` block; the editor and --set on the node's name). Saved from the node's

@@ -3,12 +3,17 @@
 // and owns ProbeState (components/probe_state.h). validate_reflector() names the first bad value.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <string>
+#include <string_view>
+#include <tuple>
 
 #include <glm/glm.hpp>
+
+#include "components/limits.h"
+#include "runtime/fields/fields.h"
 
 namespace kaskad {
 
@@ -20,6 +25,8 @@ inline constexpr int kMinProbeBounces = 1, kMaxProbeBounces = 4, kDefaultProbeBo
 
 /// The reflection map type (S3): a cube map, or a sphere map generated from the cube.
 enum class ReflectionMap { cube, sphere };
+constexpr std::array<std::string_view, 2> enum_names(ReflectionMap) { return {"cube", "sphere"}; }
+static_assert(enum_names(ReflectionMap{}).size() == std::size_t(ReflectionMap::sphere) + 1);
 
 /// When the map is (re)made. S3 names the first three (a)-(c); on_change is beyond S3.
 enum class ProbeUpdate {
@@ -28,10 +35,18 @@ enum class ProbeUpdate {
   every_n,      ///< S3 (c): re-rendered on frames 0, N, 2N, ...; the last one is reused between
   on_change,    ///< rendered on the first frame, then again when something in range changed
 };
+constexpr std::array<std::string_view, 4> enum_names(ProbeUpdate) {
+  return {"static_file", "first_frame", "every_n", "on_change"};
+}
+static_assert(enum_names(ProbeUpdate{}).size() == std::size_t(ProbeUpdate::on_change) + 1);
 
 /// How a static file holds its cube map (see README "Reflection probes" for the file names).
 /// Mirrors EnvLayout in runtime/assets/env_map.h (change together).
 enum class EnvLayoutName { auto_detect, faces, horizontal_cross, vertical_cross, equirect, sphere };
+constexpr std::array<std::string_view, 6> enum_names(EnvLayoutName) {
+  return {"auto", "faces", "horizontal_cross", "vertical_cross", "equirect", "sphere"};
+}
+static_assert(enum_names(EnvLayoutName{}).size() == std::size_t(EnvLayoutName::sphere) + 1);
 
 struct Reflector {
   ReflectionMap map = ReflectionMap::cube;
@@ -71,27 +86,35 @@ struct Reflector {
   bool z_up_3dsmax = false;
 };
 
-namespace reflector_detail {
-inline std::string str(float v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", static_cast<double>(v));
-  return buf;
+/// The fields of Reflector with one value each, once (runtime/fields/fields.h); center, box and
+/// exclude_layers have forms of their own (runtime/assets/reflector_io.cpp).
+constexpr auto field_table(fields::Of<Reflector>) {
+  using R = Reflector;
+  using namespace fields;
+  return std::tuple{
+      choice("map", &R::map, "A cube map, or a sphere map made from the cube"),
+      choice("update", &R::update, "When the map is (re)made"),
+      integer("every_n", &R::every_n, 1, 1 << 20, "update every_n: frames between captures"),
+      integer("faces_per_frame", &R::faces_per_frame, 1, 6,
+              "Cube faces rendered per frame while a capture is in progress"),
+      integer("resolution", &R::resolution, 8, 2048, "Texels per cube face side", kPowerOfTwo),
+      number("near", &R::near, 1e-6, kMaxCoordinate, "Near plane of the capture cameras, metres"),
+      number("far", &R::far, 1e-6, kMaxCoordinate,
+             "Far plane of the capture cameras (and on_change's range), metres"),
+      number("amount", &R::amount, 0, 1, "The map's amount (S3's p_r)"),
+      text("file", &R::file, "update static_file: the image or the faces' name pattern with one *"),
+      choice("layout", &R::layout, "update static_file: how the file holds its cube map"),
+      flag("z_up_3dsmax", &R::z_up_3dsmax, "update static_file: the file is 3ds Max-authored (Z up)"),
+  };
 }
-}  // namespace reflector_detail
 
 /// Empty when valid, else a message starting with the bad field's name, e.g.
-/// "faces_per_frame must be in [1, 6], was 7".
+/// "faces_per_frame must be in [1, 6], was 7": the table's ranges, then the rules across fields.
 inline std::string validate_reflector(const Reflector& r) {
-  using reflector_detail::str;
-  if (r.every_n < 1) return "every_n must be >= 1, was " + std::to_string(r.every_n);
-  if (r.faces_per_frame < 1 || r.faces_per_frame > 6)
-    return "faces_per_frame must be in [1, 6], was " + std::to_string(r.faces_per_frame);
-  if (r.resolution < 8 || r.resolution > 2048 || (r.resolution & (r.resolution - 1)) != 0)
-    return "resolution must be a power of two in [8, 2048], was " + std::to_string(r.resolution);
-  if (!(r.near > 0.0f && std::isfinite(r.near))) return "near must be > 0, was " + str(r.near);
-  if (!(r.far > r.near && std::isfinite(r.far)))
-    return "far must be finite and greater than near, was " + str(r.far);
-  if (!(r.amount >= 0.0f && r.amount <= 1.0f)) return "amount must be in [0, 1], was " + str(r.amount);
+  if (std::string bad = fields::validate_fields(r); !bad.empty()) return bad;
+  if (!(r.far > r.near))
+    return "far must be greater than near (" + fields::format_number(r.near) + "), was " +
+           fields::format_number(r.far);
   if (r.box_projection && !(r.box_min.x < r.box_max.x && r.box_min.y < r.box_max.y &&
                             r.box_min.z < r.box_max.z))
     return "box min must be below max on every axis";

@@ -4,18 +4,28 @@
 // Each default says where it comes from. The maths lives in runtime/math/cascade_math.h.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <string_view>
+#include <tuple>
 
 #include "components/limits.h"
+#include "runtime/fields/fields.h"
 
 namespace kaskad {
 
 enum class CullMode { back, front, none };
+constexpr std::array<std::string_view, 3> enum_names(CullMode) { return {"back", "front", "none"}; }
+static_assert(enum_names(CullMode{}).size() == std::size_t(CullMode::none) + 1);
 /// none: one hardware-compared tap (nearest); bilinear: one tap with GL_LINEAR compare
 /// (hardware 2x2 PCF); pcf3x3: average of a 3x3 neighbourhood of compares (S4).
 enum class ShadowFilter { none, bilinear, pcf3x3 };
+constexpr std::array<std::string_view, 3> enum_names(ShadowFilter) {
+  return {"none", "bilinear", "pcf3x3"};
+}
+static_assert(enum_names(ShadowFilter{}).size() == std::size_t(ShadowFilter::pcf3x3) + 1);
 
 /// How the view depth range [near, far] is cut into cascades (S0 eq. (1)-(3)).
 enum class SplitScheme {
@@ -28,11 +38,17 @@ enum class SplitScheme {
   /// the right partition once that range is tight; lambda is not used.
   automatic,
 };
+constexpr std::array<std::string_view, 4> enum_names(SplitScheme) {
+  return {"uniform", "log", "mixed", "auto"};
+}
+static_assert(enum_names(SplitScheme{}).size() == std::size_t(SplitScheme::automatic) + 1);
 
 /// Depth attachment format of the shadow maps.
 enum class DepthFormat { d16, d24, d32f };
+constexpr std::array<std::string_view, 3> enum_names(DepthFormat) { return {"d16", "d24", "d32f"}; }
+static_assert(enum_names(DepthFormat{}).size() == std::size_t(DepthFormat::d32f) + 1);
 
-/// How visibility is estimated from the depth map (issue 14). A frame shader feature
+/// How visibility is estimated from the depth map. A frame shader feature
 /// (VARIANT_SHADOW_TECHNIQUE), never a uniform branch.
 enum class ShadowTechnique {
   pcf,   ///< percentage-closer filtering with a fixed footprint (filter, pcf_kernel): hard shadows
@@ -61,6 +77,10 @@ enum class ShadowTechnique {
   /// lower of their two Chebyshev bounds. Bleeds much less than vsm.
   evsm,
 };
+constexpr std::array<std::string_view, 6> enum_names(ShadowTechnique) {
+  return {"pcf", "pcss", "backprojection", "lom", "vsm", "evsm"};
+}
+static_assert(enum_names(ShadowTechnique{}).size() == std::size_t(ShadowTechnique::evsm) + 1);
 
 /// The PCF footprint when filter is pcf3x3 and technique pcf.
 enum class PcfKernel {
@@ -71,6 +91,11 @@ enum class PcfKernel {
   poisson,  ///< pcf_taps taps on a disc of radius pcf_radius texels, rotated per point by a hash
             ///< of its position in the light's texel grid (still when the camera moves)
 };
+/// Files give the boxes by their side (the JSON integers 3, 5, 7, 9) and the disc by name.
+constexpr std::array<std::string_view, 5> enum_names(PcfKernel) {
+  return {"3", "5", "7", "9", "poisson"};
+}
+static_assert(enum_names(PcfKernel{}).size() == std::size_t(PcfKernel::poisson) + 1);
 
 /// How a cascade's light projection is fitted.
 enum class FitMode {
@@ -81,6 +106,8 @@ enum class FitMode {
   scene,   ///< the basic map (S4 with S2's basics): one orthographic light around the bounds of
            ///< the whole scene, independent of the camera. Needs cascade_count = 1
 };
+constexpr std::array<std::string_view, 3> enum_names(FitMode) { return {"crop", "stable", "scene"}; }
+static_assert(enum_names(FitMode{}).size() == std::size_t(FitMode::scene) + 1);
 
 /// How a point light's omnidirectional shadow is stored.
 enum class PointShadowMode {
@@ -91,18 +118,30 @@ enum class PointShadowMode {
                     ///< projection is not linear, so rasterised triangles are only approximations
                     ///< (tessellation error: large triangles need subdividing)
 };
+constexpr std::array<std::string_view, 2> enum_names(PointShadowMode) {
+  return {"cube", "dual_paraboloid"};
+}
+static_assert(enum_names(PointShadowMode{}).size() == std::size_t(PointShadowMode::dual_paraboloid) + 1);
 
 /// The projection of a light's shadow maps, derived from the light type and point_mode (not
 /// authored): directional cascades are orthographic, a spot light has one perspective map, a
 /// point light six cube faces or two paraboloid hemispheres. Selects shader code
 /// (VARIANT_SHADOW_PROJECTION).
 enum class ShadowProjection { ortho, perspective, cube, dual_paraboloid };
+constexpr std::array<std::string_view, 4> enum_names(ShadowProjection) {
+  return {"ortho", "perspective", "cube", "dual_paraboloid"};
+}
+static_assert(enum_names(ShadowProjection{}).size() == std::size_t(ShadowProjection::dual_paraboloid) + 1);
 
 /// How a shaded point picks its cascade.
 enum class CascadeSelection {
   depth,       ///< S0: slice i where D[i] <= |z_view| < D[i+1]
   map_bounds,  ///< the first cascade whose map contains the point (uses the stable fit's slack)
 };
+constexpr std::array<std::string_view, 2> enum_names(CascadeSelection) {
+  return {"depth", "map_bounds"};
+}
+static_assert(enum_names(CascadeSelection{}).size() == std::size_t(CascadeSelection::map_bounds) + 1);
 
 /// Per shadowed light, except the fields for_each_shared_field() lists: every light's layers share
 /// one texture array and the shader features are per frame, so the first shadowed light's values
@@ -212,21 +251,70 @@ struct ShadowSettings {
   PointShadowMode point_mode = PointShadowMode::cube;
 };
 
-/// The fields every shadowed light takes from the first (one texture array, one set of shader
-/// features), the one list of them: calls visit(name, a.field, b.field) for each.
+/// The fields of ShadowSettings, once (runtime/fields/fields.h). kShared marks those every
+/// shadowed light takes from the first (one texture array, one set of shader features).
+constexpr auto field_table(fields::Of<ShadowSettings>) {
+  using S = ShadowSettings;
+  using namespace fields;
+  return std::tuple{
+      integer("map_size", &S::map_size, 64, 16384, "Texels per side of each map (cascade, face)",
+              kPowerOfTwo | kShared),
+      number("constant_bias", &S::constant_bias, 0, 1.0e4,
+             "Depth bias in glPolygonOffset units (multiples of the depth resolution)"),
+      number("slope_bias", &S::slope_bias, 0, 100,
+             "Depth bias scaled by the depth slope (glPolygonOffset factor)"),
+      choice("cull", &S::cull, "Faces the shadow pass culls (back loses no single-sided caster)"),
+      choice("filter", &S::filter, "Depth compares per lookup: one, hardware 2x2, or a kernel",
+             kShared),
+      choice("technique", &S::technique, "How visibility is estimated from the map", kShared),
+      choice("pcf_kernel", &S::pcf_kernel,
+             "Footprint of filter pcf3x3 with technique pcf: box side or a Poisson disc", kShared),
+      integer("pcf_taps", &S::pcf_taps, 8, 64,
+              "Taps of the Poisson disc (pcf_kernel poisson, pcss's search and filter)"),
+      number("pcf_radius", &S::pcf_radius, 1, 16, "Radius of the Poisson disc, texels"),
+      integer("lom_layers", &S::lom_layers, 2, 16,
+              "technique lom: depth layers peeled per map layer", kShared),
+      integer("vsm_blur", &S::vsm_blur, 1, 15,
+              "technique vsm/evsm: side of the moments' Gaussian blur, texels", kOdd | kShared),
+      number("vsm_bleed_reduction", &S::vsm_bleed_reduction, 0, 1,
+             "technique vsm/evsm: Chebyshev bounds below this read as shadow",
+             kBelowHi | kShared),
+      integer("cascade_count", &S::cascade_count, 1, 8, "Cascades of a directional light"),
+      choice("split_scheme", &S::split_scheme,
+             "How the view depth range is cut into cascades (auto follows the receivers)"),
+      number("lambda", &S::lambda, 0, 1, "Weight of the log scheme in mixed splits"),
+      number("max_distance", &S::max_distance, 0, kMaxCoordinate,
+             "View depth where the last cascade ends at most; 0 or auto: no cap", kAutoIsZero),
+      choice("depth_format", &S::depth_format, "Depth format of the maps", kShared),
+      choice("fit_mode", &S::fit_mode, "How a cascade's projection is fitted"),
+      number("beam_radius", &S::beam_radius, 0, kMaxCoordinate,
+             "fit_mode crop: radius of the light's beam around its axis; 0 fits the scene"),
+      number("normal_offset_bias", &S::normal_offset_bias, 0, 16,
+             "Texels a shaded point moves along its normal before the lookup"),
+      number("blend_band", &S::blend_band, 0, 1,
+             "Fraction of a cascade over which it fades into the next; 0: hard seams"),
+      choice("selection", &S::selection, "How a shaded point picks its cascade", kShared),
+      flag("debug_cascades", &S::debug_cascades, "Colours each cascade", kDebug | kShared),
+      choice("point_mode", &S::point_mode, "How a point light's shadow is stored"),
+      flag("freeze_cascades", &S::freeze_cascades,
+           "Keeps the cascades of the frame it was turned on while the camera moves on", kDebug),
+      flag("layered", &S::layered, "Draws every layer of a light in one pass", kShared),
+      flag("cull_by_receivers", &S::cull_by_receivers,
+           "Leaves out of a cascade the casters whose shadow cannot reach its receivers"),
+      flag("scissor_to_receivers", &S::scissor_to_receivers,
+           "Draws only the part of each cascade its receivers read"),
+      integer("far_cascade_interval", &S::far_cascade_interval, 1, 16,
+              "Cascade i >= 1 is redrawn at most every k-th frame"),
+  };
+}
+
+/// The fields every shadowed light takes from the first (kShared in the table): calls
+/// visit(key, a.field, b.field) for each.
 template <typename A, typename B, typename Visit>
 void for_each_shared_field(A& a, B& b, Visit&& visit) {
-  visit("map_size", a.map_size, b.map_size);
-  visit("depth_format", a.depth_format, b.depth_format);
-  visit("filter", a.filter, b.filter);
-  visit("technique", a.technique, b.technique);
-  visit("pcf_kernel", a.pcf_kernel, b.pcf_kernel);
-  visit("lom_layers", a.lom_layers, b.lom_layers);
-  visit("vsm_blur", a.vsm_blur, b.vsm_blur);
-  visit("vsm_bleed_reduction", a.vsm_bleed_reduction, b.vsm_bleed_reduction);
-  visit("selection", a.selection, b.selection);
-  visit("layered", a.layered, b.layered);
-  visit("debug_cascades", a.debug_cascades, b.debug_cascades);
+  fields::for_each_field<ShadowSettings>([&](const auto& f) {
+    if (f.has(fields::kShared)) visit(f.key.data(), a.*f.member, b.*f.member);
+  });
 }
 
 /// Texels a lookup reaches from the point's texel: 1.5 for S4's 3x3 (and the single taps), N / 2
@@ -252,80 +340,12 @@ inline float filter_reach_texels(const ShadowSettings& s) {
   return 1.5f;
 }
 
-namespace shadow_settings_detail {
-/// Shortest readable form of a setting ("1.2", not "1.200000").
-inline std::string str(float v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", static_cast<double>(v));
-  return buf;
-}
-}  // namespace shadow_settings_detail
-
 /// Empty string when valid, else a message naming the first bad value, e.g.
-/// "lambda must be in [0, 1], was 1.2".
+/// "lambda must be in [0, 1], was 1.2": the table's ranges, then the rules across fields.
 inline std::string validate_shadow_settings(const ShadowSettings& s) {
-  using shadow_settings_detail::str;
-  if (s.map_size < 64 || s.map_size > 16384 || (s.map_size & (s.map_size - 1)) != 0)
-    return "map_size must be a power of two in [64, 16384], was " + std::to_string(s.map_size);
-  if (!(s.constant_bias >= 0.0f && s.constant_bias <= 1.0e4f))
-    return "constant_bias must be in [0, 10000], was " + str(s.constant_bias);
-  if (!(s.slope_bias >= 0.0f && s.slope_bias <= 100.0f))
-    return "slope_bias must be in [0, 100], was " + str(s.slope_bias);
-  const int cull = static_cast<int>(s.cull);
-  if (cull < 0 || cull > static_cast<int>(CullMode::none))
-    return "cull must be back, front or none, was " + std::to_string(cull);
-  const int filter = static_cast<int>(s.filter);
-  if (filter < 0 || filter > static_cast<int>(ShadowFilter::pcf3x3))
-    return "filter must be none, bilinear or pcf3x3, was " + std::to_string(filter);
-  const int technique = static_cast<int>(s.technique);
-  if (technique < 0 || technique > static_cast<int>(ShadowTechnique::evsm))
-    return "technique must be pcf, pcss, backprojection, lom, vsm or evsm, was " +
-           std::to_string(technique);
-  if (s.vsm_blur < 1 || s.vsm_blur > 15 || s.vsm_blur % 2 == 0)
-    return "vsm_blur must be an odd number of texels in [1, 15], was " + std::to_string(s.vsm_blur);
-  if (!(s.vsm_bleed_reduction >= 0.0f && s.vsm_bleed_reduction < 1.0f))
-    return "vsm_bleed_reduction must be in [0, 1), was " + str(s.vsm_bleed_reduction);
-  if (s.lom_layers < 2 || s.lom_layers > 16)
-    return "lom_layers must be in [2, 16], was " + std::to_string(s.lom_layers);
-  const int kernel = static_cast<int>(s.pcf_kernel);
-  if (kernel < 0 || kernel > static_cast<int>(PcfKernel::poisson))
-    return "pcf_kernel must be 3, 5, 7, 9 or poisson, was " + std::to_string(kernel);
-  if (s.pcf_taps < 8 || s.pcf_taps > 64)
-    return "pcf_taps must be in [8, 64], was " + std::to_string(s.pcf_taps);
-  if (!(s.pcf_radius >= 1.0f && s.pcf_radius <= 16.0f))
-    return "pcf_radius must be in [1, 16] texels, was " + str(s.pcf_radius);
-  if (s.cascade_count < 1 || s.cascade_count > 8)
-    return "cascade_count must be in [1, 8], was " + std::to_string(s.cascade_count);
-  const int scheme = static_cast<int>(s.split_scheme);
-  if (scheme < 0 || scheme > static_cast<int>(SplitScheme::automatic))
-    return "split_scheme must be auto, uniform, log or mixed, was " + std::to_string(scheme);
-  if (!(s.lambda >= 0.0f && s.lambda <= 1.0f))  // also rejects NaN
-    return "lambda must be in [0, 1], was " + str(s.lambda);
-  if (!(s.max_distance >= 0.0f && std::isfinite(s.max_distance)))
-    return "max_distance must be finite and >= 0 (0 = no cap), was " + str(s.max_distance);
-  const int format = static_cast<int>(s.depth_format);
-  if (format < 0 || format > static_cast<int>(DepthFormat::d32f))
-    return "depth_format must be d16, d24 or d32f, was " + std::to_string(format);
-  const int fit = static_cast<int>(s.fit_mode);
-  if (fit < 0 || fit > static_cast<int>(FitMode::scene))
-    return "fit_mode must be crop, stable or scene, was " + std::to_string(fit);
+  if (std::string bad = fields::validate_fields(s); !bad.empty()) return bad;
   if (s.fit_mode == FitMode::scene && s.cascade_count != 1)
     return "fit_mode scene needs cascade_count 1, was " + std::to_string(s.cascade_count);
-  if (!(s.beam_radius >= 0.0f && std::isfinite(s.beam_radius)))
-    return "beam_radius must be finite and >= 0 (0 = fit to the scene), was " + str(s.beam_radius);
-  if (!(s.normal_offset_bias >= 0.0f && s.normal_offset_bias <= 16.0f))
-    return "normal_offset_bias must be in [0, 16] texels, was " + str(s.normal_offset_bias);
-  if (!(s.blend_band >= 0.0f && s.blend_band <= 1.0f))
-    return "blend_band must be in [0, 1], was " + str(s.blend_band);
-  if (s.far_cascade_interval < 1 || s.far_cascade_interval > 16)
-    return "far_cascade_interval must be in [1, 16] frames, was " +
-           std::to_string(s.far_cascade_interval);
-  const int selection = static_cast<int>(s.selection);
-  if (selection < 0 || selection > static_cast<int>(CascadeSelection::map_bounds))
-    return "selection must be depth or map_bounds, was " + std::to_string(selection);
-  const int point_mode = static_cast<int>(s.point_mode);
-  if (point_mode < 0 || point_mode > static_cast<int>(PointShadowMode::dual_paraboloid))
-    return "point_mode must be cube or dual_paraboloid, was " + std::to_string(point_mode);
   return {};
 }
 

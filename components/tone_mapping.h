@@ -1,9 +1,11 @@
-// Tone mapping of the frame's linear colour (issue 17): the curves the forward shader applies
+// Tone mapping of the frame's linear colour: the curves the forward shader applies
 // (content/shaders/tone_mapping.glsl evaluates the same formulas; tests/render/tone_mapping_test
 // compares the two), also used on the CPU for the clear colour and by the tests. Plain maths.
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -12,6 +14,10 @@ namespace kaskad {
 /// render.tone_mapping. none: linear colour clamped by the sRGB target (the default, so that
 /// images, goldens and the reference comparisons of colour keep their meaning).
 enum class ToneMapping { none, khr_pbr_neutral, aces };
+constexpr std::array<std::string_view, 3> enum_names(ToneMapping) {
+  return {"none", "khr_pbr_neutral", "aces"};
+}
+static_assert(enum_names(ToneMapping{}).size() == std::size_t(ToneMapping::aces) + 1);
 
 /// Khronos PBR Neutral (the Khronos 3D Commerce "PBR Neutral" tone mapper, 2024): colours below
 /// a peak of 0.76 are only shifted down by an offset (at most 0.04, less for dark colours), so

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "runtime/assets/image_io.h"
+#include "runtime/core/field_io.h"
 #include "runtime/core/json_reader.h"
 
 namespace kaskad {
@@ -38,7 +39,8 @@ Result<Material> load_material_file(const std::filesystem::path& file,
     ObjectReader root(*doc, "");
     std::string description;
     root.string("description", description);
-    root.enumeration("reflection_model", m.reflection_model, reflection_model_names());
+    root.enumeration("reflection_model", m.reflection_model,
+                     field_io::name_table<ReflectionModel>());
     // 1. Features: known, of material kind, listed once, consistent with each other.
     std::vector<std::string> features;
     if (root.has("features")) {

@@ -1,35 +1,21 @@
 #include "runtime/assets/reflector_io.h"
 
+#include "runtime/core/field_io.h"
+
 namespace kaskad {
 namespace {
 
 using json = nlohmann::json;
-using json_reader::enum_name;
 using json_reader::fail;
-using json_reader::num;
 using json_reader::type_name;
 using json_reader::vec;
 
-const std::vector<std::pair<const char*, ReflectionMap>> kMaps = {
-    {"cube", ReflectionMap::cube}, {"sphere", ReflectionMap::sphere}};
-const std::vector<std::pair<const char*, ProbeUpdate>> kUpdates = {
-    {"static_file", ProbeUpdate::static_file}, {"first_frame", ProbeUpdate::first_frame},
-    {"every_n", ProbeUpdate::every_n}, {"on_change", ProbeUpdate::on_change}};
-const std::vector<std::pair<const char*, EnvLayoutName>> kLayouts = {
-    {"auto", EnvLayoutName::auto_detect}, {"faces", EnvLayoutName::faces}, {"horizontal_cross", EnvLayoutName::horizontal_cross},
-    {"vertical_cross", EnvLayoutName::vertical_cross}, {"equirect", EnvLayoutName::equirect},
-    {"sphere", EnvLayoutName::sphere}};
-
-constexpr float kBig = 1.0e7f;  // as scene_io.cpp
+constexpr float kBig = float(kMaxCoordinate);
 
 }  // namespace
 
 void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
-  r.enumeration("map", out.map, kMaps);
-  r.enumeration("update", out.update, kUpdates);
-  r.integer("every_n", out.every_n, 1, 1 << 20);
-  r.integer("faces_per_frame", out.faces_per_frame, 1, 6);
-  r.power_of_two("resolution", out.resolution, 8, 2048);
+  field_io::read_fields(r, out);
   // center: [x, y, z], or "auto" (the centre of the entity's bounds; what a file without it gets).
   if (r.has("center") && r.raw("center").is_string()) {
     if (r.raw("center") != "auto")
@@ -39,8 +25,6 @@ void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
     r.vector<3>("center", out.center, -kBig, kBig);
     out.has_center = true;
   }
-  r.number("near", out.near, 1e-6f, kBig);
-  r.number("far", out.far, 1e-6f, kBig);
   if (r.has("exclude_layers")) {
     const json& list = r.raw("exclude_layers");
     if (!list.is_array()) fail(r.at("exclude_layers"), "expected an array of layers, got " + type_name(list));
@@ -67,10 +51,6 @@ void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
     br.finish();
     out.box_projection = true;
   }
-  r.number("amount", out.amount, 0.0f, 1.0f);
-  r.string("file", out.file);
-  r.enumeration("layout", out.layout, kLayouts);
-  r.boolean("z_up_3dsmax", out.z_up_3dsmax);
   r.finish();
   if (std::string bad = validate_reflector(out); !bad.empty())
     fail(r.at(bad.substr(0, bad.find(' ')).c_str()), bad);
@@ -92,24 +72,14 @@ Result<CubeMap> load_static_env_map(const std::filesystem::path& file, const Ref
 }
 
 json reflector_to_json(const Reflector& r) {
-  json j = {{"map", enum_name(r.map, kMaps)},
-            {"update", enum_name(r.update, kUpdates)},
-            {"every_n", r.every_n},
-            {"faces_per_frame", r.faces_per_frame},
-            {"resolution", r.resolution}};
+  json j = field_io::write_fields(r);
   j["center"] = r.has_center ? vec(r.center) : json("auto");
-  j["near"] = num(r.near);
-  j["far"] = num(r.far);
   json layers = json::array();
   for (int i = 0; i < 32; ++i)
     if (r.exclude_layers & (1u << i)) layers.push_back(i);
   j["exclude_layers"] = layers;
   j["box"] =
       r.box_projection ? json{{"min", vec(r.box_min)}, {"max", vec(r.box_max)}} : json("none");
-  j["amount"] = num(r.amount);
-  j["file"] = r.file;
-  j["layout"] = enum_name(r.layout, kLayouts);
-  j["z_up_3dsmax"] = r.z_up_3dsmax;
   return j;
 }
 

@@ -1,9 +1,12 @@
 // A loaded scene: the ECS world, its CPU assets and its render settings.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
+#include <tuple>
 
 #include <glm/glm.hpp>
 
@@ -22,6 +25,8 @@ enum class GroundMode {
   none,
   on,
 };
+constexpr std::array<std::string_view, 3> enum_names(GroundMode) { return {"auto", "none", "on"}; }
+static_assert(enum_names(GroundMode{}).size() == std::size_t(GroundMode::on) + 1);
 
 /// render.exposure_ev's range: 2^-20 to 2^13 (exposure's own limit is 1e4).
 inline constexpr float kMinExposureEv = -20.0f, kMaxExposureEv = 13.0f;
@@ -75,6 +80,38 @@ struct RenderSettings {
   /// probes' maps of the round before, so round k shows mirrors seen in mirrors k - 1 deep.
   int probe_bounces = kDefaultProbeBounces;
 };
+
+/// The fields of RenderSettings, once (runtime/fields/fields.h); exposure_ev, another form of
+/// exposure, is the scene reader's.
+constexpr auto field_table(fields::Of<RenderSettings>) {
+  using R = RenderSettings;
+  using namespace fields;
+  return std::tuple{
+      integer("width", &R::width, 1, 16384, "Output image width, pixels"),
+      integer("height", &R::height, 1, 16384, "Output image height, pixels"),
+      vector("ambient", &R::ambient, 0, 1.0e4, "Linear radiance from every direction without an environment"),
+      vector("clear_color", &R::clear_color, 0, 1.0e4, "Linear background colour"),
+      number("exposure", &R::exposure, 0, 1.0e4,
+             "Scale of linear colour before tone mapping (or exposure_ev, stops)"),
+      choice("tone_mapping", &R::tone_mapping, "The curve applied after the exposure"),
+      text("environment", &R::environment, "Environment map lighting every surface; empty: ambient"),
+      number("environment_intensity", &R::environment_intensity, 0, 1.0e4,
+             "Multiplies the environment map's radiance"),
+      integer("msaa", &R::msaa, 1, 8, "Colour samples per pixel", kPowerOfTwo),
+      integer("aov_shadow_light", &R::aov_shadow_light, 0, 3,
+              "Which shadowed light the AOV's visibility and cascade channels show", kDebug),
+      choice("ground", &R::ground, "A receive-only ground plane under the models"),
+      flag("shadow_cache", &R::shadow_cache, "Shadow-map layers whose inputs did not change keep their depth"),
+      flag("shadow_scroll", &R::shadow_scroll,
+           "A stable cascade moved by whole texels draws only the texels that came into view"),
+      flag("visibility_cache", &R::visibility_cache,
+           "A frame that sees what the frame before saw reads its shadow visibility back"),
+      flag("multi_draw", &R::multi_draw,
+           "Draws of one program and material but different meshes are one multi-draw"),
+      integer("probe_bounces", &R::probe_bounces, kMinProbeBounces, kMaxProbeBounces,
+              "Capture rounds on a frame where reflection probes make their first capture"),
+  };
+}
 
 struct Scene {
   ecs::World world;

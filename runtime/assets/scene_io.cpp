@@ -31,6 +31,7 @@
 #include "runtime/assets/primitives.h"
 #include "runtime/assets/reflector_io.h"
 #include "runtime/core/atomic_file.h"
+#include "runtime/core/field_io.h"
 #include "runtime/core/file_io.h"
 #include "runtime/core/json_reader.h"
 #include "runtime/core/log.h"
@@ -40,9 +41,10 @@ namespace {
 
 using json = nlohmann::json;
 namespace fs = std::filesystem;
+using field_io::read_fields;
+using field_io::write_fields;
 using json_reader::ContentError;
 using json_reader::ObjectReader;
-using json_reader::enum_name;
 using json_reader::fail;
 using json_reader::join;
 using json_reader::num;
@@ -52,150 +54,19 @@ using json_reader::vec;
 
 constexpr int kFormatVersion = 1;
 
-const std::vector<std::pair<const char*, LightType>> kLightTypes = {
-    {"directional", LightType::directional}, {"spot", LightType::spot}, {"point", LightType::point},
-    {"area", LightType::area}};
-const std::vector<std::pair<const char*, CullMode>> kCullModes = {
-    {"back", CullMode::back}, {"front", CullMode::front}, {"none", CullMode::none}};
-const std::vector<std::pair<const char*, ShadowFilter>> kFilters = {
-    {"none", ShadowFilter::none}, {"bilinear", ShadowFilter::bilinear}, {"pcf3x3", ShadowFilter::pcf3x3}};
-const std::vector<std::pair<const char*, ShadowTechnique>> kTechniques = {
-    {"pcf", ShadowTechnique::pcf}, {"pcss", ShadowTechnique::pcss},
-    {"backprojection", ShadowTechnique::backprojection}, {"lom", ShadowTechnique::lom},
-    {"vsm", ShadowTechnique::vsm}, {"evsm", ShadowTechnique::evsm}};
-// pcf_kernel is written as the box side (3, 5, 7, 9) or "poisson".
-const std::vector<std::pair<const char*, PcfKernel>> kKernelNames = {{"poisson", PcfKernel::poisson}};
-const std::vector<std::pair<const char*, Projection>> kProjections = {
-    {"perspective", Projection::perspective}, {"orthographic", Projection::orthographic}};
-const std::vector<std::pair<const char*, PrimitiveShape>> kShapes = {
-    {"plane", PrimitiveShape::plane}, {"box", PrimitiveShape::box}, {"sphere", PrimitiveShape::sphere},
-    {"cylinder", PrimitiveShape::cylinder}, {"cone", PrimitiveShape::cone},
-    {"terrain", PrimitiveShape::terrain}};
+constexpr float kBig = float(kMaxCoordinate);
 
-const std::vector<std::pair<const char*, ToneMapping>> kToneMappings = {
-    {"none", ToneMapping::none}, {"khr_pbr_neutral", ToneMapping::khr_pbr_neutral}, {"aces", ToneMapping::aces}};
-const std::vector<std::pair<const char*, GroundMode>> kGroundModes = {
-    {"auto", GroundMode::automatic}, {"none", GroundMode::none}, {"on", GroundMode::on}};
-
-constexpr float kBig = 1.0e7f;  // |coordinate| limit: beyond it float precision is meaningless
-
-const std::vector<std::pair<const char*, SplitScheme>> kSplitSchemes = {
-    {"auto", SplitScheme::automatic}, {"uniform", SplitScheme::uniform}, {"log", SplitScheme::log},
-    {"mixed", SplitScheme::mixed}};
-const std::vector<std::pair<const char*, DepthFormat>> kDepthFormats = {
-    {"d16", DepthFormat::d16}, {"d24", DepthFormat::d24}, {"d32f", DepthFormat::d32f}};
-const std::vector<std::pair<const char*, FitMode>> kFitModes = {
-    {"crop", FitMode::crop}, {"stable", FitMode::stable}, {"scene", FitMode::scene}};
-const std::vector<std::pair<const char*, CascadeSelection>> kSelections = {
-    {"depth", CascadeSelection::depth}, {"map_bounds", CascadeSelection::map_bounds}};
-const std::vector<std::pair<const char*, PointShadowMode>> kPointModes = {
-    {"cube", PointShadowMode::cube}, {"dual_paraboloid", PointShadowMode::dual_paraboloid}};
-
-// Range checks here; combinations (fit_mode scene with several cascades) by
-// validate_shadow_settings(), whose message starts with the bad key.
+// The table's fields and ranges (components/shadow_settings.h), then the rules across fields
+// (validate_shadow_settings(), whose message starts with the bad key).
 void read_shadow(ObjectReader& r, ShadowSettings& s) {
-  r.power_of_two("map_size", s.map_size, 64, 16384);
-  r.number("constant_bias", s.constant_bias, 0.0f, 1.0e4f);
-  r.number("slope_bias", s.slope_bias, 0.0f, 100.0f);
-  r.enumeration("cull", s.cull, kCullModes);
-  r.enumeration("filter", s.filter, kFilters);
-  r.enumeration("technique", s.technique, kTechniques);
-  if (r.has("pcf_kernel") && r.raw("pcf_kernel").is_number()) {
-    int side = 3;
-    r.integer("pcf_kernel", side, 3, 9);
-    if (side % 2 == 0)
-      fail(r.at("pcf_kernel"), "must be 3, 5, 7, 9 or \"poisson\", was " + std::to_string(side));
-    s.pcf_kernel = PcfKernel((side - 3) / 2);
-  } else if (r.has("pcf_kernel")) {
-    const json& v = r.raw("pcf_kernel");
-    if (!v.is_string())
-      fail(r.at("pcf_kernel"), "expected 3, 5, 7, 9 or \"poisson\", got " + type_name(v));
-    // The sides are numbers: a string other than "poisson" ("9x9", "5") gets the whole list.
-    if (v.get<std::string>() != "poisson")
-      fail(r.at("pcf_kernel"),
-           "must be 3, 5, 7, 9 or \"poisson\", was '" + v.get<std::string>() + "'");
-    r.enumeration("pcf_kernel", s.pcf_kernel, kKernelNames);
-  }
-  r.integer("pcf_taps", s.pcf_taps, 8, 64);
-  r.number("pcf_radius", s.pcf_radius, 1.0f, 16.0f);
-  r.integer("lom_layers", s.lom_layers, 2, 16);
-  r.integer("vsm_blur", s.vsm_blur, 1, 15);
-  if (s.vsm_blur % 2 == 0)
-    fail(r.at("vsm_blur"), "must be an odd number of texels in [1, 15], was " +
-                               std::to_string(s.vsm_blur));
-  // [0, 1): 1 would shadow everything. The largest float under 1 is the bound (the editor's).
-  if (r.has("vsm_bleed_reduction") && r.raw("vsm_bleed_reduction").is_number() &&
-      r.raw("vsm_bleed_reduction").get<double>() > double(std::nextafter(1.0f, 0.0f)))
-    fail(r.at("vsm_bleed_reduction"), "must be in [0, 1) (1 would shadow everything), was " +
-                                          r.raw("vsm_bleed_reduction").dump());
-  r.number("vsm_bleed_reduction", s.vsm_bleed_reduction, 0.0f, std::nextafter(1.0f, 0.0f));
-  r.integer("cascade_count", s.cascade_count, 1, 8);
-  r.enumeration("split_scheme", s.split_scheme, kSplitSchemes);
-  r.number("lambda", s.lambda, 0.0f, 1.0f);
-  if (r.has("max_distance") && r.raw("max_distance") == "auto")
-    s.max_distance = 0.0f;  // no cap, the same as 0
-  else
-    r.number("max_distance", s.max_distance, 0.0f, kBig);
-  r.enumeration("depth_format", s.depth_format, kDepthFormats);
-  r.enumeration("fit_mode", s.fit_mode, kFitModes);
-  r.number("beam_radius", s.beam_radius, 0.0f, kBig);
-  r.number("normal_offset_bias", s.normal_offset_bias, 0.0f, 16.0f);
-  r.number("blend_band", s.blend_band, 0.0f, 1.0f);
-  r.enumeration("selection", s.selection, kSelections);
-  r.boolean("debug_cascades", s.debug_cascades);
-  r.enumeration("point_mode", s.point_mode, kPointModes);
-  r.boolean("freeze_cascades", s.freeze_cascades);
-  r.boolean("layered", s.layered);
-  r.boolean("cull_by_receivers", s.cull_by_receivers);
-  r.boolean("scissor_to_receivers", s.scissor_to_receivers);
-  r.integer("far_cascade_interval", s.far_cascade_interval, 1, 16);
+  read_fields(r, s);
   r.finish();
   if (std::string bad = validate_shadow_settings(s); !bad.empty())
     fail(r.at(bad.substr(0, bad.find(' ')).c_str()), bad);
 }
 
 json write_shadow(const ShadowSettings& s, const ShadowSettings* defaults) {
-  json j = json::object();
-  auto put = [&](const char* key, json value, bool differs) {
-    if (!defaults || differs) j[key] = std::move(value);
-  };
-  const ShadowSettings& d = defaults ? *defaults : s;
-  put("map_size", s.map_size, s.map_size != d.map_size);
-  put("constant_bias", num(s.constant_bias), s.constant_bias != d.constant_bias);
-  put("slope_bias", num(s.slope_bias), s.slope_bias != d.slope_bias);
-  put("cull", enum_name(s.cull, kCullModes), s.cull != d.cull);
-  put("filter", enum_name(s.filter, kFilters), s.filter != d.filter);
-  put("technique", enum_name(s.technique, kTechniques), s.technique != d.technique);
-  put("pcf_kernel",
-      s.pcf_kernel == PcfKernel::poisson ? json("poisson") : json(3 + 2 * int(s.pcf_kernel)),
-      s.pcf_kernel != d.pcf_kernel);
-  put("pcf_taps", s.pcf_taps, s.pcf_taps != d.pcf_taps);
-  put("pcf_radius", num(s.pcf_radius), s.pcf_radius != d.pcf_radius);
-  put("lom_layers", s.lom_layers, s.lom_layers != d.lom_layers);
-  put("vsm_blur", s.vsm_blur, s.vsm_blur != d.vsm_blur);
-  put("vsm_bleed_reduction", num(s.vsm_bleed_reduction),
-      s.vsm_bleed_reduction != d.vsm_bleed_reduction);
-  put("cascade_count", s.cascade_count, s.cascade_count != d.cascade_count);
-  put("split_scheme", enum_name(s.split_scheme, kSplitSchemes), s.split_scheme != d.split_scheme);
-  put("lambda", num(s.lambda), s.lambda != d.lambda);
-  put("max_distance", num(s.max_distance), s.max_distance != d.max_distance);
-  put("depth_format", enum_name(s.depth_format, kDepthFormats), s.depth_format != d.depth_format);
-  put("fit_mode", enum_name(s.fit_mode, kFitModes), s.fit_mode != d.fit_mode);
-  put("beam_radius", num(s.beam_radius), s.beam_radius != d.beam_radius);
-  put("normal_offset_bias", num(s.normal_offset_bias),
-      s.normal_offset_bias != d.normal_offset_bias);
-  put("blend_band", num(s.blend_band), s.blend_band != d.blend_band);
-  put("selection", enum_name(s.selection, kSelections), s.selection != d.selection);
-  put("debug_cascades", s.debug_cascades, s.debug_cascades != d.debug_cascades);
-  put("point_mode", enum_name(s.point_mode, kPointModes), s.point_mode != d.point_mode);
-  put("freeze_cascades", s.freeze_cascades, s.freeze_cascades != d.freeze_cascades);
-  put("layered", s.layered, s.layered != d.layered);
-  put("cull_by_receivers", s.cull_by_receivers, s.cull_by_receivers != d.cull_by_receivers);
-  put("scissor_to_receivers", s.scissor_to_receivers,
-      s.scissor_to_receivers != d.scissor_to_receivers);
-  put("far_cascade_interval", s.far_cascade_interval,
-      s.far_cascade_interval != d.far_cascade_interval);
-  return j;
+  return write_fields(s, defaults);
 }
 
 // Rotation from exactly one of: rotation (quaternion x,y,z,w as in glTF), euler_deg (XYZ),
@@ -237,24 +108,14 @@ void read_rotation(ObjectReader& r, Transform& t) {
 // An inline material block: the built-in parameters, features derived from the values.
 Material read_inline_material(ObjectReader& mr) {
   Material m;
-  mr.vector<4>("base_color", m.base_color, 0.0f, 1.0e4f);
-  mr.number("metallic", m.metallic, 0.0f, 1.0f);
-  mr.number("roughness", m.roughness, 0.0f, 1.0f);
-  mr.vector<3>("emissive", m.emissive, 0.0f, 1.0e6f);
-  mr.boolean("double_sided", m.double_sided);
-  mr.number("k_s", m.k_s, 0.0f, 1.0f);
-  mr.enumeration("reflection_model", m.reflection_model, reflection_model_names());
+  read_fields(mr, m);
   mr.finish();
   m.features = derive_material_features(m);
   return m;
 }
 
 void read_render(ObjectReader& r, RenderSettings& s) {
-  r.integer("width", s.width, 1, 16384);
-  r.integer("height", s.height, 1, 16384);
-  r.vector<3>("ambient", s.ambient, 0.0f, 1.0e4f);
-  r.vector<3>("clear_color", s.clear_color, 0.0f, 1.0e4f);
-  r.number("exposure", s.exposure, 0.0f, 1.0e4f);
+  read_fields(r, s);
   // Exposure in EV (stops): the scale is 2^EV. Either form, not both; saved as `exposure`.
   if (r.has("exposure_ev")) {
     if (r.has("exposure"))
@@ -263,19 +124,6 @@ void read_render(ObjectReader& r, RenderSettings& s) {
     r.number("exposure_ev", ev, kMinExposureEv, kMaxExposureEv);
     s.exposure = std::exp2(ev);
   }
-  r.enumeration("tone_mapping", s.tone_mapping, kToneMappings);
-  r.string("environment", s.environment);
-  r.number("environment_intensity", s.environment_intensity, 0.0f, 1.0e4f);
-  r.integer("msaa", s.msaa, std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
-  if (s.msaa != 1 && s.msaa != 2 && s.msaa != 4 && s.msaa != 8)
-    fail(r.at("msaa"), "must be 1, 2, 4 or 8 (samples per pixel), was " + std::to_string(s.msaa));
-  r.integer("aov_shadow_light", s.aov_shadow_light, 0, 3);
-  r.enumeration("ground", s.ground, kGroundModes);
-  r.boolean("shadow_cache", s.shadow_cache);
-  r.boolean("shadow_scroll", s.shadow_scroll);
-  r.boolean("visibility_cache", s.visibility_cache);
-  r.boolean("multi_draw", s.multi_draw);
-  r.integer("probe_bounces", s.probe_bounces, kMinProbeBounces, kMaxProbeBounces);
   r.finish();
 }
 
@@ -287,26 +135,15 @@ void read_transform(ObjectReader& tr, Transform& t) {
 }
 
 void read_renderer(ObjectReader& rr, MeshRenderer& m) {
-  rr.boolean("cast_shadows", m.cast_shadows);
-  rr.boolean("receive_shadows", m.receive_shadows);
-  rr.integer("layer", m.layer, 0, 31);
+  read_fields(rr, m);
   rr.finish();
 }
 
 // Returns whether the block says cast_shadows.
 bool read_light(ObjectReader& lr, Light& l) {
-  lr.enumeration("type", l.type, kLightTypes);
-  lr.vector<3>("color", l.color, 0.0f, 1.0e4f);
-  lr.number("intensity", l.intensity, 0.0f, 1.0e9f);
-  lr.number("range", l.range, 0.0f, kBig);
-  lr.number("inner_cone_deg", l.inner_cone_deg, 0.0f, 90.0f);
-  lr.number("outer_cone_deg", l.outer_cone_deg, 0.0f, 90.0f);
   const bool cast_given = lr.has("cast_shadows");
-  lr.boolean("cast_shadows", l.cast_shadows);
-  lr.number("angular_size_deg", l.angular_size_deg, 0.0f, 45.0f);
-  lr.number("radius", l.radius, 0.0f, 100.0f);
   const bool size_given = lr.has("size");
-  lr.vector("size", l.size, 1e-3f, 100.0f);
+  read_fields(lr, l);
   lr.finish();
   if (l.type == LightType::directional && l.radius > 0.0f)
     fail(lr.at("radius"), "is for spot and point lights; a directional light's size is "
@@ -331,14 +168,7 @@ bool read_light(ObjectReader& lr, Light& l) {
 }
 
 void read_camera(ObjectReader& cr, Camera& c) {
-  cr.enumeration("projection", c.projection, kProjections);
-  cr.number("fov_y_deg", c.fov_y_deg, 0.01f, 179.0f);
-  cr.number("ortho_height", c.ortho_height, 1e-6f, kBig);
-  cr.number("near", c.near, 1e-7f, kBig);
-  cr.number("far", c.far, 1e-6f, 1e12f);
-  cr.number("aspect", c.aspect, 0.0f, 1000.0f);
-  cr.boolean("active", c.active);
-  cr.boolean("auto_frame", c.auto_frame);
+  read_fields(cr, c);
   cr.finish();
   if (!(c.far > c.near)) fail(cr.at("far"), "far must be greater than near");
 }
@@ -389,10 +219,8 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
   if (has_primitive) {
     PrimitiveMesh p;
     ObjectReader pr(r.raw("primitive"), r.at("primitive"));
-    pr.enumeration("shape", p.shape, kShapes);
-    pr.integer("segments", p.segments, 3, 1024);
+    read_fields(pr, p);
     if (pr.has("tiles")) {
-      pr.integer("tiles", p.tiles, 1, 64);
       if (p.shape != PrimitiveShape::terrain && p.tiles != 1)
         fail(r.at("primitive") + "/tiles", "tiles applies to the terrain shape only");
       if (p.segments % p.tiles != 0)
@@ -494,8 +322,8 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
     j["transform"] = tj;
   }
   if (const auto* p = w.try_get<PrimitiveMesh>(e)) {
-    j["primitive"] = {{"shape", enum_name(p->shape, kShapes)}, {"segments", p->segments}};
-    if (p->shape == PrimitiveShape::terrain) j["primitive"]["tiles"] = p->tiles;
+    j["primitive"] = write_fields(*p);
+    if (p->shape != PrimitiveShape::terrain) j["primitive"].erase("tiles");
   }
   auto rebase = [&](const std::string& path) { return rebase_path(scene, base, path); };
   if (const auto* m = w.try_get<ModelRef>(e)) {
@@ -503,31 +331,15 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
     if (!m->nodes.empty()) j["model"]["nodes"] = write_node_overrides(scene, e);
   }
   if (const auto* mr = w.try_get<MeshRenderer>(e))
-    j["renderer"] = {{"cast_shadows", mr->cast_shadows},
-                     {"receive_shadows", mr->receive_shadows},
-                     {"layer", mr->layer}};
+    j["renderer"] = write_fields(*mr);
   if (const auto* ref = w.try_get<MaterialRef>(e)) {
     j["material"] = {{"file", rebase(ref->path)}};
   } else if (const auto* m = w.try_get<Material>(e)) {
-    j["material"] = {{"base_color", vec(m->base_color)},
-                     {"metallic", num(m->metallic)},
-                     {"roughness", num(m->roughness)},
-                     {"emissive", vec(m->emissive)},
-                     {"double_sided", m->double_sided},
-                     {"k_s", num(m->k_s)},
-                     {"reflection_model", enum_name(m->reflection_model, reflection_model_names())}};
+    j["material"] = write_fields(*m);
   }
   if (const auto* l = w.try_get<Light>(e)) {
-    j["light"] = {{"type", enum_name(l->type, kLightTypes)},
-                  {"color", vec(l->color)},
-                  {"intensity", num(l->intensity)},
-                  {"range", num(l->range)},
-                  {"inner_cone_deg", num(l->inner_cone_deg)},
-                  {"outer_cone_deg", num(l->outer_cone_deg)},
-                  {"cast_shadows", l->cast_shadows},
-                  {"angular_size_deg", num(l->angular_size_deg)},
-                  {"radius", num(l->radius)}};
-    if (l->type == LightType::area) j["light"]["size"] = vec(l->size);
+    j["light"] = write_fields(*l);
+    if (l->type != LightType::area) j["light"].erase("size");
     if (const auto* s = w.try_get<ShadowSettings>(e)) {
       json sj = write_shadow(*s, &scene.shadow_defaults);
       if (!sj.empty()) j["shadow"] = sj;
@@ -538,14 +350,7 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
     if (!refl->file.empty()) j["reflector"]["file"] = rebase(refl->file);
   }
   if (const auto* c = w.try_get<Camera>(e)) {
-    j["camera"] = {{"projection", enum_name(c->projection, kProjections)},
-                   {"fov_y_deg", num(c->fov_y_deg)},
-                   {"ortho_height", num(c->ortho_height)},
-                   {"near", num(c->near)},
-                   {"far", num(c->far)},
-                   {"aspect", num(c->aspect)},
-                   {"active", c->active},
-                   {"auto_frame", c->auto_frame}};
+    j["camera"] = write_fields(*c);
   }
   return j;
 }
@@ -1433,22 +1238,8 @@ json scene_to_json(const Scene& scene, const fs::path& base_dir) {
   json doc;
   doc["kaskad_scene"] = kFormatVersion;
   const RenderSettings& r = scene.render;
-  doc["render"] = {{"width", r.width},
-                   {"height", r.height},
-                   {"ambient", vec(r.ambient)},
-                   {"clear_color", vec(r.clear_color)},
-                   {"exposure", num(r.exposure)},
-                   {"tone_mapping", enum_name(r.tone_mapping, kToneMappings)},
-                   {"environment", rebase_path(scene, base_dir, r.environment)},
-                   {"environment_intensity", num(r.environment_intensity)},
-                   {"msaa", r.msaa},
-                   {"aov_shadow_light", r.aov_shadow_light},
-                   {"ground", enum_name(r.ground, kGroundModes)},
-                   {"shadow_cache", r.shadow_cache},
-                   {"shadow_scroll", r.shadow_scroll},
-                   {"visibility_cache", r.visibility_cache},
-                   {"multi_draw", r.multi_draw},
-                   {"probe_bounces", r.probe_bounces}};
+  doc["render"] = write_fields(r);
+  doc["render"]["environment"] = rebase_path(scene, base_dir, r.environment);
   doc["shadow"] = write_shadow(scene.shadow_defaults, nullptr);
   std::vector<ecs::Entity> authored;
   scene.world.view<Transform>().each([&](ecs::Entity e, const Transform&) {

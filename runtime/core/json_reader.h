@@ -187,20 +187,29 @@ class ObjectReader {
                               at(key) + "/" + std::to_string(i));
     }
   }
-  template <class E>
-  void enumeration(const char* key, E& out, const std::vector<std::pair<const char*, E>>& table) {
+  /// One of the table's names. A name made of digits is given as that JSON integer (pcf_kernel's
+  /// box sides: 3, 5, 7, 9).
+  template <class E, class Name>
+  void enumeration(const char* key, E& out, const std::vector<std::pair<Name, E>>& table) {
     std::vector<std::string> names;
     for (const auto& [n, e] : table) names.push_back(n);
     if (FieldRecorder* recorder = FieldRecorder::current()) recorder->record(at(key), names);
     if (!has(key)) return;
     const json& v = j_.at(key);
-    if (!v.is_string()) fail(at(key), "expected one of " + join(names) + ", got " + type_name(v));
+    const bool integer_names = std::any_of(names.begin(), names.end(), [](const std::string& n) {
+      return !n.empty() && n.find_first_not_of("0123456789") == std::string::npos;
+    });
+    std::string given;
+    if (v.is_string()) given = v.get<std::string>();
+    else if (integer_names && v.is_number_integer()) given = v.dump();
+    else fail(at(key), "expected one of " + join(names) + ", got " + type_name(v));
     for (const auto& [n, e] : table)
-      if (v.get<std::string>() == n) {
+      if (given == n) {
         out = e;
         return;
       }
-    fail(at(key), "unknown value '" + v.get<std::string>() + "'; expected one of " + join(names));
+    fail(at(key), "unknown value " + (v.is_string() ? "'" + given + "'" : given) +
+                      "; expected one of " + join(names));
   }
   /// Fails on keys that no reader asked for.
   void finish() const {
@@ -235,8 +244,8 @@ class ObjectReader {
   std::vector<std::string> known_;
 };
 
-template <class E>
-const char* enum_name(E value, const std::vector<std::pair<const char*, E>>& table) {
+template <class E, class Name>
+std::string enum_name(E value, const std::vector<std::pair<Name, E>>& table) {
   for (const auto& [n, e] : table)
     if (e == value) return n;
   return "?";

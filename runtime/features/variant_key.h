@@ -3,7 +3,7 @@
 //   material features  (bits 0-15)  what a material uses      -> MATERIAL_* defines
 //   frame features     (bits 16-47) what the frame needs      -> VARIANT_* defines
 // (bits 48-63 stay free: the shader library keeps the pass there). 32 bits ran out when the
-// soft-shadow techniques and PCF kernels arrived (issue 14).
+// soft-shadow techniques and PCF kernels arrived.
 //
 // kFeatureTable below is the one place a feature is declared: its name, define, stages, bit
 // offset, value range or value names, and what it requires or excludes. Everything else is
@@ -36,6 +36,9 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+
+#include "components/shadow_settings.h"
+#include "components/tone_mapping.h"
 
 namespace kaskad::render {
 
@@ -73,6 +76,17 @@ struct KeyField {
   constexpr std::uint64_t mask() const { return ((std::uint64_t(1) << width) - 1u) << offset; }
   constexpr std::uint32_t max() const { return (1u << width) - 1u; }
 };
+
+/// The value names of an enumerated feature that stores enum E: the enum's own names
+/// (enum_names(), the ones files use), so that the two cannot disagree.
+template <class E>
+consteval std::array<std::string_view, 8> values_of() {
+  constexpr auto names = enum_names(E{});
+  static_assert(names.size() <= 8, "an enumerated feature has at most 8 values");
+  std::array<std::string_view, 8> out{};
+  for (std::size_t i = 0; i < names.size(); ++i) out[i] = names[i];
+  return out;
+}
 
 /// One shader feature (a row of kFeatureTable).
 struct FeatureSpec {
@@ -142,7 +156,7 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     {.name = "shadow", .kind = FeatureKind::frame, .define = "VARIANT_HAS_SHADOW",
      .stages = kFragmentStage, .offset = 16},
     {.name = "shadow_filter", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_FILTER",
-     .stages = kFragmentStage, .offset = 17, .values = {"none", "bilinear", "pcf3x3"},
+     .stages = kFragmentStage, .offset = 17, .values = values_of<ShadowFilter>(),
      .requires_ = {"shadow"}},
     {.name = "cascade_count", .kind = FeatureKind::frame, .define = "VARIANT_CASCADE_COUNT",
      .stages = kVertexStage | kFragmentStage, .offset = 19, .min = 1, .max = 8,
@@ -150,11 +164,11 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     {.name = "aovs", .kind = FeatureKind::frame, .define = "VARIANT_HAS_AOVS",
      .stages = kFragmentStage, .offset = 22},
     {.name = "cascade_selection", .kind = FeatureKind::frame, .define = "VARIANT_CASCADE_SELECTION",
-     .stages = kFragmentStage, .offset = 24, .values = {"depth", "map_bounds"},
+     .stages = kFragmentStage, .offset = 24, .values = values_of<CascadeSelection>(),
      .requires_ = {"shadow"}},
     {.name = "shadow_projection", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_PROJECTION",
      .stages = kVertexStage | kFragmentStage, .offset = 25,
-     .values = {"ortho", "perspective", "cube", "dual_paraboloid"}, .requires_ = {"shadow"},
+     .values = values_of<ShadowProjection>(), .requires_ = {"shadow"},
      .excludes = {"cascade_count"}},
     {.name = "shadow_layered", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_LAYERED",
      .stages = kVertexStage, .offset = 27, .requires_ = {"shadow"}},
@@ -164,24 +178,26 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // loops over them get a compile-time bound, so lights that do not exist cost nothing.
     {.name = "shadow_lights", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_LIGHTS",
      .stages = kFragmentStage, .offset = 28, .min = 1, .max = 4, .requires_ = {"shadow"}},
-    // Soft shadows (issue 14), per frame like shadow_filter (the first shadowed light's
+    // Soft shadows, per frame like shadow_filter (the first shadowed light's
     // ShadowSettings::technique). Bits 32-35: room for up to 16 techniques.
     {.name = "shadow_technique", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_TECHNIQUE",
      .stages = kFragmentStage, .offset = 32,
-     .values = {"pcf", "pcss", "backprojection", "lom", "vsm", "evsm"}, .requires_ = {"shadow"}},
+     .values = values_of<ShadowTechnique>(), .requires_ = {"shadow"}},
     // The depth pass peeling layer j > 0 of S1's layered depth map (LomPass): fragments at or in
     // front of layer j - 1 are discarded, and each writes its depth, signed by whether its draw
     // casts shadows.
     {.name = "shadow_peel", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_PEEL",
      .stages = kVertexStage | kFragmentStage, .offset = 30, .requires_ = {"shadow"}},
     // The PCF footprint of shadow_filter pcf3x3 (ShadowSettings::pcf_kernel): N x N boxes of
-    // nearest compares, or a rotated Poisson-like disc of ShadowSettings::pcf_taps taps.
+    // nearest compares, or a rotated Poisson-like disc of ShadowSettings::pcf_taps taps. Its
+    // value names (the defines' suffixes) are the shader's, "3x3" where files say 3; the count is
+    // tied to the enum below.
     {.name = "shadow_kernel", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_KERNEL",
      .stages = kFragmentStage, .offset = 36,
      .values = {"3x3", "5x5", "7x7", "9x9", "poisson"}, .requires_ = {"shadow"}},
     // render.tone_mapping (components/tone_mapping.h): the curve the colour output goes through.
     {.name = "tone_mapping", .kind = FeatureKind::frame, .define = "VARIANT_TONE_MAPPING",
-     .stages = kFragmentStage, .offset = 40, .values = {"none", "khr_pbr_neutral", "aces"}},
+     .stages = kFragmentStage, .offset = 40, .values = values_of<ToneMapping>()},
     // render.msaa > 1: the multisampled colour pass. An alpha-masked draw writes its coverage
     // (alpha sharpened around the cutoff) instead of discarding, and GL_SAMPLE_ALPHA_TO_COVERAGE
     // turns it into samples. Only alpha-masked programs keep it (filtered_for()), so the others
@@ -208,6 +224,10 @@ constexpr int feature_index(std::string_view name) {
     if (kFeatureTable[i].name == name) return i;
   return -1;
 }
+
+// The kernel's value names are the shader's own; their count must still be the enum's.
+static_assert(kFeatureTable[feature_index("shadow_kernel")].value_count() ==
+              int(enum_names(PcfKernel{}).size()));
 
 /// A feature's key field by name; a name not in the table does not compile.
 consteval KeyField feature_field(std::string_view name) {

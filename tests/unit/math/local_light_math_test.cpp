@@ -309,7 +309,7 @@ TEST(ShadowCascadeSystem, SharedSettingsOfLaterLightsAreNamedInTheNotice) {
   // The light is named (by its entity index) and exactly the differing shared fields are listed.
   EXPECT_NE(state.last_notice.find(std::to_string(second.index)), std::string::npos)
       << state.last_notice;
-  EXPECT_NE(state.last_notice.find(": its filter, layered, debug_cascades differ from the first "
+  EXPECT_NE(state.last_notice.find(": its filter, debug_cascades, layered differ from the first "
                                    "shadowed light's, whose values apply (one shared texture "
                                    "array, one set of shader features)"),
             std::string::npos)
