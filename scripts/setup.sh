@@ -14,7 +14,7 @@ packages=(
   libopenimageio-dev openimageio-tools
   nlohmann-json3-dev libimgui-dev libstb-dev libembree-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3-matplotlib python3-numpy xvfb xauth xdotool
+  python3-matplotlib python3-numpy python3-jsonschema xvfb xauth xdotool
 )
 bash scripts/install_packages.sh setup "${packages[@]}"
 

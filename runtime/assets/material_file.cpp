@@ -39,6 +39,8 @@ Result<Material> load_material_file(const std::filesystem::path& file,
     ObjectReader root(*doc, "");
     std::string description;
     root.string("description", description);
+    std::string schema;  // "$schema": the file's JSON Schema, for editors (`kaskad schema`)
+    root.string("$schema", schema);
     root.enumeration("reflection_model", m.reflection_model,
                      field_io::name_table<ReflectionModel>());
     // 1. Features: known, of material kind, listed once, consistent with each other.

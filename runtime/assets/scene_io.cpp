@@ -790,6 +790,8 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
                  std::to_string(kFormatVersion) + "): written by a later Kaskad?");
     }
     root.integer("kaskad_scene", version, 1, kFormatVersion);
+    std::string schema;  // "$schema": the file's JSON Schema, for editors (`kaskad schema`)
+    root.string("$schema", schema);
     if (root.has("render")) {
       ObjectReader r(root.raw("render"), "/render");
       read_render(r, scene.render);

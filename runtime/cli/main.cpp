@@ -26,6 +26,7 @@
 #include "runtime/assets/scene_io.h"
 #include "runtime/app/bench.h"
 #include "runtime/app/envmap_command.h"
+#include "runtime/app/schema_command.h"
 #include "runtime/app/playback.h"
 #include "runtime/app/player.h"
 #include "runtime/core/atomic_file.h"
@@ -642,6 +643,16 @@ int run_render(Args a) {
 int run_command(int argc, char** argv) {
   if (argc >= 2 && std::strcmp(argv[1], "envmap") == 0) return run_envmap_command(argc, argv);
   if (argc >= 2 && std::strcmp(argv[1], "play") == 0) return run_play_command(argc, argv);
+  if (argc >= 2 && std::strcmp(argv[1], "schema") == 0) {
+    std::filesystem::path out = content_dir().parent_path() / "docs" / "reference";
+    bool check = false;
+    for (int i = 2; i < argc; ++i) {
+      if (std::strcmp(argv[i], "--check") == 0) check = true;
+      else if (std::strcmp(argv[i], "--out") == 0 && i + 1 < argc) out = argv[++i];
+      else usage_error(std::string("schema: unknown option '") + argv[i] + "'");
+    }
+    return run_schema_command(out, check);
+  }
   if (argc >= 2 && std::strcmp(argv[1], "edit") == 0) {
 #ifdef KASKAD_HAS_EDITOR
     return editor::run_edit_command(argc, argv);

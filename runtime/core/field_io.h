@@ -156,8 +156,8 @@ json schema_properties() {
   return props;
 }
 
-/// Markdown rows "| key | type | default | range or values | doc |" of S's table, for the
-/// settings reference.
+/// Markdown rows "| key | type | default | range or values | doc | notes |" of S's table, for
+/// the settings reference (notes: shared, debug).
 template <class S>
 std::string reference_rows() {
   std::string out;
@@ -185,11 +185,11 @@ std::string reference_rows() {
       type = std::to_string(fields::VectorTraits<M>::size) + " numbers";
       range = "each in " + fields::range_text(f);
     }
-    std::string flags;
-    if (f.has(fields::kShared)) flags += " Shared: every shadowed light takes the first one's.";
-    if (f.has(fields::kDebug)) flags += " A debug view.";
+    std::string notes;
+    if (f.has(fields::kShared)) notes = "shared";
+    if (f.has(fields::kDebug)) notes += notes.empty() ? "debug" : ", debug";
     out += "| `" + std::string(f.key) + "` | " + type + " | `" + s["default"].dump() + "` | " +
-           range + " | " + std::string(f.doc) + flags + " |\n";
+           range + " | " + std::string(f.doc) + " | " + notes + " |\n";
   });
   return out;
 }
