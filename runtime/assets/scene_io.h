@@ -6,7 +6,9 @@
 //   parse_scene          JSON -> Scene with the authored entities only (validated, no file I/O)
 //   instantiate_scene    primitives -> meshes, glTF references -> imported entities
 // load_scene (runtime/app/player.h) runs all three plus the load phase (transforms, auto cameras).
-// The format is documented in README.md ("Scene files").
+// The format is documented in docs/guide/scenes.md; the fields in docs/reference/settings.md.
+// The implementation is split by job: scene_io.cpp (the file), scene_blocks.cpp (block readers
+// and writers), scene_overrides.cpp (--set), model_import.cpp, scene_instantiate.cpp.
 #pragma once
 
 #include <filesystem>
