@@ -1,6 +1,7 @@
 #include "runtime/core/log.h"
 
 #include <atomic>
+#include <cstdarg>
 #include <cstdio>
 #include <mutex>
 #include <set>
@@ -14,9 +15,19 @@ std::atomic<int> g_errors{0};
 
 void vlog(Level lvl, const char* tag, const char* fmt, va_list args) {
   if (lvl < g_level.load()) return;
-  std::fprintf(stderr, "[kaskad %s] ", tag);
-  std::vfprintf(stderr, fmt, args);
-  std::fputc('\n', stderr);
+  // The whole line is formatted first and written with one call, so that lines logged from
+  // several threads do not interleave.
+  va_list measure;
+  va_copy(measure, args);
+  const int body = std::vsnprintf(nullptr, 0, fmt, measure);
+  va_end(measure);
+  if (body < 0) return;
+  std::string line = "[kaskad " + std::string(tag) + "] ";
+  const std::size_t prefix = line.size();
+  line.resize(prefix + std::size_t(body) + 1);
+  std::vsnprintf(line.data() + prefix, std::size_t(body) + 1, fmt, args);
+  line.back() = '\n';
+  std::fwrite(line.data(), 1, line.size(), stderr);
 }
 }  // namespace
 
