@@ -1,12 +1,16 @@
 #include "runtime/app/bench.h"
 
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <optional>
@@ -128,12 +132,23 @@ std::uint64_t geometry_signature(const Scene& scene) {
 
 }  // namespace
 
-// scripts/bench_chart.py over a bench CSV: one chart per scene into `out_dir`.
+// scripts/bench_chart.py over a bench CSV: one chart per scene into `out_dir`. Started without a
+// shell (paths with quotes or spaces are arguments as they are).
 static Status draw_charts(const fs::path& csv_path, const fs::path& out_dir) {
   const fs::path script = content_dir().parent_path() / "scripts" / "bench_chart.py";
-  const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + csv_path.string() +
-                          "' '" + out_dir.string() + "'";
-  if (std::system(cmd.c_str()) != 0)
+  // Debian's python3, which has python3-matplotlib, whatever else is first on PATH.
+  const char* python = "/usr/bin/python3";
+  std::vector<std::string> args = {python, script.string(), csv_path.string(), out_dir.string()};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (const int err = posix_spawn(&pid, python, nullptr, nullptr, argv.data(), environ); err != 0)
+    return Error{script.string(), "", std::string("cannot start ") + python + ": " + std::strerror(err)};
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return Error{script.string(), "", "lost the chart script's exit status"};
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
     return Error{script.string(), "", "chart script failed (is python3-matplotlib installed?)"};
   return {};
 }

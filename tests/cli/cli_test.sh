@@ -334,6 +334,12 @@ check near_at_bound 0 "wrote" -- "$KASKAD" render --headless --size 96x64 --fram
   -o "$tmp/near.png" --set camera.camera.near=1e-7 --set camera.camera.far=1e7
 check near_below_bound nonzero "near: must be in \[1e-07" -- "$KASKAD" render --headless \
   --size 96x64 --frames 1 -o "$tmp/near.png" --set camera.camera.near=9.9e-8
+# The chart script is started without a shell: a folder named with a quote and a space gets its
+# chart like any other.
+quoted="$tmp/it's a bench"
+check bench_quoted_out 0 "wrote .*bench.csv \(1 row\)" -- "$KASKAD" bench --size 32x32 --frames 1 \
+  --stability-frames 0 --out "$quoted" --sweep "shadow.map_size=256"
+if [ -s "$quoted/default.png" ]; then echo "ok   bench_quoted_chart"; passed=$((passed + 1)); else echo "FAIL bench_quoted_chart: no chart in $quoted"; failed=$((failed + 1)); fi
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
