@@ -12,6 +12,7 @@
 
 #include <glm/glm.hpp>
 
+#include "components/env_layout.h"
 #include "components/limits.h"
 #include "runtime/fields/fields.h"
 
@@ -39,14 +40,6 @@ constexpr std::array<std::string_view, 4> enum_names(ProbeUpdate) {
   return {"static_file", "first_frame", "every_n", "on_change"};
 }
 static_assert(enum_names(ProbeUpdate{}).size() == std::size_t(ProbeUpdate::on_change) + 1);
-
-/// How a static file holds its cube map (see README "Reflection probes" for the file names).
-/// Mirrors EnvLayout in runtime/assets/env_map.h (change together).
-enum class EnvLayoutName { auto_detect, faces, horizontal_cross, vertical_cross, equirect, sphere };
-constexpr std::array<std::string_view, 6> enum_names(EnvLayoutName) {
-  return {"auto", "faces", "horizontal_cross", "vertical_cross", "equirect", "sphere"};
-}
-static_assert(enum_names(EnvLayoutName{}).size() == std::size_t(EnvLayoutName::sphere) + 1);
 
 struct Reflector {
   ReflectionMap map = ReflectionMap::cube;
@@ -81,7 +74,7 @@ struct Reflector {
   /// static_file: the image, or the six faces' name pattern with one `*` (load_cube_map in
   /// runtime/assets/env_map.h), relative to the scene. Resampled to `resolution` texels a face.
   std::string file;
-  EnvLayoutName layout = EnvLayoutName::auto_detect;
+  EnvLayout layout = EnvLayout::auto_detect;
   /// static_file: the file is 3ds Max-authored (Z up): S3 eq. (7) and its face table apply.
   bool z_up_3dsmax = false;
 };

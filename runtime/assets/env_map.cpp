@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "runtime/assets/image_io.h"
+#include "runtime/fields/fields.h"
 
 namespace kaskad {
 namespace {
@@ -330,21 +331,7 @@ const char* cube_face_suffix(CubeFace face) {
 }
 
 const char* env_layout_name(EnvLayout layout) {
-  switch (layout) {
-    case EnvLayout::auto_detect:
-      return "auto";
-    case EnvLayout::faces:
-      return "faces";
-    case EnvLayout::horizontal_cross:
-      return "horizontal_cross";
-    case EnvLayout::vertical_cross:
-      return "vertical_cross";
-    case EnvLayout::equirect:
-      return "equirect";
-    case EnvLayout::sphere:
-      return "sphere";
-  }
-  return "?";
+  return fields::name_of(layout).data();  // the names are literals: NUL-terminated
 }
 
 

@@ -28,6 +28,7 @@
 
 #include <glm/glm.hpp>
 
+#include "components/env_layout.h"
 #include "runtime/result/result.h"
 #include "runtime/math/sphere_map_math.h"
 
@@ -97,8 +98,6 @@ SphereMap sphere_map_from_cube(const CubeMap& cube, int size,
 /// Empty map: vec4(0).
 glm::vec4 sample_sphere(const SphereMap& map, const glm::vec3& reflected_view);
 
-/// How an environment file is laid out. See load_cube_map() and README "Environment maps".
-enum class EnvLayout { auto_detect, faces, horizontal_cross, vertical_cross, equirect, sphere };
 
 /// Name of a layout as used in messages and settings: "auto", "faces", "horizontal_cross",
 /// "vertical_cross", "equirect", "sphere".

@@ -58,14 +58,7 @@ void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
 
 Result<CubeMap> load_static_env_map(const std::filesystem::path& file, const Reflector& r) {
   EnvLoadOptions options;
-  switch (r.layout) {
-    case EnvLayoutName::auto_detect: options.layout = EnvLayout::auto_detect; break;
-    case EnvLayoutName::faces: options.layout = EnvLayout::faces; break;
-    case EnvLayoutName::horizontal_cross: options.layout = EnvLayout::horizontal_cross; break;
-    case EnvLayoutName::vertical_cross: options.layout = EnvLayout::vertical_cross; break;
-    case EnvLayoutName::equirect: options.layout = EnvLayout::equirect; break;
-    case EnvLayoutName::sphere: options.layout = EnvLayout::sphere; break;
-  }
+  options.layout = r.layout;
   options.z_up_3dsmax = r.z_up_3dsmax;
   options.face_size = r.resolution;
   return load_cube_map(file, options);

@@ -53,7 +53,7 @@ struct ReferenceLight {
 };
 
 /// The reference light of a Light component on an entity with this world matrix: direction from
-/// the matrix's -Z (as systems/shadow_map_system.cpp light_direction(); change together), right
+/// the matrix's -Z (light_direction(), components/light.h, as the shadow systems take it), right
 /// from its +X, position from its translation; a directional light's angular_size_deg from the
 /// component (an area light when > 0); a spot or point light's size = 2 Light::radius (a square
 /// emitter of side 2 radius; punctual when the radius is 0); an area light's size and height
