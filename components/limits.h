@@ -8,7 +8,7 @@ namespace kaskad {
 
 /// The largest |coordinate| or distance a file may give, scene units: beyond it float precision is
 /// meaningless (a metre step at 1e7 is below float's resolution).
-inline constexpr double kMaxCoordinate = 1.0e7;
+inline constexpr float kMaxCoordinate = 1.0e7f;
 /// Lights shaded per frame; further lights are left out (with a warning).
 inline constexpr int kMaxLights = 8;
 /// Cascades of one directional light (S0's N), and the most layers any shadow view has (a point

@@ -22,6 +22,7 @@ extern char** environ;
 
 #include "components/camera.h"
 #include "components/light.h"
+#include "components/limits.h"
 #include "components/name.h"
 #include "components/transform.h"
 #include "runtime/assets/image_io.h"
@@ -47,7 +48,6 @@ using namespace json_reader;
 
 constexpr int kFormatVersion = 1;
 constexpr int kMaxFrames = 1000000;
-constexpr float kBig = 1.0e7f;
 
 const std::vector<std::pair<const char*, Interpolation>> kInterpolations = {
     {"linear", Interpolation::linear}, {"catmull_rom", Interpolation::catmull_rom}};
@@ -107,11 +107,11 @@ Track read_track(const json& j, const std::string& where, bool camera) {
     glm::vec3 v;
     if (k.has("position") && k.has("move")) fail(at, "give only one of position and move");
     if (k.has("position")) {
-      k.vector<3>("position", v, -kBig, kBig);
+      k.vector<3>("position", v, -kMaxCoordinate, kMaxCoordinate);
       key.position = v;
     }
     if (k.has("move")) {
-      k.vector<3>("move", v, -kBig, kBig);
+      k.vector<3>("move", v, -kMaxCoordinate, kMaxCoordinate);
       key.position = v;
       if (i > 0 && !track.relative) fail(at + "/move", "a track's keys all use position or all move");
       track.relative = true;
@@ -121,7 +121,7 @@ Track read_track(const json& j, const std::string& where, bool camera) {
     if (k.has("look_at") && k.has("rotation")) fail(at, "give only one of look_at and rotation");
     if (k.has("look_at") && track.relative) fail(at + "/look_at", "look_at needs absolute positions");
     if (k.has("look_at")) {
-      k.vector<3>("look_at", v, -kBig, kBig);
+      k.vector<3>("look_at", v, -kMaxCoordinate, kMaxCoordinate);
       key.look_at = v;
       if (!key.position) fail(at + "/look_at", "look_at needs a position in the same key");
       if (glm::length(v - *key.position) < 1e-6f) fail(at + "/look_at", "looks at its own position");
@@ -134,7 +134,7 @@ Track read_track(const json& j, const std::string& where, bool camera) {
       key.rotation = glm::quat(q.w, q.x, q.y, q.z);
     }
     if (k.has("scale")) {
-      k.vector<3>("scale", v, -kBig, kBig);
+      k.vector<3>("scale", v, -kMaxCoordinate, kMaxCoordinate);
       key.scale = v;
     }
     if (k.has("fov_y_deg")) {

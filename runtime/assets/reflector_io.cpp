@@ -10,8 +10,6 @@ using json_reader::fail;
 using json_reader::type_name;
 using json_reader::vec;
 
-constexpr float kBig = float(kMaxCoordinate);
-
 }  // namespace
 
 void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
@@ -22,7 +20,7 @@ void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
       fail(r.at("center"), "expected [x, y, z] or \"auto\", got " + r.raw("center").dump());
     out.has_center = false;
   } else if (r.has("center")) {
-    r.vector<3>("center", out.center, -kBig, kBig);
+    r.vector<3>("center", out.center, -kMaxCoordinate, kMaxCoordinate);
     out.has_center = true;
   }
   if (r.has("exclude_layers")) {
@@ -46,8 +44,8 @@ void read_reflector(json_reader::ObjectReader& r, Reflector& out) {
   } else if (r.has("box")) {
     json_reader::ObjectReader br(r.raw("box"), r.at("box"));
     if (!br.has("min") || !br.has("max")) fail(r.at("box"), "a box needs min and max");
-    br.vector<3>("min", out.box_min, -kBig, kBig);
-    br.vector<3>("max", out.box_max, -kBig, kBig);
+    br.vector<3>("min", out.box_min, -kMaxCoordinate, kMaxCoordinate);
+    br.vector<3>("max", out.box_max, -kMaxCoordinate, kMaxCoordinate);
     br.finish();
     out.box_projection = true;
   }

@@ -47,11 +47,11 @@ void read_rotation(ObjectReader& r, Transform& t) {
     glm::vec3 dir;
     if (r.has("look_at")) {
       glm::vec3 target{0.0f};
-      r.vector<3>("look_at", target, -kBig, kBig);
+      r.vector<3>("look_at", target, -kMaxCoordinate, kMaxCoordinate);
       dir = target - t.translation;
     } else {
       dir = glm::vec3(0.0f);
-      r.vector<3>("direction", dir, -kBig, kBig);
+      r.vector<3>("direction", dir, -kMaxCoordinate, kMaxCoordinate);
     }
     const char* key = r.has("look_at") ? "look_at" : "direction";
     if (glm::length(dir) < 1e-6f) fail(r.at(key), "direction has zero length");
@@ -97,8 +97,8 @@ void read_render(ObjectReader& r, RenderSettings& s) {
 
 // One reader per component block, shared by scene files and --set on imported entities.
 void read_transform(ObjectReader& tr, Transform& t) {
-  tr.vector<3>("translation", t.translation, -kBig, kBig);
-  tr.vector<3>("scale", t.scale, -kBig, kBig);
+  tr.vector<3>("translation", t.translation, -kMaxCoordinate, kMaxCoordinate);
+  tr.vector<3>("scale", t.scale, -kMaxCoordinate, kMaxCoordinate);
   read_rotation(tr, t);
 }
 

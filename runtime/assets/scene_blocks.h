@@ -31,8 +31,6 @@ using json = nlohmann::json;
 using json_reader::ObjectReader;
 
 inline constexpr int kFormatVersion = 1;
-/// |coordinate| limit of positions and directions in files.
-inline constexpr float kBig = float(kMaxCoordinate);
 
 /// The ways of giving a transform's rotation; a block takes any one of them.
 inline constexpr std::array<const char*, 4> kRotationKeys = {"rotation", "euler_deg", "look_at",

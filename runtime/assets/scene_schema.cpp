@@ -177,9 +177,7 @@ json material_schema(const render::FeatureManifest& manifest) {
   json j = object(
       {{"$schema", text("This schema's address, for editors")},
        {"description", text("What the material is for")},
-       {"reflection_model", field_io::field_schema(fields::choice(
-                                "reflection_model", &Material::reflection_model,
-                                "How the material reflects its environment"))},
+       {"reflection_model", field_io::schema_properties<Material>()["reflection_model"]},
        {"features", {{"type", "array"},
                      {"uniqueItems", true},
                      {"items", {{"enum", features}}},

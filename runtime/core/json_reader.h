@@ -244,13 +244,6 @@ class ObjectReader {
   std::vector<std::string> known_;
 };
 
-template <class E, class Name>
-std::string enum_name(E value, const std::vector<std::pair<Name, E>>& table) {
-  for (const auto& [n, e] : table)
-    if (e == value) return n;
-  return "?";
-}
-
 /// "line L, column C" of the 1-based byte position `byte` (what nlohmann reports) in `text`.
 inline std::string line_column(const std::string& text, std::size_t byte) {
   std::size_t line = 1, col = 1;
