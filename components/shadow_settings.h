@@ -317,28 +317,7 @@ void for_each_shared_field(A& a, B& b, Visit&& visit) {
   });
 }
 
-/// Texels a lookup reaches from the point's texel: 1.5 for S4's 3x3 (and the single taps), N / 2
-/// for an N x N box, the disc's radius plus one (its taps filter linearly) for poisson, PCSS's
-/// largest radius plus one, and one for lom (its four neighbouring samples; the occlusion factors
-/// already hold the light's reach). Local lights keep this (plus the normal offset and one spare)
-/// free at their maps' edges; map_bounds selection likewise (ShadowView::filter_reach carries it
-/// to shadow.glsl's map_border()). vsm and evsm: the blur's half width plus one (the lookup
-/// filters linearly; its mip levels past 0 reach further, into texels the blur left clear).
-inline float filter_reach_texels(const ShadowSettings& s) {
-  if (s.technique == ShadowTechnique::lom) return 1.0f;
-  if (s.technique == ShadowTechnique::vsm || s.technique == ShadowTechnique::evsm)
-    return float(s.vsm_blur / 2) + 1.0f;
-  if (s.technique != ShadowTechnique::pcf) return float(kPcssMaxRadiusTexels) + 1.0f;
-  if (s.filter != ShadowFilter::pcf3x3) return 1.5f;
-  switch (s.pcf_kernel) {
-    case PcfKernel::k3x3: return 1.5f;
-    case PcfKernel::k5x5: return 2.5f;
-    case PcfKernel::k7x7: return 3.5f;
-    case PcfKernel::k9x9: return 4.5f;
-    case PcfKernel::poisson: return s.pcf_radius + 1.0f;
-  }
-  return 1.5f;
-}
+// filter_reach_texels(): components/shadow_technique.h, from the technique table.
 
 /// Empty string when valid, else a message naming the first bad value, e.g.
 /// "lambda must be in [0, 1], was 1.2": the table's ranges, then the rules across fields.

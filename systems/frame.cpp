@@ -8,6 +8,7 @@
 #include "components/material.h"
 #include "components/mesh_renderer.h"
 #include "components/model.h"
+#include "components/shadow_technique.h"
 #include "components/transform.h"
 #include "runtime/core/log.h"
 #include "systems/transform_system.h"
@@ -46,7 +47,9 @@ render::ShadowView shadow_view(const ShadowData& d, int light_index) {
                         : s.normal_offset_bias;
   v.blend_band = s.blend_band;
   v.paraboloid_margin = d.paraboloid_margin;
-  v.light_size = d.light_size;
+  // Only the techniques that read the light's size get it: for the others a light that grows
+  // changes neither the frame block nor what the visibility cache compares.
+  v.light_size = traits(s.technique).needs_light_size ? d.light_size : glm::vec2(0.0f);
   v.pcf_taps = s.pcf_taps;
   v.pcf_radius = s.pcf_radius;
   v.filter_reach = filter_reach_texels(s);

@@ -7,6 +7,7 @@
 #include "components/light.h"
 #include "components/mesh_renderer.h"
 #include "components/name.h"
+#include "components/shadow_technique.h"
 #include "components/transform.h"
 #include "runtime/core/log.h"
 #include "runtime/math/local_light_math.h"

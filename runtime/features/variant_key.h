@@ -332,7 +332,6 @@ class VariantKey {
   static constexpr Field kShadowLightsMinus1 = feature_field("shadow_lights");
   /// ShadowTechnique: 0 pcf, 1 pcss, 2 backprojection, 3 lom, 4 vsm, 5 evsm.
   static constexpr Field kShadowTechnique = feature_field("shadow_technique");
-  static constexpr std::uint32_t kTechniqueLom = 3, kTechniqueVsm = 4, kTechniqueEvsm = 5;
   /// Depth pass: peel a layer of S1's layered depth map.
   static constexpr Field kShadowPeel = feature_field("shadow_peel");
   /// PcfKernel: 0 3x3, 1 5x5, 2 7x7, 3 9x9, 4 poisson.

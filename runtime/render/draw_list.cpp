@@ -24,7 +24,7 @@ VariantKey frame_variant(const FrameInput& frame) {
     k.set(VariantKey::kShadowFilter, std::uint32_t(s.filter));
     k.set(VariantKey::kShadowTechnique, std::uint32_t(s.technique));
     // The kernel is pcf3x3's footprint; pcss filters with its own disc: one key for each.
-    if (s.filter == ShadowFilter::pcf3x3 && s.technique == ShadowTechnique::pcf)
+    if (s.filter == ShadowFilter::pcf3x3 && traits(s.technique).uses_pcf_kernel)
       k.set(VariantKey::kShadowKernel, std::uint32_t(s.pcf_kernel));
     k.set(VariantKey::kShadowProjection, std::uint32_t(first.projection));
     // Paraboloid hemispheres are projected in code, one pass each: no layered pass for them.
@@ -80,12 +80,14 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   // With the visibility cache, a still frame's programs (the shadow-receiving ones) load it.
   if (fk.get(VariantKey::kShadowReuse) == VariantKey::kReuseStore)
     main_fks.push_back(VariantKey(fk).set(VariantKey::kShadowReuse, VariantKey::kReuseLoad));
+  // The technique's own pass (none without shadows: the key then holds pcf).
+  const ShadowExtraPass extra_pass = shadow_technique_of(fk).extra_pass;
   std::vector<ProgramRequest> out;
   for (const DrawItem& d : frame.draws) {
     const VariantKey k = material_variant(d) | fk;
     for (const VariantKey main : main_fks)
       out.push_back({Pass::forward, (material_variant(d) | main).filtered_for(Pass::forward)});
-    if (fk.get(VariantKey::kShadowTechnique) == VariantKey::kTechniqueLom &&
+    if (extra_pass == ShadowExtraPass::lom_peeling &&
         (d.cast_shadows || d.receive_shadows)) {  // LomPass's peels
       const VariantKey peel =
           VariantKey(k).set(VariantKey::kShadowPeel, 1).set(VariantKey::kShadowLayered, 0);
@@ -116,10 +118,9 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
       if (!frame.probes.empty()) out.push_back({Pass::forward, (m | capture_fk).filtered_for(Pass::forward)});
     }
   }
-  if (fk.get(VariantKey::kShadowTechnique) == VariantKey::kTechniqueLom)
+  if (extra_pass == ShadowExtraPass::lom_peeling)
     out.push_back({Pass::lom_occlusion, fk.filtered_for(Pass::lom_occlusion)});
-  if (fk.get(VariantKey::kShadowTechnique) == VariantKey::kTechniqueVsm ||
-      fk.get(VariantKey::kShadowTechnique) == VariantKey::kTechniqueEvsm)
+  if (extra_pass == ShadowExtraPass::moments)
     out.push_back({Pass::vsm_moments, fk.filtered_for(Pass::vsm_moments)});
   auto less = [](const ProgramRequest& a, const ProgramRequest& b) {
     return std::pair(a.pass, a.key) < std::pair(b.pass, b.key);

@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "components/shadow_technique.h"
 #include "runtime/render/frame_input.h"
 #include "runtime/features/variant_key.h"
 
@@ -16,6 +17,18 @@ namespace kaskad::render {
 
 /// The frame features of a frame (shadow, filter, AOVs): the VARIANT_* part of every key.
 VariantKey frame_variant(const FrameInput& frame);
+/// The traits of the shadow technique of frame features `frame` (pcf's when it has no shadow).
+inline const ShadowTechniqueTraits& shadow_technique_of(VariantKey frame) {
+  return traits(ShadowTechnique(frame.get(VariantKey::kShadowTechnique)));
+}
+/// The name of technique `t` as files and the VARIANT_SHADOW_TECHNIQUE_* defines spell it.
+constexpr std::string_view technique_name(ShadowTechnique t) {
+  return kFeatureTable[feature_index("shadow_technique")].values[std::size_t(t)];
+}
+// The key's technique field names one value per row of the technique table.
+static_assert(kFeatureTable[feature_index("shadow_technique")].value_count() ==
+                  int(kShadowTechniqueCount),
+              "the shadow_technique feature needs one value per ShadowTechnique");
 /// The frame features of a probe capture of a frame with features `frame`: no AOVs, and cascades
 /// selected by map bounds. S0's view-depth selection measures the main camera's depth, which
 /// says nothing about a point behind it or beside it that a probe face sees: that point would

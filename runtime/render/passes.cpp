@@ -336,7 +336,7 @@ bool lookups_can_wrap(const VariantKey& frame_key) {
   const bool wide = frame_key.get(VariantKey::kShadowFilter) == 2 &&
                     frame_key.get(VariantKey::kShadowKernel) != 0;
   return frame_key.get(VariantKey::kCascadeSelection) == 0 &&
-         frame_key.get(VariantKey::kShadowTechnique) == 0 && !wide;
+         shadow_technique_of(frame_key).may_wrap && !wide;
 }
 
 // The texture rectangles of map rectangle `r` in a layer whose texture holds map texel x at
@@ -945,7 +945,8 @@ Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const Sha
   stats.lom_overflow_texels = 0;
   redraw_ = 0;
   const std::vector<ShadowView>& views = frame.shadow_views;
-  if (views.empty() || frame.shadow_map.technique != ShadowTechnique::lom) return {};
+  if (views.empty() || traits(frame.shadow_map.technique).extra_pass != ShadowExtraPass::lom_peeling)
+    return {};
   const int size = frame.shadow_map.size;
   const int total = views.back().first_layer + views.back().layer_count;
   const int peels = frame.shadow_map.lom_layers + 1;
@@ -1009,7 +1010,9 @@ Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const Sha
 
 Status LomPass::record(const FrameInput& frame, const DrawList& list, GpuCache& cache,
                        DrawState& state, FrameStats& stats) {
-  if (frame.shadow_views.empty() || frame.shadow_map.technique != ShadowTechnique::lom) return {};
+  if (frame.shadow_views.empty() ||
+      traits(frame.shadow_map.technique).extra_pass != ShadowExtraPass::lom_peeling)
+    return {};
   const int peels = peels_;
   Status status;
   std::vector<InstanceRecord> records;
@@ -1135,14 +1138,6 @@ Image LomPass::read_first_factors() const {
 
 // ---- MomentsPass ---------------------------------------------------------------------------------
 
-namespace {
-
-bool moments_technique(ShadowTechnique t) {
-  return t == ShadowTechnique::vsm || t == ShadowTechnique::evsm;
-}
-
-}  // namespace
-
 void MomentsPass::ensure_storage(int size, int layers, bool four) {
   if (moments_ && size == size_ && layers == layers_ && four == four_) return;
   size_ = size;
@@ -1178,10 +1173,11 @@ Status MomentsPass::prepare(const FrameInput& frame, const ShadowMapPass& shadow
   stats.vsm_layers_computed = 0;
   redraw_ = 0;
   const std::vector<ShadowView>& views = frame.shadow_views;
-  if (views.empty() || !moments_technique(frame.shadow_map.technique)) return {};
+  const ShadowTechniqueTraits& technique = traits(frame.shadow_map.technique);
+  if (views.empty() || technique.extra_pass != ShadowExtraPass::moments) return {};
   const int size = frame.shadow_map.size;
   const int total = views.back().first_layer + views.back().layer_count;
-  const bool four = frame.shadow_map.technique == ShadowTechnique::evsm;
+  const bool four = technique.moment_channels == 4;
   if (!moments_ || size != size_ || total != layers_ || four != four_) {
     const GLenum format = four ? GL_RGBA32F : GL_RG32F;
     glTexImage3D(GL_PROXY_TEXTURE_2D_ARRAY, 0, GLint(format), size, size, total, 0,
@@ -1192,8 +1188,8 @@ Status MomentsPass::prepare(const FrameInput& frame, const ShadowMapPass& shadow
       const double mib = double(size) * size * total * (four ? 16.0 : 8.0) * 4.0 / 3.0 /
                          double(1 << 20);
       return Error{"", "shadow.technique",
-                   std::string("the OpenGL driver refuses the ") + (four ? "evsm" : "vsm") +
-                       " moments (" + std::to_string(total) + " layers of " +
+                   "the OpenGL driver refuses the " +
+                       std::string(technique_name(frame.shadow_map.technique)) + " moments (" + std::to_string(total) + " layers of " +
                        std::to_string(size) + "^2 with mipmaps, " + std::to_string(int(mib)) +
                        " MiB); use a smaller map_size or fewer cascades"};
     }

@@ -298,9 +298,9 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   Status st = im.shadow.record(frame, list, *im.cache, state, stats_);
   im.timers.end(TimedPart::shadow_depth);
   // S1's layered occlusion map (technique lom) from those layers.
-  const std::uint32_t technique = list.frame_key.get(VariantKey::kShadowTechnique);
-  const bool lom = technique == VariantKey::kTechniqueLom;
-  const bool moments = technique == VariantKey::kTechniqueVsm || technique == VariantKey::kTechniqueEvsm;
+  const ShadowExtraPass extra_pass = shadow_technique_of(list.frame_key).extra_pass;
+  const bool lom = extra_pass == ShadowExtraPass::lom_peeling;
+  const bool moments = extra_pass == ShadowExtraPass::moments;
   if (lom) im.timers.begin(TimedPart::lom);
   if (st) st = im.lom.prepare(frame, list, im.shadow, stats_);
   if (st) st = im.lom.record(frame, list, *im.cache, state, stats_);
@@ -576,9 +576,9 @@ Image Renderer::read_lom_factors() const { return impl_->lom.read_factors(); }
 Image Renderer::read_soft_shadow_maps() const {
   const Impl& im = *impl_;
   if (!im.frame_key || !im.frame_key->has(VariantKey::kShadow)) return {};
-  const std::uint32_t technique = im.frame_key->get(VariantKey::kShadowTechnique);
-  if (technique == VariantKey::kTechniqueLom) return im.lom.read_first_factors();
-  if (technique != VariantKey::kTechniqueVsm && technique != VariantKey::kTechniqueEvsm) return {};
+  const ShadowExtraPass extra_pass = shadow_technique_of(*im.frame_key).extra_pass;
+  if (extra_pass == ShadowExtraPass::lom_peeling) return im.lom.read_first_factors();
+  if (extra_pass != ShadowExtraPass::moments) return {};
   const Image moments = im.moments.read();
   if (moments.pixels.empty()) return {};
   Image first;
