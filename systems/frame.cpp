@@ -99,11 +99,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.multi_draw = scene.render.multi_draw;
   in.visibility_cache = scene.render.visibility_cache;
   if (!shadows.empty()) {
-    const ShadowSettings& s = shadows.front().settings;  // shared by every view (ShadowData)
-    in.shadow_map = {s.map_size,   s.depth_format, s.filter,
-                     s.technique,  s.pcf_kernel,   s.lom_layers,
-                     s.vsm_blur,   s.vsm_bleed_reduction, s.selection,
-                     s.layered,    s.debug_cascades};
+    in.shadow_settings = shadows.front().settings;  // its shared fields are every view's
     in.aov_shadow_view = aov_shadow_index(scene, shadows.size());
   }
 

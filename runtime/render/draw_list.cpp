@@ -16,7 +16,7 @@ namespace kaskad::render {
 VariantKey frame_variant(const FrameInput& frame) {
   VariantKey k;
   if (!frame.shadow_views.empty()) {
-    const ShadowMapSettings& s = frame.shadow_map;
+    const ShadowSettings& s = frame.shadow_settings;
     const ShadowView& first = frame.shadow_views.front();
     const int views = std::min<int>(int(frame.shadow_views.size()), kMaxShadowedLights);
     k.set(VariantKey::kShadow, 1);

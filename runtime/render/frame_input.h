@@ -157,23 +157,6 @@ struct ShadowView {
   CullMode cull = CullMode::back;
 };
 
-/// The shadow map array and the shadow features shared by every view (the first shadowed
-/// light's settings; see ShadowData::settings).
-struct ShadowMapSettings {
-  int size = ShadowSettings{}.map_size;
-  DepthFormat format = ShadowSettings{}.depth_format;
-  ShadowFilter filter = ShadowSettings{}.filter;
-  ShadowTechnique technique = ShadowSettings{}.technique;
-  PcfKernel pcf_kernel = ShadowSettings{}.pcf_kernel;
-  int lom_layers = ShadowSettings{}.lom_layers;  ///< technique lom: depth layers per map layer
-  int vsm_blur = ShadowSettings{}.vsm_blur;  ///< technique vsm/evsm: blur side, texels (MomentsPass)
-  /// technique vsm/evsm: light-bleeding reduction (shadow.glsl's vsm())
-  float vsm_bleed_reduction = ShadowSettings{}.vsm_bleed_reduction;
-  CascadeSelection selection = ShadowSettings{}.selection;
-  bool layered = ShadowSettings{}.layered;  ///< all of a view's layers in one instanced pass
-  bool debug_cascades = ShadowSettings{}.debug_cascades;
-};
-
 struct FrameInput {
   int width = 1280;
   int height = 720;
@@ -182,7 +165,10 @@ struct FrameInput {
   std::vector<LightItem> lights;  ///< at most kMaxLights are shaded
   /// One per shadowed light, at most kMaxShadowedLights; empty: no shadow pass.
   std::vector<ShadowView> shadow_views;
-  ShadowMapSettings shadow_map;
+  /// The first shadowed light's settings: the shadow map array and the shadow features every
+  /// view shares (for_each_shared_field(); ShadowData::settings). The passes read those fields
+  /// only; a view's own values are in its ShadowView.
+  ShadowSettings shadow_settings;
   /// The view whose visibility and cascade the AOV shows (an index into shadow_views).
   int aov_shadow_view = 0;
   std::vector<ProbeJob> probes;

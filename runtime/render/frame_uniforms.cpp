@@ -71,13 +71,13 @@ FrameBlock pack_frame_block(const FrameInput& frame) {
     fb.environment = glm::vec4(frame.environment_intensity,
                                float(ibl_specular_levels(frame.environment->size) - 1), 0.0f, 0.0f);
   for (std::size_t i = 0; i < 9; ++i) fb.environment_sh[i] = glm::vec4(frame.environment_sh[i], 0.0f);
-  fb.frame_params = glm::vec4(frame.exposure, float(frame.shadow_map.size),
-                              float(frame.shadow_map.lom_layers),
-                              frame.shadow_map.vsm_bleed_reduction);
+  fb.frame_params = glm::vec4(frame.exposure, float(frame.shadow_settings.map_size),
+                              float(frame.shadow_settings.lom_layers),
+                              frame.shadow_settings.vsm_bleed_reduction);
   const int lights = shaded_lights(frame);
   const int views = int(frame.shadow_views.size());
   fb.counts =
-      glm::ivec4(lights, views, views > 0 ? frame.aov_shadow_view : -1, frame.shadow_map.vsm_blur);
+      glm::ivec4(lights, views, views > 0 ? frame.aov_shadow_view : -1, frame.shadow_settings.vsm_blur);
   for (int i = 0; i < lights; ++i) {
     const LightItem& l = frame.lights[std::size_t(i)];
     fb.light_color[i] = glm::vec4(l.color, 0.0f);

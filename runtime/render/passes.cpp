@@ -367,7 +367,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
                               const AssetStore& assets, bool layered, bool features_by_uniform,
                               int shader_reloads, FrameStats& stats) {
   const std::vector<ShadowView>& views = frame.shadow_views;
-  const ShadowMapSettings& map = frame.shadow_map;
+  const ShadowSettings& map = frame.shadow_settings;
   const int total = views.empty() ? 0 : views.back().first_layer + views.back().layer_count;
   stats.layer_casters.fill(0);
   stats.layer_triangles.fill(0);
@@ -386,9 +386,9 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   if (views.empty()) return {};
   // A shadow map array the driver refuses (llvmpipe: over 1 GiB, e.g. 16384^2 x 4 cascades) is
   // an error before any pass starts, not a string of GL errors.
-  if (!fbo_ || map.size != size_ || total != layers_ || map.format != format_)
-    KASKAD_TRY(check_shadow_map_size(map.size, total, map.format));
-  ensure_storage(map.size, total, map.format, map.filter);
+  if (!fbo_ || map.map_size != size_ || total != layers_ || map.depth_format != format_)
+    KASKAD_TRY(check_shadow_map_size(map.map_size, total, map.depth_format));
+  ensure_storage(map.map_size, total, map.depth_format, map.filter);
 
   // A layer's inputs: its matrix (and paraboloid data), bias and culling, pass mode, and the
   // casters (mesh, model matrix, depth program, alpha-mask parameters) in order. A moved caster
@@ -472,7 +472,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
         joined.push_back(id);
     }
     if (joined.empty()) return false;
-    const glm::vec4 ndc = drawn_ndc(kept, map.size);
+    const glm::vec4 ndc = drawn_ndc(kept, map.map_size);
     for (std::uint32_t i : list.depth_order) {
       const DrawItem& d = frame.draws[i];
       if (!(caster_mask(v, d) & (1u << c)) ||
@@ -498,7 +498,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   inputs_.assign(std::size_t(total), 0);
   fixed_.assign(std::size_t(total), 0);
   casters_.assign(std::size_t(total), {});
-  rects_.assign(std::size_t(total), glm::ivec4(0, 0, map.size, map.size));
+  rects_.assign(std::size_t(total), glm::ivec4(0, 0, map.map_size, map.map_size));
   pieces_.assign(std::size_t(total), {});
   std::uint32_t drawn_now = 0;  // layers with texels to draw
   for (std::size_t view = 0; view < views.size(); ++view) {
@@ -513,7 +513,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
       const std::size_t layer = std::size_t(v.first_layer + c);
       const bool skipped = v.skipped[std::size_t(c)];
       inputs_[layer] = layer_inputs(view, c);
-      if (!whole && !skipped) rects_[layer] = texel_rect(v.read_rect[std::size_t(c)], map.size);
+      if (!whole && !skipped) rects_[layer] = texel_rect(v.read_rect[std::size_t(c)], map.map_size);
       const bool drawn = drawn_from_[layer] != 0 && holds(drawn_rect_[layer], rects_[layer]);
       const bool held = ((v.held >> c) & 1u) != 0;
       const bool keep =
@@ -526,7 +526,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
           fixed_[layer] = fixed_inputs(view, c, casters);
           layer_casters(v, c, casters_[layer]);
         }
-        add_pieces(rects_[layer], origin_[layer], map.size, pieces);
+        add_pieces(rects_[layer], origin_[layer], map.map_size, pieces);
         redraw_ |= 1u << layer;
         drawn_now |= 1u << layer;
         continue;
@@ -537,15 +537,15 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
       std::vector<glm::ivec4> regions{rects_[layer]};
       glm::ivec2 shift(0);
       if (drawn_from_[layer] != 0 && drawn_fixed_[layer] == fixed_[layer] &&
-          moved_by_texels(drawn_matrix_[layer], v.view_proj[std::size_t(c)], map.size, shift)) {
-        const glm::ivec4 kept = shifted(drawn_rect_[layer], shift, map.size);
+          moved_by_texels(drawn_matrix_[layer], v.view_proj[std::size_t(c)], map.map_size, shift)) {
+        const glm::ivec4 kept = shifted(drawn_rect_[layer], shift, map.map_size);
         if (!newcomer_over(v, c, layer, kept, casters_[layer])) {
-          origin_[layer] = ((origin_[layer] - shift) % map.size + map.size) % map.size;
+          origin_[layer] = ((origin_[layer] - shift) % map.map_size + map.map_size) % map.map_size;
           regions = outside(rects_[layer], kept);
           stats.shadow_layers_scrolled |= 1u << layer;
         }
       }
-      for (const glm::ivec4& r : regions) add_pieces(r, origin_[layer], map.size, pieces);
+      for (const glm::ivec4& r : regions) add_pieces(r, origin_[layer], map.map_size, pieces);
       redraw_ |= 1u << layer;
       if (!pieces.empty()) drawn_now |= 1u << layer;
     }
@@ -554,7 +554,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   if (layered && redraw_ != 0) redraw_ = drawn_now = ~0u >> (32 - total);  // total <= 32
   stats.shadow_layers_rendered = drawn_now;
   if (layered) {
-    stats.shadow_texels_drawn = std::int64_t(std::popcount(drawn_now)) * map.size * map.size;
+    stats.shadow_texels_drawn = std::int64_t(std::popcount(drawn_now)) * map.map_size * map.map_size;
   } else {
     for (const std::vector<Piece>& pieces : pieces_)
       for (const Piece& p : pieces)
@@ -945,11 +945,11 @@ Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const Sha
   stats.lom_overflow_texels = 0;
   redraw_ = 0;
   const std::vector<ShadowView>& views = frame.shadow_views;
-  if (views.empty() || traits(frame.shadow_map.technique).extra_pass != ShadowExtraPass::lom_peeling)
+  if (views.empty() || traits(frame.shadow_settings.technique).extra_pass != ShadowExtraPass::lom_peeling)
     return {};
-  const int size = frame.shadow_map.size;
+  const int size = frame.shadow_settings.map_size;
   const int total = views.back().first_layer + views.back().layer_count;
-  const int peels = frame.shadow_map.lom_layers + 1;
+  const int peels = frame.shadow_settings.lom_layers + 1;
   const int slices = total * peels;
   if (!depth_ || size != size_ || slices != slices_ || peels != peels_) {
     GLint max_layers = 0;
@@ -1011,7 +1011,7 @@ Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const Sha
 Status LomPass::record(const FrameInput& frame, const DrawList& list, GpuCache& cache,
                        DrawState& state, FrameStats& stats) {
   if (frame.shadow_views.empty() ||
-      traits(frame.shadow_map.technique).extra_pass != ShadowExtraPass::lom_peeling)
+      traits(frame.shadow_settings.technique).extra_pass != ShadowExtraPass::lom_peeling)
     return {};
   const int peels = peels_;
   Status status;
@@ -1173,9 +1173,9 @@ Status MomentsPass::prepare(const FrameInput& frame, const ShadowMapPass& shadow
   stats.vsm_layers_computed = 0;
   redraw_ = 0;
   const std::vector<ShadowView>& views = frame.shadow_views;
-  const ShadowTechniqueTraits& technique = traits(frame.shadow_map.technique);
+  const ShadowTechniqueTraits& technique = traits(frame.shadow_settings.technique);
   if (views.empty() || technique.extra_pass != ShadowExtraPass::moments) return {};
-  const int size = frame.shadow_map.size;
+  const int size = frame.shadow_settings.map_size;
   const int total = views.back().first_layer + views.back().layer_count;
   const bool four = technique.moment_channels == 4;
   if (!moments_ || size != size_ || total != layers_ || four != four_) {
@@ -1189,7 +1189,7 @@ Status MomentsPass::prepare(const FrameInput& frame, const ShadowMapPass& shadow
                          double(1 << 20);
       return Error{"", "shadow.technique",
                    "the OpenGL driver refuses the " +
-                       std::string(technique_name(frame.shadow_map.technique)) + " moments (" + std::to_string(total) + " layers of " +
+                       std::string(technique_name(frame.shadow_settings.technique)) + " moments (" + std::to_string(total) + " layers of " +
                        std::to_string(size) + "^2 with mipmaps, " + std::to_string(int(mib)) +
                        " MiB); use a smaller map_size or fewer cascades"};
     }
@@ -1202,7 +1202,7 @@ Status MomentsPass::prepare(const FrameInput& frame, const ShadowMapPass& shadow
       const int layer = v.first_layer + c;
       rects_[std::size_t(layer)] = stats.layer_rect[std::size_t(layer)];
       InputHash h;
-      h.add(shadow.layer_inputs(layer)).add(frame.shadow_map.vsm_blur).add(four);
+      h.add(shadow.layer_inputs(layer)).add(frame.shadow_settings.vsm_blur).add(four);
       inputs_[std::size_t(layer)] = h.value();
       const glm::ivec4 rect = stats.layer_rect[std::size_t(layer)];
       const bool drawn = drawn_from_[std::size_t(layer)] != 0 &&
@@ -1231,7 +1231,7 @@ Status MomentsPass::record(const FrameInput& frame, const DrawList& list, Shadow
   glBindVertexArray(empty_vao_.id());
   glBindTextureUnit(kTexVsmSource, along_x_.id());
   glBindSampler(kTexVsmSource, 0);
-  const int side = frame.shadow_map.vsm_blur;
+  const int side = frame.shadow_settings.vsm_blur;
   for (std::size_t view = 0; view < frame.shadow_views.size(); ++view) {
     const ShadowView& v = frame.shadow_views[view];
     for (int c = 0; c < v.layer_count; ++c) {

@@ -405,8 +405,8 @@ TEST(FrameUniforms, PackPutsEveryViewAndLightInItsPlace) {
   frame.lights.resize(3);
   frame.lights[2].type = LightType::spot;
   frame.exposure = 2.5f;
-  frame.shadow_map.vsm_bleed_reduction = 0.3f;
-  frame.shadow_map.vsm_blur = 7;
+  frame.shadow_settings.vsm_bleed_reduction = 0.3f;
+  frame.shadow_settings.vsm_blur = 7;
   frame.height = 200;
   frame.camera.proj = glm::perspective(glm::radians(90.0f), 2.0f, 0.1f, 100.0f);
   ShadowView a;
