@@ -15,7 +15,7 @@
 #include "components/probe_state.h"
 #include "components/reflector.h"
 #include "runtime/ecs/world.h"
-#include "runtime/render/renderer.h"
+#include "runtime/render/frame_input.h"
 
 namespace kaskad {
 

@@ -330,7 +330,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   stats_.msaa_samples = im.forward.samples();
   //    A storing frame writes its visibility only when it sees what the frame before saw, so
   //    that the frames of a moving camera, which no frame could read back, do not pay for it
-  //    (about 3% of the default scene's moving frame on llvmpipe): a camera that stops looks up
+  //    (docs/design/shadow_cost.md, "Visibility cache"): a camera that stops looks up
   //    twice, stores on the second frame and reads back from the third.
   std::uint32_t reuse = list.frame_key.get(VariantKey::kShadowReuse);
   const std::uint64_t stored = std::exchange(im.stored_visibility, 0);

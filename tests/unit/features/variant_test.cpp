@@ -112,8 +112,9 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
           .set(VariantKey::kShadowProjection, 3)
           .set(VariantKey::kShadowTechnique, 1)
           .set(VariantKey::kShadowKernel, 4)};
-  // shadow_reuse's two bits are left out of the subsets (4x the time otherwise) and tried in
-  // each of their values on every valid frame key: its only rule is that it needs shadow.
+  // shadow_reuse's two bits are left out of the subsets (they would make four times as many)
+  // and tried in each of their values on every valid frame key: its only rule is that it needs
+  // shadow.
   const std::uint64_t reuse = VariantKey::kShadowReuse.mask();
   const std::uint64_t enumerated = frame_used & ~reuse;
   int valid_frames = 0, valid_materials = 0, valid_reuse = 0;
@@ -258,7 +259,7 @@ TEST(ShaderConstants, LimitsAreDefinedFromTheOneCppDefinition) {
 }
 
 // The number of shadow views is a frame feature: a frame compiles the lookups of the views it
-// shades and no others (issue 13: dormant extra-light code cost a quarter of the frame).
+// shades and no others (dormant extra-light code is not free: docs/design/shadow_cost.md).
 TEST(FrameVariant, ShadowLightsCountsTheShadowViews) {
   const FeatureManifest m = manifest();
   const Feature& lights = *m.find("shadow_lights");
