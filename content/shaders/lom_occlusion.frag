@@ -1,7 +1,7 @@
 // S1 pass 1, second half (Xu 2016, "Layered occlusion map soft shadows"): the occlusion factor of
 // every point stored in peel j of one shadow-map layer, i.e. the fraction of the light that the
 // scene hides from it. One fullscreen draw per peel into that peel's slice of the occlusion map
-// (LomPass). Reads the peeled depths (shadow.glsl's u_lom_depth).
+// (LomPass). Reads the peeled depths (shadow_lom.glsl's u_lom_depth).
 //
 // For a stored point P (texel t, depth z_P, distance d from the light):
 //  1. The nearest occluder: the smallest depth of peel 0 (nearest the light) in front of P over
@@ -18,11 +18,11 @@
 //                                      of the map, as if P were infinitely far;
 //       (2)  w_k = z' (d - z) / d      the kernel width for P at d.
 //     n r / w is 1 / view_texel (texels per tangent unit at 1 m), so w_k / 2 is pcss_radius()
-//     with d_b = z (shadow.glsl). Ortho (a directional light): l = 2 tan(theta / 2) and
+//     with d_b = z (shadow_pcss.glsl). Ortho (a directional light): l = 2 tan(theta / 2) and
 //     w_k = l (d - z) / texel, the limit of (2) with the light at infinity.
 //  3. Every stored point in the kernel in front of P, in any peel, is a micro-occluder (a square
 //     as wide as its kernel cell at its depth), back-projected from P onto the light as in
-//     backprojection() (shadow.glsl). S1 counts only the occluder nearest P: overlapping
+//     backprojection() (shadow_pcss.glsl). S1 counts only the occluder nearest P: overlapping
 //     projections must not be summed (plain backprojection's over-darkening). Here the light is
 //     64 sample points (a 64-bit mask, light_cells()), and a sample is blocked when the
 //     projection of some micro-occluder covers it: each part of the light counts once,
@@ -140,11 +140,12 @@ vec2 surface_slope(ivec2 s, int layer, int m, float z, float size) {
 // from P, a cell `step` texels wide) hides from P at distance d_r: the line from P through a
 // point of it reaches the light plane at (texels from P) x f, f = texel d_r d_b / (d_r - d_b)
 // (perspective, texel in tangent units, light plane at distance 0) or texel / (d_r - d_b) in
-// tangent units (ortho), d_b its distance, as backprojection() (shadow.glsl). Each of its edges
-// is projected at the distance the stored surface has there (surface_slope(), steeper than 8
-// texels per texel taken as an edge, as receiver_slope()), so the projections of neighbouring
-// cells of one surface meet on the light: no gaps for light to leak through between cells at
-// different depths (backprojection's gaps, which Guennebaud et al. fill with a separate step).
+// tangent units (ortho), d_b its distance, as backprojection() (shadow_pcss.glsl). Each of its
+// edges is projected at the distance the stored surface has there (surface_slope(), steeper
+// than 8 texels per texel taken as an edge, as receiver_slope()), so the projections of
+// neighbouring cells of one surface meet on the light: no gaps for light to leak through
+// between cells at different depths (backprojection's gaps, which Guennebaud et al. fill with a
+// separate step).
 uvec2 micro_occluder(PcssMap map, ivec2 s, int layer, int m, float z, vec2 offset, float step,
                      float d_r, vec2 half_light, float size) {
   float d_b = pcss_distance(map, z);

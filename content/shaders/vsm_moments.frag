@@ -1,4 +1,4 @@
-// The moments of variance shadow maps (MomentsPass; shadow.glsl's vsm()): one layer of the
+// The moments of variance shadow maps (MomentsPass; shadow_moments.glsl's vsm()): one layer of the
 // shadow map array into its moments, blurred by a separable Gaussian of vsm_blur texels. Two
 // fullscreen draws per layer:
 //  step 0: the moments vsm_warp(vsm_depth(z)) of each depth texel, blurred along x, into a 2D

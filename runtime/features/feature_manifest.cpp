@@ -4,6 +4,7 @@
 #include <cctype>
 
 #include "components/limits.h"
+#include "components/shadow_technique.h"
 #include "runtime/features/shader_interface.h"
 #include "runtime/core/json_reader.h"
 
@@ -173,6 +174,13 @@ std::vector<std::pair<std::string, std::string>> FeatureManifest::defines(Varian
     for (auto& c : upper) c = char(std::toupper(static_cast<unsigned char>(c)));
     out.emplace_back("BIT_" + upper, std::to_string(f.field.offset));
   }
+  // What the shadow technique's lookup files switch on (shadow_filter.glsl), from its row of
+  // the technique table, so that no shader lists techniques by name.
+  const std::uint32_t t = key.get(VariantKey::kShadowTechnique);
+  const ShadowTechniqueTraits& technique =
+      traits(t < kShadowTechniqueCount ? ShadowTechnique(t) : ShadowTechnique::pcf);
+  out.emplace_back("TECHNIQUE_NEEDS_LIGHT_SIZE", technique.needs_light_size ? "1" : "0");
+  out.emplace_back("TECHNIQUE_MOMENT_CHANNELS", std::to_string(technique.moment_channels));
   // The limits that size the frame block (common.glsl), from their one definition.
   out.emplace_back("MAX_LIGHTS", std::to_string(kMaxLights));
   out.emplace_back("MAX_CASCADES", std::to_string(kMaxCascades));

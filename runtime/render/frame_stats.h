@@ -64,7 +64,7 @@ struct FrameStats {
   /// ShadowTechnique::lom: shadow-map layers whose peels and occlusion factors were recomputed
   /// this frame (bit l, as shadow_layers_rendered), and texels, over all layers, where the
   /// depth peels found more light-facing surfaces than lom_layers (a point under all of them
-  /// reads as umbra; shadow.glsl's lom()).
+  /// reads as umbra; shadow_lom.glsl's lom()).
   std::uint32_t lom_layers_computed = 0;
   std::int64_t lom_overflow_texels = 0;
   /// ShadowTechnique::vsm/evsm: shadow-map layers whose moments were recomputed this frame (bit

@@ -99,7 +99,7 @@ FrameBlock probe_face_block(const FrameBlock& main, const ProbeJob& job, int fac
   fb.view_proj = job.view_proj[std::size_t(face)];
   // A 90-degree face: 2 tan(45 deg) / resolution metres per pixel at 1 m. A face's depth is not
   // the main view's (u_view stays the main camera's), so negated as for an ortho camera: the
-  // lookup's footprint then uses the distance from u_camera_pos (shadow.glsl's pixel_footprint()).
+  // lookup's footprint then uses the distance from u_camera_pos (shadow_moments.glsl's pixel_footprint()).
   fb.camera_pos = glm::vec4(job.center, -2.0f / float(std::max(job.resolution, 1)));
   fb.frame_params.x = 1.0f;
   return fb;

@@ -20,8 +20,9 @@ namespace kaskad::render {
 ///  a. lom_layers depth peels from the light (one scene render each, plus an overflow peel that
 ///     finds what did not fit), casters and the receivers in the layer's frustum;
 ///  b. the occlusion factor of every stored point (content/shaders/lom_occlusion.frag).
-/// Pass 2 is the lookup in shadow.glsl's lom(). A layer is recomputed when the shadow pass redraws
-/// it or when what else it depends on changed (receivers that cast nothing, light size, layers).
+/// Pass 2 is the lookup in shadow_lom.glsl's lom(). A layer is recomputed when the shadow pass
+/// redraws it or when what else it depends on changed (receivers that cast nothing, light size,
+/// layers).
 class LomPass {
  public:
   /// Sizes the peel and occlusion arrays (an error, before drawing, when the driver refuses

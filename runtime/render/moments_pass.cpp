@@ -33,7 +33,7 @@ void MomentsPass::ensure_storage(int size, int layers, bool four) {
     glSamplerParameteri(filtered_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glSamplerParameteri(filtered_.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glSamplerParameteri(filtered_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    // Trilinear only: moments_filtered() (shadow.glsl) filters anisotropically along
+    // Trilinear only: moments_filtered() (shadow_moments.glsl) filters anisotropically along
     // the footprint itself; the sampler's own anisotropy is slow on llvmpipe and less accurate
     // (measured: docs/design/soft_shadows.md).
     empty_vao_ = gpu::make_vertex_array();

@@ -18,9 +18,9 @@ namespace kaskad::render {
 /// The moments of variance shadow maps (ShadowTechnique vsm: Donnelly, Lauritzen 2006; evsm:
 /// Lauritzen, McCool 2008), after the shadow maps: for every layer of every perspective or
 /// ortho shadow view that the shadow pass redrew, the moments of each texel's linear depth
-/// (shadow.glsl's vsm_warp()), blurred by a separable Gaussian of vsm_blur texels (one draw
+/// (shadow_moments.glsl's vsm_warp()), blurred by a separable Gaussian of vsm_blur texels (one draw
 /// along x from the depth, one along y into the layer), then mipmaps for every layer. The
-/// lookup is shadow.glsl's vsm(). Format: RGBA32F for evsm (four moments; e^(2 * 40) of the
+/// lookup is shadow_moments.glsl's vsm(). Format: RGBA32F for evsm (four moments; e^(2 * 40) of the
 /// positive warp's second moment is far past half floats' 65504), RG32F for vsm (two moments;
 /// half floats' 11-bit mantissa cannot hold E[z^2] - E[z]^2 of depths that differ by less than
 /// about 1e-3, so the variance of a flat receiver would be noise).

@@ -293,7 +293,7 @@ TEST_F(PermutationTest, HotReloadOfTheShadowCodeShowsUnderAStillCamera) {
   EXPECT_TRUE(r->stats().visibility_reused);  // still: read back, every layer kept
   EXPECT_EQ(r->stats().shadow_layers_rendered, 0u);
   // Edit the lookup: no shadows at all.
-  ASSERT_TRUE(replace_in(dir / "shadow.glsl", "  return sum / 9.0;", "  return 1.0;", 4));
+  ASSERT_TRUE(replace_in(dir / "shadow_filter.glsl", "  return sum / 9.0;", "  return 1.0;", 4));
   EXPECT_TRUE(r->shaders().reload_changed().empty());
   const Image after = render(*r, s);
   EXPECT_FALSE(r->stats().visibility_reused);

@@ -98,8 +98,13 @@ std::vector<float> draw_lookup(const std::string& dir_name, const std::string& f
   const fs::path shaders = fs::path(KASKAD_CONTENT_DIR) / "shaders";
   const fs::path dir = testing_util::test_tmp(dir_name);
   fs::create_directories(dir);
-  for (const char* f : {"common.glsl", "features.glsl", "shadow.glsl", "fullscreen.vert"})
-    fs::copy_file(shaders / f, dir / f, fs::copy_options::overwrite_existing);
+  // The lookup's files: common.glsl, features.glsl, shadow.glsl and the filter files it includes.
+  for (const auto& entry : fs::directory_iterator(shaders))
+    if (entry.path().extension() == ".glsl")
+      fs::copy_file(entry.path(), dir / entry.path().filename(),
+                    fs::copy_options::overwrite_existing);
+  fs::copy_file(shaders / "fullscreen.vert", dir / "fullscreen.vert",
+                fs::copy_options::overwrite_existing);
   std::ofstream(dir / "test.frag") << frag;
 
   auto manifest = render::FeatureManifest::load(shaders / "features.json");

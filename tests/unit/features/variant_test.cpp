@@ -199,6 +199,17 @@ TEST(VariantKey, DefinesComeFromOneFunctionForBothKinds) {
   EXPECT_EQ(value("VARIANT_CASCADE_COUNT"), "4");
   EXPECT_EQ(m.describe(k), "normal_map shadow shadow_filter=pcf3x3 cascade_count=4");
   EXPECT_EQ(value("BIT_NORMAL_MAP"), "1");
+  // The technique's traits the lookup files switch on, from the technique table.
+  EXPECT_EQ(value("TECHNIQUE_NEEDS_LIGHT_SIZE"), "0");
+  EXPECT_EQ(value("TECHNIQUE_MOMENT_CHANNELS"), "0");
+  const auto evsm = m.defines(m.with(k, *m.find("shadow_technique"), 5), ShaderStage::fragment);
+  const auto pcss = m.defines(m.with(k, *m.find("shadow_technique"), 1), ShaderStage::fragment);
+  EXPECT_NE(std::find(evsm.begin(), evsm.end(), std::pair<std::string, std::string>(
+                                                    "TECHNIQUE_MOMENT_CHANNELS", "4")),
+            evsm.end());
+  EXPECT_NE(std::find(pcss.begin(), pcss.end(), std::pair<std::string, std::string>(
+                                                    "TECHNIQUE_NEEDS_LIGHT_SIZE", "1")),
+            pcss.end());
   // Stages: emissive is fragment-only; normal_map reaches the vertex stage too (its tangents).
   bool normal_map_in_vertex = false;
   for (const auto& [n, v] : m.defines(k, ShaderStage::vertex)) {
