@@ -10,6 +10,7 @@
 #include <iterator>
 #include <string>
 
+#include "components/shadow_technique.h"
 #include "runtime/assets/material_file.h"
 #include "runtime/features/feature_manifest.h"
 #include "runtime/render/frame_uniforms.h"
@@ -53,8 +54,8 @@ bool documented_rules_hold(VariantKey k) {
   if (k.bits() & ~used) return false;
   if (k.get(V::kToneMapping) > 2) return false;      // none, khr_pbr_neutral, aces
   if (k.get(V::kShadowFilter) > 2) return false;     // none, bilinear, pcf3x3
-  // pcf, pcss, backprojection, lom, vsm, evsm
-  if (k.get(V::kShadowTechnique) > 5) return false;
+  // one per row of the technique table (components/shadow_technique.h)
+  if (k.get(V::kShadowTechnique) >= kShadowTechniqueCount) return false;
   if (k.get(V::kShadowKernel) > 4) return false;     // 3x3, 5x5, 7x7, 9x9, poisson
   if (k.get(V::kShadowReuse) > 2) return false;      // off, store, load
   if (k.has(V::kReflectionCube) && k.has(V::kReflectionSphere)) return false;
