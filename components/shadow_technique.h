@@ -35,9 +35,11 @@ struct ShadowTechniqueTraits {
   ShadowTechnique technique;
   ShadowExtraPass extra_pass = ShadowExtraPass::none;
   /// Moments stored per texel by the moments pass: 0 (none), 2 (E[z], E[z^2]) or 4 (two warps).
+  /// The shaders' TECHNIQUE_MOMENT_CHANNELS (FeatureManifest::defines()).
   int moment_channels = 0;
   /// The lookup uses the light's size (Light::angular_size_deg or Light::radius; a punctual
-  /// light gives hard shadows).
+  /// light gives hard shadows); views of other techniques get size 0. The shaders'
+  /// TECHNIQUE_NEEDS_LIGHT_SIZE.
   bool needs_light_size = false;
   ShadowReach reach = ShadowReach::filter_footprint;
   /// ShadowSettings::pcf_kernel picks the footprint of filter pcf3x3 (VariantKey::kShadowKernel).
