@@ -83,8 +83,9 @@ constexpr bool rows_consistent() {
 }
 }  // namespace shadow_technique_detail
 
-// Change together with ShadowTechnique: one row per enumerator, row i for enumerator i.
-static_assert(kShadowTechniqueCount == static_cast<std::size_t>(ShadowTechnique::evsm) + 1,
+// One row per enumerator (enum_names() beside the enum is tied to its last one), row i for
+// enumerator i.
+static_assert(kShadowTechniqueCount == enum_names(ShadowTechnique{}).size(),
               "kShadowTechniques needs one row per ShadowTechnique");
 static_assert(shadow_technique_detail::rows_in_enum_order(),
               "row i of kShadowTechniques must describe ShadowTechnique value i");
