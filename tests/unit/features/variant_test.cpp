@@ -143,12 +143,14 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   // pbr) = 2304.
   // Frame keys: 2 without shadow (aovs), and with shadow 3 filters x 2 aovs x 2 debug x
   // 2 selection x 2 layered x 4 shadowed-light counts x (8 ortho cascade counts + 3 other
-  // projections) x 6 techniques (pcf, pcss, backprojection, lom, vsm, evsm) x 5 kernels x
-  // 2 peel = 126720; all of them x 3 tone mappings x 2 environments x 2 alpha_to_coverage.
+  // projections) x the techniques (6 today: pcf, pcss, backprojection, lom, vsm, evsm) x
+  // 5 kernels x 2 peel = 126720; all of them x 3 tone mappings x 2 environments x
+  // 2 alpha_to_coverage.
+  const int shadowed = 3 * 2 * 2 * 2 * 2 * 4 * (8 + 3) * int(kShadowTechniqueCount) * 5 * 2;
   EXPECT_EQ(valid_materials, 2304);
-  EXPECT_EQ(valid_frames, 2 * 2 * 3 * (2 + 126720));
+  EXPECT_EQ(valid_frames, 2 * 2 * 3 * (2 + shadowed));
   // shadow_reuse store and load on every frame key with shadow; "3" is past its values.
-  EXPECT_EQ(valid_reuse, 2 * 2 * 2 * 3 * 126720);
+  EXPECT_EQ(valid_reuse, 2 * 2 * 2 * 3 * shadowed);
 }
 
 // The table is the one source: the manifest's features, their fields and the GLSL bit numbers
