@@ -57,70 +57,7 @@ namespace kaskad::editor {
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: kaskad edit [SCENE] [--set key=value]... [--size WxH] [--script FILE]\n"
-    "  SCENE          a scene file (.json, .gltf, .glb); default content/scenes/default.json\n"
-    "  --set K=V      an override, as for `kaskad render` (repeatable)\n"
-    "  --size WxH     the window size (default 1280x720)\n"
-    "  --script FILE  replay actions, one per line (README \"Editor: kaskad edit\")\n";
-
-[[noreturn]] void usage_error(const std::string& msg) {
-  std::fprintf(stderr, "kaskad edit: %s\n%s", msg.c_str(), kUsage);
-  std::exit(2);
-}
-
-struct Options {
-  fs::path scene;
-  std::vector<std::string> sets;
-  int width = 1280, height = 720;
-  fs::path script;
-};
-
-int parse_dimension(const std::string& what, const std::string& v) {
-  int n = 0;
-  try {
-    std::size_t used = 0;
-    n = std::stoi(v, &used);
-    if (used != v.size()) n = 0;
-  } catch (const std::exception&) {
-    n = 0;
-  }
-  if (n < 64 || n > 16384) usage_error("--size " + what + " must be an integer in [64, 16384], got '" + v + "'");
-  return n;
-}
-
-Options parse_options(int argc, char** argv) {
-  Options o;
-  for (int i = 2; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error(arg + " needs a value");
-      return argv[++i];
-    };
-    if (arg == "-h" || arg == "--help") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (arg == "--set") {
-      o.sets.push_back(value());
-    } else if (arg == "--size") {
-      const std::string v = value();
-      const auto x = v.find('x');
-      if (x == std::string::npos) usage_error("--size expects WxH, e.g. 1280x720, got '" + v + "'");
-      o.width = parse_dimension("width", v.substr(0, x));
-      o.height = parse_dimension("height", v.substr(x + 1));
-    } else if (arg == "--script") {
-      o.script = value();
-    } else if (!arg.empty() && arg[0] == '-') {
-      usage_error("unknown option '" + arg + "'");
-    } else if (o.scene.empty()) {
-      o.scene = arg;
-    } else {
-      usage_error("unexpected argument '" + arg + "' (one SCENE only)");
-    }
-  }
-  if (o.scene.empty()) o.scene = content_dir() / "scenes" / "default.json";
-  return o;
-}
+using Options = EditOptions;
 
 // The fly camera: a position and a heading, written into the scene's active camera when moved.
 struct FlyCamera {
@@ -2123,10 +2060,11 @@ int Editor::run() {
 
 }  // namespace
 
-int run_edit_command(int argc, char** argv) {
+int run_edit(const EditOptions& options) {
   // Whole lines: the frame lines (stdout) and errors (stderr) do not cut into each other.
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  Options opt = parse_options(argc, argv);
+  Options opt = options;
+  if (opt.scene.empty()) opt.scene = content_dir() / "scenes" / "default.json";
   std::vector<ScriptAction> script;
   if (!opt.script.empty()) {
     auto parsed = parse_script(opt.script);

@@ -2,10 +2,22 @@
 // renderer as the headless player. Controls and the script language: README.md ("Editor").
 #pragma once
 
+#include <filesystem>
+#include <string>
+#include <vector>
+
 namespace kaskad::editor {
 
-/// `kaskad edit [SCENE] [--set k=v]... [--size WxH] [--script FILE]`; argv[1] is "edit".
-/// Returns the process exit status: 0 done, 1 an error (scene, script line, GL errors), 2 usage.
-int run_edit_command(int argc, char** argv);
+/// What `kaskad edit` was asked for (runtime/cli/ reads it from the command line).
+struct EditOptions {
+  std::filesystem::path scene;    ///< .json, .gltf or .glb; empty: content/scenes/default.json
+  std::vector<std::string> sets;  ///< overrides, as for `kaskad render --set`
+  int width = 1280, height = 720;  ///< the window's size in pixels, each in [64, 16384]
+  std::filesystem::path script;   ///< actions to replay, one per line; empty: interactive
+};
+
+/// `kaskad edit`: opens the editor on the scene. Returns the process exit status: 0 done, 1 an
+/// error (scene, script line, no display, GL errors).
+int run_edit(const EditOptions& options);
 
 }  // namespace kaskad::editor

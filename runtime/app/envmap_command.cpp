@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <string_view>
 
@@ -23,100 +22,38 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-int usage_error(const std::string& message) {
-  std::fprintf(stderr, "kaskad: %s\n(run `kaskad --help` for usage)\n", message.c_str());
-  return 2;
-}
-
 int fail(const Error& e) {
   std::fprintf(stderr, "kaskad: error: %s\n", e.to_string().c_str());
   return 1;
 }
 
-/// A positive integer no larger than `hi`, or -1.
-int parse_size(const std::string& v, int hi) {
-  char* end = nullptr;
-  const long n = std::strtol(v.c_str(), &end, 10);
-  if (v.empty() || *end != '\0' || n < 1 || n > hi) return -1;
-  return int(n);
-}
-
-
 }  // namespace
 
-int run_envmap_command(int argc, char** argv) {
-  std::string in, faces_out, sphere_out;
-  EnvLoadOptions options;
-  int sphere_size = 0;
-  for (int i = 2; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](std::string& into) {
-      if (i + 1 >= argc) return false;
-      into = argv[++i];
-      return true;
-    };
-    std::string v;
-    if (arg == "--layout") {
-      if (!value(v)) return usage_error(arg + " needs a value");
-      bool known = false;
-      for (EnvLayout l : {EnvLayout::auto_detect, EnvLayout::faces, EnvLayout::horizontal_cross,
-                          EnvLayout::vertical_cross, EnvLayout::equirect, EnvLayout::sphere}) {
-        if (v == env_layout_name(l)) {
-          options.layout = l;
-          known = true;
-        }
-      }
-      if (!known) {
-        return usage_error(
-            "--layout expects auto, faces, horizontal_cross, vertical_cross, "
-            "equirect or sphere, got '" +
-            v + "'");
-      }
-    } else if (arg == "--3dsmax") {
-      options.z_up_3dsmax = true;
-    } else if (arg == "--face-size" || arg == "--sphere-size") {
-      if (!value(v)) return usage_error(arg + " needs a value");
-      const int n = parse_size(v, 8192);
-      if (n < 0) return usage_error(arg + " expects an integer in [1, 8192], got '" + v + "'");
-      (arg == "--face-size" ? options.face_size : sphere_size) = n;
-    } else if (arg == "--faces") {
-      if (!value(faces_out)) return usage_error(arg + " needs a value");
-    } else if (arg == "--sphere") {
-      if (!value(sphere_out)) return usage_error(arg + " needs a value");
-    } else if (!arg.empty() && arg[0] == '-') {
-      return usage_error("unknown option '" + arg + "'");
-    } else if (in.empty()) {
-      in = arg;
-    } else {
-      return usage_error("unexpected argument '" + arg + "'");
-    }
-  }
-  if (in.empty()) return usage_error("envmap needs an input map");
-
+int run_envmap(const EnvmapOptions& o) {
   // Outputs are checked before any work (README "Outputs"); no folder is made but one named
   // by --faces DIR.
-  if (!faces_out.empty())
-    if (auto st = check_cube_faces_output(faces_out); !st) return fail(st.error());
-  if (!sphere_out.empty())
-    if (auto st = check_image_output(sphere_out); !st) return fail(st.error());
+  if (!o.faces_out.empty())
+    if (auto st = check_cube_faces_output(o.faces_out); !st) return fail(st.error());
+  if (!o.sphere_out.empty())
+    if (auto st = check_image_output(o.sphere_out); !st) return fail(st.error());
   const auto t0 = std::chrono::steady_clock::now();
-  EnvLayout layout = options.layout;
-  auto cube = load_cube_map(in, options, &layout);
+  EnvLayout layout = o.load.layout;
+  auto cube = load_cube_map(o.input, o.load, &layout);
   if (!cube) return fail(cube.error());
-  std::printf("envmap    %s: %s, %d^2 x 6 faces%s (load %.1f ms)\n", in.c_str(),
+  std::printf("envmap    %s: %s, %d^2 x 6 faces%s (load %.1f ms)\n", o.input.c_str(),
               env_layout_name(layout), cube->size,
-              options.z_up_3dsmax ? ", converted from 3ds Max Z-up" : "", ms_since(t0));
-  if (!faces_out.empty()) {
-    if (auto st = save_cube_faces(*cube, faces_out); !st) return fail(st.error());
-    std::printf("wrote     %s (px nx py ny pz nz)\n", faces_out.c_str());
+              o.load.z_up_3dsmax ? ", converted from 3ds Max Z-up" : "", ms_since(t0));
+  if (!o.faces_out.empty()) {
+    if (auto st = save_cube_faces(*cube, o.faces_out); !st) return fail(st.error());
+    std::printf("wrote     %s (px nx py ny pz nz)\n", o.faces_out.c_str());
   }
-  if (!sphere_out.empty()) {
-    const int size = sphere_size > 0 ? sphere_size : 2 * cube->size;
+  if (!o.sphere_out.empty()) {
+    const int size = o.sphere_size > 0 ? o.sphere_size : 2 * cube->size;
     const auto t1 = std::chrono::steady_clock::now();
     const SphereMap map = sphere_map_from_cube(*cube, size);
     const double ms = ms_since(t1);
-    if (auto st = save_sphere_map(map, sphere_out); !st) return fail(st.error());
-    std::printf("wrote     %s (sphere map %d^2, S3 eq. 2, %.1f ms)\n", sphere_out.c_str(), size,
+    if (auto st = save_sphere_map(map, o.sphere_out); !st) return fail(st.error());
+    std::printf("wrote     %s (sphere map %d^2, S3 eq. 2, %.1f ms)\n", o.sphere_out.c_str(), size,
                 ms);
   }
   return 0;

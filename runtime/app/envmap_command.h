@@ -7,16 +7,26 @@
 
 #include <glm/glm.hpp>
 
+#include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene.h"
 #include "runtime/result/result.h"
 
 namespace kaskad {
 
-/// `kaskad envmap IN [options]`: loads an environment map in any layout, prints what it found
-/// and how long loading took, and writes faces / a sphere map. argv[1] is "envmap". Returns the
-/// exit status: 0 success, 1 content error, 2 usage error.
-int run_envmap_command(int argc, char** argv);
+/// What `kaskad envmap` was asked for (runtime/cli/ reads it from the command line).
+struct EnvmapOptions {
+  std::string input;      ///< a file, a face pattern sky_*.png or a folder of faces
+  EnvLoadOptions load;    ///< the layout (auto: detected) and the 3ds Max conversion
+  std::string faces_out;  ///< empty: no faces written; else a pattern with * or a folder
+  std::string sphere_out;  ///< empty: no sphere map written
+  int sphere_size = 0;     ///< pixels; 0: twice the cube's face size
+};
+
+/// `kaskad envmap`: loads an environment map in any layout, prints what it found and how long
+/// loading took, and writes faces / a sphere map. Outputs are checked before any work. Returns
+/// the exit status: 0 success, 1 content error.
+int run_envmap(const EnvmapOptions& options);
 
 /// Traces the reflection reference of an AOV image (Renderer::read_aovs()) rendered from `eye`
 /// and writes it as EXR to `out` (channels reflection.R/G/B, reflection.hit, mask). `environment`

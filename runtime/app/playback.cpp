@@ -990,57 +990,16 @@ Result<std::size_t> merge_summaries(const std::vector<fs::path>& dirs, const fs:
   return failed;
 }
 
-int run_play_command(int argc, char** argv) {
+int run_play(const PlayCommandOptions& command) {
   auto usage = [](const std::string& msg) {
-    std::fprintf(stderr, "kaskad play: %s\n(run `kaskad --help` for usage)\n", msg.c_str());
+    std::fprintf(stderr, "kaskad play: %s\n(run `kaskad play --help` for usage)\n", msg.c_str());
     return 2;
   };
-  PlayOptions options;
-  options.headless = !gpu::display_available();
-  std::vector<fs::path> inputs;  // files and folders as given
-  bool out_given = false;
-  bool merge = false;
-  int jobs = 1;
-  for (int i = 2; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--merge") {
-      merge = true;
-      continue;
-    }
-    if (arg == "--jobs") {
-      if (i + 1 >= argc) return usage("--jobs needs a value");
-      const std::string v = argv[++i];
-      char tail = 0;
-      if (std::sscanf(v.c_str(), "%d%c", &jobs, &tail) != 1 || jobs < 1 || jobs > 256)
-        return usage("--jobs expects a number of processes in [1, 256], got '" + v + "'");
-      continue;
-    }
-    if (arg == "--out" || arg == "--shard") {
-      if (i + 1 >= argc) return usage(arg + " needs a value");
-      const std::string v = argv[++i];
-      if (arg == "--out") {
-        options.out_dir = v;
-        out_given = true;
-        continue;
-      }
-      int idx = -1, n = 0;
-      char tail = 0;
-      if (std::sscanf(v.c_str(), "%d/%d%c", &idx, &n, &tail) != 2 || n < 1 || idx < 0 || idx >= n)
-        return usage("--shard expects i/n with 0 <= i < n, e.g. 0/4; got '" + v + "'");
-      options.shard_index = idx;
-      options.shard_count = n;
-    } else if (arg == "--update-goldens") {
-      options.update_goldens = true;
-    } else if (arg == "--headless") {
-      options.headless = true;
-    } else if (arg == "--window") {
-      options.headless = false;
-    } else if (!arg.empty() && arg[0] == '-') {
-      return usage("unknown option '" + arg + "'");
-    } else {
-      inputs.push_back(arg);
-    }
-  }
+  const PlayOptions& options = command.run;
+  const std::vector<fs::path>& inputs = command.inputs;
+  const bool out_given = command.out_given;
+  const bool merge = command.merge;
+  const int jobs = command.jobs;
   // Like every output folder Kaskad makes: one level, in a folder that exists (the default
   // out/play is made whole).
   if (out_given) {

@@ -166,10 +166,18 @@ std::vector<std::size_t> shard_files(std::size_t count, int index, int n);
 Result<std::size_t> merge_summaries(const std::vector<std::filesystem::path>& dirs,
                                     const std::filesystem::path& out_dir);
 
-/// `kaskad play FILE|DIR... [--out DIR] [--update-goldens] [--shard i/n | --jobs N]
-/// [--headless|--window]` (a DIR stands for its *.json files; --jobs runs N shard processes
-/// into OUT/shard-i and merges their summaries). argv[1] is "play". Exit status: 0 all expectations
-/// held, 1 an expectation failed or a file could not be read or run, 2 usage error.
-int run_play_command(int argc, char** argv);
+/// What `kaskad play` was asked for (runtime/cli/ reads it from the command line).
+struct PlayCommandOptions {
+  std::vector<std::filesystem::path> inputs;  ///< playback files, and folders for their *.json
+  PlayOptions run;                            ///< out_dir, update_goldens, shard, headless
+  bool out_given = false;  ///< --out named: its parent must exist (the default out/play is made whole)
+  bool merge = false;      ///< --merge: the inputs are shard output folders to merge
+  int jobs = 1;            ///< --jobs N: N shard processes into OUT/shard-i, then one merged summary
+};
+
+/// `kaskad play`: runs the playback files (or merges shard summaries, or runs --jobs shard
+/// processes). Exit status: 0 all expectations held, 1 an expectation failed or a file could not
+/// be read or run, 2 usage error (no files, --jobs with --shard).
+int run_play(const PlayCommandOptions& command);
 
 }  // namespace kaskad

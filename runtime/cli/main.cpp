@@ -1,13 +1,12 @@
 // The `kaskad` command line: render scenes headless (or in a window), write images and AOVs,
 // and save canonical scene files. Run `kaskad --help`.
 #include <algorithm>
-#include <cctype>
 #include <bit>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,9 +32,8 @@
 #include "runtime/core/log.h"
 #include "runtime/core/memory.h"
 #include "runtime/gpu/context.h"
-#ifdef KASKAD_HAS_EDITOR
-#include "editor/editor.h"
-#endif
+#include "runtime/cli/commands.h"
+#include "runtime/cli/options.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -45,190 +43,44 @@ using namespace kaskad;
 
 namespace {
 
-constexpr const char* kUsage = R"(kaskad - real-time shadows and reflections, headless or windowed
+// The options of each command, as the command line gives them (add_*_command() declares them).
 
-usage:
-  kaskad render [SCENE] [options]   render a scene (default: content/scenes/default.json)
-  kaskad save SCENE -o OUT.json [--set key=value]...
-                                    write the canonical scene file (after overrides)
-  kaskad variants [SCENE] [--set key=value]... [--aov]
-                                    list the shader variants (pass, key, defines) the scene needs
-  kaskad bench [SCENE]... [--sweep SPEC] [--out DIR] [--frames N] [--size WxH] [--no-chart]
-               [--stability-frames N] [--shard i/n]
-  kaskad bench --merge SHARD_OUT_DIR... [--out DIR] [--no-chart]
-                                    sweep settings, write DIR/bench.csv and one speed-vs-accuracy
-                                    chart per scene (default sweep: see README; --sweep soft:
-                                    the soft-shadow techniques and kernels); flicker at fixed
-                                    points over an N-frame camera path (default 16, 0 = off)
-  kaskad envmap IN [--layout L] [--3dsmax] [--face-size N] [--faces OUT] [--sphere OUT.png]
-                [--sphere-size N]
-                                    load an environment map (IN: a file, a face pattern sky_*.png
-                                    or a folder of faces; L: auto, faces, horizontal_cross,
-                                    vertical_cross, equirect, sphere), print what was found, write
-                                    its faces (OUT: a pattern with * or a folder) or S3 sphere map
-  kaskad play FILE|DIR... [--out DIR] [--update-goldens] [--shard i/n | --jobs N]
-                                    replay playback files (camera keys, timeline, captures) and
-                                    check their expectations (README "Scene playback"); writes
-                                    DIR/<file>/frame_NNNN.png, frames.csv, diffs, DIR/summary.json
-  kaskad edit [SCENE] [--set key=value]... [--size WxH] [--script FILE]
-                                    the editor: a window with an entity list, inspectors, a
-                                    fly camera, undo and saving; --script replays actions
-                                    (README "Editor: kaskad edit"); needs a display (xvfb-run -a)
-  kaskad info [SCENE] [--set K=V]   print the OpenGL context kaskad gets on this machine; with
-                                    a SCENE, its entities instead (name, parent, components): the
-                                    names --set addresses, a glTF file's own nodes included
-
-render options:
-  -o, --output FILE      colour image (PNG, JPEG, EXR, ...); default out/<scene>.png
-  --size WxH             output size in pixels (default: the scene's render.width/height)
-  --frames N             frames to render; times are the median of frames 2..N (default 10)
-  --set KEY=VALUE        override a setting or component field, e.g. shadow.map_size=4096,
-                         sun.light.intensity=3, camera.camera.fov_y_deg=40 (repeatable)
-  --aov FILE.exr         write the AOVs of the last frame (P, N, Z, visibility, mask, cascade)
-  --shadow-map FILE      write the shadow map depth of the last frame
-  --probe-maps DIR       write each reflection probe's visible cube faces (NAME_px.png ...
-                         NAME_nz.png) and, for sphere probes, NAME_sphere.png into DIR
-  --reflection-reference FILE.exr
-                         ray-traced reflected radiance C_t of every pixel (README "Environment maps")
-  --env PATH             environment map for the reflection reference's misses (any layout)
-  --shadow-reference FILE.exr
-                         the ray-traced visibility of the light the visibility AOV shows (area
-                         lights sampled), the AOV's, and their difference, per pixel; prints
-                         RMSE and MAE over the receivers (README "Soft shadows")
-  --headless             never open a window (default when there is no display)
-  --window               open a window even if --headless would be the default
-  -v, --verbose          debug logging (GL debug messages of every severity)
-)";
-
-struct Args {
-  std::string command;
-  std::string scene;
-  std::vector<std::string> more_scenes;  ///< bench: every SCENE after the first
-  int shard_index = 0, shard_count = 1;  ///< bench --shard i/n
-  bool merge = false;                    ///< bench --merge: the SCENEs are shard folders
-  std::string sweep;
-  std::string out_dir;
-  bool chart = true;
-  int stability_frames = -1;  ///< bench: -1 = default
-  std::string output;
+struct RenderArgs {
+  std::string scene;   ///< empty: content/scenes/default.json
+  std::string output;  ///< empty: out/<scene>.png
   std::string aov;
   std::string shadow_map;
   std::string probe_maps;
-  std::string reflection_reference;  ///< render: reference EXR to write
-  std::string shadow_reference;      ///< render: shadow visibility reference EXR to write
-  std::string env;                   ///< render: environment map of the reflection reference
+  std::string reflection_reference;  ///< reference EXR to write
+  std::string shadow_reference;      ///< shadow visibility reference EXR to write
+  std::string env;                   ///< environment map of the reflection reference
   std::vector<std::string> sets;
-  int width = 0, height = 0, frames = 10;
+  int width = 0, height = 0;  ///< 0: the scene's render.width/height
+  int frames = 10;
   bool headless = !gpu::display_available();
 };
 
-[[noreturn]] void usage_error(const std::string& msg) {
-  std::fprintf(stderr, "kaskad: %s\n(run `kaskad --help` for usage)\n", msg.c_str());
-  std::exit(2);
-}
+struct SaveArgs {
+  std::string scene, output;
+  std::vector<std::string> sets;
+};
 
-int parse_int(const std::string& flag, const std::string& v, int lo, int hi) {
-  try {
-    std::size_t used = 0;
-    const long n = std::stol(v, &used);
-    if (used != v.size() || n < lo || n > hi) throw std::out_of_range(v);
-    return int(n);
-  } catch (const std::exception&) {
-    usage_error(flag + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                "], got '" + v + "'");
-  }
-}
+struct VariantsArgs {
+  std::string scene;  ///< empty: content/scenes/default.json
+  std::vector<std::string> sets;
+  bool aovs = false;
+};
 
-Args parse_args(int argc, char** argv) {
-  Args a;
-  if (argc < 2) usage_error("missing command");
-  a.command = argv[1];
-  if (a.command == "--help" || a.command == "-h" || a.command == "help") {
-    std::fputs(kUsage, stdout);
-    std::exit(0);
-  }
-  if (a.command != "render" && a.command != "save" && a.command != "info" &&
-      a.command != "variants" && a.command != "bench")
-    usage_error("unknown command '" + a.command + "'");
-  for (int i = 2; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error(arg + " needs a value");
-      // `--set -o x.png`: the option's value is missing, not "-o" (a negative number is left to
-      // the value's own check; a file named -x is ./-x).
-      const std::string v = argv[i + 1];
-      if (v.size() > 1 && v[0] == '-' && !std::isdigit(static_cast<unsigned char>(v[1])))
-        usage_error(arg + " needs a value, got the option '" + v + "'");
-      return argv[++i];
-    };
-    if (arg == "-h" || arg == "--help") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (arg == "-o" || arg == "--output") {
-      a.output = value();
-    } else if (arg == "--aov" && a.command == "variants") {
-      a.aov = "yes";
-    } else if (arg == "--aov") {
-      a.aov = value();
-    } else if (arg == "--shadow-map") {
-      a.shadow_map = value();
-    } else if (arg == "--probe-maps") {
-      a.probe_maps = value();
-    } else if (arg == "--reflection-reference") {
-      a.reflection_reference = value();
-    } else if (arg == "--env") {
-      a.env = value();
-    } else if (arg == "--shadow-reference" && a.command == "render") {
-      a.shadow_reference = value();
-    } else if (arg == "--sweep" && a.command == "bench") {
-      a.sweep = value();
-      if (a.sweep.empty())
-        usage_error("--sweep needs a sweep (e.g. shadow.map_size=1024,2048, or soft); without "
-                    "--sweep, bench runs the default one");
-    } else if (arg == "--out" && a.command == "bench") {
-      a.out_dir = value();
-    } else if ((arg == "--out" || arg == "--sweep") && a.command == "render") {
-      usage_error(arg + " is a bench option; kaskad render writes its image to -o FILE");
-    } else if (arg == "--stability-frames" && a.command == "bench") {
-      a.stability_frames = parse_int(arg, value(), 0, 10000);
-    } else if (arg == "--shard" && a.command == "bench") {
-      const std::string v = value();
-      const auto slash = v.find('/');
-      if (slash == std::string::npos) usage_error("--shard expects i/n, e.g. 0/4, got '" + v + "'");
-      a.shard_count = parse_int("--shard n", v.substr(slash + 1), 1, 100000);
-      a.shard_index = parse_int("--shard i", v.substr(0, slash), 0, a.shard_count - 1);
-    } else if (arg == "--merge" && a.command == "bench") {
-      a.merge = true;
-    } else if (arg == "--no-chart" && a.command == "bench") {
-      a.chart = false;
-    } else if (arg == "--set") {
-      a.sets.push_back(value());
-    } else if (arg == "--frames") {
-      a.frames = parse_int(arg, value(), 1, 100000);
-    } else if (arg == "--size") {
-      const std::string v = value();
-      const auto x = v.find('x');
-      if (x == std::string::npos) usage_error("--size expects WxH, e.g. 1280x720, got '" + v + "'");
-      a.width = parse_int("--size width", v.substr(0, x), 1, 16384);
-      a.height = parse_int("--size height", v.substr(x + 1), 1, 16384);
-    } else if (arg == "--headless") {
-      a.headless = true;
-    } else if (arg == "--window") {
-      a.headless = false;
-    } else if (arg == "-v" || arg == "--verbose") {
-      log::set_level(log::Level::debug);
-    } else if (!arg.empty() && arg[0] == '-') {
-      usage_error("unknown option '" + arg + "'");
-    } else if (a.scene.empty()) {
-      a.scene = arg;
-    } else if (a.command == "bench") {
-      a.more_scenes.push_back(arg);
-    } else {
-      usage_error("unexpected argument '" + arg + "'");
-    }
-  }
-  return a;
-}
+struct InfoArgs {
+  std::string scene;  ///< empty: print the OpenGL context instead
+  std::vector<std::string> sets;
+  bool headless = !gpu::display_available();
+};
+
+struct BenchArgs {
+  BenchOptions bench;
+  bool merge = false;  ///< --merge: the SCENEs are shard output folders
+};
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -239,9 +91,9 @@ int fail(const Error& e) {
   return 1;
 }
 
-int run_info(const Args& a) {
+int run_info(const InfoArgs& a) {
   if (a.scene.empty() && !a.sets.empty())
-    usage_error("info --set needs a SCENE (without one, info prints the OpenGL context)");
+    throw cli::UsageError("info --set needs a SCENE (without one, info prints the OpenGL context)");
   if (!a.scene.empty()) {
     auto scene = load_scene(a.scene, a.sets);
     if (!scene) return fail(scene.error());
@@ -277,11 +129,9 @@ int run_info(const Args& a) {
   return 0;
 }
 
-int run_save(const Args& a) {
-  if (a.scene.empty()) usage_error("save needs a SCENE");
-  if (a.output.empty()) usage_error("save needs -o OUT.json");
+int run_save(const SaveArgs& a) {
   if (lowercase_extension(a.output) != ".json")
-    usage_error("save writes a scene file: -o needs a .json path, got '" + a.output + "'");
+    throw cli::UsageError("save writes a scene file: -o needs a .json path, got '" + a.output + "'");
   auto scene = read_scene(a.scene, a.sets);
   if (!scene) return fail(scene.error());
   if (auto st = save_scene(a.output, *scene); !st) return fail(st.error());
@@ -289,7 +139,7 @@ int run_save(const Args& a) {
   return 0;
 }
 
-int run_variants(const Args& a) {
+int run_variants(const VariantsArgs& a) {
   const fs::path scene_path =
       a.scene.empty() ? content_dir() / "scenes" / "default.json" : fs::path(a.scene);
   auto scene = load_scene(scene_path, a.sets);
@@ -299,7 +149,7 @@ int run_variants(const Args& a) {
   FrameContext ctx;
   ctx.width = scene->render.width;
   ctx.height = scene->render.height;
-  ctx.write_aovs = !a.aov.empty();
+  ctx.write_aovs = a.aovs;
   const auto requests = render::required_programs(plan_frame(*scene, ctx));
   std::printf("%s: %zu programs (%s AOVs)\n", scene_path.string().c_str(), requests.size(),
               ctx.write_aovs ? "with" : "without");
@@ -314,27 +164,14 @@ int run_variants(const Args& a) {
   return 0;
 }
 
-int run_bench_command(const Args& a, bool frames_given) {
-  BenchOptions o;
-  if (!a.scene.empty()) o.scenes.push_back(a.scene);
-  for (const auto& s : a.more_scenes) o.scenes.push_back(s);
-  o.sweep = a.sweep;
-  if (!a.out_dir.empty()) o.out_dir = a.out_dir;
-  if (frames_given) o.frames = a.frames;
-  if (a.width > 0) {
-    o.width = a.width;
-    o.height = a.height;
-  }
-  o.chart = a.chart;
-  if (a.stability_frames >= 0) o.stability_frames = a.stability_frames;
-  o.shard_index = a.shard_index;
-  o.shard_count = a.shard_count;
+int run_bench_command(const BenchArgs& a) {
   if (a.merge) {
-    if (o.scenes.empty()) usage_error("bench --merge needs the shards' --out folders");
-    if (auto st = merge_bench(o.scenes, o.out_dir, o.chart); !st) return fail(st.error());
+    if (a.bench.scenes.empty()) throw cli::UsageError("bench --merge needs the shards' --out folders");
+    if (auto st = merge_bench(a.bench.scenes, a.bench.out_dir, a.bench.chart); !st)
+      return fail(st.error());
     return 0;
   }
-  if (auto st = run_bench(o); !st) return fail(st.error());
+  if (auto st = run_bench(a.bench); !st) return fail(st.error());
   return 0;
 }
 
@@ -380,7 +217,7 @@ Status make_named_folder(const fs::path& dir) {
 /// Every output of `kaskad render`, checked before the scene is loaded or a frame rendered:
 /// writable, not a folder, a format we can write. The default colour output out/<scene>.png
 /// (README) is the one folder made for the user.
-Status check_render_outputs(const Args& a, const fs::path& out) {
+Status check_render_outputs(const RenderArgs& a, const fs::path& out) {
   std::error_code ec;
   if (a.output.empty() && !fs::exists(out.parent_path(), ec)) {
     // out/ is made just before writing; here only that it can be made.
@@ -417,13 +254,13 @@ Status check_render_outputs(const Args& a, const fs::path& out) {
   return {};
 }
 
-int run_render(Args a) {
+int run_render(RenderArgs a) {
   const fs::path scene_path =
       a.scene.empty() ? content_dir() / "scenes" / "default.json" : fs::path(a.scene);
   const fs::path out = a.output.empty() ? fs::path("out") / (scene_path.stem().string() + ".png")
                                         : fs::path(a.output);
   if (!a.env.empty() && a.reflection_reference.empty())
-    usage_error("--env is the environment of --reflection-reference; a scene's own is "
+    throw cli::UsageError("--env is the environment of --reflection-reference; a scene's own is "
                 "render.environment (--set render.environment=FILE)");
   if (auto st = check_render_outputs(a, out); !st) return fail(st.error());
   if (!a.env.empty()) {
@@ -638,40 +475,214 @@ int run_render(Args a) {
   return gpu::exit_status_for_gl_errors("kaskad");
 }
 
+// The commands' options. Each add_*_command() declares one command's options, bound to the
+// options struct its returned function owns and runs (cli::Command, runtime/cli/options.h).
+
+/// `[SCENE]` and `--set KEY=VALUE`..., the scene every scene command reads.
+void add_scene_options(CLI::App& cmd, std::string& scene, std::vector<std::string>& sets,
+                       const std::string& scene_description) {
+  cmd.add_option("SCENE", scene, scene_description)->type_name("FILE");
+  cli::add_value_option(cmd, "--set", sets,
+                        "override a setting or component field, e.g. shadow.map_size=4096, "
+                        "sun.light.intensity=3, camera.camera.fov_y_deg=40 (repeatable)")
+      ->type_name("KEY=VALUE");
+}
+
+cli::RunCommand add_render_command(CLI::App& cmd) {
+  auto a = std::make_shared<RenderArgs>();
+  add_scene_options(cmd, a->scene, a->sets,
+                    "a scene file (.json, .gltf, .glb); default content/scenes/default.json");
+  cli::add_value_option(cmd, "-o,--output", a->output,
+                        "colour image (PNG, JPEG, EXR, ...); default out/<scene>.png")
+      ->type_name("FILE");
+  cli::add_size_option(cmd, a->width, a->height, 1, 16384,
+                       "output size in pixels (default: the scene's render.width/height)");
+  cli::add_frames_option(cmd, a->frames,
+                         "frames to render; times are the median of frames 2..N (default 10)");
+  cli::add_value_option(cmd, "--aov", a->aov,
+                        "write the AOVs of the last frame (P, N, Z, visibility, mask, cascade)")
+      ->type_name("FILE.exr");
+  cli::add_value_option(cmd, "--shadow-map", a->shadow_map,
+                        "write the shadow map depth of the last frame")
+      ->type_name("FILE.exr");
+  cli::add_value_option(cmd, "--probe-maps", a->probe_maps,
+                        "write each reflection probe's visible cube faces (NAME_px.png ... "
+                        "NAME_nz.png) and, for sphere probes, NAME_sphere.png into DIR")
+      ->type_name("DIR");
+  cli::add_value_option(cmd, "--reflection-reference", a->reflection_reference,
+                        "ray-traced reflected radiance C_t of every pixel (README \"Environment "
+                        "maps\")")
+      ->type_name("FILE.exr");
+  cli::add_value_option(cmd, "--env", a->env,
+                        "environment map for the reflection reference's misses (any layout)")
+      ->type_name("PATH");
+  cli::add_value_option(cmd, "--shadow-reference", a->shadow_reference,
+                        "the ray-traced visibility of the light the visibility AOV shows (area "
+                        "lights sampled), the AOV's, and their difference, per pixel; prints RMSE "
+                        "and MAE over the receivers (README \"Soft shadows\")")
+      ->type_name("FILE.exr");
+  cli::add_window_flags(cmd, a->headless);
+  cli::add_verbose_flag(cmd);
+  // bench's output options, refused with a pointer to -o instead of "unknown option".
+  CLI::Option* out = cmd.add_option("--out")->group("");
+  CLI::Option* sweep = cmd.add_option("--sweep")->group("");
+  return [a, out, sweep] {
+    for (const CLI::Option* o : {out, sweep})
+      if (o->count() > 0)
+        throw cli::UsageError(o->get_name() +
+                              " is a bench option; kaskad render writes its image to -o FILE");
+    return run_render(*a);
+  };
+}
+
+cli::RunCommand add_save_command(CLI::App& cmd) {
+  auto a = std::make_shared<SaveArgs>();
+  add_scene_options(cmd, a->scene, a->sets, "the scene file to read (.json, .gltf, .glb)");
+  cmd.get_option("SCENE")->required();
+  cli::add_value_option(cmd, "-o,--output", a->output, "the canonical scene file to write")
+      ->type_name("OUT.json")
+      ->required();
+  cli::add_verbose_flag(cmd);
+  return [a] { return run_save(*a); };
+}
+
+cli::RunCommand add_variants_command(CLI::App& cmd) {
+  auto a = std::make_shared<VariantsArgs>();
+  add_scene_options(cmd, a->scene, a->sets,
+                    "a scene file (.json, .gltf, .glb); default content/scenes/default.json");
+  cmd.add_flag("--aov", a->aovs, "the programs of a frame that writes AOVs");
+  cli::add_verbose_flag(cmd);
+  return [a] { return run_variants(*a); };
+}
+
+cli::RunCommand add_info_command(CLI::App& cmd) {
+  auto a = std::make_shared<InfoArgs>();
+  add_scene_options(cmd, a->scene, a->sets,
+                    "a scene file: print its entities (name, parent, components), the names "
+                    "--set addresses, a glTF file's own nodes included; without one, print the "
+                    "OpenGL context kaskad gets on this machine");
+  cli::add_window_flags(cmd, a->headless);
+  cli::add_verbose_flag(cmd);
+  return [a] { return run_info(*a); };
+}
+
+cli::RunCommand add_bench_command(CLI::App& cmd) {
+  auto a = std::make_shared<BenchArgs>();
+  BenchOptions& o = a->bench;
+  cmd.add_option("SCENE", o.scenes,
+                 "scene files (default: content/scenes/default.json); with --merge, the shards' "
+                 "--out folders")
+      ->type_name("FILE");
+  cli::add_value_option(cmd, "--sweep", o.sweep,
+                        "the settings to sweep, key=a,b;key2=c,d, or soft (the soft-shadow "
+                        "techniques and kernels); default: see README")
+      ->type_name("SPEC")
+      ->check(CLI::Validator(
+          [](const std::string& v) -> std::string {
+            return v.empty() ? "needs a sweep (e.g. shadow.map_size=1024,2048, or soft); without "
+                               "--sweep, bench runs the default one"
+                             : "";
+          },
+          ""));
+  cli::add_value_option(cmd, "--out", o.out_dir, "where bench.csv and the charts go (default out/bench)")
+      ->type_name("DIR");
+  cli::add_frames_option(cmd, o.frames, "timed frames per configuration (default 10)");
+  cli::add_size_option(cmd, o.width, o.height, 1, 16384, "output size in pixels (default 640x360)");
+  cmd.add_flag_callback("--no-chart", [a] { a->bench.chart = false; },
+                        "no speed-vs-accuracy chart (scripts/bench_chart.py)");
+  cmd.add_option("--stability-frames", o.stability_frames,
+                 "flicker at fixed points over an N-frame camera path (default 16, 0 = off)")
+      ->type_name("N")
+      ->allow_extra_args(false)
+      ->check(CLI::Range(0, 10000));
+  cli::add_shard_option(cmd, o.shard_index, o.shard_count,
+                        "run part i of n of the scene x configuration list (for a CI matrix); "
+                        "--merge joins the parts' CSVs");
+  cmd.add_flag("--merge", a->merge,
+               "merge the bench.csv of the shard folders named as SCENEs into --out");
+  cli::add_verbose_flag(cmd);
+  cmd.footer("Writes DIR/bench.csv and one speed-vs-accuracy chart per scene.");
+  return [a] { return run_bench_command(*a); };
+}
+
+cli::RunCommand add_schema_command(CLI::App& cmd) {
+  auto out = std::make_shared<std::filesystem::path>(content_dir().parent_path() / "docs" /
+                                                     "reference");
+  auto check = std::make_shared<bool>(false);
+  cli::add_value_option(cmd, "--out", *out,
+                        "where scene.schema.json, material.schema.json and settings.md go "
+                        "(default docs/reference beside content/)")
+      ->type_name("DIR");
+  cmd.add_flag("--check", *check,
+               "write nothing; fail if the files in DIR differ from what the field tables give");
+  return [out, check] { return run_schema_command(*out, *check); };
+}
+
 }  // namespace
 
+/// Every command, in the order `kaskad --help` lists them; the play, envmap and edit commands are
+/// declared in runtime/cli/commands.cpp.
+const cli::Command kCommands[] = {
+    {"render", "render a scene (headless or in a window), write images, AOVs and references",
+     add_render_command},
+    {"save", "write the canonical scene file (after overrides)", add_save_command},
+    {"variants", "list the shader variants (pass, key, defines) the scene needs",
+     add_variants_command},
+    {"bench", "sweep settings; write bench.csv and speed-vs-accuracy charts", add_bench_command},
+    {"envmap", "load an environment map, print what was found, write its faces or sphere map",
+     cli::add_envmap_command},
+    {"play", "replay playback files (camera keys, timeline, captures) and check their expectations",
+     cli::add_play_command},
+    {"edit", "the editor: a window with an entity list, inspectors, a fly camera, undo, saving",
+     cli::add_edit_command},
+    {"info", "print the OpenGL context, or with a SCENE its entities", add_info_command},
+    {"schema", "write the scene and material JSON schemas and the settings reference",
+     add_schema_command},
+};
+
 int run_command(int argc, char** argv) {
-  if (argc >= 2 && std::strcmp(argv[1], "envmap") == 0) return run_envmap_command(argc, argv);
-  if (argc >= 2 && std::strcmp(argv[1], "play") == 0) return run_play_command(argc, argv);
-  if (argc >= 2 && std::strcmp(argv[1], "schema") == 0) {
-    std::filesystem::path out = content_dir().parent_path() / "docs" / "reference";
-    bool check = false;
-    for (int i = 2; i < argc; ++i) {
-      if (std::strcmp(argv[i], "--check") == 0) check = true;
-      else if (std::strcmp(argv[i], "--out") == 0 && i + 1 < argc) out = argv[++i];
-      else usage_error(std::string("schema: unknown option '") + argv[i] + "'");
+  CLI::App app("kaskad - real-time shadows and reflections, headless or windowed", "kaskad");
+  app.require_subcommand(1);
+  app.footer("Run `kaskad COMMAND --help` for a command's options.");
+  std::vector<std::pair<CLI::App*, cli::RunCommand>> commands;
+  for (const cli::Command& c : kCommands) {
+    CLI::App* cmd = app.add_subcommand(c.name, c.summary);
+    // Left-over arguments are reported below, in the old words ("unknown option '--x'").
+    cmd->allow_extras();
+    commands.emplace_back(cmd, c.add(*cmd));
+  }
+  // Before CLI11, which would say "A subcommand is required" of both.
+  if (argc < 2) return cli::print_usage_error("", "missing command");
+  const std::string first = argv[1];
+  if (first == "help") {
+    std::fputs(app.help().c_str(), stdout);
+    return 0;
+  }
+  if (first.empty() || first[0] != '-') {
+    bool known = false;
+    for (const cli::Command& c : kCommands) known |= first == c.name;
+    if (!known) return cli::print_usage_error("", "unknown command '" + first + "'");
+  }
+  std::string command;
+  try {
+    app.parse(argc, argv);
+    for (auto& [cmd, run] : commands) {
+      if (!cmd->parsed()) continue;
+      command = cmd->get_name();
+      for (const std::string& extra : cmd->remaining())
+        throw cli::UsageError(extra.size() > 1 && extra[0] == '-'
+                                  ? "unknown option '" + extra + "'"
+                                  : "unexpected argument '" + extra + "'");
+      return run();
     }
-    return run_schema_command(out, check);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    if (command.empty() && !app.get_subcommands().empty())
+      command = app.get_subcommands().front()->get_name();
+    return cli::print_usage_error(command, e.what());
   }
-  if (argc >= 2 && std::strcmp(argv[1], "edit") == 0) {
-#ifdef KASKAD_HAS_EDITOR
-    return editor::run_edit_command(argc, argv);
-#else
-    std::fprintf(stderr, "kaskad: this build has no editor (configure with "
-                         "-DKASKAD_BUILD_EDITOR=ON: GLFW and Dear ImGui)\n");
-    return 2;
-#endif
-  }
-  const Args a = parse_args(argc, argv);
-  if (a.command == "info") return run_info(a);
-  if (a.command == "save") return run_save(a);
-  if (a.command == "variants") return run_variants(a);
-  if (a.command == "bench") {
-    bool frames_given = false;
-    for (int i = 2; i < argc; ++i) frames_given |= std::strcmp(argv[i], "--frames") == 0;
-    return run_bench_command(a, frames_given);
-  }
-  return run_render(a);
+  return cli::print_usage_error("", "missing command");
 }
 
 int main(int argc, char** argv) {
