@@ -99,4 +99,15 @@ fs::path resolve_typed(const fs::path& folder, const std::string& typed) {
   return p.is_absolute() ? p : folder / p;
 }
 
+void FileDialog::enter(const fs::path& dir) {
+  std::error_code ec;
+  const fs::path abs = fs::absolute(dir, ec);
+  folder = (ec ? dir : abs).lexically_normal();
+  // "a/b/.." normalises to "a/": shown, and gone up from, as "a".
+  if (!folder.has_filename() && folder != folder.root_path()) folder = folder.parent_path();
+  listing = list_folder(folder, extensions());
+  picked.clear();
+  error.clear();
+}
+
 }  // namespace kaskad::editor

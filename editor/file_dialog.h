@@ -1,5 +1,6 @@
 // The file dialog's folder logic (`kaskad edit`: Open, Save as, Import model): listing a folder and
-// resolving a typed name. Pure (no window, no ImGui); the dialog itself is drawn in editor.cpp.
+// resolving a typed name, and the dialog's state. Pure (no window, no ImGui); the dialog itself is
+// drawn in file_dialog_panel.cpp.
 #pragma once
 
 #include <filesystem>
@@ -33,5 +34,31 @@ std::string display_name(const std::string& name);
 /// The file a typed name means in the dialog showing `folder`: an absolute path as it is, else the
 /// name under `folder`; "~/" is not expanded. Empty for an empty name.
 std::filesystem::path resolve_typed(const std::filesystem::path& folder, const std::string& typed);
+
+// The file dialog's state: what it is for, the folder shown and the name typed.
+struct FileDialog {
+  enum class Purpose { open, save_as, import };
+  Purpose purpose = Purpose::open;
+  bool visible = false;           ///< shown; the operation's success or Cancel ends it
+  bool appearing = false;         ///< open the popup on the next frame
+  std::filesystem::path folder;   ///< absolute
+  FolderListing listing;          ///< of `folder`, read when it changes (and on refresh)
+  char name[1024] = "";           ///< typed, or the label of the entry clicked
+  std::filesystem::path picked;   ///< the entry clicked (its bytes, whatever its label)
+  std::filesystem::path replace;  ///< save as: the existing file the user was asked about
+  std::string error;              ///< the last refusal (an operation's error), shown in the dialog
+
+  const char* title() const {
+    return purpose == Purpose::open ? "Open scene###file_dialog"
+           : purpose == Purpose::save_as ? "Save scene as###file_dialog"
+                                         : "Import model###file_dialog";
+  }
+  std::vector<std::string> extensions() const {
+    if (purpose == Purpose::import) return {".gltf", ".glb"};
+    return {".json"};
+  }
+  /// Shows `dir` (made absolute and normal), listed afresh; forgets the entry picked and the error.
+  void enter(const std::filesystem::path& dir);
+};
 
 }  // namespace kaskad::editor

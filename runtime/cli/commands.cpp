@@ -96,6 +96,7 @@ RunCommand add_edit_command(CLI::App& cmd) {
   return [o] { return editor::run_edit(*o); };
 #else
   cmd.allow_extras();
+  cmd.footer("This build has no editor (configure with -DKASKAD_BUILD_EDITOR=ON).");
   return [] {
     std::fprintf(stderr, "kaskad: this build has no editor (configure with "
                          "-DKASKAD_BUILD_EDITOR=ON: GLFW and Dear ImGui)\n");

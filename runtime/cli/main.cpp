@@ -523,13 +523,15 @@ cli::RunCommand add_render_command(CLI::App& cmd) {
       ->type_name("FILE.exr");
   cli::add_window_flags(cmd, a->headless);
   cli::add_verbose_flag(cmd);
-  // bench's output options, refused with a pointer to -o instead of "unknown option".
-  CLI::Option* out = cmd.add_option("--out")->group("");
-  CLI::Option* sweep = cmd.add_option("--sweep")->group("");
-  return [a, out, sweep] {
-    for (const CLI::Option* o : {out, sweep})
+  // bench's output options, refused with a pointer to -o instead of "unknown option" (hidden
+  // from the help: an option without a group has no name to print, so the names are kept here).
+  const std::pair<const char*, CLI::Option*> bench_only[] = {
+      {"--out", cmd.add_option("--out")->group("")},
+      {"--sweep", cmd.add_option("--sweep")->group("")}};
+  return [a, out = bench_only[0], sweep = bench_only[1]] {
+    for (const auto& [name, o] : {out, sweep})
       if (o->count() > 0)
-        throw cli::UsageError(o->get_name() +
+        throw cli::UsageError(std::string(name) +
                               " is a bench option; kaskad render writes its image to -o FILE");
     return run_render(*a);
   };
@@ -643,7 +645,6 @@ const cli::Command kCommands[] = {
 int run_command(int argc, char** argv) {
   CLI::App app("kaskad - real-time shadows and reflections, headless or windowed", "kaskad");
   app.require_subcommand(1);
-  app.footer("Run `kaskad COMMAND --help` for a command's options.");
   std::vector<std::pair<CLI::App*, cli::RunCommand>> commands;
   for (const cli::Command& c : kCommands) {
     CLI::App* cmd = app.add_subcommand(c.name, c.summary);
@@ -651,6 +652,8 @@ int run_command(int argc, char** argv) {
     cmd->allow_extras();
     commands.emplace_back(cmd, c.add(*cmd));
   }
+  // After the commands: a subcommand starts with its parent's footer.
+  app.footer("Run `kaskad COMMAND --help` for a command's options.");
   // Before CLI11, which would say "A subcommand is required" of both.
   if (argc < 2) return cli::print_usage_error("", "missing command");
   const std::string first = argv[1];
