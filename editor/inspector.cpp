@@ -12,6 +12,7 @@
 #include "components/camera.h"
 #include "components/light.h"
 #include "components/model.h"
+#include "components/name.h"
 #include "components/shadow_settings.h"
 #include "components/transform.h"
 #include "editor/editor_app.h"

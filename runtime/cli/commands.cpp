@@ -36,20 +36,15 @@ RunCommand add_envmap_command(CLI::App& cmd) {
       ->check(CLI::IsMember(layouts));
   cmd.add_flag("--3dsmax", o->load.z_up_3dsmax,
                "the faces were authored in 3ds Max (Z up): convert them to Y up");
-  cmd.add_option("--face-size", o->load.face_size, "resample the faces to N^2 pixels")
-      ->type_name("N")
-      ->allow_extra_args(false)
-      ->check(CLI::Range(1, 8192));
+  add_integer_option(cmd, "--face-size", o->load.face_size, 1, 8192,
+                     "resample the faces to N^2 pixels");
   add_value_option(cmd, "--faces", o->faces_out,
                    "write the six faces: a pattern with * (sky_*.png) or a folder")
       ->type_name("OUT");
   add_value_option(cmd, "--sphere", o->sphere_out, "write the S3 sphere map")
       ->type_name("OUT.png");
-  cmd.add_option("--sphere-size", o->sphere_size,
-                 "the sphere map's size in pixels (default: twice the face size)")
-      ->type_name("N")
-      ->allow_extra_args(false)
-      ->check(CLI::Range(1, 8192));
+  add_integer_option(cmd, "--sphere-size", o->sphere_size, 1, 8192,
+                     "the sphere map's size in pixels (default: twice the face size)");
   return [o] { return run_envmap(*o); };
 }
 
@@ -72,7 +67,7 @@ RunCommand add_play_command(CLI::App& cmd) {
   cmd.add_flag("--merge", o->merge,
                "combine the summary.json of the shard folders named into DIR/summary.json");
   add_window_flags(cmd, o->run.headless);
-  cmd.footer("Checks the files' expectations (README \"Scene playback\"); exit status 1 when one "
+  cmd.footer("Checks the files' expectations (docs/guide/playback.md); exit status 1 when one "
              "failed.");
   return [o, out] {
     o->out_given = out->count() > 0;
@@ -90,7 +85,7 @@ RunCommand add_edit_command(CLI::App& cmd) {
       ->type_name("KEY=VALUE");
   add_size_option(cmd, o->width, o->height, 64, 16384, "the window size (default 1280x720)");
   add_value_option(cmd, "--script", o->script,
-                   "replay actions, one per line (README \"Editor: kaskad edit\")")
+                   "replay actions, one per line (docs/guide/editor.md)")
       ->type_name("FILE");
   cmd.footer("Needs a display (under CI: xvfb-run -a).");
   return [o] { return editor::run_edit(*o); };

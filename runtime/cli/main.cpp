@@ -510,8 +510,7 @@ cli::RunCommand add_render_command(CLI::App& cmd) {
                         "NAME_nz.png) and, for sphere probes, NAME_sphere.png into DIR")
       ->type_name("DIR");
   cli::add_value_option(cmd, "--reflection-reference", a->reflection_reference,
-                        "ray-traced reflected radiance C_t of every pixel (README \"Environment "
-                        "maps\")")
+                        "ray-traced reflected radiance C_t of every pixel (docs/guide/envmaps.md)")
       ->type_name("FILE.exr");
   cli::add_value_option(cmd, "--env", a->env,
                         "environment map for the reflection reference's misses (any layout)")
@@ -519,7 +518,7 @@ cli::RunCommand add_render_command(CLI::App& cmd) {
   cli::add_value_option(cmd, "--shadow-reference", a->shadow_reference,
                         "the ray-traced visibility of the light the visibility AOV shows (area "
                         "lights sampled), the AOV's, and their difference, per pixel; prints RMSE "
-                        "and MAE over the receivers (README \"Soft shadows\")")
+                        "and MAE over the receivers (docs/design/soft_shadows.md)")
       ->type_name("FILE.exr");
   cli::add_window_flags(cmd, a->headless);
   cli::add_verbose_flag(cmd);
@@ -577,7 +576,7 @@ cli::RunCommand add_bench_command(CLI::App& cmd) {
       ->type_name("FILE");
   cli::add_value_option(cmd, "--sweep", o.sweep,
                         "the settings to sweep, key=a,b;key2=c,d, or soft (the soft-shadow "
-                        "techniques and kernels); default: see README")
+                        "techniques and kernels); default: docs/guide/bench.md")
       ->type_name("SPEC")
       ->check(CLI::Validator(
           [](const std::string& v) -> std::string {
@@ -592,11 +591,9 @@ cli::RunCommand add_bench_command(CLI::App& cmd) {
   cli::add_size_option(cmd, o.width, o.height, 1, 16384, "output size in pixels (default 640x360)");
   cmd.add_flag_callback("--no-chart", [a] { a->bench.chart = false; },
                         "no speed-vs-accuracy chart (scripts/bench_chart.py)");
-  cmd.add_option("--stability-frames", o.stability_frames,
-                 "flicker at fixed points over an N-frame camera path (default 16, 0 = off)")
-      ->type_name("N")
-      ->allow_extra_args(false)
-      ->check(CLI::Range(0, 10000));
+  cli::add_integer_option(cmd, "--stability-frames", o.stability_frames, 0, 10000,
+                          "flicker at fixed points over an N-frame camera path (default 16, 0 = "
+                          "off)");
   cli::add_shard_option(cmd, o.shard_index, o.shard_count,
                         "run part i of n of the scene x configuration list (for a CI matrix); "
                         "--merge joins the parts' CSVs");
@@ -645,6 +642,9 @@ const cli::Command kCommands[] = {
 int run_command(int argc, char** argv) {
   CLI::App app("kaskad - real-time shadows and reflections, headless or windowed", "kaskad");
   app.require_subcommand(1);
+  // An option given twice takes its last value (`-o a.png -o b.png` writes b.png), as scripts
+  // that append to a base command line expect; repeatable options (--set) keep every value.
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   std::vector<std::pair<CLI::App*, cli::RunCommand>> commands;
   for (const cli::Command& c : kCommands) {
     CLI::App* cmd = app.add_subcommand(c.name, c.summary);

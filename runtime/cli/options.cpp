@@ -31,27 +31,33 @@ bool split_at(const std::string& v, char sep, std::string& a, std::string& b) {
   return true;
 }
 
-// The checks return "" for a good value, else the message CLI11 prints after "--option: ".
-// Change together with the parsers below them, which rely on the value having passed.
+/// A pair option's value ("1280x720", "0/4"), read once: the validator reports `error`, the
+/// option's function stores `first` and `second` (only called once the validator passed).
+struct Pair {
+  std::string error;  ///< "" for a good value, else the message CLI11 prints after "--option: "
+  int first = 0, second = 0;
+};
 
-std::string check_size(const std::string& v, int lo, int hi) {
+Pair read_size(const std::string& v, int lo, int hi) {
   std::string w, h;
-  if (!split_at(v, 'x', w, h)) return "expects WxH, e.g. 1280x720, got '" + v + "'";
+  if (!split_at(v, 'x', w, h)) return {"expects WxH, e.g. 1280x720, got '" + v + "'"};
   const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
-  if (!integer_in(w, lo, hi)) return "the width must be an integer in " + range + ", got '" + v + "'";
-  if (!integer_in(h, lo, hi)) return "the height must be an integer in " + range + ", got '" + v + "'";
-  return {};
+  const auto width = integer_in(w, lo, hi), height = integer_in(h, lo, hi);
+  if (!width) return {"the width must be an integer in " + range + ", got '" + v + "'"};
+  if (!height) return {"the height must be an integer in " + range + ", got '" + v + "'"};
+  return {"", *width, *height};
 }
 
 constexpr int kMaxShards = 100000;
 
-std::string check_shard(const std::string& v) {
+Pair read_shard(const std::string& v) {
   std::string i, n;
   const auto count = split_at(v, '/', i, n) ? integer_in(n, 1, kMaxShards) : std::nullopt;
-  if (!count || !integer_in(i, 0, *count - 1))
-    return "expects i/n with 0 <= i < n <= " + std::to_string(kMaxShards) + ", e.g. 0/4, got '" +
-           v + "'";
-  return {};
+  const auto index = count ? integer_in(i, 0, *count - 1) : std::nullopt;
+  if (!index)
+    return {"expects i/n with 0 <= i < n <= " + std::to_string(kMaxShards) + ", e.g. 0/4, got '" +
+            v + "'"};
+  return {"", *index, *count};
 }
 
 }  // namespace
@@ -78,15 +84,14 @@ CLI::Option* add_size_option(CLI::App& cmd, int& width, int& height, int lo, int
                              const std::string& description) {
   CLI::Option* o = cmd.add_option_function<std::string>(
       "--size",
-      [&width, &height](const std::string& v) {
-        std::string w, h;
-        split_at(v, 'x', w, h);
-        width = *integer_in(w, 0, 1 << 30);
-        height = *integer_in(h, 0, 1 << 30);
+      [&width, &height, lo, hi](const std::string& v) {
+        const Pair size = read_size(v, lo, hi);
+        width = size.first;
+        height = size.second;
       },
-      description + " (W and H in [" + std::to_string(lo) + ", " + std::to_string(hi) + "])");
+      description + "; W and H in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
   o->type_name("WxH")->allow_extra_args(false);
-  o->check(CLI::Validator([lo, hi](std::string& v) { return check_size(v, lo, hi); }, ""));
+  o->check(CLI::Validator([lo, hi](std::string& v) { return read_size(v, lo, hi).error; }, ""));
   return o;
 }
 
@@ -95,29 +100,31 @@ CLI::Option* add_shard_option(CLI::App& cmd, int& index, int& count,
   CLI::Option* o = cmd.add_option_function<std::string>(
       "--shard",
       [&index, &count](const std::string& v) {
-        std::string i, n;
-        split_at(v, '/', i, n);
-        index = *integer_in(i, 0, kMaxShards);
-        count = *integer_in(n, 1, kMaxShards);
+        const Pair shard = read_shard(v);
+        index = shard.first;
+        count = shard.second;
       },
       description);
   o->type_name("i/n")->allow_extra_args(false);
-  o->check(CLI::Validator([](std::string& v) { return check_shard(v); }, ""));
+  o->check(CLI::Validator([](std::string& v) { return read_shard(v).error; }, ""));
   return o;
 }
 
-CLI::Option* add_jobs_option(CLI::App& cmd, int& jobs, const std::string& description) {
-  return cmd.add_option("--jobs", jobs, description)
+CLI::Option* add_integer_option(CLI::App& cmd, const std::string& name, int& into, int lo, int hi,
+                                const std::string& description) {
+  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  return cmd.add_option(name, into, description + "; N in " + range)
       ->type_name("N")
       ->allow_extra_args(false)
-      ->check(CLI::Range(1, 256));
+      ->check(CLI::Range(lo, hi).description(""));
+}
+
+CLI::Option* add_jobs_option(CLI::App& cmd, int& jobs, const std::string& description) {
+  return add_integer_option(cmd, "--jobs", jobs, 1, 256, description);
 }
 
 CLI::Option* add_frames_option(CLI::App& cmd, int& frames, const std::string& description) {
-  return cmd.add_option("--frames", frames, description)
-      ->type_name("N")
-      ->allow_extra_args(false)
-      ->check(CLI::Range(1, 100000));
+  return add_integer_option(cmd, "--frames", frames, 1, 100000, description);
 }
 
 void add_window_flags(CLI::App& cmd, bool& headless) {

@@ -52,6 +52,10 @@ CLI::Option* add_value_option(CLI::App& cmd, const std::string& name, T& into,
   return cmd.add_option(name, into, description)->allow_extra_args(false)->check(not_an_option());
 }
 
+/// An option with one integer value in [lo, hi] (its help says the range once, as "N in [lo, hi]").
+CLI::Option* add_integer_option(CLI::App& cmd, const std::string& name, int& into, int lo, int hi,
+                                const std::string& description);
+
 /// `--size WxH`: width and height in pixels, each in [lo, hi].
 CLI::Option* add_size_option(CLI::App& cmd, int& width, int& height, int lo, int hi,
                              const std::string& description);

@@ -74,6 +74,12 @@ help_options envmap IN --layout --3dsmax --face-size --faces --sphere --sphere-s
 help_options play FILE --out --update-goldens --shard --jobs --merge --headless --window
 help_options edit SCENE --set --size --script
 help_options info SCENE --set --headless --window
+help_options schema --out --check
+# An option given twice takes its last value, as before CLI11 (scripts append to a base line).
+check option_given_twice 0 "wrote .*twice_b.png" -- "$KASKAD" render --headless --size 32x32 --frames 1 \
+  -o "$tmp/twice_a.png" -o "$tmp/twice_b.png"
+[ ! -e "$tmp/twice_a.png" ] && passed=$((passed + 1)) ||
+  { echo "FAIL option_given_twice: the first -o was written too"; failed=$((failed + 1)); }
 # One --size for every command: the same checks and words, within each command's own bounds.
 check render_size_no_height 2 "^kaskad render: --size: the height must be an integer in \[1, 16384\], got '640x'" -- \
   "$KASKAD" render --headless --size 640x -o "$tmp/no_height.png"
