@@ -12,7 +12,7 @@ packages=(
   libegl-mesa0 libgl1-mesa-dri libglx-mesa0 libgl1 mesa-utils
   libtinygltf-dev libdraco-dev draco
   libopenimageio-dev openimageio-tools
-  nlohmann-json3-dev libcli11-dev libimgui-dev libstb-dev libembree-dev
+  nlohmann-json3-dev libcli11-dev libxxhash-dev libimgui-dev libstb-dev libembree-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-matplotlib python3-numpy python3-jsonschema xvfb xauth xdotool
 )

@@ -12,6 +12,7 @@
 #include "components/mesh_renderer.h"
 #include "components/model.h"
 #include "components/transform.h"
+#include "runtime/core/hash.h"
 #include "runtime/core/log.h"
 #include "runtime/result/result.h"
 
@@ -29,7 +30,7 @@ bool sphere_intersects_box(const glm::vec3& c, float r, const Aabb& b) {
   return glm::dot(d, d) <= r * r;
 }
 
-void hash_material(SignatureHash& h, const Material& m) {
+void hash_material(Hash& h, const Material& m) {
   h.add(m.base_color);
   h.add(m.base_color_texture);
   h.add(m.metallic);
@@ -50,14 +51,6 @@ const ProbeData::Entry* ProbeData::find(ecs::Entity e) const {
   for (const Entry& p : probes)
     if (p.entity == e) return &p;
   return nullptr;
-}
-
-void SignatureHash::add(const void* data, std::size_t bytes) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < bytes; ++i) {
-    h_ ^= p[i];
-    h_ *= 1099511628211ull;  // FNV-1a 64 prime
-  }
 }
 
 ProbeWork schedule_probe(const Reflector& r, ProbeState& s, std::uint64_t frame,
@@ -132,7 +125,7 @@ glm::mat4 cube_face_projection(float near, float far) {
 
 std::uint64_t scene_signature(const ecs::World& world, ecs::Entity self, const glm::vec3& center,
                               float far, std::uint32_t exclude_layers) {
-  SignatureHash h;
+  Hash h;
   h.add(center);
   world.view<Light, WorldTransform>().each(
       [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {

@@ -93,18 +93,6 @@ glm::mat4 cube_face_view(int face, const glm::vec3& center);
 /// The matching projection: 90° vertical field of view, aspect 1.
 glm::mat4 cube_face_projection(float near, float far);
 
-/// Order-dependent hash of the values that a probe's capture depends on.
-class SignatureHash {
- public:
-  void add(const void* data, std::size_t bytes);
-  template <class T>
-  void add(const T& v) { add(&v, sizeof v); }
-  std::uint64_t value() const { return h_; }
-
- private:
-  std::uint64_t h_ = 1469598103934665603ull;  // FNV-1a 64 offset basis
-};
-
 /// The on_change signature of the probe on `self` centred at `center` with range `far`: every
 /// light, and every MeshRenderer other than `self` and outside `exclude_layers` whose world
 /// bounds intersect the sphere (center, far): entity, world matrix, mesh and material.

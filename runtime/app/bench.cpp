@@ -27,6 +27,7 @@
 #include "runtime/app/stability.h"
 #include "runtime/core/atomic_file.h"
 #include "runtime/core/file_io.h"
+#include "runtime/core/hash.h"
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
 
@@ -104,11 +105,8 @@ void progress_line(std::size_t done, std::size_t total, double elapsed_s, const 
 // material's alpha cut-out (the tracer copies it), and the meshes' sizes. Configurations of one scene usually differ in settings only, so the BVH is
 // rebuilt only when this changes (a --set may move or hide geometry).
 std::uint64_t geometry_signature(const Scene& scene) {
-  std::uint64_t h = 1469598103934665603ull;
-  auto mix = [&](const void* data, std::size_t n) {
-    const auto* b = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
-  };
+  Hash h;
+  auto mix = [&](const void* data, std::size_t n) { h.add_bytes(data, n); };
   scene.world.view<const MeshRenderer, const WorldTransform>().each(
       [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
         const std::uint32_t id = e.index;
@@ -127,7 +125,7 @@ std::uint64_t geometry_signature(const Scene& scene) {
     const std::size_t sizes[2] = {m.positions.size(), m.indices.size()};
     mix(sizes, sizeof sizes);
   }
-  return h;
+  return h.value();
 }
 
 }  // namespace

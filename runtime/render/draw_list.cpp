@@ -9,7 +9,7 @@
 #include <utility>
 
 #include "components/bounds.h"
-#include "runtime/render/input_hash.h"
+#include "runtime/core/hash.h"
 
 namespace kaskad::render {
 
@@ -175,7 +175,7 @@ using MaterialBits = decltype(material_bits(Material{}));
 
 struct MaterialBitsHash {
   std::size_t operator()(const MaterialBits& bits) const {
-    return std::size_t(InputHash().add(bits).value());
+    return std::size_t(Hash().add(bits).value());
   }
 };
 

@@ -9,7 +9,7 @@
 #include "runtime/core/log.h"
 #include "runtime/features/shader_interface.h"
 #include "runtime/render/depth_draws.h"
-#include "runtime/render/input_hash.h"
+#include "runtime/core/hash.h"
 #include "runtime/render/texture_storage.h"
 
 namespace kaskad::render {
@@ -105,7 +105,7 @@ Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const Sha
   }
   // A layer's inputs beyond its casters: the receivers that cast nothing (stored, so that they
   // are shaded; hashed once for every layer), the light's size and the layer count.
-  InputHash receivers;
+  Hash receivers;
   for (std::uint32_t i : list.depth_order) {
     const DrawItem& d = frame.draws[i];
     if (d.receive_shadows && !d.cast_shadows) receivers.add(d.mesh).add(d.model);
@@ -114,7 +114,7 @@ Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const Sha
   for (const ShadowView& v : views)
     for (int c = 0; c < v.layer_count; ++c) {
       const int layer = v.first_layer + c;
-      InputHash h;
+      Hash h;
       h.add(shadow.layer_inputs(layer)).add(v.light_size).add(peels).add(v.cull);
       h.add(receivers.value());
       inputs_[std::size_t(layer)] = h.value();

@@ -7,7 +7,7 @@
 
 #include "components/shadow_technique.h"
 #include "runtime/features/shader_interface.h"
-#include "runtime/render/input_hash.h"
+#include "runtime/core/hash.h"
 #include "runtime/render/texture_storage.h"
 
 namespace kaskad::render {
@@ -72,7 +72,7 @@ Status MomentsPass::prepare(const FrameInput& frame, const ShadowMapPass& shadow
     for (int c = 0; c < v.layer_count; ++c) {
       const int layer = v.first_layer + c;
       rects_[std::size_t(layer)] = stats.layer_rect[std::size_t(layer)];
-      InputHash h;
+      Hash h;
       h.add(shadow.layer_inputs(layer)).add(frame.shadow_settings.vsm_blur).add(four);
       inputs_[std::size_t(layer)] = h.value();
       if (!keeps_layer(frame.shadow_cache, drawn_[std::size_t(layer)], inputs_[std::size_t(layer)],

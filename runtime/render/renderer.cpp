@@ -22,7 +22,7 @@
 #include "runtime/render/frame_uniforms.h"
 #include "runtime/render/gpu_cache.h"
 #include "runtime/render/gpu_timers.h"
-#include "runtime/render/input_hash.h"
+#include "runtime/core/hash.h"
 #include "runtime/render/passes.h"
 #include "runtime/render/probe_capture.h"
 #include "runtime/features/shader_interface.h"
@@ -180,7 +180,7 @@ std::string gib(double bytes) {
 std::uint64_t visibility_inputs(const FrameInput& frame, const DrawList& list,
                                 const AssetStore& assets, const FrameBlock& block,
                                 int shader_reloads) {
-  InputHash h;
+  Hash h;
   h.add(assets.uid).add(shader_reloads).add(frame.width).add(frame.height);
   h.add(list.frame_key.bits()).add(block);
   for (std::uint32_t i : list.forward_order) {

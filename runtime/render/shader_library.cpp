@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "runtime/core/atomic_file.h"
+#include "runtime/core/hash.h"
 #include "runtime/core/log.h"
 #include "runtime/gpu/shader.h"
 
@@ -95,14 +96,6 @@ void write_cache(const fs::path& file, std::uint64_t hash, GLenum format,
 
 }  // namespace
 
-std::uint64_t fnv1a64(std::string_view data, std::uint64_t h) {
-  for (unsigned char c : data) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 fs::path default_shader_cache_dir() {
   if (const char* env = std::getenv("KASKAD_SHADER_CACHE"); env && *env)
     return std::string(env) == "off" ? fs::path() : fs::path(env);
@@ -163,7 +156,7 @@ Result<ShaderLibrary::Entry> ShaderLibrary::build(Pass pass, VariantKey key, boo
   // Cache key: driver + both preprocessed sources. Editing any included file changes the text,
   // so stale binaries are never used (they are simply not found).
   const std::uint64_t hash =
-      fnv1a64(fs_src->text, fnv1a64(vs->text, fnv1a64(driver_)));
+      hash_bytes(fs_src->text, hash_bytes(vs->text, hash_bytes(driver_)));
   const bool use_cache = !cache_dir_.empty() && binary_formats_ > 0;
   const fs::path cache_file = cache_dir_ / (hex(hash) + ".bin");
   if (use_cache) {

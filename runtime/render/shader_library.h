@@ -82,8 +82,6 @@ class ShaderLibrary {
   ShaderStats stats_;
 };
 
-/// 64-bit FNV-1a (stable across runs and builds: used for cache file names).
-std::uint64_t fnv1a64(std::string_view data, std::uint64_t seed = 14695981039346656037ull);
 
 /// Default binary cache folder: $KASKAD_SHADER_CACHE ("off" disables), else
 /// $XDG_CACHE_HOME/kaskad/shaders, else ~/.cache/kaskad/shaders.

@@ -8,7 +8,7 @@
 
 #include "runtime/features/shader_interface.h"
 #include "runtime/render/depth_draws.h"
-#include "runtime/render/input_hash.h"
+#include "runtime/core/hash.h"
 #include "runtime/render/texture_storage.h"
 
 namespace kaskad::render {
@@ -137,7 +137,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   // casters (mesh, model matrix, depth program, alpha-mask parameters) in order. A moved caster
   // changes its matrix, a moved camera the layer's matrix or casters; other assets (another
   // scene) change assets.uid. New storage invalidated every layer.
-  auto add_caster = [&](InputHash& h, std::size_t view, std::uint32_t i) {
+  auto add_caster = [&](Hash& h, std::size_t view, std::uint32_t i) {
     const DrawItem& d = frame.draws[i];
     const VariantKey key = list.depth_key(view, i);
     h.add(d.mesh).add(d.model).add(key.filtered_for(Pass::depth).bits());
@@ -147,7 +147,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
           .add(d.material.base_color_texture)
           .add(d.material.base_color_transform);
   };
-  auto add_pass = [&](InputHash& h, const ShadowView& v) {
+  auto add_pass = [&](Hash& h, const ShadowView& v) {
     h.add(assets.uid).add(shader_reloads).add(layered).add(v.projection).add(v.cull);
     h.add(v.slope_bias).add(v.constant_bias);
   };
@@ -156,10 +156,10 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   std::vector<std::uint64_t> caster_ids;
   auto view_casters = [&](std::size_t view) {
     caster_ids.assign(frame.draws.size(), 0);
-    InputHash all;
+    Hash all;
     for (std::uint32_t i : list.depth_order)
       if (frame.draws[i].cast_shadows) {
-        InputHash one;
+        Hash one;
         add_caster(one, view, i);
         caster_ids[i] = one.value();
         all.add(caster_ids[i]);
@@ -168,7 +168,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   };
   auto layer_inputs = [&](std::size_t view, int c) {
     const ShadowView& v = views[view];
-    InputHash h;
+    Hash h;
     add_pass(h, v);
     h.add(v.view_proj[std::size_t(c)]).add(v.skipped[std::size_t(c)]);
     // Only the paraboloid depth pass reads splits (near, far) and the margin (shadow_depth.vert).
@@ -185,7 +185,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
     const ShadowView& v = views[view];
     glm::mat4 m = v.view_proj[std::size_t(c)];
     m[3][0] = m[3][1] = 0.0f;
-    InputHash h;
+    Hash h;
     add_pass(h, v);
     h.add(m).add(casters);
     return h.value();

@@ -1,17 +1,14 @@
-// The draw list's order (runtime/render/draw_list.h) and the cache's input hash
-// (runtime/render/input_hash.h), without GL. Draws that may share one instanced draw must be
-// neighbours in every pass's order; equal inputs hash equal and a changed byte changes the hash.
+// The draw list's order (runtime/render/draw_list.h), without GL. Draws that may share one
+// instanced draw must be neighbours in every pass's order.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <random>
-#include <set>
 #include <tuple>
 #include <vector>
 
 #include "runtime/render/draw_list.h"
-#include "runtime/render/input_hash.h"
 
 namespace kaskad::render {
 namespace {
@@ -149,30 +146,6 @@ TEST(DrawList, TheOrderOfClassesIsTheSameWhateverOrderDrawsArriveIn) {
     return out;
   };
   EXPECT_EQ(classes(a), classes(b));
-}
-
-struct Odd {
-  std::uint8_t bytes[13];
-};
-
-TEST(InputHash, EqualInputsHashEqualAndEveryBitCounts) {
-  Odd x{};
-  for (int i = 0; i < 13; ++i) x.bytes[i] = std::uint8_t(i * 37);
-  const std::uint64_t base = InputHash().add(x).add(2.5f).value();
-  EXPECT_EQ(InputHash().add(x).add(2.5f).value(), base);
-  EXPECT_NE(base, 0u);
-  std::set<std::uint64_t> seen{base};
-  for (int byte = 0; byte < 13; ++byte)
-    for (int bit = 0; bit < 8; ++bit) {
-      Odd y = x;
-      y.bytes[byte] ^= std::uint8_t(1u << bit);
-      const std::uint64_t h = InputHash().add(y).add(2.5f).value();
-      EXPECT_NE(h, 0u);
-      EXPECT_TRUE(seen.insert(h).second) << "byte " << byte << " bit " << bit;
-    }
-  // Order and grouping count.
-  EXPECT_NE(InputHash().add(1.0f).add(2.0f).value(), InputHash().add(2.0f).add(1.0f).value());
-  EXPECT_NE(InputHash().add(std::uint32_t(0)).value(), InputHash().add(std::uint64_t(0)).value());
 }
 
 }  // namespace
