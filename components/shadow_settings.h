@@ -228,9 +228,9 @@ struct ShadowSettings {
   /// the vertex shader picks the layer (gl_Layer, GL_ARB_shader_viewport_layer_array; drivers
   /// without it fall back to false). false: one pass per layer. Same maps either way (render
   /// test, exact). false by default: on llvmpipe, once the terrain was tiled (so casters overlap
-  /// few cascades), one pass per layer made content/scenes/terrain.json's frame about 12%
-  /// faster; default.json is even (README, "Layered shadow pass"). Dual-paraboloid maps always
-  /// draw per layer. Taken from the first shadowed light for all.
+  /// few cascades), one pass per layer made content/scenes/terrain.json's frame faster and
+  /// default.json no slower (docs/design/batching.md, "Layered shadow pass"). Dual-paraboloid
+  /// maps always draw per layer. Taken from the first shadowed light for all.
   bool layered = false;
   /// Directional lights with view-depth selection: leave out of a cascade the casters whose
   /// shadow cannot fall on the receivers it serves (may_shadow(): e.g. a ground plane when every

@@ -25,7 +25,8 @@ std::string entity_label(const ecs::World& world, ecs::Entity e) {
 // call: every WorldTransform recomputed in that call gets it as its TransformCache::version. A
 // child compares its parent's handle and version, so a parent recomputed in a later call always
 // shows a version the child has not recorded. Starts at 1: 0 means "never computed". (One atomic
-// per call, not per entity: an atomic add per recompute cost ~15% when everything moves.)
+// per call, not per entity: an atomic add per recompute was measurably slower when everything
+// moves; docs/design/ecs.md, "Transforms".)
 std::uint64_t next_stamp() {
   static std::atomic<std::uint64_t> counter{1};
   return counter.fetch_add(1, std::memory_order_relaxed);

@@ -10,7 +10,8 @@
 layout(binding = UNIT_DFG) uniform sampler2D u_dfg;
 // Rows of 9 SH coefficients (rgb) of radiance, one per probe prefiltered for the pbr reflection
 // model (IblMaps in runtime/render/ibl_maps.h). The environment map's are in the frame block
-// (u_environment_sh: nine fetches per pixel cost llvmpipe about a quarter of a frame).
+// (u_environment_sh: nine texture fetches per pixel cost llvmpipe much more;
+// docs/design/shading.md, "The model").
 layout(binding = UNIT_SH) uniform sampler2D u_sh;
 
 // sh9_irradiance_over_pi() of components/ibl.h: E(n) / pi from coefficients c[0..8].

@@ -43,7 +43,8 @@ layout(location = 0) out float o_factor;
 
 // Cells per side of the widest kernel: 2 LOM_HALF + 1 (coarser cells past LOM_HALF texels of
 // radius). As backprojection()'s BP_HALF: a cell of `step` texels samples one depth, so an
-// occluder's edge moves by up to half a cell with P; 6 made penumbrae 10-20% wider.
+// occluder's edge moves by up to half a cell with P; fewer cells made penumbrae wider
+// (docs/design/soft_shadows.md, lom).
 #define LOM_HALF 12
 
 // The light's 64 sample points, one per bit of a 64-bit mask (uvec2: bits 0-31, 32-63): bit

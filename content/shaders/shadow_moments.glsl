@@ -59,7 +59,7 @@ const float VSM_MIN_VARIANCE = 1.1920929e-7;
 // nothing) while the blur covers the footprint. The sampler's own anisotropy was tried:
 // llvmpipe's takes the ellipse from the coordinates' screen derivatives, not from textureGrad's,
 // and in non-uniform control flow or at a spot map's near plane scanned thousands of texels per
-// pixel (seconds a frame).
+// pixel (docs/design/soft_shadows.md, vsm).
 const int VSM_MAX_ANISOTROPY = 8;
 
 vec4 moments_filtered(int layer, vec2 uv, vec2 dx, vec2 dy) {

@@ -104,7 +104,7 @@ float pcss(int k, int i, int layer, vec3 c, vec2 g, float angle) {
   // A square or rectangular emitter (spot, point, area): the filter has the light's own shape,
   // half-widths pcss_radius() per axis; the disc's taps are carried onto the square by an
   // area-preserving map, so they stay as even (a round filter over a square light's straight
-  // edge gave penumbrae 12% too narrow, 10-90%).
+  // edge gave penumbrae too narrow; docs/design/soft_shadows.md, pcss).
   vec2 radius = vec2(pcss_radius(map, extent.x, d_r, d_b), pcss_radius(map, extent.y, d_r, d_b));
   radius = clamp(radius, vec2(1.5), vec2(PCSS_MAX_RADIUS));
   float sum_lit = 0.0;

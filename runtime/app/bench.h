@@ -47,7 +47,7 @@ void end_progress();
 /// The sweep used when none is given: the settings whose speed/accuracy trade-off matters.
 std::string default_sweep();
 
-/// `--sweep soft` (issue 14): the soft-shadow techniques and PCF kernels, for scenes whose lights
+/// `--sweep soft`: the soft-shadow techniques and PCF kernels, for scenes whose lights
 /// have a size (content/scenes/soft/): pcf with kernels 3x3, 5x5, 9x9 and a 16- and 32-tap
 /// disc, pcss with 16 and 32 taps, backprojection, lom (S1's 1024^2 map, 4 and 8 layers), vsm
 /// and evsm (default blur and bleeding reduction), each with the shadow cache off (maps redrawn

@@ -1,4 +1,4 @@
-// World-space shadow stability (issue "metrics"): a fixed set of points on receivers, a camera
+// World-space shadow stability: a fixed set of points on receivers, a camera
 // path while the light and the scene stay still, and each frame the engine's visibility at those
 // points through the forward pass's own shadow lookup (Renderer::shadow_at_points). A stabilised
 // configuration under camera translation can score exactly 0.

@@ -226,8 +226,8 @@ std::string one_line(std::string s) {
 
 /// GIF: the decoder allocates and clears a canvas of the logical screen's size (bytes 6..9 of
 /// the header, little-endian width and height) before it looks at any image in the file, so a
-/// 14-byte file claiming a 25443 x 18761 screen took 1.9 GB and seconds (found by scripts/fuzz.sh
-/// image, as a timeout). The screen is held to the limits of decoded images: at most
+/// 14-byte file claiming a 25443 x 18761 screen took gigabytes and seconds (found by
+/// scripts/fuzz.sh image, as a timeout; docs/guide/testing.md, "Fuzzing"). The screen is held to the limits of decoded images: at most
 /// kMaxImageSide a side, kMaxImageValues RGBA values, and no more than the data could hold.
 Status check_gif_screen(const std::uint8_t* d, std::size_t n, const std::string& name) {
   if (n < 10) return Error{name, "byte 0", "truncated GIF: no logical screen descriptor"};
@@ -244,8 +244,8 @@ Status check_gif_screen(const std::uint8_t* d, std::size_t n, const std::string&
 }
 
 /// PNG: libpng allocates a chunk's declared length before reading it, so a 335-byte file whose
-/// tEXt chunk claimed 1 GiB took 1.2 GB and most of a second before failing (found by
-/// scripts/fuzz.sh envmap, as a timeout under ASan). The chunks are walked first (8-byte
+/// tEXt chunk claimed 1 GiB took over a gigabyte before failing (found by scripts/fuzz.sh
+/// envmap, as a timeout under ASan; docs/guide/testing.md, "Fuzzing"). The chunks are walked first (8-byte
 /// signature, then per chunk: length, type, data, CRC, up to IEND): each must fit in the file.
 Status check_png_chunks(const std::uint8_t* d, std::size_t n, const std::string& name) {
   // The format can come from the extension alone: say so before reading garbage as chunks.
@@ -432,7 +432,8 @@ Result<Image> decode(const std::uint8_t* data, std::size_t size, const std::stri
   // No codec we allow packs more than a few thousand values into one byte (deflate's limit is
   // about 1000:1), so a header that claims far more than the data could hold is refused before
   // the buffers are allocated: a 626-byte EXR claiming a huge data window made the decoder take
-  // 2 GB and 3 s before it failed (found by scripts/fuzz.sh image).
+  // gigabytes and seconds before it failed (found by scripts/fuzz.sh image; docs/guide/testing.md,
+  // "Fuzzing").
   if (values > std::uint64_t(size) * kMaxValuesPerByte) {
     return Error{name, "",
                  "corrupt or truncated: the header claims " + std::to_string(spec.width) + " x " +

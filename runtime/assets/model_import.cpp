@@ -17,8 +17,8 @@ using json_reader::ContentError;
 // Gives entity e a copy of `originals`, the entities an earlier import made under `first`: the
 // same meshes, textures and materials, so N instances of one model load and upload it once and
 // draw it instanced. Parents are remapped into the copy; copied cameras are not active. Returns
-// the copies. (Scanning every Imported entity per copy made loading N instances O(N^2): 5 s for
-// 33,000 copies of a one-node model.)
+// the copies. (Scanning every Imported entity per copy made loading N instances O(N^2);
+// docs/design/large_scenes.md, "Loading many instances".)
 std::vector<ecs::Entity> copy_import(ecs::World& w, const FirstImport& from, ecs::Entity e) {
   const ecs::Entity first = from.first;
   const std::vector<ecs::Entity>& originals = from.made;

@@ -38,11 +38,11 @@ class View;
 ///     pool is probed per entity: first the fast path (does it hold the entity at the same
 ///     position? one compare), then the sparse lookup.
 /// Why steps 2 and 3 avoid the per-entity compare where they can: it streams two 8-byte entity
-/// arrays besides the components, and at 10^6 entities that measured 1.9-2.6x the plain loop,
-/// over the 1.5x target (tests/bench/ecs_bench.cpp); memcmp over blocks reads the same bytes
-/// several times faster, and a remembered prefix reads none. Views of a non-const World refresh
-/// the remembered prefix; views of a const World only read it, so concurrent const views never
-/// write shared state.
+/// arrays besides the components, and at 10^6 entities that is well over the target
+/// (tests/bench/ecs_bench.cpp; measured: docs/design/ecs.md, "Views over several components");
+/// memcmp over blocks reads the same bytes much faster, and a remembered prefix reads none.
+/// Views of a non-const World refresh the remembered prefix; views of a const World only read
+/// it, so concurrent const views never write shared state.
 template <class... I, class... X>
 class View<detail::TypeList<I...>, detail::TypeList<X...>> {
   static constexpr std::size_t N = sizeof...(I);

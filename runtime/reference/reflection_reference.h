@@ -1,4 +1,4 @@
-// The ray-traced reflection reference (issue 5, for the probe issue 6): for every pixel of a
+// The ray-traced reflection reference (for the reflection probes): for every pixel of a
 // rendered AOV image, the radiance C_t a perfect mirror at that surface point reflects (S3 eq. 1
 // and 3: I' = I + k_s p_r C_t). The mirror ray is traced with Embree (RayTracer::trace_mirror);
 // a hit is shaded with the forward pass's material model (content/shaders/forward.frag: change

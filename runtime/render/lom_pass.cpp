@@ -95,7 +95,8 @@ Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const Sha
     depth_ = {};
     ensure_storage(size, slices);
     // Pass 1 works per map texel and layer: past S1's one 1024^2 map, a software rasteriser
-    // takes seconds whenever the maps are redrawn (the first frame, a moving camera or light).
+    // is slow whenever the maps are redrawn (the first frame, a moving camera or light;
+    // measured: docs/design/soft_shadows.md, lom).
     if (double(size) * size * total > 2.0 * 1024.0 * 1024.0)
       log::warn_once("shadow.technique lom: %d map layers of %d^2 with %d depth peels each; its "
                      "pass 1 runs per map texel and layer, so every frame that redraws the maps "

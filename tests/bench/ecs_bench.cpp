@@ -4,8 +4,9 @@
 // re-aligned with sort_like) stay within 1.5x of the plain loop in ns/entity. They get there
 // through the aligned prefix (runtime/ecs/world.h, View step 2): once a view has seen that both
 // pools hold the same entity at every position, later iterations read only the component arrays.
-// The per-entity fast-path compare alone streams two extra 8-byte entity arrays and measured ~1.9x
-// at 10^6 entities (the plain loop's 24 MB fit in L3; 40 MB do not). Sparse and churned-but-
+// The per-entity fast-path compare alone streams two extra 8-byte entity arrays and misses the
+// target at 10^6 entities (the plain loop's 24 MB fit in L3; 40 MB do not; measured:
+// docs/design/ecs.md, "Views over several components"). Sparse and churned-but-
 // unsorted views pay a sparse lookup (two dependent loads) per entity and are reported for
 // comparison, not held to the target.
 //

@@ -1,4 +1,4 @@
-// Frame cost against object count, and what a still camera saves (issue 13's benchmark).
+// Frame cost against object count, and what a still camera saves (docs/design/shadow_cost.md).
 //   scaling_bench [frames=8] [max_instances=100000] [scenes=default,terrain]
 //   (build/release/tests/scaling_bench; max_instances 0 runs part 2 alone, scenes "" part 1 alone)
 // 1. Scaling: generated scenes of 100, 1,000, 10,000 and 100,000 instances of three meshes

@@ -1,4 +1,4 @@
-// Normals as the shader shades them (issue 17): the interpolated normal flips only on back faces
+// Normals as the shader shades them: the interpolated normal flips only on back faces
 // (gl_FrontFacing), which only double-sided materials show; a mirrored transform (negative
 // determinant) keeps its front faces in front. Before, the normal flipped wherever it faced away
 // from the camera, which darkened terrain ridges (normals pointing down on a heightfield lit from

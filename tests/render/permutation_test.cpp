@@ -164,7 +164,7 @@ TEST_F(PermutationTest, EveryVariantMatchesTheUberShaderOracle) {
   }
 }
 
-// The material inputs of issue 17 (occlusion, metallic-roughness and emissive textures, texture
+// The glTF material inputs (occlusion, metallic-roughness and emissive textures, texture
 // transforms, also on an alpha-masked caster) render the same through their variants as through
 // the oracle.
 TEST_F(PermutationTest, NewMaterialInputsMatchTheUberShaderOracle) {

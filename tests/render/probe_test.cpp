@@ -526,7 +526,7 @@ TEST_F(ProbeTest, BoxProjectionCorrectsParallaxInARoom) {
   }
 }
 
-// Issue 17: mirrors that see mirrors on the first frame. In content/scenes/reflections.json the
+// Mirrors that see mirrors on the first frame. In content/scenes/reflections.json the
 // mirror ball and the mirror plane both capture on frame 0. With one capture round each sees the
 // other before the other has a map: a mirror reflecting nothing, near black (the ball's base
 // colour is 0.05, the plane's 0.02, both metallic). With render.probe_bounces = 2 the second
@@ -653,17 +653,17 @@ TEST_F(MirrorsSeeMirrors, OnTheFirstFrameOfTheReflectionsDemo) {
     EXPECT_EQ(r->ball_in_plane.clear + r->plane_in_ball.clear + r->plane_aov.clear, 0);
   }
   // One round: each mirror is black in the other's map (the sun's highlight aside), and so is
-  // the ball in the plane as the camera sees it. Seen: 99%, 85%, 100%.
+  // the ball in the plane as the camera sees it (measured: docs/design/probes.md, "Bounces").
   EXPECT_GT(one.ball_in_plane.dark_fraction(), 0.8f);
   EXPECT_GT(one.plane_in_ball.dark_fraction(), 0.7f);
   EXPECT_GT(one.plane_aov.dark_fraction(), 0.8f);
   // Two rounds: the ball in the plane's map and in the main view shows its surroundings; the
   // plane in the ball's map still shows the ball black where it reflects it (ball -> plane ->
-  // ball, a third bounce). Seen: 4%, 21%, 2%.
+  // ball, a third bounce; measured: docs/design/probes.md).
   EXPECT_LT(two.ball_in_plane.dark_fraction(), 0.1f);
   EXPECT_LT(two.plane_in_ball.dark_fraction(), 0.3f);
   EXPECT_LT(two.plane_aov.dark_fraction(), 0.1f);
-  // Three rounds fill that in too. Seen: under 2% each.
+  // Three rounds fill that in too (docs/design/probes.md).
   EXPECT_LT(three.ball_in_plane.dark_fraction(), 0.05f);
   EXPECT_LT(three.plane_in_ball.dark_fraction(), 0.05f);
   EXPECT_LT(three.plane_aov.dark_fraction(), 0.05f);

@@ -1,4 +1,4 @@
-// Shadow caching (issue 13): a shadow-map layer is re-rendered only when what it is drawn from
+// Shadow caching: a shadow-map layer is re-rendered only when what it is drawn from
 // changed (its matrix, its casters, a caster's matrix, bias, pass mode); otherwise it keeps its
 // depth. Checked on the default scene: a repeated frame re-renders nothing and keeps the same
 // maps; after a caster, the sun or the camera moves, the maps (kept and re-rendered layers

@@ -1,7 +1,7 @@
 // The shadow lookup (content/shaders/shadow.glsl) in GL.
 // 1. Its filter kernel, shadow_taps(), against the 3x3 PCF as first written (S4): nine
 // nearest-filtered compares at constant texel offsets around the lookup point. shadow_taps() may
-// compute the same box differently (issue 13: four compare-gathers instead of nine taps); this
+// compute the same box differently (four compare-gathers instead of nine taps); this
 // pins that it is the same kernel. A random depth array is sampled at random points (inside
 // texels away from their edges, where "the nearest texel" is unambiguous; some outside the map,
 // where clamp-to-border compares as lit), random layers and random reference depths; both

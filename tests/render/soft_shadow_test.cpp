@@ -1,4 +1,4 @@
-// Soft shadows (issue 14): ShadowSettings::technique pcss and the wide PCF kernels, measured
+// Soft shadows: ShadowSettings::technique pcss and the wide PCF kernels, measured
 // against independent answers. The penumbra of a slab's edge under a sized sun against the width
 // similar triangles give; the visibility AOV of the default scene with a 5-degree sun against the
 // ray-traced area-light reference (RMSE); world-space flicker of every new lookup under camera
@@ -237,7 +237,8 @@ TEST_F(SoftShadowTest, PcssPenumbraWidthMatchesSimilarTriangles) {
 // The same under S1's square area light (a perspective map from its centre): the penumbra of the
 // slab's edge is as wide as similar triangles give, l (d - z) / z for a light of side l, a
 // blocker z and a receiver d from it, within 10%, for pcss, backprojection and lom. Measured
-// +3.5%, +1.1%, +3.3%; pcss filtering over a disc instead of the light's square gave -11.7%.
+// values: docs/design/soft_shadows.md, "Accuracy" (pcss over a disc instead of the light's
+// square fails).
 TEST_F(SoftShadowTest, AreaLightPenumbraWidthMatchesSimilarTriangles) {
   constexpr float kSpacing = 0.001f;
   const fs::path file = write_area_slab_scene();
@@ -524,8 +525,8 @@ TEST_F(SoftShadowTest, PcssBeatsHardPcfAgainstTheAreaLightReference) {
     // light's): they are held to hard pcf, not to the sized techniques. Measured with the
     // shader's own anisotropic filtering (moments_filtered()): sun 0.0257 and 0.0255 against
     // pcf's 0.0245; spot 0.0396 and 0.0396 against 0.0435. (The sampler's 8x anisotropy read
-    // 0.0240 on the sun and 0.0671 on the spot, 88% of that from 149 pixels beside the thin pole
-    // read shadowed, with seconds-long frames on llvmpipe.) Bounds: sun 1.1 x pcf, spot 1.0 x pcf.
+    // much worse on the spot, mostly from pixels beside the thin pole read shadowed, with slow
+    // frames on llvmpipe: docs/design/soft_shadows.md, vsm.) Bounds: sun 1.1 x pcf, spot 1.0 x pcf.
     const double vsm_factor = c.sets.empty() ? 1.1 : 1.0;
     EXPECT_LT(rmse[4], vsm_factor * rmse[1]) << c.name << " vsm";
     EXPECT_LT(rmse[5], vsm_factor * rmse[1]) << c.name << " evsm";
@@ -627,7 +628,7 @@ TEST_F(SoftShadowTest, LomPeelsEverySurfaceAndCountsWhereTheLayersRunOut) {
 // translation changes no shadow value at fixed world points (flicker exactly 0; PCSS up to float
 // rounding). The disc kernels' rotation comes from the point's cell in the light's texel grid,
 // numbered without the cascade's snapped translation (numbered from map coordinates, the poisson
-// kernel flickered 2.4e-4 with 1.1% of samples changed, PCSS 5.5e-4 / 1.7%).
+// kernel and PCSS flickered; docs/design/soft_shadows.md, poisson).
 TEST_F(SoftShadowTest, WideKernelsAndPcssDoNotFlickerUnderCameraTranslation) {
   const fs::path file = content_dir() / "scenes" / "soft" / "sun_5deg.json";
   const std::vector<std::vector<std::string>> cases = {

@@ -1,4 +1,4 @@
-// The visibility cache (render.visibility_cache, issue 13): a frame whose camera, draws, lights
+// The visibility cache (render.visibility_cache): a frame whose camera, draws, lights
 // and shadow maps are those of the frame that stored its visibility reads each pixel's shadow
 // visibility back instead of looking the maps up; a frame stores only when it sees what the
 // frame before saw (a moving camera's frames do not). Checked by replaying one sequence of scene

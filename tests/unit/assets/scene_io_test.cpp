@@ -180,8 +180,8 @@ TEST(SceneIo, CascadeFieldsLoadWithRangeChecksAndPerLightOverrides) {
                {"/shadow/point_mode", "sphere", "cube", "dual_paraboloid"});
 }
 
-// Issue 13's switches: both on by default, off by override, saved only when off, and not
-// numbers; the far-cascade interval within [1, 16].
+// The receiver-culling and far-cascade switches: both on by default, off by override, saved
+// only when off, and not numbers; the far-cascade interval within [1, 16].
 TEST(SceneIo, ReceiverCullingSwitchesLoadAndSave) {
   const fs::path def = kContent / "scenes" / "default.json";
   auto d = read_scene(def);
@@ -206,7 +206,7 @@ TEST(SceneIo, ReceiverCullingSwitchesLoadAndSave) {
   expect_error(read_scene(def, {"shadow.far_cascade_interval=17"}), {"/shadow/far_cascade_interval", "17"});
 }
 
-// Issue 14's settings: shadow.technique, pcf_kernel, pcf_taps, pcf_radius, lom_layers, vsm_blur,
+// The soft-shadow settings: shadow.technique, pcf_kernel, pcf_taps, pcf_radius, lom_layers, vsm_blur,
 // vsm_bleed_reduction and the spot/point light radius load, save, override and are rejected out of range with the key and the value.
 TEST(SceneIo, SoftShadowSettingsLoadSaveAndRejectBadValues) {
   const fs::path def = kContent / "scenes" / "default.json";
