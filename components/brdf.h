@@ -14,7 +14,7 @@
 //   f_specular = F D V
 //   f = f_diffuse + f_specular                       (per steradian: a BRDF)
 //
-// Radiometry (Kaskad's convention, README "Shading"): a light's colour * intensity is the
+// Radiometry (Kaskad's convention, docs/design/shading.md, "The model"): a light's colour * intensity is the
 // illuminance E it delivers to a surface facing it (KHR_lights_punctual: lux for directional
 // lights; candela / d^2 for spot and point lights), so the radiance leaving a surface is
 // f * E * N.L. A white Lambert surface facing a light of colour c shows c / pi.

@@ -33,7 +33,8 @@ inline std::array<glm::vec3, 2> uv_transform_rows(const TextureTransform& t) {
           glm::vec3(-s * t.scale.x, c * t.scale.y, t.offset.y)};
 }
 
-/// How a reflector's probe map reaches the surface (README "Shading"). s3: S3 eq. (3), the
+/// How a reflector's probe map reaches the surface (docs/guide/materials.md, "What a material's
+/// inputs do"). s3: S3 eq. (3), the
 /// surface's own shading plus k_s p_r times the mirror-direction lookup (exact, compared with the
 /// ray-traced reference). pbr: the probe lights the glTF BRDF like an environment map (its SH
 /// irradiance and GGX-prefiltered radiance, components/ibl.h), blended with the scene's

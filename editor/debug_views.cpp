@@ -39,7 +39,7 @@ float display_gamma(float linear) {
 }
 
 // An AOV view as an RGB image; `aovs` has the channels of Renderer::read_aovs(), found by the
-// names it gives them (README "AOV contract").
+// names it gives them (docs/guide/cli.md, "AOV contract").
 Image aov_view(View view, const Image& aovs) {
   Image out;
   out.width = aovs.width;

@@ -16,7 +16,7 @@ Image read_window(int w, int h);
 float display_gamma(float linear);
 
 /// An AOV view (is_aov_view(view)) as an RGB image; `aovs` has the channels of
-/// Renderer::read_aovs(), found by the names it gives them (README "AOV contract").
+/// Renderer::read_aovs(), found by the names it gives them (docs/guide/cli.md, "AOV contract").
 Image aov_view(View view, const Image& aovs);
 
 /// A cube map's faces side by side (+X -X +Y -Y +Z -Z), encoded by display_gamma().

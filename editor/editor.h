@@ -1,5 +1,6 @@
 // `kaskad edit`: the windowed editor (GLFW + Dear ImGui) over the same runtime, frame loop and
-// renderer as the headless player. Controls and the script language: README.md ("Editor").
+// renderer as the headless player. Controls and the script language: docs/guide/editor.md
+// ("Controls", "Scripts").
 #pragma once
 
 #include <filesystem>

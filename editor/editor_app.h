@@ -184,7 +184,8 @@ class Editor {
   std::pair<std::string, std::string> typed_;  ///< a number being typed: its key and edit
   /// The named widgets of the last UI frame and where they were (min x, min y, max x, max y):
   /// fields by their key, buttons and text fields by their label, entity rows "entity:NAME",
-  /// a combo's items "KEY=ITEM", the file dialog's rows "dialog:NAME" (README, `click`).
+  /// a combo's items "KEY=ITEM", the file dialog's rows "dialog:NAME" (docs/guide/editor.md,
+  /// "Scripts", `click`).
   struct Widget {
     std::array<float, 4> rect;  ///< min x, min y, max x, max y
     bool visible;               ///< not scrolled out of its panel

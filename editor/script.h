@@ -1,5 +1,5 @@
 // `kaskad edit --script FILE`: UI actions replayed one per line, for tests and demos. The language
-// is documented in README.md ("Editor: kaskad edit"); parsing is pure (no window, no scene).
+// is documented in docs/guide/editor.md ("Scripts"); parsing is pure (no window, no scene).
 #pragma once
 
 #include <filesystem>
@@ -18,10 +18,11 @@ enum class ActionKind {
   input, open, save, save_as, undo, redo, quit, force_quit
 };
 
-/// What the viewport shows: the colour, or as a debug view one of the frame's AOVs (README "AOV
-/// contract"), the shadow map (its layers stacked), a reflection probe's six cube faces (the
-/// selected entity's probe, else the first; +X -X +Y -Y +Z -Z left to right) or its sphere map
-/// (S3 eq. (2), made for the current camera; a probe of cube maps has none: the colour shows),
+/// What the viewport shows: the colour, or as a debug view one of the frame's AOVs
+/// (docs/guide/cli.md, "AOV contract"), the shadow map (its layers stacked), a reflection
+/// probe's six cube faces (the selected entity's probe, else the first; +X -X +Y -Y +Z -Z left
+/// to right) or its sphere map (S3 eq. (2), made for the current camera; a probe of cube maps
+/// has none: the colour shows),
 /// or the soft-shadow technique's own maps (lom: each layer's occlusion factors of its first
 /// peel; vsm/evsm: the first moment, scaled to its largest value; other techniques have none:
 /// the colour shows). position and reflection are AOVs too: the world position spanning the
@@ -34,7 +35,7 @@ enum class View {
 inline constexpr const char* kViewNames[] = {"colour",     "visibility", "cascade",    "normal",
                                              "depth",      "position",   "reflection", "shadow_map",
                                              "probe_faces", "sphere_map", "soft_maps"};
-/// Whether the view is made from the frame's AOVs (README "AOV contract").
+/// Whether the view is made from the frame's AOVs (docs/guide/cli.md, "AOV contract").
 inline bool is_aov_view(View v) {
   return v == View::visibility || v == View::cascade || v == View::normal || v == View::depth ||
          v == View::position || v == View::reflection;

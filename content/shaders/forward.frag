@@ -3,7 +3,7 @@
 // illuminance it delivers (outgoing radiance = f * E * N.L; components/brdf.h). Light from the
 // surroundings (ibl.glsl, components/ibl.h) is the environment map (VARIANT_ENVIRONMENT map),
 // else u_ambient as a uniform radiance, or a pbr reflector's probe. Features
-// (content/shaders/features.json) are selected by the preprocessor only; see README.md here.
+// (content/shaders/features.json) are selected by the preprocessor only; see content/shaders/README.md.
 #include "brdf.glsl"
 #include "common.glsl"
 #include "features.glsl"

@@ -59,7 +59,7 @@ std::string soft_sweep();
 /// '=', empty value lists, a key given twice within one product.
 Result<std::vector<BenchConfig>> parse_sweep(const std::string& spec);
 
-/// The CSV header, one name per column (documented in README.md "kaskad bench").
+/// The CSV header, one name per column (documented in docs/guide/bench.md, "CSV columns").
 std::vector<std::string> bench_csv_columns();
 
 /// `kaskad bench --merge DIR...`: concatenates the shards' bench.csv (same columns, else an

@@ -30,8 +30,8 @@ int fail(const Error& e) {
 }  // namespace
 
 int run_envmap(const EnvmapOptions& o) {
-  // Outputs are checked before any work (README "Outputs"); no folder is made but one named
-  // by --faces DIR.
+  // Outputs are checked before any work (docs/guide/bad_input.md, "Outputs"); no folder is made
+  // but one named by --faces DIR.
   if (!o.faces_out.empty())
     if (auto st = check_cube_faces_output(o.faces_out); !st) return fail(st.error());
   if (!o.sphere_out.empty())

@@ -1,6 +1,6 @@
-// CLI pieces for environment maps and the ray-traced references (README "Environment maps",
-// "Soft shadows"): `kaskad envmap`, `kaskad render --reflection-reference` and
-// `--shadow-reference`.
+// CLI pieces for environment maps and the ray-traced references (docs/guide/envmaps.md; the
+// reference outputs in docs/guide/cli.md, "What `kaskad render` prints and writes"):
+// `kaskad envmap`, `kaskad render --reflection-reference` and `--shadow-reference`.
 #pragma once
 
 #include <string>

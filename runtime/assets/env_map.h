@@ -117,7 +117,7 @@ struct EnvLoadOptions {
   int face_size = 0;
 };
 
-/// Loads a cube map. Layouts (README "Environment maps"):
+/// Loads a cube map. Layouts (docs/guide/envmaps.md, "Layouts"):
 ///   - faces: six images `<prefix>px<suffix>` ... `<prefix>nz<suffix>`; `path` is either a
 ///     pattern with one `*` (e.g. "sky_*.png"), any one of the six files (e.g. "sky_px.png":
 ///     the name's stem must end in one of the six face names), or a folder holding px.<ext> ...

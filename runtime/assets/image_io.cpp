@@ -70,7 +70,7 @@ class IgnoreLeaksInOiio {
 /// libpng (inside OIIO's PNG reader) prints "libpng error: ..." lines to stderr itself; the same
 /// text reaches us through OIIO's geterror() and ends up in our error message. While a decoder
 /// runs, the process's stderr therefore goes to /dev/null, so raw library lines never reach the
-/// user (README "Bad input"). Sanitizer reports keep the real stderr (a duplicate of it).
+/// user (docs/guide/bad_input.md, "How files are read"). Sanitizer reports keep the real stderr (a duplicate of it).
 /// Serialised: the file descriptor is process-wide.
 class QuietStderr {
  public:

@@ -1,5 +1,6 @@
 // Material files (JSON, content/materials/): features, typed parameters and textures, validated
-// against the feature manifest (kFeatureTable and content/shaders/features.json). Format in README.md ("Materials").
+// against the feature manifest (kFeatureTable and content/shaders/features.json). Format:
+// docs/guide/materials.md.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,5 @@
-// The "reflector" block of a scene entity (README "Reflection probes"): parse with validation
-// and write back in canonical form. Used by scene_io.cpp only.
+// The "reflector" block of a scene entity (docs/guide/scenes.md, "Reflectors"): parse with
+// validation and write back in canonical form. Used by scene_io.cpp only.
 #pragma once
 
 #include <nlohmann/json.hpp>

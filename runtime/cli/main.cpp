@@ -216,7 +216,7 @@ Status make_named_folder(const fs::path& dir) {
 
 /// Every output of `kaskad render`, checked before the scene is loaded or a frame rendered:
 /// writable, not a folder, a format we can write. The default colour output out/<scene>.png
-/// (README) is the one folder made for the user.
+/// (docs/guide/bad_input.md, "Outputs") is the one folder made for the user.
 Status check_render_outputs(const RenderArgs& a, const fs::path& out) {
   std::error_code ec;
   if (a.output.empty() && !fs::exists(out.parent_path(), ec)) {
@@ -693,7 +693,7 @@ int main(int argc, char** argv) {
   // A file-size limit (`ulimit -f`) or a full disk must fail the write with an error, not kill
   // the process: write() then returns EFBIG and the atomic writer keeps the previous file.
   std::signal(SIGXFSZ, SIG_IGN);
-  // The last line of defence (README "Bad input"): every reader turns library exceptions into
+  // The last line of defence (docs/guide/bad_input.md, "How files are read"): every reader turns library exceptions into
   // content errors; anything that still escapes is an error exit with a message, never an abort.
   try {
     return run_command(argc, argv);

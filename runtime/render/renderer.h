@@ -65,7 +65,7 @@ class Renderer {
   /// sRGB-encoded colour of the last frame, RGBA in [0,1], rows top to bottom.
   Image read_color() const;
   /// AOVs of the last frame: P.X P.Y P.Z N.X N.Y N.Z Z visibility mask cascade reflection.R
-  /// reflection.G reflection.B reflector (see README).
+  /// reflection.G reflection.B reflector (docs/guide/cli.md, "AOV contract").
   /// Precondition: the last frame was rendered with write_aovs.
   Image read_aovs() const;
   /// A probe's cube buffer (0 or 1; level 0) or its sphere map (row 0 at the top) as last

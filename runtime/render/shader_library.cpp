@@ -73,7 +73,8 @@ bool read_cache(const fs::path& file, std::uint64_t hash, GLenum& format,
 
 void write_cache(const fs::path& file, std::uint64_t hash, GLenum format,
                  const std::vector<std::uint8_t>& binary) {
-  // The cache folder is Kaskad's own (documented in README.md), so it is created here.
+  // The cache folder is Kaskad's own (docs/design/permutations.md, "The variant key"), so it is
+  // created here.
   std::error_code ec;
   fs::create_directories(file.parent_path(), ec);
   const std::uint32_t fmt = format;
