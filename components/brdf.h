@@ -1,6 +1,7 @@
 // The glTF 2.0 metallic-roughness BRDF (glTF 2.0 specification, Appendix B), on the CPU: the
-// formulas content/shaders/brdf.glsl evaluates on the GPU (change together; tests/render/
-// brdf_test compares the two), also used by the reflection reference (shade_point). Plain maths.
+// formulas content/shaders/brdf.glsl evaluates on the GPU (the render test
+// BrdfTest.GlslMatchesTheCpuEvaluationOfAppendixB fails when the two part), also used by the
+// reflection reference (shade_point). Plain maths.
 //
 //   c_diff = lerp(base.rgb, black, metallic)        f0 = lerp(0.04, base.rgb, metallic)
 //   alpha  = roughness^2

@@ -3,7 +3,10 @@
 // (six face images, horizontal / vertical crosses, equirectangular panoramas, sphere-map images),
 // including 3ds Max (Z-up) authored cube maps via S3's face table and M_rot.
 //
-// Conventions used throughout (change together with the GPU side: systems/environment_probe_*):
+// Conventions used throughout, shared with the GPU side (systems/environment_probe_*,
+// content/shaders/cube_face.glsl); the render tests ProbeTest.ColouredCubeInAMirrorSphereAndPlane
+// (GPU reflections of a cube loaded here against sample_cube()), ThreeDsMaxCubeIsConvertedOnLoad
+// and SphereMapFromTheCubeAndRuntimeSwitch (against sphere_map_from_cube()) fail when they part:
 //   - Directions are in the engine's world space: right-handed, +Y up, a camera looks down -Z.
 //     A CubeMap maps a world direction d to the environment seen along d; no extra rotation is
 //     applied between world space and cube-map space (the shader samples with R_world directly).

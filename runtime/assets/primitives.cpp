@@ -1,7 +1,9 @@
 // Built-in unit primitives.
 //
-// Conventions shared by every shape (change together with the tests in
-// tests/unit/assets/primitives_test.cpp):
+// Conventions shared by every shape, each checked by a test in
+// tests/unit/assets/primitives_test.cpp (Primitives.FrontFacesAreCounterClockwiseFromOutside,
+// TexturesReadUnmirroredFromOutsideAndVGrowsDownTheSides,
+// ClosedShapesShareEveryEdgeBetweenExactlyTwoTriangles):
 // - right-handed, +Y up; front faces are counter-clockwise seen from outside (OpenGL default);
 // - angle theta runs around +Y from +Z towards +X: x = r sin(theta), z = r cos(theta), so that u
 //   grows to the right for a viewer outside the surface;

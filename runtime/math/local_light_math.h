@@ -4,7 +4,13 @@
 // hemispheres of a dual-paraboloid map (S0's earlier work). Pure GLM: no GL, no ECS.
 //
 // Conventions as cascade_math.h: OpenGL clip space, view spaces look down -z. The shader mirrors
-// cube_face_of() and paraboloid_project() (content/shaders/shadow.glsl; change together).
+// cube_face_of() and paraboloid_project() (content/shaders/shadow.glsl: cube_face(),
+// paraboloid_visibility()). The CPU side is checked by the unit tests
+// LocalLightMath.CubeFaceOfEveryDirectionHoldsIt and ParaboloidProjectionCoversEachHemisphere,
+// the shader side by the render tests (LocalLightTest)
+// PointLightCubeMapAgreesWithRayCastsAwayFromEdges and
+// PointLightDualParaboloidAgreesWithRayCastsAwayFromEdges: a face or hemisphere the shader picks
+// differently from the one these views drew would fail them.
 #pragma once
 
 #include <array>
@@ -62,7 +68,7 @@ PerspectiveShadow fit_spot_shadow(const glm::vec3& position, const glm::vec3& di
 /// Cube faces in GL order: +X, -X, +Y, -Y, +Z, -Z.
 inline constexpr int kCubeFaces = 6;
 /// The face a direction from the light falls on: its major axis (ties prefer x, then y), as
-/// the GL cube-map face selection. The shader mirrors this (change together).
+/// the GL cube-map face selection. The shader's cube_face() mirrors this (checked as above).
 int cube_face_of(const glm::vec3& direction);
 /// tan(half field of view) of a cube face: 90 degrees widened by border_texels, so the PCF kernel
 /// at a face edge reads this face's own texels, never the border.

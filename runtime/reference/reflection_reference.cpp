@@ -123,7 +123,9 @@ ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment)
 glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
                       const Material& material, const glm::vec3& position, const glm::vec3& normal,
                       const glm::vec3& to_eye, bool receives_shadows, std::uint64_t* rays) {
-  // forward.frag, main(), line by line (change together); the BRDF is components/brdf.h.
+  // forward.frag, main(), line by line; the BRDF is components/brdf.h. The render tests
+  // ForwardModelTest.ShadePointReproducesTheForwardPass and BaseColourTexturesMatchTheForwardPass
+  // fail when the two part.
   const BrdfInputs brdf{glm::vec3(material.base_color), material.metallic, material.roughness};
   const glm::vec3& n = normal;
   const glm::vec3& v = to_eye;

@@ -1,8 +1,8 @@
 // The ray-traced reflection reference (for the reflection probes): for every pixel of a
 // rendered AOV image, the radiance C_t a perfect mirror at that surface point reflects (S3 eq. 1
 // and 3: I' = I + k_s p_r C_t). The mirror ray is traced with Embree (RayTracer::trace_mirror);
-// a hit is shaded with the forward pass's material model (content/shaders/forward.frag: change
-// together), a miss returns the environment cube map, else the clear colour. Plus the error of
+// a hit is shaded with the forward pass's material model (content/shaders/forward.frag; checked
+// by the render test ForwardModelTest.ShadePointReproducesTheForwardPass), a miss returns the environment cube map, else the clear colour. Plus the error of
 // an engine `reflection` image against it. CPU only; no GL.
 //
 // C_t is linear radiance BEFORE exposure (the quantity forward.frag adds to I before multiplying

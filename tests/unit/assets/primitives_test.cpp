@@ -138,6 +138,35 @@ TEST(Primitives, FrontFacesAreCounterClockwiseFromOutside) {
   }
 }
 
+TEST(Primitives, TexturesReadUnmirroredFromOutsideAndVGrowsDownTheSides) {
+  // primitives.cpp's uv conventions: u grows to the right for a viewer outside, v downwards
+  // (glTF: (0,0) the image's top-left). Then a triangle's uvs wind clockwise in (u, v) where its
+  // positions wind counter-clockwise from outside: cross(dP/du, dP/dv) = cross(b - a, c - a) / det
+  // with det = du1 dv2 - du2 dv1 < 0. On the sides (normal within 60 degrees of horizontal) of
+  // the sphere and cylinder, dP/dv also points down.
+  for (PrimitiveShape shape : kAllShapes) {
+    for (int segments : kSegmentCounts) {
+      SCOPED_TRACE(shape_name(shape) + " " + std::to_string(segments));
+      const MeshData m = make_primitive(shape, segments);
+      for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+        const auto ia = m.indices[3 * t], ib = m.indices[3 * t + 1], ic = m.indices[3 * t + 2];
+        const glm::vec3 e1 = m.positions[ib] - m.positions[ia];
+        const glm::vec3 e2 = m.positions[ic] - m.positions[ia];
+        const glm::vec2 d1 = m.uvs[ib] - m.uvs[ia], d2 = m.uvs[ic] - m.uvs[ia];
+        const float det = d1.x * d2.y - d2.x * d1.y;
+        if (std::abs(det) < 1e-12f) continue;  // a pole's fan: no u extent
+        ASSERT_LT(det, 0.0f) << "mirrored uvs on triangle " << t;
+        const glm::vec3 n = glm::normalize(glm::cross(e1, e2));
+        if ((shape == PrimitiveShape::sphere || shape == PrimitiveShape::cylinder) &&
+            std::abs(n.y) < 0.5f) {
+          const glm::vec3 dp_dv = (e2 * d1.x - e1 * d2.x) / det;
+          ASSERT_LT(dp_dv.y, 0.0f) << "v does not grow downwards on triangle " << t;
+        }
+      }
+    }
+  }
+}
+
 TEST(Primitives, ClosedShapesShareEveryEdgeBetweenExactlyTwoTriangles) {
   // Weld vertices by exact position (split copies must be bit-identical), then count each
   // undirected edge; a closed, consistently wound mesh uses each directed edge exactly once.
