@@ -1,9 +1,11 @@
 // GL resources of the reflection probes (S3): per probe two cube maps (RGBA16F, full mip chain;
-// a front one shown and a back one captured into), a 2D sphere map when the probe shows one,
-// one capture framebuffer with a depth renderbuffer per face size, and the fullscreen pass that
-// makes sphere maps from cubes (S3 eq. (2), content/shaders/probe_sphere.frag). The Renderer owns
-// one ProbeMaps and records captures through its own forward path (renderer.cpp); this file holds
-// everything else about probes on the GPU.
+// a front one shown and a back one captured into: ProbeState::front), a 2D sphere map when the
+// probe shows one, and for the pbr reflection model a prefiltered cube and an SH row per buffer
+// (made by IblMaps, which ProbeMaps owns); one capture framebuffer with one depth renderbuffer,
+// remade when the face size changes; and the fullscreen pass that makes sphere maps from cubes
+// (S3 eq. (2), content/shaders/probe_sphere.frag). GpuCache owns one ProbeMaps; the captures
+// themselves (which faces, drawn through the forward path) are ProbeCapturePass's
+// (probe_capture_pass.h), which draws into the faces begin_face() binds.
 #pragma once
 
 #include <cstdint>
