@@ -131,6 +131,10 @@ Result<Playback> read_playback(const std::filesystem::path& file);
 /// relative paths).
 Result<Playback> parse_playback(const std::string& text, const std::filesystem::path& file);
 
+/// The JSON Schema of playback files (docs/reference/playback.schema.json, `kaskad schema`),
+/// from the reader's keys and limits.
+nlohmann::json playback_schema();
+
 /// The pose of a track at time t (seconds): positions interpolated linearly or by a centripetal-
 /// free uniform Catmull-Rom spline through the keys, rotations (rotation or look_at) by slerp,
 /// scale and fov linearly. Fields no key has stay empty.

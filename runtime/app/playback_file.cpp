@@ -1,5 +1,5 @@
 // The playback file format: reading and validating a playback JSON into a Playback. The limits
-// are declared in playback_internal.h.
+// are declared in playback_internal.h, where the schema (playback_schema.cpp) takes them too.
 #include <algorithm>
 #include <cmath>
 
@@ -234,6 +234,8 @@ Result<Playback> playback_from(const json& doc, const fs::path& file) {
     ObjectReader r(doc, "");
     int version = kFormatVersion;
     r.integer("kaskad_playback", version, 1, kFormatVersion);
+    std::string schema;  // "$schema": the file's JSON Schema, for editors (`kaskad schema`)
+    r.string("$schema", schema);
     std::string scene;
     r.string("scene", scene);
     if (scene.empty()) fail("/scene", "name the scene file (.json, .gltf or .glb)");

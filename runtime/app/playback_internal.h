@@ -1,5 +1,5 @@
 // Internal to runtime/app: what the parts of `kaskad play` share. The playback file's reader
-// (playback_file.cpp) takes its limits from here;
+// (playback_file.cpp) and its JSON Schema (playback_schema.cpp) take their limits from here;
 // the timeline (playback_timeline.cpp) applies events and poses for the runner
 // (playback_runner.cpp), whose expectations are in playback_checks.cpp; shards and the command
 // are play_command.cpp. The public API is playback.h.
@@ -20,7 +20,8 @@
 
 namespace kaskad::playback_detail {
 
-// --- The file format's limits: the reader refuses a value outside them, naming the range.
+// --- The file format's limits: the reader refuses a value outside them (naming the range) and
+// the schema states them, both from these declarations.
 
 inline constexpr int kFormatVersion = 1;
 inline constexpr int kMaxFrames = 1000000;

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <system_error>
 
+#include "runtime/app/playback.h"
 #include "runtime/app/player.h"
 #include "runtime/assets/scene_schema.h"
 #include "runtime/core/atomic_file.h"
@@ -26,7 +27,9 @@ int run_schema_command(const std::filesystem::path& out_dir, bool check) {
     }
   }
   int stale = 0;
-  for (const auto& [name, text] : reference_files(*manifest)) {
+  auto files = reference_files(*manifest);
+  files.emplace_back("playback.schema.json", playback_schema().dump(2) + "\n");
+  for (const auto& [name, text] : files) {
     const std::filesystem::path path = out_dir / name;
     if (check) {
       auto committed = read_file_bytes(path, std::uintmax_t(64) << 20);

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""Validates every scene and material file under content/ (and the playback files of
-tests/playback when a playback schema is given) against the JSON Schemas that `kaskad schema`
-generates from the field tables, with a real validator (python3-jsonschema). Then checks that
-the schemas refuse a few files the readers refuse, so that a schema accepting anything fails.
+"""Validates every scene and material file under content/ (and, given PLAYBACK_DIR, every
+playback file under it) against the JSON Schemas that `kaskad schema` generates from the field
+tables and the playback reader's limits, with a real validator (python3-jsonschema). Then checks
+that the schemas refuse a few files the readers refuse, so that a schema accepting anything fails.
 
-usage: validate_content.py REFERENCE_DIR CONTENT_DIR
+usage: validate_content.py REFERENCE_DIR CONTENT_DIR [PLAYBACK_DIR]
 """
 import copy
 import json
@@ -20,12 +20,47 @@ def validator(path):
     return jsonschema.Draft202012Validator(schema)
 
 
+# Changes to a good playback file that make the reader refuse it: the schema must refuse them too.
+BAD_PLAYBACKS = {
+    "unknown top-level key": lambda d: d.update(speed=2),
+    "no frames": lambda d: d.update(frames=0),
+    "unknown interpolation": lambda d: d["timeline"][0].update(interpolation="cubic"),
+    "fov_y_deg on an entity key": lambda d: d["timeline"][0]["keys"][0].update(fov_y_deg=40),
+    "a key with position and move": lambda d: d["timeline"][0]["keys"][0].update(move=[0, 0, 0]),
+    "an event with set and remove": lambda d: d["timeline"].append(
+        {"frame": 1, "set": "shadow.filter=none", "remove": "box_floating"}),
+    "an event with frame and t": lambda d: d["timeline"].append({"frame": 1, "t": 0, "set": "a=1"}),
+    "an unknown expectation": lambda d: d["expect"].update(misclassified=1),
+}
+
+
+def refuse_bad_playbacks(playback_v, good):
+    if not playback_v.is_valid(good):
+        print("FAIL the playback schema refuses the good file the bad ones are made from")
+        return 1
+    failed = 0
+    for name, change in BAD_PLAYBACKS.items():
+        doc = copy.deepcopy(good)
+        change(doc)
+        if playback_v.is_valid(doc):
+            print(f"FAIL the playback schema accepts a file with {name}")
+            failed += 1
+    return failed
+
+
 def main():
     reference, content = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+    playback = pathlib.Path(sys.argv[3]) if len(sys.argv) > 3 else None
     groups = [
         (validator(reference / "scene.schema.json"), sorted((content / "scenes").rglob("*.json"))),
         (validator(reference / "material.schema.json"), sorted((content / "materials").glob("*.json"))),
     ]
+    if playback:
+        playback_files = sorted(playback.rglob("*.json"))
+        if not playback_files:
+            print("FAIL no playback files found under", playback)
+            return 1
+        groups.append((validator(reference / "playback.schema.json"), playback_files))
     failed = checked = 0
     for v, files in groups:
         for f in files:
@@ -56,7 +91,11 @@ def main():
         if scene_v.is_valid(doc):
             print(f"FAIL the scene schema accepts a file with {name}")
             failed += 1
-    print(f"{checked} content files validated, {len(bad)} bad files tried; {failed} failures")
+    tried = len(bad)
+    if playback:
+        failed += refuse_bad_playbacks(groups[2][0], json.loads((playback / "moving_caster.json").read_text()))
+        tried += len(BAD_PLAYBACKS)
+    print(f"{checked} content files validated, {tried} bad files tried; {failed} failures")
     return 1 if failed else 0
 
 
