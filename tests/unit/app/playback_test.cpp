@@ -45,6 +45,11 @@ TEST(Playback, AFullFileParses) {
   EXPECT_EQ(pb->probes->frames, (std::vector<int>{0, 10}));
 }
 
+TEST(Playback, AFileMayNameItsSchema) {
+  auto pb = parse(R"({"$schema": "../docs/reference/playback.schema.json", "scene": "a.json"})");
+  EXPECT_TRUE(pb.ok()) << pb.error().to_string();
+}
+
 TEST(Playback, ErrorsNameTheFileThePathAndTheValidKeys) {
   expect_error(R"({"scene": "a.json", "frames": 0})", {"dir/test.json", "/frames", "[1, 1000000]"});
   expect_error(R"({"scene": "a.json", "speed": 2})", {"/speed", "valid keys here", "frames"});
