@@ -476,6 +476,8 @@ Status merge_bench(const std::vector<fs::path>& dirs, const fs::path& out_dir, b
   std::size_t count = 0;
   for (const fs::path& dir : dirs) {
     const fs::path file = dir / "bench.csv";
+    if (std::string why = not_a_regular_file(file); !why.empty() && fs::exists(file))
+      return Error{file.string(), "", why};
     std::ifstream in(file, std::ios::binary);
     if (!in) return Error{file.string(), "", "cannot open (is this a kaskad bench --out folder?)"};
     std::string line;

@@ -242,6 +242,26 @@ bool all_finite(const std::vector<double>& values) {
   return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
 }
 
+/// tinygltf's file callbacks for external buffers and images. Its own FileExists() opens the
+/// file, which blocks forever on a FIFO; this one only asks the file system. Reads go through
+/// read_file_bytes(), so a URI naming a FIFO or a device is refused with the same words and size
+/// limit as any file.
+bool file_exists(const std::string& path, void* /*user_data*/) {
+  std::error_code ec;
+  return std::filesystem::exists(path, ec);
+}
+
+bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                     void* /*user_data*/) {
+  auto bytes = read_file_bytes(path, kMaxFileBytes);
+  if (!bytes) {
+    if (err) *err += bytes.error().to_string() + "\n";
+    return false;
+  }
+  out->assign(bytes->begin(), bytes->end());
+  return true;
+}
+
 Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadState& images,
                                    std::vector<std::string>& warnings) {
   const std::string file = path.string();
@@ -289,6 +309,8 @@ Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadS
 
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(&load_image_callback, &images);
+  loader.SetFsCallbacks({&file_exists, &tinygltf::ExpandFilePath, &read_whole_file,
+                         &tinygltf::WriteWholeFile, nullptr});
   tinygltf::Model model;
   std::string err, warn;
   const std::string base_dir = path.parent_path().string();

@@ -32,6 +32,13 @@ fi
 
 snapshot() { (cd "$1" && find . -print0 | sort -z | xargs -0 md5sum 2>/dev/null; find . | sort); }
 
+# Files that are not regular files ({FIFO}/...): named pipes, which block a reader that opens
+# them until a writer comes, and the glTF files that name them as a buffer and an image.
+fifo="$tmp/fifo"
+mkdir -p "$fifo/shard"
+for f in pipe.json pipe.bin pipe.png shard/bench.csv; do mkfifo "$fifo/$f"; done
+cp "$here/gltf/fifo_buffer.gltf" "$here/gltf/fifo_image.gltf" "$fifo/"
+
 while IFS= read -r line; do
   case "$line" in ''|'#'*) continue ;; esac
   n=$((n + 1))
@@ -41,6 +48,7 @@ while IFS= read -r line; do
   cp "$tmp/prev.png" "$out/out.png"; cp "$tmp/prev.exr" "$out/out.exr"; cp "$tmp/prev.json" "$out/out.json"
   printf 'scene,config\nold,row\n' >"$out/bench/bench.csv"
   words="${words//\{R\}/--headless --size 32x32 --frames 1 -o \{OUT\}/out.png}"
+  words="${words//\{FIFO\}/$fifo}"
   words="${words//\{DIR\}/$here}" words="${words//\{CONTENT\}/$content}" words="${words//\{OUT\}/$out}"
   mention="${mention//\{OUT\}/$out}"
   eval "args=($words)"

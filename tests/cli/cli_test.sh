@@ -75,6 +75,16 @@ help_options play FILE --out --update-goldens --shard --jobs --merge --headless 
 help_options edit SCENE --set --size --script
 help_options info SCENE --set --headless --window
 help_options schema --out --check
+# Named pipes (FIFOs) are refused before they are opened (opening one blocks until a writer
+# comes): a playback file is recorded as failed, a glTF image is a missing texture (a warning).
+# The other commands' cases are in tests/bad_input/cases.txt.
+mkfifo "$tmp/pipe.json" "$tmp/pipe.png"
+cp "$(dirname "$0")/../bad_input/gltf/fifo_image.gltf" "$tmp/"
+check play_fifo 1 "pipe.json: cannot open: not a regular file but a named pipe" -- \
+  timeout -k 5 60 "$KASKAD" play "$tmp/pipe.json" --out "$tmp/play_fifo"
+check gltf_image_fifo 0 "pipe.png: not a regular file but a named pipe" -- \
+  timeout -k 5 60 "$KASKAD" render "$tmp/fifo_image.gltf" --headless --size 32x32 --frames 1 \
+  -o "$tmp/fifo_image.png"
 # An option given twice takes its last value, as before CLI11 (scripts append to a base line).
 check option_given_twice 0 "wrote .*twice_b.png" -- "$KASKAD" render --headless --size 32x32 --frames 1 \
   -o "$tmp/twice_a.png" -o "$tmp/twice_b.png"

@@ -3,6 +3,10 @@
 #include "editor/script.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <string>
 
 using namespace kaskad::editor;
 
@@ -98,6 +102,18 @@ TEST(EditorScript, BadLinesNameTheFileAndLine) {
   EXPECT_NE(error_of("undo now\n").find("expected 'undo'"), std::string::npos);
   EXPECT_NE(error_of("screenshot\n").find("expected 'screenshot PATH.png'"), std::string::npos);
   EXPECT_NE(error_of("save a b\n").find("expected 'save [PATH]'"), std::string::npos);
+}
+
+TEST(EditorScript, NamedPipeIsRefusedUnopened) {
+  // Opening a named pipe waits for a writer: the script is refused by its kind instead.
+  const std::string pipe = std::string(::testing::TempDir()) + "kaskad_script_pipe.txt";
+  std::remove(pipe.c_str());
+  ASSERT_EQ(mkfifo(pipe.c_str(), 0600), 0);
+  auto r = parse_script(pipe);
+  std::remove(pipe.c_str());
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().to_string(),
+            pipe + ": not a regular file but a named pipe (FIFO); kaskad reads only regular files");
 }
 
 TEST(EditorScript, MissingFileIsAnError) {

@@ -1,0 +1,44 @@
+// Whole-file reads (runtime/core/file_io.h): what is not a regular file is refused by name before
+// it is opened, so a named pipe given as an input fails at once instead of blocking the read.
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "runtime/core/file_io.h"
+#include "tests/test_tmp.h"
+
+namespace kaskad {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(FileIo, OnlyRegularFilesAreRead) {
+  const fs::path dir = testing_util::test_tmp();
+  fs::remove(dir / "pipe.bin");
+  const fs::path file = dir / "a.bin", pipe = dir / "pipe.bin";
+  std::ofstream(file) << "abc";
+  ASSERT_EQ(mkfifo(pipe.c_str(), 0600), 0);
+
+  EXPECT_EQ(not_a_regular_file(file), "");
+  EXPECT_EQ(not_a_regular_file(dir), "is a directory, not a file");
+  EXPECT_EQ(not_a_regular_file(dir / "none"), "file not found");
+  EXPECT_EQ(not_a_regular_file(pipe),
+            "not a regular file but a named pipe (FIFO); kaskad reads only regular files");
+  EXPECT_EQ(not_a_regular_file("/dev/null"),
+            "not a regular file but a character device; kaskad reads only regular files");
+
+  auto bytes = read_file_bytes(file, 1024);
+  ASSERT_TRUE(bytes.ok());
+  EXPECT_EQ(bytes->size(), 3u);
+  // Returns at once (opening the pipe would wait for a writer).
+  auto piped = read_file_bytes(pipe, 1024);
+  ASSERT_FALSE(piped.ok());
+  EXPECT_EQ(piped.error().file, pipe.string());
+  EXPECT_NE(piped.error().message.find("named pipe"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace kaskad
