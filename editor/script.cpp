@@ -156,8 +156,7 @@ Result<std::vector<ScriptAction>> parse_script_text(const std::string& text,
 }
 
 Result<std::vector<ScriptAction>> parse_script(const std::filesystem::path& file) {
-  if (std::string why = not_a_regular_file(file); !why.empty() && std::filesystem::exists(file))
-    return Error{file.string(), "", why};
+  if (std::string why = special_file_error(file); !why.empty()) return Error{file.string(), "", why};
   std::ifstream in(file, std::ios::binary);
   if (!in) return Error{file.string(), "", "cannot open the script"};
   std::stringstream text;

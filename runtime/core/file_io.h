@@ -25,15 +25,15 @@ inline std::string lowercase_extension(const std::filesystem::path& path) {
   return ext;
 }
 
-/// Why `path` cannot be read as a file, or "" when it is a regular file (links followed):
-/// missing, a folder, or something else (a FIFO, a device, a socket), which is refused before it
-/// is opened: opening a FIFO for reading waits for a writer, forever.
-inline std::string not_a_regular_file(const std::filesystem::path& path) {
+/// Why `path`, which exists and is not a folder, must not be opened for reading: a named pipe, a
+/// device or a socket (opening a FIFO waits for a writer, forever). "" for a regular file (links
+/// followed) and for paths that are missing or folders, which each reader words itself.
+inline std::string special_file_error(const std::filesystem::path& path) {
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(status)) return "file not found";
-  if (std::filesystem::is_directory(status)) return "is a directory, not a file";
-  if (std::filesystem::is_regular_file(status)) return {};
+  if (!std::filesystem::exists(status) || std::filesystem::is_directory(status) ||
+      std::filesystem::is_regular_file(status))
+    return {};
   const char* kind = std::filesystem::is_fifo(status)           ? "a named pipe (FIFO)"
                      : std::filesystem::is_character_file(status) ? "a character device"
                      : std::filesystem::is_block_file(status)     ? "a block device"
@@ -47,8 +47,11 @@ inline std::string not_a_regular_file(const std::filesystem::path& path) {
 inline Result<std::vector<std::uint8_t>> read_file_bytes(const std::filesystem::path& path,
                                                          std::uintmax_t max_bytes) {
   const std::string name = path.string();
-  if (std::string why = not_a_regular_file(path); !why.empty()) return Error{name, "", why};
   std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) return Error{name, "", "file not found"};
+  if (std::filesystem::is_directory(status)) return Error{name, "", "is a directory, not a file"};
+  if (std::string why = special_file_error(path); !why.empty()) return Error{name, "", why};
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) return Error{name, "", "cannot read file size: " + ec.message()};
   if (size == 0) return Error{name, "", "empty file (0 bytes)"};

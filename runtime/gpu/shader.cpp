@@ -11,8 +11,7 @@ namespace kaskad::gpu {
 namespace {
 
 Result<std::string> read_text(const std::filesystem::path& file) {
-  if (std::string why = not_a_regular_file(file); !why.empty() && std::filesystem::exists(file))
-    return Error{file.string(), "", why};
+  if (std::string why = special_file_error(file); !why.empty()) return Error{file.string(), "", why};
   std::ifstream in(file, std::ios::binary);
   if (!in) return Error{file.string(), "", "cannot open shader file"};
   std::ostringstream ss;
