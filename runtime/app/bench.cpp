@@ -295,10 +295,10 @@ Status run_bench(const BenchOptions& options) {
   auto player = Player::create(copt);
   if (!player) return player.error();
 
-  g_interrupted = false;
-  auto previous = std::signal(SIGINT, on_sigint);
   if (options.shard_count < 1 || options.shard_index < 0 || options.shard_index >= options.shard_count)
     return Error{"--shard", "", "expected i/n with 0 <= i < n"};
+  g_interrupted = false;
+  auto previous = std::signal(SIGINT, on_sigint);
   // This shard's runs: i, i + n, ... of the scene x configuration list.
   const std::size_t all_runs = scenes.size() * configs->size();
   std::size_t total = 0;
@@ -476,8 +476,7 @@ Status merge_bench(const std::vector<fs::path>& dirs, const fs::path& out_dir, b
   std::size_t count = 0;
   for (const fs::path& dir : dirs) {
     const fs::path file = dir / "bench.csv";
-    if (std::string why = not_a_regular_file(file); !why.empty() && fs::exists(file))
-      return Error{file.string(), "", why};
+    if (std::string why = special_file_error(file); !why.empty()) return Error{file.string(), "", why};
     std::ifstream in(file, std::ios::binary);
     if (!in) return Error{file.string(), "", "cannot open (is this a kaskad bench --out folder?)"};
     std::string line;
