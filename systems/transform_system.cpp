@@ -42,43 +42,73 @@ static_assert(sizeof(Transform) == 3 * sizeof(glm::vec3) + sizeof(float) + sizeo
               "Transform has padding: same_bits would compare indeterminate bytes");
 static_assert(sizeof(Aabb) == 2 * sizeof(glm::vec3), "Aabb has padding");
 
-// Brings one entity's WorldTransform up to date, parent chain first, and returns its version;
-// `state` marks entities as 0 = unvisited, 1 = on the current chain (cycle detection), 2 = done.
-// The parent applied is decided exactly as when everything was recomputed each call (same order,
-// same cycle breaking); the matrix is recomputed only when that parent, its version or this
-// entity's Transform bits differ from the TransformCache. `t`, `cache` and `out` are e's.
-std::uint64_t resolve(ecs::World& world, ecs::Entity e, const Transform& t, TransformCache& cache,
-                      WorldTransform& out, std::uint64_t stamp, std::vector<std::uint8_t>& state,
-                      TransformStats& stats) {
-  if (e.index >= state.size()) state.resize(std::size_t{e.index} + 1, 0);
-  if (state[e.index] == 2) return cache.version;
-  ecs::Entity parent = ecs::kNullEntity;
-  std::uint64_t parent_version = 0;
-  if (t.parent.valid()) {
-    if (!world.alive(t.parent) || !world.has<Transform>(t.parent)) {
-      log::warn_once("%s: parent (entity %u) is gone; treating it as a root",
-                     entity_label(world, e).c_str(), t.parent.index);
-    } else if (t.parent.index < state.size() && state[t.parent.index] == 1) {
-      log::warn_once("%s: parent cycle through %s; treating it as a root",
-                     entity_label(world, e).c_str(), entity_label(world, t.parent).c_str());
-    } else {
-      state[e.index] = 1;
-      parent = t.parent;
-      parent_version = resolve(world, parent, world.get<Transform>(parent),
-                               world.get<TransformCache>(parent),
-                               world.get<WorldTransform>(parent), stamp, state, stats);
+// One entity of a parent chain being brought up to date, with the parent decided for it.
+struct ChainLink {
+  ecs::Entity entity;
+  ecs::Entity parent;  ///< kNullEntity: a root (also a gone parent or one that closes a cycle)
+  const Transform* transform;
+  TransformCache* cache;
+  WorldTransform* world;
+};
+
+// Brings e's WorldTransform up to date, parent chain first; `state` marks entities as 0 =
+// unvisited, 1 = on the current chain (cycle detection), 2 = done. The chain is walked up into
+// `chain` and computed from its top down, without recursion: a chain as long as the scene is
+// fine. The parent applied is decided exactly as when everything was recomputed each call (same
+// order, same cycle breaking); a matrix is recomputed only when that parent, its version or the
+// entity's Transform bits differ from its TransformCache. `link` is e's, its components from the
+// caller's view.
+void resolve(ecs::World& world, ChainLink link, std::uint64_t stamp,
+             std::vector<std::uint8_t>& state, std::vector<ChainLink>& chain,
+             TransformStats& stats) {
+  chain.clear();
+  auto done = [&](ecs::Entity x) { return x.index < state.size() && state[x.index] == 2; };
+  if (done(link.entity)) return;
+  for (;;) {
+    const ecs::Entity at = link.entity;
+    if (at.index >= state.size()) state.resize(std::size_t{at.index} + 1, 0);
+    const ecs::Entity p = link.transform->parent;
+    if (p.valid()) {
+      if (!world.alive(p) || !world.has<Transform>(p)) {
+        log::warn_once("%s: parent (entity %u) is gone; treating it as a root",
+                       entity_label(world, at).c_str(), p.index);
+      } else if (p.index < state.size() && state[p.index] == 1) {
+        log::warn_once("%s: parent cycle through %s; treating it as a root",
+                       entity_label(world, at).c_str(), entity_label(world, p).c_str());
+      } else {
+        link.parent = p;
+      }
     }
+    state[at.index] = 1;
+    chain.push_back(link);
+    if (!link.parent.valid() || done(link.parent)) break;
+    link = {link.parent, ecs::kNullEntity, &world.get<Transform>(link.parent),
+            &world.get<TransformCache>(link.parent), &world.get<WorldTransform>(link.parent)};
   }
-  state[e.index] = 2;
-  if (cache.version != 0 && cache.parent == parent && cache.parent_version == parent_version &&
-      same_bits(cache.local, t))
-    return cache.version;
-  const glm::mat4 parent_matrix =
-      parent.valid() ? world.get<WorldTransform>(parent).matrix : glm::mat4(1.0f);
-  out.matrix = parent_matrix * local_matrix(t);
-  cache = TransformCache{t, parent, parent_version, stamp};
-  ++stats.transforms;
-  return cache.version;
+  // Top down: each parent is done (this walk's, the link above, or an earlier one's) before its
+  // child reads it.
+  for (std::size_t i = chain.size(); i-- > 0;) {
+    const ChainLink& l = chain[i];
+    state[l.entity.index] = 2;
+    const TransformCache* parent_cache = nullptr;
+    const WorldTransform* parent_world = nullptr;
+    if (i + 1 < chain.size()) {
+      parent_cache = chain[i + 1].cache;
+      parent_world = chain[i + 1].world;
+    } else if (l.parent.valid()) {
+      parent_cache = &world.get<TransformCache>(l.parent);
+      parent_world = &world.get<WorldTransform>(l.parent);
+    }
+    const std::uint64_t parent_version = parent_cache ? parent_cache->version : 0;
+    TransformCache& cache = *l.cache;
+    if (cache.version != 0 && cache.parent == l.parent && cache.parent_version == parent_version &&
+        same_bits(cache.local, *l.transform))
+      continue;
+    const glm::mat4 parent_matrix = parent_world ? parent_world->matrix : glm::mat4(1.0f);
+    l.world->matrix = parent_matrix * local_matrix(*l.transform);
+    cache = TransformCache{*l.transform, l.parent, parent_version, stamp};
+    ++stats.transforms;
+  }
 }
 
 // Recomputes e's WorldBounds when its inputs differ from the BoundsCache; world_version 0: no
@@ -128,10 +158,11 @@ TransformStats update_transforms(ecs::World& world, const AssetStore& assets) {
   //    never larger than the other two now, and ties go to the first type), so parent cycles
   //    break where they always did.
   std::vector<std::uint8_t> state;
+  std::vector<ChainLink> chain;
   const std::uint64_t stamp = next_stamp();
   world.view<Transform, TransformCache, WorldTransform>().each(
       [&](ecs::Entity e, Transform& t, TransformCache& cache, WorldTransform& out) {
-        resolve(world, e, t, cache, out, stamp, state, stats);
+        resolve(world, {e, ecs::kNullEntity, &t, &cache, &out}, stamp, state, chain, stats);
       });
 
   // 3. Bounds, for every MeshRenderer with a WorldTransform: structural step as in 1, then values.

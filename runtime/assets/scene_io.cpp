@@ -3,6 +3,9 @@
 #include "runtime/assets/scene_io.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <map>
+#include <vector>
 
 #include "components/name.h"
 #include "runtime/assets/gltf_loader.h"
@@ -108,18 +111,51 @@ Result<Scene> parse_scene(const json& doc, const fs::path& file) {
       scene.world.get<Transform>(p.entity).parent = it->second;
     }
     // Parent cycles (a -> b -> a) are content errors here, with the names, rather than a
-    // warning from the transform system every frame.
-    std::map<ecs::Entity, std::string, bool (*)(ecs::Entity, ecs::Entity)> names(entity_less);
-    for (const auto& [n, e] : by_name) names[e] = n;
+    // warning from the transform system every frame. Each entity is walked once (a chain as
+    // long as the scene stays linear): 1 = on the walk now, 2 = reaches a root, 3 = on a cycle.
+    std::vector<std::uint8_t> state;
+    auto parent_of = [&](ecs::Entity e) {
+      const Transform* t = scene.world.try_get<Transform>(e);
+      return t ? t->parent : ecs::kNullEntity;
+    };
+    auto state_of = [&](ecs::Entity e) -> std::uint8_t& {
+      if (e.index >= state.size()) state.resize(std::size_t{e.index} + 1, 0);
+      return state[e.index];
+    };
+    std::vector<ecs::Entity> walk;
     for (const Pending& p : parents) {
-      std::string chain = names[p.entity];
-      ecs::Entity at = scene.world.get<Transform>(p.entity).parent;
-      for (std::size_t steps = 0; at.valid() && steps <= parents.size(); ++steps) {
-        chain += " -> " + names[at];
-        if (at == p.entity) fail(p.where, "parent cycle: " + chain);
-        const Transform* t = scene.world.try_get<Transform>(at);
-        at = t ? t->parent : ecs::kNullEntity;
+      walk.clear();
+      ecs::Entity at = p.entity;
+      for (; at.valid() && state_of(at) == 0; at = parent_of(at)) {
+        state_of(at) = 1;
+        walk.push_back(at);
       }
+      const bool closes = at.valid() && state_of(at) == 1;
+      for (ecs::Entity e : walk) state_of(e) = 2;
+      if (closes)  // the walk from `at` on is the cycle
+        for (ecs::Entity e = at; state_of(e) != 3; e = parent_of(e)) state_of(e) = 3;
+    }
+    // The first entity on a cycle, in file order, names it (from itself round to itself; a long
+    // one by its first and last few entities).
+    for (const Pending& p : parents) {
+      if (state_of(p.entity) != 3) continue;
+      std::map<ecs::Entity, std::string, bool (*)(ecs::Entity, ecs::Entity)> names(entity_less);
+      for (const auto& [n, e] : by_name) names[e] = n;
+      std::vector<ecs::Entity> cycle{p.entity};
+      for (ecs::Entity at = parent_of(p.entity); at != p.entity; at = parent_of(at))
+        cycle.push_back(at);
+      cycle.push_back(p.entity);
+      constexpr std::size_t kShown = 4;  // at each end
+      std::string chain;
+      for (std::size_t i = 0; i < cycle.size(); ++i) {
+        if (cycle.size() > 2 * kShown + 1 && i == kShown) {
+          chain += " -> ... (" + std::to_string(cycle.size() - 2 * kShown) + " more)";
+          i = cycle.size() - kShown - 1;
+          continue;
+        }
+        chain += (i ? " -> " : "") + names[cycle[i]];
+      }
+      fail(p.where, "parent cycle: " + chain);
     }
   } catch (const ContentError& e) {
     return Error{file.string(), e.where, e.message};

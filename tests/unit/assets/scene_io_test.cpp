@@ -292,6 +292,32 @@ TEST(SceneIo, AParentCycleIsALoadErrorNamingTheChain) {
                {"cycle.json", "/entities/0/transform/parent", "parent cycle: a -> c -> b -> a"});
 }
 
+// Parent chains as long as the scene load in linear time: a chain of 100,000 loads (the tail
+// entities first in the file), and the same chain closed into a cycle is named by its ends.
+TEST(SceneIo, AHundredThousandLongParentChainLoadsAndItsCycleIsNamedShortly) {
+  constexpr int kLength = 100000;
+  auto chain = [&](bool closed) {
+    std::string text = R"({"entities": [)";
+    for (int i = kLength - 1; i >= 0; --i) {
+      text += R"({"name": "e)" + std::to_string(i) + '"';
+      if (i > 0 || closed)
+        text += R"(, "transform": {"parent": "e)" + std::to_string(i > 0 ? i - 1 : kLength - 1) +
+                R"("})";
+      text += i > 0 ? "}," : "}";
+    }
+    return text + "]}";
+  };
+  auto open = read_scene(write_file("long_chain.json", chain(false)));
+  ASSERT_TRUE(open.ok()) << open.error().to_string();
+  EXPECT_EQ(open->world.get<Transform>(find(*open, "e1")).parent, find(*open, "e0"));
+  auto closed = read_scene(write_file("long_cycle.json", chain(true)));
+  ASSERT_FALSE(closed.ok());
+  EXPECT_EQ(closed.error().where, "/entities/0/transform/parent");
+  EXPECT_EQ(closed.error().message, "parent cycle: e99999 -> e99998 -> e99997 -> e99996 -> ... (" +
+                                        std::to_string(kLength - 7) +
+                                        " more) -> e2 -> e1 -> e0 -> e99999");
+}
+
 TEST(SceneIo, GroundCoversTheFootprintAndTheShadowOfTheBounds) {
   const Aabb model = Aabb::from_corners({-1, 2, -1}, {1, 4, 1});  // 2 m tall, floating at 2
   // Straight down: the footprint plus a quarter of the size (|extent| = sqrt(12)) around.

@@ -35,6 +35,28 @@ TEST(TransformSystem, ParentChainsCompose) {
   EXPECT_NEAR(p.z, 0.0f, 1e-5f);
 }
 
+// A chain as long as a big scene (each entity the parent of the next, created leaf first so the
+// walk from the first entity climbs the whole chain) is resolved without recursion: the leaf
+// sits at the sum of the steps, and a second call recomputes nothing.
+TEST(TransformSystem, AChainAHundredThousandLongComposes) {
+  ecs::World w;
+  AssetStore assets;
+  constexpr int kLength = 100000;
+  std::vector<ecs::Entity> chain(kLength);
+  for (ecs::Entity& e : chain) e = w.create();
+  for (int i = 0; i < kLength; ++i)
+    w.emplace<Transform>(chain[std::size_t(kLength - 1 - i)],
+                         Transform{{0, 0.5f, 0}, {1, 0, 0, 0}, glm::vec3(1.0f),
+                                   i + 1 < kLength ? chain[std::size_t(kLength - 2 - i)]
+                                                   : ecs::kNullEntity});
+  // chain[k]'s parent is chain[k - 1]; chain[0] is the root, created first, emplaced last.
+  const TransformStats first = update_transforms(w, assets);
+  EXPECT_EQ(first.transforms, std::size_t(kLength));
+  const glm::vec3 leaf = glm::vec3(w.get<WorldTransform>(chain.back()).matrix[3]);
+  EXPECT_NEAR(leaf.y, 0.5f * kLength, 1e-3f * kLength);
+  EXPECT_EQ(update_transforms(w, assets).transforms, std::size_t(0));
+}
+
 // decompose() (components/transform.h): what the glTF loader makes of node matrices and the
 // editor of a parented camera's pose. T * R * S recomposes to the matrix, a mirror goes into
 // scale.x, a zero scale keeps the identity rotation.
