@@ -161,6 +161,13 @@ void end_progress() {
   g_progress_open = false;
 }
 
+void CheckProgress::update(std::size_t done) {
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  if (!shown_ && s < 2.0) return;
+  shown_ = true;
+  print_progress(done, total_, s, what_);
+}
+
 std::string default_sweep() {
   // Cascade count x fit x map size x filter: 24 configurations, the trade-offs that matter most.
   return "shadow.cascade_count=1,2,4;shadow.fit_mode=stable,crop;shadow.map_size=1024,2048;"
@@ -203,6 +210,11 @@ Result<std::vector<BenchConfig>> parse_product(const std::string& spec) {
     for (const auto& v : split(part.substr(eq + 1), ','))
       if (!trim(v).empty()) values.push_back(trim(v));
     if (values.empty()) return Error{"--sweep", key, "no values"};
+    if (configs.size() * values.size() > kMaxSweepConfigurations)
+      return Error{"--sweep", key,
+                   "the sweep expands to more than " + std::to_string(kMaxSweepConfigurations) +
+                       " configurations (" + std::to_string(configs.size()) + " x " +
+                       std::to_string(values.size()) + " values of " + key + ")"};
     std::vector<BenchConfig> next;
     for (const auto& c : configs)
       for (const auto& v : values) {
@@ -229,6 +241,9 @@ Result<std::vector<BenchConfig>> parse_sweep(const std::string& spec) {
   for (const std::string& product : split(spec, '|')) {
     auto configs = parse_product(product);
     if (!configs) return configs.error();
+    if (all.size() + configs->size() > kMaxSweepConfigurations)
+      return Error{"--sweep", "", "the sweep expands to more than " +
+                                      std::to_string(kMaxSweepConfigurations) + " configurations"};
     all.insert(all.end(), configs->begin(), configs->end());
   }
   return all;
@@ -260,7 +275,9 @@ Status run_bench(const BenchOptions& options) {
     const std::vector<std::string> size = {"render.width=" + std::to_string(options.width),
                                            "render.height=" + std::to_string(options.height)};
     if (auto loaded = load_scene(scene_path, size); !loaded) return loaded.error();
+    CheckProgress progress(configs->size(), scene_path.filename().string() + ": configurations");
     for (const BenchConfig& config : *configs) {
+      progress.update(std::size_t(&config - configs->data()));
       std::vector<std::string> sets = config.sets;
       sets.insert(sets.end(), size.begin(), size.end());
       if (auto checked = read_scene(scene_path, sets); !checked) {

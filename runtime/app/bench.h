@@ -7,6 +7,8 @@
 // scene: frame ms on x, error on y, the Pareto front highlighted.
 #pragma once
 
+#include <chrono>
+#include <cstddef>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -43,6 +45,30 @@ void print_progress(std::size_t done, std::size_t total, double elapsed_s, const
 
 /// Ends a progress line left on the terminal (nothing when there is none).
 void end_progress();
+
+/// Progress of a check that is usually quick (reading every configuration, every timeline
+/// event): silent for its first 2 seconds, then print_progress() lines; the destructor ends them.
+class CheckProgress {
+ public:
+  CheckProgress(std::size_t total, std::string what) : total_(total), what_(std::move(what)) {}
+  CheckProgress(const CheckProgress&) = delete;
+  CheckProgress& operator=(const CheckProgress&) = delete;
+  ~CheckProgress() {
+    if (shown_) end_progress();
+  }
+  /// `done` of the total are checked.
+  void update(std::size_t done);
+
+ private:
+  std::size_t total_;
+  std::string what_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  bool shown_ = false;
+};
+
+/// The most configurations a sweep may expand to (its products together): each is read before
+/// the first frame and run for --frames frames.
+inline constexpr std::size_t kMaxSweepConfigurations = 10000;
 
 /// The sweep used when none is given: the settings whose speed/accuracy trade-off matters.
 std::string default_sweep();

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -55,7 +56,8 @@ struct SetEvent {
   int frame = 0;
   std::string assignment;  ///< "key=value"; empty for add and remove events
   std::string remove;      ///< the entity to remove (with its children)
-  std::optional<nlohmann::json> add;  ///< an entity block of a scene file to add
+  /// An entity block of a scene file to add; shared by the copies an "every" repeats.
+  std::shared_ptr<const nlohmann::json> add;
   std::string where;       ///< the event's JSON path, for messages
 };
 

@@ -279,7 +279,7 @@ Result<Playback> playback_from(const json& doc, const fs::path& file) {
         er.string("remove", ev.remove);
         if (er.has("add")) {
           if (!er.raw("add").is_object()) fail(er.at("add"), "expected an entity block of a scene file");
-          ev.add = er.raw("add");
+          ev.add = std::make_shared<const json>(er.raw("add"));
         }
         const int kinds = !ev.assignment.empty() + !ev.remove.empty() + bool(ev.add);
         if (kinds != 1)

@@ -61,7 +61,16 @@ Result<Scene> load_checked(const Playback& pb, render::Renderer* prewarm = nullp
   if (!trial) return trial.error();
   const bool points = bool(pb.flicker);  // the flicker gate reads the points pass
   if (prewarm) KASKAD_TRY(prewarm_frame(*trial, *prewarm, *ctx, {}, points));
-  for (const SetEvent& ev : pb.events) {
+  // A setting given again right after itself (an event that repeats every frame with nothing
+  // between) reaches no new state: it is checked and pre-warmed once. Long timelines show
+  // progress.
+  CheckProgress progress(pb.events.size(), pb.file.filename().string() + ": timeline");
+  const SetEvent* last = nullptr;
+  for (std::size_t i = 0; i < pb.events.size(); ++i) {
+    const SetEvent& ev = pb.events[i];
+    if ((i & 255) == 0) progress.update(i);
+    if (last && !ev.assignment.empty() && ev.assignment == last->assignment) continue;
+    last = &ev;
     if (auto st = apply_event(*trial, ev, pb.file); !st) {
       Error e = st.error();
       e.message += " (timeline event at frame " + std::to_string(ev.frame) +
