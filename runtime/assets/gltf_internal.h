@@ -26,9 +26,6 @@ namespace kaskad::gltf_detail {
 /// Limits on what a file may ask for (guards against absurd or hostile values).
 /// tinygltf takes sizes as unsigned int; 1 GiB is far above any model we expect.
 inline constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t(1) << 30;
-/// tinygltf converts "extras"/"extensions" JSON recursively: bound the depth so a crafted file
-/// cannot overflow the stack. Real files nest fewer than 10 levels.
-inline constexpr int kMaxJsonDepth = 256;
 /// Elements per accessor (vertices or indices): 2^26 = 67M; a buffer view also has to hold them.
 inline constexpr std::uint64_t kMaxAccessorElements = std::uint64_t(1) << 26;
 /// Accessors without a buffer view are implicitly zero (plus sparse values): nothing in the file

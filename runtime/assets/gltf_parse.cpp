@@ -2,6 +2,7 @@
 // (size, JSON nesting, a broken GLB container), strips what it must not see (Draco primitives'
 // index accessors), parses with tinygltf and decodes images given by URI through OIIO.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <iterator>
@@ -77,25 +78,44 @@ bool load_image_callback(tinygltf::Image* image, const int index, std::string* /
 
 // ---- Reading and parsing the file -----------------------------------------------------------
 
-/// Refuses JSON nested deeper than kMaxJsonDepth (brackets outside strings are counted).
-Status check_json_depth(const std::uint8_t* json, std::size_t size, const std::string& file) {
-  int depth = 0;
-  bool in_string = false, escaped = false;
-  for (std::size_t i = 0; i < size; ++i) {
-    const char c = char(json[i]);
-    if (in_string) {
-      if (!escaped && c == '"') in_string = false;
-      escaped = !escaped && c == '\\';
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '{' || c == '[') {
-      if (++depth > kMaxJsonDepth) {
-        return Error{file, "",
-                     "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels"};
-      }
-    } else if (c == '}' || c == ']') {
-      --depth;
-    }
+std::string lowercase(std::string s) {
+  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+/// The media type of a "data:" URI (lower case, "" when it names none), or nullopt for a URI that
+/// is not one. `base64` tells whether the data is base64, the only encoding tinygltf decodes.
+std::optional<std::string> data_uri_media_type(const std::string& uri, bool& base64) {
+  if (uri.size() < 5 || lowercase(uri.substr(0, 5)) != "data:") return std::nullopt;
+  const std::size_t comma = uri.find(',');
+  std::string head = lowercase(uri.substr(5, comma == std::string::npos ? comma : comma - 5));
+  base64 = head.size() >= 7 && head.compare(head.size() - 7, 7, ";base64") == 0;
+  return head.substr(0, head.find(';'));
+}
+
+/// A data: URI must carry the media type its place takes. tinygltf decodes any base64 data: URI
+/// as a buffer (text/plain too) and takes one with another image type for a file name.
+Status check_data_uris(const tinygltf::Model& model, const std::string& file) {
+  bool base64 = false;
+  for (std::size_t i = 0; i < model.buffers.size(); ++i) {
+    const auto type = data_uri_media_type(model.buffers[i].uri, base64);
+    if (!type) continue;
+    const std::string where = "/buffers/" + std::to_string(i) + "/uri";
+    if (*type != "application/octet-stream" && *type != "application/gltf-buffer")
+      return Error{file, where,
+                   "a data: URI of media type '" + *type +
+                       "'; a buffer's is application/octet-stream or application/gltf-buffer"};
+    if (!base64) return Error{file, where, "a data: URI without ';base64': only base64 is read"};
+  }
+  for (std::size_t i = 0; i < model.images.size(); ++i) {
+    const auto type = data_uri_media_type(model.images[i].uri, base64);
+    if (!type) continue;
+    const std::string where = "/images/" + std::to_string(i) + "/uri";
+    if (type->rfind("image/", 0) != 0)
+      return Error{file, where,
+                   "a data: URI of media type '" + *type + "'; an image's is an image type "
+                   "(image/png, image/jpeg)"};
+    if (!base64) return Error{file, where, "a data: URI without ';base64': only base64 is read"};
   }
   return {};
 }
@@ -294,14 +314,16 @@ Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadS
     const std::size_t json_start = std::min<std::size_t>(20, data.size());
     const std::size_t available = data.size() - json_start;
     const std::size_t json_size = std::min<std::size_t>(json_length, available);
-    KASKAD_TRY(check_json_depth(data.data() + json_start, json_size, file));
+    KASKAD_TRY(json_reader::check_depth(
+        std::string_view(reinterpret_cast<const char*>(data.data() + json_start), json_size), file));
     if (total_length == data.size() && json_length <= available) {
       const auto* json_text = reinterpret_cast<const char*>(data.data() + json_start);
       if (auto rewritten = strip_draco_indices(json_text, json_size))
         data = replace_glb_json(data, json_length, std::move(*rewritten));
     }
   } else {
-    KASKAD_TRY(check_json_depth(data.data(), data.size(), file));
+    KASKAD_TRY(json_reader::check_depth(
+        std::string_view(reinterpret_cast<const char*>(data.data()), data.size()), file));
     if (auto rewritten =
             strip_draco_indices(reinterpret_cast<const char*>(data.data()), data.size()))
       data.assign(rewritten->begin(), rewritten->end());
@@ -354,6 +376,7 @@ Result<tinygltf::Model> parse_file(const std::filesystem::path& path, ImageLoadS
   for (const auto& line : split_lines(warn)) warnings.push_back(line);
   // tinygltf reports some spec violations in `err` yet succeeds; keep them as warnings.
   for (const auto& line : split_lines(err)) warnings.push_back(line);
+  KASKAD_TRY(check_data_uris(model, file));
   return model;
 }
 

@@ -84,6 +84,8 @@ Status set_field(json* node, const std::vector<std::string>& parts, const std::s
       return Error{"--set", key, "'" + parts[i - 1] + "' is a value, it has no field '" + p + "'"};
     }
   }
+  if (auto depth = json_reader::check_depth(text, "--set"); !depth)
+    return Error{"--set", key, "value " + json_reader::quote(text) + ": " + depth.error().message};
   json value = json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (value.is_discarded()) {
     // A bare word is a string (4k_sky.hdr); a well-formed number JSON cannot hold (1e999) is an
@@ -91,7 +93,7 @@ Status set_field(json* node, const std::vector<std::string>& parts, const std::s
     static const std::regex kNumber(R"(-?[0-9]+(\.[0-9]+)?([eE][+-]?[0-9]+)?)");
     if (std::regex_match(text, kNumber)) {
       auto parsed = json_reader::parse_json_text(text, "--set");
-      return Error{"--set", key, std::string("value '") + text + "' is not a valid number" +
+      return Error{"--set", key, "value " + json_reader::quote(text) + " is not a valid number" +
                                      (parsed ? std::string() : ": " + parsed.error().message)};
     }
     value = text;

@@ -11,6 +11,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -128,7 +129,7 @@ class ObjectReader {
   }
 
   bool has(const char* key) {
-    known_.push_back(key);
+    if (std::find(known_.begin(), known_.end(), key) == known_.end()) known_.push_back(key);
     return j_.contains(key);
   }
   const json& raw(const char* key) { return j_.at(key); }
@@ -258,6 +259,49 @@ inline std::string line_column(const std::string& text, std::size_t byte) {
   return "line " + std::to_string(line) + ", column " + std::to_string(col);
 }
 
+/// `text` in single quotes for a message; a long one (a number of thousands of digits, a value
+/// pasted by mistake) is cut to its first 32 characters and its length.
+inline std::string quote(std::string_view text) {
+  constexpr std::size_t kShown = 32;
+  std::string out = "'";
+  if (text.size() <= 2 * kShown) return out.append(text).append("'");
+  return out.append(text.substr(0, kShown))
+      .append("...' (")
+      .append(std::to_string(text.size()))
+      .append(" characters)");
+}
+
+/// The deepest nesting of arrays and objects in any JSON Kaskad reads: scene, material,
+/// playback and glTF files, `--set` values and the blocks inside them. Scenes nest about 6 deep
+/// and glTF about 10; the limit keeps the code that walks a value recursively (copying,
+/// comparing, writing it) far from the end of the stack.
+inline constexpr int kMaxDepth = 256;
+
+/// Refuses `text` when its arrays and objects nest deeper than kMaxDepth, naming the line and
+/// column of the first bracket too deep; brackets inside strings do not count. One linear scan
+/// that needs no valid JSON (syntax errors are the parser's to report), so it runs first.
+inline Status check_depth(std::string_view text, const std::string& file) {
+  int depth = 0;
+  bool in_string = false, escaped = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (!escaped && c == '"') in_string = false;
+      escaped = !escaped && c == '\\';
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '{' || c == '[') {
+      if (++depth > kMaxDepth)
+        return Error{file, line_column(std::string(text.substr(0, i + 1)), i + 1),
+                     "arrays and objects nested deeper than " + std::to_string(kMaxDepth) +
+                         " levels (the limit of every JSON Kaskad reads)"};
+    } else if (c == '}' || c == ']') {
+      --depth;
+    }
+  }
+  return {};
+}
+
 /// nlohmann's message without its "[json.exception.xxx.N] " prefix and the "parse error at line
 /// L, column C: " that our Error::where already gives; bytes that are not printable ASCII (the
 /// message quotes the input) are shown as \xNN.
@@ -279,7 +323,19 @@ inline std::string json_message(const std::exception& e) {
       out += hex[u & 15];
     }
   }
-  return out;
+  // Quoted input (a number of thousands of digits) is cut as quote() cuts it.
+  std::string cut;
+  for (std::size_t at = 0; at < out.size();) {
+    const std::size_t open = out.find('\'', at);
+    const std::size_t close = open == std::string::npos ? open : out.find('\'', open + 1);
+    if (close == std::string::npos) {
+      cut += out.substr(at);
+      break;
+    }
+    cut += out.substr(at, open - at) + quote(std::string_view(out).substr(open + 1, close - open - 1));
+    at = close + 1;
+  }
+  return cut;
 }
 
 /// A SAX consumer that only remembers where the parser gave up: nlohmann reports number
@@ -366,10 +422,11 @@ struct DuplicateKeyFinder {
   bool parse_error(std::size_t, const std::string&, const json::exception&) { return false; }
 };
 
-/// Parses JSON text read from `file` (used in messages). Every error nlohmann can raise (syntax,
-/// number overflow, invalid UTF-8, ...) becomes a content error with line and column; a key
-/// given twice in one object, an error at its JSON pointer.
+/// Parses JSON text read from `file` (used in messages). Nesting deeper than kMaxDepth and every
+/// error nlohmann can raise (syntax, number overflow, invalid UTF-8, ...) become a content error
+/// with line and column; a key given twice in one object, an error at its JSON pointer.
 inline Result<json> parse_json_text(const std::string& text, const std::string& file) {
+  KASKAD_TRY(check_depth(text, file));
   try {
     json doc = json::parse(text, nullptr, true, /*ignore_comments=*/false);
     DuplicateKeyFinder keys;

@@ -39,6 +39,20 @@ mkdir -p "$fifo/shard"
 for f in pipe.json pipe.bin pipe.png shard/bench.csv; do mkfifo "$fifo/$f"; done
 cp "$here/gltf/fifo_buffer.gltf" "$here/gltf/fifo_image.gltf" "$fifo/"
 
+# Generated cases ({GEN}/...), too big for git: JSON nested 100,000 deep in a model's node
+# settings and in an entity block, and a parent cycle through 100,000 entities.
+gen="$tmp/gen"
+mkdir -p "$gen"
+printf -v blanks '%100000s' ''
+deep_array="${blanks// /[}${blanks// /]}"
+printf '{"kaskad_scene": 1, "entities": [{"name": "m", "model": {"path": "%s", "nodes": {"n": {"transform": {"translation": %s}}}}}]}\n' \
+  "$content/models/Box/glTF-Binary/Box.glb" "$deep_array" >"$gen/deep_node_settings.json"
+printf '{"kaskad_scene": 1, "entities": [{"name": "e", "transform": {"translation": %s}}]}\n' \
+  "$deep_array" >"$gen/deep_entity.json"
+awk 'BEGIN { n = 100000; printf "{\"kaskad_scene\": 1, \"entities\": [";
+             for (i = 0; i < n; ++i) printf "%s{\"name\": \"e%d\", \"transform\": {\"parent\": \"e%d\"}}", (i ? ", " : ""), i, (i + 1) % n;
+             print "]}" }' >"$gen/long_parent_cycle.json"
+
 while IFS= read -r line; do
   case "$line" in ''|'#'*) continue ;; esac
   n=$((n + 1))
@@ -48,7 +62,7 @@ while IFS= read -r line; do
   cp "$tmp/prev.png" "$out/out.png"; cp "$tmp/prev.exr" "$out/out.exr"; cp "$tmp/prev.json" "$out/out.json"
   printf 'scene,config\nold,row\n' >"$out/bench/bench.csv"
   words="${words//\{R\}/--headless --size 32x32 --frames 1 -o \{OUT\}/out.png}"
-  words="${words//\{FIFO\}/$fifo}"
+  words="${words//\{FIFO\}/$fifo}" words="${words//\{GEN\}/$gen}"
   words="${words//\{DIR\}/$here}" words="${words//\{CONTENT\}/$content}" words="${words//\{OUT\}/$out}"
   mention="${mention//\{OUT\}/$out}"
   eval "args=($words)"

@@ -85,6 +85,19 @@ check play_fifo 1 "pipe.json: cannot open: not a regular file but a named pipe" 
 check gltf_image_fifo 0 "pipe.png: not a regular file but a named pipe" -- \
   timeout -k 5 60 "$KASKAD" render "$tmp/fifo_image.gltf" --headless --size 32x32 --frames 1 \
   -o "$tmp/fifo_image.png"
+# Input at scale, generated here (too big for git). A playback file whose added entity nests
+# 100,000 deep fails on its own, at the bracket too deep; a parent chain 100,000 long renders.
+printf -v blanks '%100000s' ''
+printf '{"kaskad_playback": 1, "scene": "%s", "size": [16, 16], "frames": 2, "timeline": [{"frame": 1, "add": %s}]}\n' \
+  "$KASKAD_CONTENT/scenes/default.json" "${blanks// /[}${blanks// /]}" >"$tmp/deep_add.json"
+check play_deep_add 1 "deep_add.json: line 1, column [0-9]+: arrays and objects nested deeper than 256 levels" -- \
+  timeout -k 5 120 "$KASKAD" play "$tmp/deep_add.json" --out "$tmp/play_deep"
+awk 'BEGIN { n = 100000; printf "{\"kaskad_scene\": 1, \"entities\": [";
+             for (i = n - 1; i > 0; --i) printf "{\"name\": \"e%d\", \"transform\": {\"parent\": \"e%d\", \"translation\": [0, 0.001, 0]}}, ", i, i - 1;
+             print "{\"name\": \"e0\"}, {\"name\": \"cam\", \"camera\": {}, \"transform\": {\"translation\": [0, 50, 300]}}]}" }' \
+  >"$tmp/long_chain.json"
+check parent_chain_100k 0 "wrote" -- timeout -k 5 300 "$KASKAD" render "$tmp/long_chain.json" --headless \
+  --size 32x32 --frames 1 -o "$tmp/long_chain.png"
 # An option given twice takes its last value, as before CLI11 (scripts append to a base line).
 check option_given_twice 0 "wrote .*twice_b.png" -- "$KASKAD" render --headless --size 32x32 --frames 1 \
   -o "$tmp/twice_a.png" -o "$tmp/twice_b.png"

@@ -463,6 +463,23 @@ TEST(GltfLoaderErrors, DeeplyNestedJson) {
   expect_import_error(path, "nested");
 }
 
+// A data: URI's media type must be one its place takes: tinygltf alone decodes a text/plain
+// buffer and reads an image of another type as a file name. The error names the URI's place.
+TEST(GltfLoaderErrors, DataUrisOfTheWrongMediaType) {
+  json doc = triangle_gltf();
+  const std::string uri = doc["buffers"][0]["uri"];
+  ASSERT_EQ(uri.rfind("data:application/octet-stream;base64,", 0), 0u) << uri.substr(0, 40);
+  const std::string payload = uri.substr(uri.find(',') + 1);
+  doc["buffers"][0]["uri"] = "data:application/gltf-buffer;base64," + payload;
+  EXPECT_TRUE(import_file(write_gltf("gltf_buffer_uri.gltf", doc))->report.ok());
+  doc["buffers"][0]["uri"] = "data:text/plain;base64," + payload;
+  expect_import_error(write_gltf("text_buffer_uri.gltf", doc), "/buffers/0/uri");
+  expect_import_error(write_gltf("text_buffer_uri.gltf", doc), "'text/plain'");
+  doc = triangle_gltf();
+  doc["images"] = {{{"uri", "data:text/html;base64,PGh0bWw+"}}};
+  expect_import_error(write_gltf("html_image_uri.gltf", doc), "/images/0/uri");
+}
+
 TEST(GltfLoaderErrors, MissingBufferFile) {
   json doc = triangle_gltf();
   doc["buffers"][0]["uri"] = "missing.bin";

@@ -27,6 +27,41 @@ TEST(JsonReader, NumberOverflowIsAContentErrorWithLineAndColumn) {
   EXPECT_EQ(doc.error().message.find("[json.exception"), std::string::npos) << doc.error().message;
 }
 
+// One depth limit for every JSON: kMaxDepth levels read, one more is an error at the bracket
+// too deep (line and column), long before a recursive walk could overflow the stack; brackets
+// in strings do not count.
+TEST(JsonReader, NestingDeeperThanTheLimitIsRefusedWhereItStarts) {
+  const int limit = json_reader::kMaxDepth;
+  const auto nested = [](int depth) {
+    return "{\"a\":\n" + std::string(std::size_t(depth - 1), '[') + "\"[[[{{{\"" +
+           std::string(std::size_t(depth - 1), ']') + "}";
+  };
+  EXPECT_TRUE(parse_json_text(nested(limit), "ok.json").ok());
+  auto deep = parse_json_text(nested(limit + 1), "deep.json");
+  ASSERT_FALSE(deep.ok());
+  EXPECT_EQ(deep.error().file, "deep.json");
+  EXPECT_EQ(deep.error().where, "line 2, column " + std::to_string(limit));
+  EXPECT_NE(deep.error().message.find("nested deeper than " + std::to_string(limit) + " levels"),
+            std::string::npos)
+      << deep.error().message;
+  // A hundred thousand levels: refused as quickly, nothing recurses.
+  const std::string huge = std::string(100000, '[') + std::string(100000, ']');
+  EXPECT_FALSE(parse_json_text(huge, "huge.json").ok());
+  EXPECT_FALSE(json_reader::check_depth(huge, "--set").ok());
+}
+
+// A value quoted in a message is cut when long: a number of thousands of digits names its length.
+TEST(JsonReader, LongValuesInMessagesAreCut) {
+  EXPECT_EQ(json_reader::quote("1e999"), "'1e999'");
+  const std::string digits(5000, '9');
+  EXPECT_EQ(json_reader::quote(digits), "'" + std::string(32, '9') + "...' (5000 characters)");
+  auto doc = parse_json_text("[" + digits + "]", "digits.json");
+  ASSERT_FALSE(doc.ok());
+  EXPECT_NE(doc.error().message.find("number overflow parsing '9999"), std::string::npos)
+      << doc.error().message;
+  EXPECT_LT(doc.error().message.size(), 200u) << doc.error().message;
+}
+
 TEST(JsonReader, SyntaxErrorsAndBadBytesAreShownPrintably) {
   auto doc = parse_json_text("{ \"k\": \"\xff\xfe\" }", "y.json");
   ASSERT_FALSE(doc.ok());
