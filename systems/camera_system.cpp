@@ -13,13 +13,31 @@
 namespace kaskad {
 namespace {
 
-// World matrix without scale: rotation columns normalised.
+// World matrix without scale: rotation columns normalised. A column a zero scale collapsed (a
+// camera scaled to 0 on one axis, or under such a parent) is the cross product of the other two,
+// so the view stays invertible; with fewer than two left the orientation is the world's.
 glm::mat4 rigid(const glm::mat4& m) {
   glm::mat4 r = m;
+  int collapsed = -1, count = 0;
   for (int i = 0; i < 3; ++i) {
     const float len = glm::length(glm::vec3(m[i]));
-    if (len > 0.0f) r[i] = m[i] / len;
+    if (std::isfinite(len) && len > 1e-30f) {
+      r[i] = glm::vec4(glm::vec3(m[i]) / len, 0.0f);
+    } else {
+      collapsed = i;
+      ++count;
+    }
   }
+  if (count == 1) {
+    const int a = (collapsed + 1) % 3, b = (collapsed + 2) % 3;  // x = y^z, y = z^x, z = x^y
+    const glm::vec3 c = glm::cross(glm::vec3(r[a]), glm::vec3(r[b]));
+    if (glm::length(c) > 1e-6f) {
+      r[collapsed] = glm::vec4(glm::normalize(c), 0.0f);
+      return r;
+    }
+  }
+  if (count > 0)
+    for (int i = 0; i < 3; ++i) r[i] = glm::mat4(1.0f)[i];
   return r;
 }
 

@@ -2,6 +2,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <string>
@@ -371,6 +372,32 @@ TEST(CameraSystem, AWellSetCameraHasNothingToSay) {
   EXPECT_EQ(joined(CameraSetup(glm::vec3(0), 0.1f, 100.0f).warnings()), "");
   EXPECT_EQ(joined(CameraSetup(glm::vec3(0), 1e-3f, 1e3f).warnings()), "");  // step 0.6 mm at 10 m
   EXPECT_EQ(joined(CameraSetup(glm::vec3(1e3f, 0, -1e3f), 0.1f, 100.0f).warnings()), "");
+}
+
+// A camera scaled to zero on an axis (or under such a parent) keeps an invertible view: the
+// collapsed axis is rebuilt from the other two, so it sees what the unscaled camera sees; with
+// two axes gone its orientation is the world's. Nothing is infinite.
+TEST(CameraSystem, AZeroScaleKeepsTheViewInvertible) {
+  const glm::quat turned = glm::angleAxis(glm::radians(30.0f), glm::normalize(glm::vec3(1, 2, 0)));
+  auto view_with_scale = [&](glm::vec3 scale) {
+    ecs::World w;
+    AssetStore assets;
+    const ecs::Entity cam = w.create();
+    w.emplace<Transform>(cam, Transform{{1, 2, 3}, turned, scale});
+    w.emplace<Camera>(cam, Camera{});
+    update_transforms(w, assets);
+    return select_camera(w, 1.0f).view;
+  };
+  const glm::mat4 reference = view_with_scale(glm::vec3(1.0f));
+  for (const glm::vec3 scale : {glm::vec3(0, 1, 1), glm::vec3(1, 0, 1), glm::vec3(2, 2, 0)}) {
+    const glm::mat4 view = view_with_scale(scale);
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) EXPECT_NEAR(view[c][r], reference[c][r], 1e-5f) << c << r;
+  }
+  const glm::mat4 flat = view_with_scale(glm::vec3(0, 0, 1));
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) EXPECT_TRUE(std::isfinite(flat[c][r])) << c << r;
+  EXPECT_NEAR(flat[0][0], 1.0f, 1e-6f);  // the world's orientation
 }
 
 TEST(CameraSystem, SeveralActiveCamerasAreNamedAndTheFirstRenders) {
