@@ -83,7 +83,7 @@ RunCommand add_edit_command(CLI::App& cmd) {
       ->type_name("FILE");
   add_value_option(cmd, "--set", o->sets, "an override, as for `kaskad render` (repeatable)")
       ->type_name("KEY=VALUE");
-  add_size_option(cmd, o->width, o->height, 64, 16384, "the window size (default 1280x720)");
+  add_size_option(cmd, o->width, o->height, 1, 16384, "the window size (default 1280x720)");
   add_value_option(cmd, "--script", o->script,
                    "replay actions, one per line (docs/guide/editor.md)")
       ->type_name("FILE");
