@@ -22,7 +22,9 @@
 #include "components/camera.h"
 #include "editor/debug_views.h"
 #include "editor/editor_app.h"
+#include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
+#include "runtime/core/atomic_file.h"
 #include "runtime/core/file_io.h"
 #include "runtime/gpu/context.h"
 
@@ -348,6 +350,20 @@ int run_edit(const EditOptions& options) {
       return 1;
     }
     script = std::move(parsed.value());
+    // Its outputs are checked before the scene loads or a frame renders, as a command line's
+    // are: a screenshot or save into a folder that does not exist fails at once, naming its line.
+    for (const ScriptAction& a : script) {
+      Status st;
+      if (a.kind == ActionKind::screenshot || a.kind == ActionKind::window_screenshot)
+        st = check_image_output(a.args[0]);
+      else if ((a.kind == ActionKind::save || a.kind == ActionKind::save_as) && !a.args.empty())
+        st = check_output_path(a.args[0]);
+      if (!st) {
+        std::fprintf(stderr, "kaskad edit: error: %s: line %d: %s\n", opt.script.string().c_str(),
+                     a.line, st.error().to_string().c_str());
+        return 1;
+      }
+    }
   }
   auto scene = load_scene(opt.scene, opt.sets);
   if (!scene) {

@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "runtime/assets/image_io.h"
+#include "runtime/core/atomic_file.h"
 #include "runtime/fields/fields.h"
 
 namespace kaskad {
@@ -539,13 +540,9 @@ Status check_cube_faces_output(const std::filesystem::path& pattern_or_dir) {
   const std::string s = pattern_or_dir.string();
   if (s.find('*') == std::string::npos) {
     // A folder the user named: made when missing (one level; its parent must exist).
+    KASKAD_TRY(check_output_folder_to_make(pattern_or_dir));
     std::error_code ec;
-    const auto parent = pattern_or_dir.parent_path().empty() ? std::filesystem::path(".")
-                                                             : pattern_or_dir.parent_path();
     if (!std::filesystem::exists(pattern_or_dir, ec)) {
-      if (!std::filesystem::is_directory(parent, ec))
-        return Error{s, "", "cannot make this folder: '" + parent.string() +
-                                "' does not exist (kaskad makes only the folder named)"};
       std::filesystem::create_directory(pattern_or_dir, ec);
       if (ec) return Error{s, "", "cannot make this folder: " + ec.message()};
     }
