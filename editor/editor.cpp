@@ -22,21 +22,22 @@
 #include "components/camera.h"
 #include "editor/debug_views.h"
 #include "editor/editor_app.h"
+#include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
+#include "runtime/core/atomic_file.h"
 #include "runtime/core/file_io.h"
 #include "runtime/gpu/context.h"
 
 namespace kaskad::editor {
 
-/// `left` and `right` < 0: the first layout, a share of the window with limits in pixels, the
-/// two panels together at most 55% of it. `hidden`: no panels, the viewport is the window.
 Layout layout_for(int w, int h, float left, float right, bool hidden) {
   Layout l;
-  if (hidden) {
+  if (hidden || w < kMinPanelsWindow) {
     l.view_w = w;
     l.view_h = h;
     return l;
   }
+  l.panels = true;
   const float fw = float(w);
   l.left = left < 0 ? std::clamp(0.2f * fw, 160.0f, 300.0f) : left;
   l.right = right < 0 ? std::clamp(0.32f * fw, 200.0f, 460.0f) : right;
@@ -47,8 +48,9 @@ Layout layout_for(int w, int h, float left, float right, bool hidden) {
   }
   l.left = std::clamp(l.left, kMinPanel, max_panel(w));
   l.right = std::clamp(l.right, kMinPanel, max_panel(w));
+  // Each panel is at most 45% of a window at least 2 * kMinPanel wide: the viewport keeps 10%.
   l.view_x = int(l.left);
-  l.view_w = std::max(0, w - int(l.left) - int(l.right));
+  l.view_w = w - int(l.left) - int(l.right);
   l.view_h = h;
   return l;
 }
@@ -58,7 +60,7 @@ void Editor::draw_ui(int w, int h) {
   const Layout l = layout_for(w, h, left_w_, right_w_, panels_hidden_);
   const ImGuiWindowFlags fixed = kPanelFlags | ImGuiWindowFlags_NoResize;
   // Panels keep the window's height; only their inner edge moves. H hides them.
-  if (!panels_hidden_) entities_panel(w, h, l);
+  if (l.panels) entities_panel(w, h, l);
 
   ImGui::SetNextWindowPos(ImVec2(float(l.view_x), 0));
   ImGui::SetNextWindowSize(ImVec2(float(l.view_w), float(l.view_h)));
@@ -101,7 +103,7 @@ void Editor::draw_ui(int w, int h) {
   ImGui::End();
   ImGui::PopStyleVar();
 
-  if (!panels_hidden_) {
+  if (l.panels) {
     ImGui::SetNextWindowPos(ImVec2(float(w) - l.right, 0));
     ImGui::SetNextWindowSize(ImVec2(l.right, float(h)));
     ImGui::SetNextWindowSizeConstraints(ImVec2(kMinPanel, float(h)),
@@ -189,6 +191,7 @@ int Editor::run() {
   // `input SECONDS`: until then the window takes real input and no script action runs.
   std::optional<std::chrono::steady_clock::time_point> input_until;
   int input_phases = 0;
+  int pixelless_waits = 0;  // passes in a row with a minimised window, 0.1 s each
   auto last = std::chrono::steady_clock::now();
   auto last_reload_check = last;
   for (;;) {
@@ -251,18 +254,30 @@ int Editor::run() {
 
     int w = 0, h = 0;
     glfwGetFramebufferSize(window, &w, &h);
-    if (w <= 0 || h <= 0) continue;  // minimised
-    const Layout l = layout_for(w, h, left_w_, right_w_, panels_hidden_);
-    if (l.view_w > 0 && l.view_h > 0) {
-      if (Status st = render_viewport(l.view_w, l.view_h); !st) {
-        if (!opt_.script.empty()) {
-          std::fprintf(stderr, "kaskad edit: error: %s\n", st.error().to_string().c_str());
-          return 1;
-        }
-        // A scene that cannot be drawn (its camera deleted, say) is shown as an error until an
-        // edit or an undo fixes it; the window stays.
-        if (message_ != st.error().to_string()) report(st.error().to_string());
+    if (w <= 0 || h <= 0) {
+      // Minimised: nothing to draw until the window is back. A script's frames and screenshots
+      // would wait for it for ever: it gives up after a few seconds instead.
+      if (!opt_.script.empty() && ++pixelless_waits > 50) {
+        std::fprintf(stderr, "kaskad edit: error: %s: the window has had no pixels (%dx%d, "
+                     "minimised?) for 5 s; the script needs its frames\n",
+                     opt_.script.string().c_str(), w, h);
+        return 1;
       }
+      glfwWaitEventsTimeout(0.1);
+      continue;
+    }
+    pixelless_waits = 0;
+    // The layout leaves the viewport at least 1x1 (layout_for), so every pass renders it: a
+    // screenshot after a change waits for exactly this frame.
+    const Layout l = layout_for(w, h, left_w_, right_w_, panels_hidden_);
+    if (Status st = render_viewport(l.view_w, l.view_h); !st) {
+      if (!opt_.script.empty()) {
+        std::fprintf(stderr, "kaskad edit: error: %s\n", st.error().to_string().c_str());
+        return 1;
+      }
+      // A scene that cannot be drawn (its camera deleted, say) is shown as an error until an
+      // edit or an undo fixes it; the window stays.
+      if (message_ != st.error().to_string()) report(st.error().to_string());
     }
     if (frames_left > 0) --frames_left;
 
@@ -335,6 +350,20 @@ int run_edit(const EditOptions& options) {
       return 1;
     }
     script = std::move(parsed.value());
+    // Its outputs are checked before the scene loads or a frame renders, as a command line's
+    // are: a screenshot or save into a folder that does not exist fails at once, naming its line.
+    for (const ScriptAction& a : script) {
+      Status st;
+      if (a.kind == ActionKind::screenshot || a.kind == ActionKind::window_screenshot)
+        st = check_image_output(a.args[0]);
+      else if ((a.kind == ActionKind::save || a.kind == ActionKind::save_as) && !a.args.empty())
+        st = check_output_path(a.args[0]);
+      if (!st) {
+        std::fprintf(stderr, "kaskad edit: error: %s: line %d: %s\n", opt.script.string().c_str(),
+                     a.line, st.error().to_string().c_str());
+        return 1;
+      }
+    }
   }
   auto scene = load_scene(opt.scene, opt.sets);
   if (!scene) {

@@ -13,7 +13,7 @@ namespace kaskad::editor {
 struct EditOptions {
   std::filesystem::path scene;    ///< .json, .gltf or .glb; empty: content/scenes/default.json
   std::vector<std::string> sets;  ///< overrides, as for `kaskad render --set`
-  int width = 1280, height = 720;  ///< the window's size in pixels, each in [64, 16384]
+  int width = 1280, height = 720;  ///< the window's size in pixels, each in [1, 16384]
   std::filesystem::path script;   ///< actions to replay, one per line; empty: interactive
 };
 

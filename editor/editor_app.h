@@ -43,20 +43,26 @@ using json = nlohmann::json;
 using Options = EditOptions;
 
 // The panels: full height at the window's sides, resizable in width (each at most 45% of the
-// window); the viewport is what is left between them.
+// window); the viewport is what is left between them, never less than one pixel.
 struct Layout {
+  bool panels = false;        ///< the side panels are drawn (not hidden by H, the window wide enough)
   float left = 0, right = 0;  ///< panel widths in pixels
   int view_x = 0, view_w = 0, view_h = 0;
 };
 
 inline constexpr float kMinPanel = 120.0f;
+/// The narrowest window that has the side panels: both at their least width and 64 pixels of
+/// viewport. A narrower window is all viewport, as after H (the viewport's frame, which a
+/// script's screenshot waits for, would otherwise have no pixels).
+inline constexpr int kMinPanelsWindow = 2 * int(kMinPanel) + 64;
 // The side panels: fixed in place, resizable at their inner edge.
 inline constexpr ImGuiWindowFlags kPanelFlags =
     ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
 inline float max_panel(int window_width) { return std::max(kMinPanel, 0.45f * float(window_width)); }
 
 /// `left` and `right` < 0: the first layout, a share of the window with limits in pixels, the
-/// two panels together at most 55% of it. `hidden`: no panels, the viewport is the window.
+/// two panels together at most 55% of it. `hidden`, or a window narrower than kMinPanelsWindow:
+/// no panels, the viewport is the window. For w, h >= 1 the viewport is at least 1x1.
 Layout layout_for(int w, int h, float left, float right, bool hidden);
 
 class Editor {

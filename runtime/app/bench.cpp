@@ -290,12 +290,12 @@ Status run_bench(const BenchOptions& options) {
   // The output folder is the one the user named (--out, or out/bench): made when missing, one
   // level only.
   std::error_code ec;
-  const fs::path out_parent =
-      folder_of(options.out_dir);
-  if (options.out_dir == BenchOptions{}.out_dir)
+  if (options.out_dir == BenchOptions{}.out_dir) {
     fs::create_directories(options.out_dir, ec);  // the documented default, out/bench
-  else if (!fs::exists(options.out_dir, ec) && fs::is_directory(out_parent, ec))
-    fs::create_directory(options.out_dir, ec);
+  } else {
+    KASKAD_TRY(check_output_folder_to_make(options.out_dir));  // one level, the one named
+    if (!fs::exists(options.out_dir, ec)) fs::create_directory(options.out_dir, ec);
+  }
   KASKAD_TRY(check_output_folder(options.out_dir));
   const fs::path csv_path = options.out_dir / "bench.csv";
   // The CSV is rewritten atomically after every row (atomic_file.h): rows survive Ctrl-C and

@@ -75,13 +75,8 @@ int run_play(const PlayCommandOptions& command) {
   // Like every output folder Kaskad makes: one level, in a folder that exists (the default
   // out/play is made whole).
   if (out_given) {
-    const fs::path parent = options.out_dir.has_parent_path() ? options.out_dir.parent_path() : ".";
-    std::error_code ec;
-    if (!fs::is_directory(parent, ec)) {
-      std::fprintf(
-          stderr,
-          "kaskad: error: %s: the folder it goes in does not exist (--out makes one level)\n",
-          options.out_dir.string().c_str());
+    if (Status st = check_output_folder_to_make(options.out_dir); !st) {
+      std::fprintf(stderr, "kaskad: error: --out: %s\n", st.error().to_string().c_str());
       return 1;
     }
   }

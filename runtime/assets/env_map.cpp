@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "runtime/assets/image_io.h"
+#include "runtime/core/atomic_file.h"
 #include "runtime/fields/fields.h"
 
 namespace kaskad {
@@ -86,6 +87,38 @@ std::vector<glm::vec4> rgba_texels(const Image& image) {
     }
   }
   return out;
+}
+
+/// An environment's texels are summed into its SH coefficients and prefiltered radiance, and
+/// sampled by every reflection: one NaN or infinity spreads over the whole lighting. So each
+/// image an environment is made from is checked whole, and the first such value (in file order:
+/// rows from the top, then columns, then channels) is an error naming its pixel and channel.
+Status check_finite(const Image& image, const std::string& file) {
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      for (int c = 0; c < image.channels; ++c) {
+        const float v = image.at(x, y, c);
+        if (std::isfinite(v)) continue;
+        const std::string channel = c < int(image.channel_names.size()) &&
+                                            !image.channel_names[std::size_t(c)].empty()
+                                        ? image.channel_names[std::size_t(c)]
+                                        : std::to_string(c);
+        const char* what = std::isnan(v) ? "NaN" : v > 0 ? "+Inf" : "-Inf";
+        std::string message = "pixel (";
+        message += std::to_string(x);
+        message += ", ";
+        message += std::to_string(y);
+        message += "), channel ";
+        message += channel;
+        message += ", is ";
+        message += what;
+        message += ": an environment map's pixels must be finite numbers (x from the left, y "
+                   "from the top row)";
+        return Error{file, "", message};
+      }
+    }
+  }
+  return {};
 }
 
 Image image_of(const std::vector<glm::vec4>& texels, int w, int h) {
@@ -230,6 +263,7 @@ Result<CubeMap> load_faces(const std::filesystem::path& path, bool max) {
     }
     auto image = load_image(file);
     if (!image) return image.error();
+    KASKAD_TRY(check_finite(*image, file));
     if (image->width != image->height) {
       return Error{
           file, "",
@@ -424,6 +458,7 @@ Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOp
   } else {
     auto image = load_image(path);
     if (!image) return image.error();
+    KASKAD_TRY(check_finite(*image, name));
     const int w = image->width, h = image->height;
     if (layout == EnvLayout::auto_detect) {
       if (3 * w == 4 * h)
@@ -475,6 +510,7 @@ Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOp
 Result<SphereMap> load_sphere_map(const std::filesystem::path& path) {
   auto image = load_image(path);
   if (!image) return image.error();
+  KASKAD_TRY(check_finite(*image, path.string()));
   return sphere_from_image(*image, path.string());
 }
 
@@ -504,13 +540,9 @@ Status check_cube_faces_output(const std::filesystem::path& pattern_or_dir) {
   const std::string s = pattern_or_dir.string();
   if (s.find('*') == std::string::npos) {
     // A folder the user named: made when missing (one level; its parent must exist).
+    KASKAD_TRY(check_output_folder_to_make(pattern_or_dir));
     std::error_code ec;
-    const auto parent = pattern_or_dir.parent_path().empty() ? std::filesystem::path(".")
-                                                             : pattern_or_dir.parent_path();
     if (!std::filesystem::exists(pattern_or_dir, ec)) {
-      if (!std::filesystem::is_directory(parent, ec))
-        return Error{s, "", "cannot make this folder: '" + parent.string() +
-                                "' does not exist (kaskad makes only the folder named)"};
       std::filesystem::create_directory(pattern_or_dir, ec);
       if (ec) return Error{s, "", "cannot make this folder: " + ec.message()};
     }

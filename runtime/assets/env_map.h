@@ -142,13 +142,15 @@ struct EnvLoadOptions {
 ///     folder of faces;
 ///     otherwise by the image's aspect ratio (4:3, 3:4, 2:1, 1:1).
 /// Errors name the file and the problem: unreadable images, missing face files, non-square or
-/// mismatched faces, a wrong aspect for the layout, face_size out of range.
+/// mismatched faces, a wrong aspect for the layout, face_size out of range, a NaN or infinite
+/// pixel (the first one's x, y and channel; every image is checked whole, before any layout).
 /// `detected`, when given, receives the layout used (auto_detect resolved), also on errors
 /// found after detection.
 Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOptions& options = {},
                               EnvLayout* detected = nullptr);
 
-/// Loads a sphere-map image (square; row 0 at the top, see SphereMap).
+/// Loads a sphere-map image (square; row 0 at the top, see SphereMap). A NaN or infinite pixel
+/// is an error, as for load_cube_map().
 Result<SphereMap> load_sphere_map(const std::filesystem::path& path);
 
 /// Debug dump of the six faces as images (format from the extension; EXR keeps floats).

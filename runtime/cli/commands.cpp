@@ -38,10 +38,10 @@ RunCommand add_envmap_command(CLI::App& cmd) {
                "the faces were authored in 3ds Max (Z up): convert them to Y up");
   add_integer_option(cmd, "--face-size", o->load.face_size, 1, 8192,
                      "resample the faces to N^2 pixels");
-  add_value_option(cmd, "--faces", o->faces_out,
+  add_output_option(cmd, "--faces", o->faces_out, OutputKind::faces,
                    "write the six faces: a pattern with * (sky_*.png) or a folder")
       ->type_name("OUT");
-  add_value_option(cmd, "--sphere", o->sphere_out, "write the S3 sphere map")
+  add_output_option(cmd, "--sphere", o->sphere_out, OutputKind::image, "write the S3 sphere map")
       ->type_name("OUT.png");
   add_integer_option(cmd, "--sphere-size", o->sphere_size, 1, 8192,
                      "the sphere map's size in pixels (default: twice the face size)");
@@ -55,7 +55,7 @@ RunCommand add_play_command(CLI::App& cmd) {
                  "playback files, or folders standing for their *.json files; with --merge, "
                  "the shards' output folders")
       ->type_name("FILE|DIR");
-  CLI::Option* out = add_value_option(cmd, "--out", o->run.out_dir,
+  CLI::Option* out = add_output_option(cmd, "--out", o->run.out_dir, OutputKind::folder,
                                       "DIR/<file>/frame_NNNN.png, frames.csv, diffs, "
                                       "DIR/summary.json (default out/play)")
                          ->type_name("DIR");
@@ -83,7 +83,7 @@ RunCommand add_edit_command(CLI::App& cmd) {
       ->type_name("FILE");
   add_value_option(cmd, "--set", o->sets, "an override, as for `kaskad render` (repeatable)")
       ->type_name("KEY=VALUE");
-  add_size_option(cmd, o->width, o->height, 64, 16384, "the window size (default 1280x720)");
+  add_size_option(cmd, o->width, o->height, 1, 16384, "the window size (default 1280x720)");
   add_value_option(cmd, "--script", o->script,
                    "replay actions, one per line (docs/guide/editor.md)")
       ->type_name("FILE");

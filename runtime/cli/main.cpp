@@ -202,12 +202,9 @@ void print_layer_table(const render::FrameStats& st, const ShadowData& sh, bool 
 /// A folder the user named for outputs (--probe-maps DIR): made when missing, but only that one
 /// level; its parent must exist.
 Status make_named_folder(const fs::path& dir) {
+  KASKAD_TRY(check_output_folder_to_make(dir));
   std::error_code ec;
   if (!fs::exists(dir, ec)) {
-    const fs::path parent = folder_of(dir);
-    if (!fs::is_directory(parent, ec))
-      return Error{dir.string(), "", "cannot make this folder: '" + parent.string() +
-                                         "' does not exist (kaskad makes only the folder named)"};
     fs::create_directory(dir, ec);
     if (ec) return Error{dir.string(), "", "cannot make this folder: " + ec.message()};
   }
@@ -492,30 +489,31 @@ cli::RunCommand add_render_command(CLI::App& cmd) {
   auto a = std::make_shared<RenderArgs>();
   add_scene_options(cmd, a->scene, a->sets,
                     "a scene file (.json, .gltf, .glb); default content/scenes/default.json");
-  cli::add_value_option(cmd, "-o,--output", a->output,
-                        "colour image (PNG, JPEG, EXR, ...); default out/<scene>.png")
+  cli::add_output_option(cmd, "-o,--output", a->output, cli::OutputKind::image,
+                         "colour image (PNG, JPEG, EXR, ...); default out/<scene>.png")
       ->type_name("FILE");
   cli::add_size_option(cmd, a->width, a->height, 1, 16384,
                        "output size in pixels (default: the scene's render.width/height)");
   cli::add_frames_option(cmd, a->frames,
                          "frames to render; times are the median of frames 2..N (default 10)");
-  cli::add_value_option(cmd, "--aov", a->aov,
+  cli::add_output_option(cmd, "--aov", a->aov, cli::OutputKind::image,
                         "write the AOVs of the last frame (P, N, Z, visibility, mask, cascade)")
       ->type_name("FILE.exr");
-  cli::add_value_option(cmd, "--shadow-map", a->shadow_map,
+  cli::add_output_option(cmd, "--shadow-map", a->shadow_map, cli::OutputKind::image,
                         "write the shadow map depth of the last frame")
       ->type_name("FILE.exr");
-  cli::add_value_option(cmd, "--probe-maps", a->probe_maps,
+  cli::add_output_option(cmd, "--probe-maps", a->probe_maps, cli::OutputKind::folder,
                         "write each reflection probe's visible cube faces (NAME_px.png ... "
                         "NAME_nz.png) and, for sphere probes, NAME_sphere.png into DIR")
       ->type_name("DIR");
-  cli::add_value_option(cmd, "--reflection-reference", a->reflection_reference,
+  cli::add_output_option(cmd, "--reflection-reference", a->reflection_reference,
+                         cli::OutputKind::image,
                         "ray-traced reflected radiance C_t of every pixel (docs/guide/envmaps.md)")
       ->type_name("FILE.exr");
   cli::add_value_option(cmd, "--env", a->env,
                         "environment map for the reflection reference's misses (any layout)")
       ->type_name("PATH");
-  cli::add_value_option(cmd, "--shadow-reference", a->shadow_reference,
+  cli::add_output_option(cmd, "--shadow-reference", a->shadow_reference, cli::OutputKind::image,
                         "the ray-traced visibility of the light the visibility AOV shows (area "
                         "lights sampled), the AOV's, and their difference, per pixel; prints RMSE "
                         "and MAE over the receivers (docs/design/soft_shadows.md)")
@@ -540,7 +538,8 @@ cli::RunCommand add_save_command(CLI::App& cmd) {
   auto a = std::make_shared<SaveArgs>();
   add_scene_options(cmd, a->scene, a->sets, "the scene file to read (.json, .gltf, .glb)");
   cmd.get_option("SCENE")->required();
-  cli::add_value_option(cmd, "-o,--output", a->output, "the canonical scene file to write")
+  cli::add_output_option(cmd, "-o,--output", a->output, cli::OutputKind::file,
+                         "the canonical scene file to write")
       ->type_name("OUT.json")
       ->required();
   cli::add_verbose_flag(cmd);
@@ -585,7 +584,8 @@ cli::RunCommand add_bench_command(CLI::App& cmd) {
                              : "";
           },
           ""));
-  cli::add_value_option(cmd, "--out", o.out_dir, "where bench.csv and the charts go (default out/bench)")
+  cli::add_output_option(cmd, "--out", o.out_dir, cli::OutputKind::folder,
+                         "where bench.csv and the charts go (default out/bench)")
       ->type_name("DIR");
   cli::add_frames_option(cmd, o.frames, "timed frames per configuration (default 10)");
   cli::add_size_option(cmd, o.width, o.height, 1, 16384, "output size in pixels (default 640x360)");

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <optional>
 
+#include "runtime/assets/image_io.h"
+#include "runtime/core/atomic_file.h"
 #include "runtime/core/log.h"
 
 namespace kaskad::cli {
@@ -78,6 +80,32 @@ const CLI::Validator& not_an_option() {
       },
       "");
   return check;
+}
+
+std::string output_problem(const std::string& path, OutputKind kind) {
+  Status st;
+  switch (kind) {
+    case OutputKind::file:
+      st = check_output_path(path);
+      break;
+    case OutputKind::image:
+      st = check_image_output(path);
+      break;
+    case OutputKind::folder:
+      st = check_output_folder_to_make(path);
+      break;
+    case OutputKind::faces:
+      if (const auto star = path.find('*'); star != std::string::npos) {
+        // The six files differ only in the face name: one stands for all (its folder, format).
+        std::string px = path;
+        px.replace(star, 1, "px");
+        st = check_image_output(px);
+      } else {
+        st = check_output_folder_to_make(path);
+      }
+      break;
+  }
+  return st ? std::string() : st.error().to_string();
 }
 
 CLI::Option* add_size_option(CLI::App& cmd, int& width, int& height, int lo, int hi,

@@ -52,6 +52,28 @@ CLI::Option* add_value_option(CLI::App& cmd, const std::string& name, T& into,
   return cmd.add_option(name, into, description)->allow_extra_args(false)->check(not_an_option());
 }
 
+/// What an output option names, for add_output_option's check.
+enum class OutputKind {
+  file,    ///< a file: its folder exists and takes new files; not a folder, not a device
+  image,   ///< a file as above, in an image format kaskad writes (by its extension)
+  folder,  ///< a folder that takes new files, or one the command makes: its parent must exist
+  faces,   ///< envmap --faces: a pattern with one * (six images) or a folder as above
+};
+
+/// The check of every output option, done as the command line is parsed, so before any work:
+/// a path that cannot be written (runtime/core/atomic_file.h's checks) is a usage error naming
+/// the option and the path ("--sphere: /no/dir/x.png: cannot write here: folder '/no/dir' does
+/// not exist ..."), exit status 2. Nothing is made here; a folder is made by the command.
+std::string output_problem(const std::string& path, OutputKind kind);
+
+/// An option naming an output (add_value_option, checked by output_problem()).
+template <class T>
+CLI::Option* add_output_option(CLI::App& cmd, const std::string& name, T& into, OutputKind kind,
+                               const std::string& description) {
+  return add_value_option(cmd, name, into, description)
+      ->check(CLI::Validator([kind](std::string& v) { return output_problem(v, kind); }, ""));
+}
+
 /// An option with one integer value in [lo, hi] (its help says the range once, as "N in [lo, hi]").
 CLI::Option* add_integer_option(CLI::App& cmd, const std::string& name, int& into, int lo, int hi,
                                 const std::string& description);

@@ -102,6 +102,21 @@ Status check_output_folder(const fs::path& dir) {
   return {};
 }
 
+Status check_output_folder_to_make(const fs::path& dir) {
+  if (dir.empty()) return Error{"", "", "empty output folder name"};
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(dir, ec)) || fs::exists(dir, ec)) return check_output_folder(dir);
+  // "a/b/" names b: its parent is a.
+  const fs::path named = dir.has_filename() ? dir : dir.parent_path();
+  const fs::path parent = folder_of(named);
+  if (!fs::exists(parent, ec))
+    return Error{dir.string(), "", "cannot make this folder: its parent '" + parent.string() +
+                                       "' does not exist (kaskad makes only the folder named)"};
+  if (const std::string problem = folder_problem(parent); !problem.empty())
+    return Error{dir.string(), "", "cannot make this folder: " + problem};
+  return {};
+}
+
 Status check_output_path(const fs::path& path) {
   const std::string name = path.string();
   if (path.empty()) return Error{"", "", "empty output file name"};

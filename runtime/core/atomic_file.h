@@ -25,6 +25,11 @@ Status check_output_path(const std::filesystem::path& path);
 /// Checks that `dir` is an existing folder in which files can be created.
 Status check_output_folder(const std::filesystem::path& dir);
 
+/// For an output folder the caller makes when it is missing (one level, the one the user
+/// named): `dir` is a folder that takes new files, or it does not exist and its parent is one.
+/// Makes nothing.
+Status check_output_folder_to_make(const std::filesystem::path& dir);
+
 /// Writes `size` bytes atomically to `path` (see the top of this file). Errors name the path,
 /// how many bytes were written and why it stopped (e.g. "File too large" under `ulimit -f`).
 Status write_file_atomic(const std::filesystem::path& path, const void* data, std::size_t size);

@@ -24,11 +24,13 @@
 #             checkbox, a combo item, an entity row and a button act
 #   docs      the editor guide's screenshots (docs/editor/screenshots.txt) are what this run takes
 #   input     unknown flags, bad script lines, rejected values and unsaved quits fail clearly
+#   tiny      windows from 1x1 up: one too narrow for the side panels is all viewport, and its
+#             screenshots are taken (a script there waited for ever for a viewport frame)
 #   real_input  real X events (xdotool) during the script's `input` phases: right mouse + W flies
 #             forward, F frames the selection, Ctrl+Z undoes an edit, Ctrl+O's file dialog opens
 #             a typed scene, Ctrl+Shift+S's saves over a file after asking (skipped, saying so,
 #             without xdotool)
-# usage: editor_test.sh toggles|saving|entities|every_n|soft_maps|combos|clicks|docs|input|real_input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
+# usage: editor_test.sh toggles|saving|entities|every_n|soft_maps|combos|clicks|docs|input|tiny|real_input   (KASKAD, KASKAD_CONTENT, TMPDIR set)
 set -u
 : "${KASKAD:?path to the kaskad binary}" "${KASKAD_CONTENT:?content dir}"
 if ! command -v xvfb-run >/dev/null 2>&1; then
@@ -793,6 +795,33 @@ undo
 quit" "$scene"
   [ "$rc" -eq 0 ] && ok "an edit undone leaves nothing unsaved" || { fail "undone quit: exit $rc"; cat "$tmp/out"; }
   ;;
+tiny)
+  # SIZE, then the viewport's screenshot: the window less the panels where it is wide enough for
+  # them (2 * 120 + 64 pixels), else the whole window; after H, and the whole window, always
+  # the window. Each run is bounded: the old editor never returned at 128x72.
+  for sizes in "1x1 1x1" "2x300 2x300" "300x1 300x1" "64x64 64x64" "128x72 128x72" \
+               "303x200 303x200" "304x200 64x200"; do
+    read -r size view <<<"$sizes"
+    rm -f "$tmp"/tiny_*.png
+    printf '%s\n' "frames 1" "screenshot $tmp/tiny_view.png" "window_screenshot $tmp/tiny_window.png" \
+      "view normal" "screenshot $tmp/tiny_normal.png" "view colour" "key h" \
+      "screenshot $tmp/tiny_hidden.png" "quit!" >"$tmp/script.txt"
+    timeout -k 5 60 xvfb-run -a -f "$tmp/xauthority" -s "-screen 0 1024x600x24" "$KASKAD" edit \
+      --size "$size" --script "$tmp/script.txt" "$scene" >"$tmp/out" 2>&1
+    rc=$?
+    if [ "$rc" -ne 0 ]; then
+      fail "a ${size} window: exit $rc$([ "$rc" -eq 124 ] && echo ' (timed out after 60 s)')"
+      grep -v '^frame' "$tmp/out" | tail -5
+      continue
+    fi
+    got="$(png_size tiny_view.png) $(png_size tiny_normal.png) $(png_size tiny_hidden.png) $(png_size tiny_window.png)"
+    if [ "$got" = "$view $view $size $size" ]; then
+      ok "a ${size} window: viewport ${view}, after H and the whole window ${size}"
+    else
+      fail "a ${size} window: screenshots $got, expected $view $view $size $size"
+    fi
+  done
+  ;;
 real_input)
   if ! command -v xdotool >/dev/null 2>&1 || ! command -v Xvfb >/dev/null 2>&1; then
     echo "SKIPPED: no xdotool (install the xdotool package: scripts/setup.sh)"
@@ -921,6 +950,6 @@ PY
   esac
   ;;
 *)
-  echo "usage: editor_test.sh toggles|saving|entities|every_n|soft_maps|combos|input|real_input"; exit 2 ;;
+  echo "usage: editor_test.sh toggles|saving|entities|every_n|soft_maps|combos|clicks|docs|input|tiny|real_input"; exit 2 ;;
 esac
 exit $failed

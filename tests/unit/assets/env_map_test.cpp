@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <string>
@@ -598,6 +599,54 @@ std::pair<double, double> seam_and_interior_difference(const CubeMap& cube) {
     }
   }
   return {seam / seams, interior / interiors};
+}
+
+// A NaN or infinite pixel would spread over the SH sums and the prefiltered radiance: every
+// layout refuses it, naming the file and the first such pixel in file order, before any
+// resampling (a bilinear lookup could have missed it).
+TEST(EnvLayouts, NonFinitePixelsAreErrorsNamingTheFirst) {
+  const fs::path d = dir_for("non_finite");
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  // Equirect 16x8: a NaN at (5, 3) G, an infinity after it (row 6) that is not the one named.
+  std::vector<glm::vec4> pano(16 * 8, glm::vec4(0.5f, 0.5f, 0.5f, 1.0f));
+  pano[3 * 16 + 5].g = nan;
+  pano[6 * 16 + 9].r = inf;
+  ASSERT_TRUE(save_image(d / "pano.exr", image_of(pano, 16, 8)).ok());
+  expect_error(load_cube_map(d / "pano.exr"), d / "pano.exr", "pixel (5, 3), channel G, is NaN");
+  EnvLoadOptions small;
+  small.face_size = 1;  // a 1-texel cube samples 6 directions only, never (5, 3)
+  expect_error(load_cube_map(d / "pano.exr", small), d / "pano.exr", "pixel (5, 3), channel G");
+  // Horizontal cross 16x12: -Inf at (6, 5) B, in the +Z cell.
+  std::vector<glm::vec4> cross(16 * 12, glm::vec4(1.0f));
+  cross[5 * 16 + 6].b = -inf;
+  ASSERT_TRUE(save_image(d / "cross.exr", image_of(cross, 16, 12)).ok());
+  expect_error(load_cube_map(d / "cross.exr"), d / "cross.exr", "pixel (6, 5), channel B, is -Inf");
+  // A cross cell nothing reads (the top-left corner) is checked too: the whole file is.
+  cross[5 * 16 + 6].b = 1.0f;
+  cross[0].a = nan;
+  ASSERT_TRUE(save_image(d / "corner.exr", image_of(cross, 16, 12)).ok());
+  expect_error(load_cube_map(d / "corner.exr"), d / "corner.exr", "pixel (0, 0), channel A, is NaN");
+  // Six faces: +Inf in nz's texel (2, 1), R; the error names that face's file.
+  CubeMap cube = coloured_cube(4);
+  cube.at(CubeFace::neg_z, 2, 1).r = inf;
+  ASSERT_TRUE(save_cube_faces(cube, d / "faces_*.exr").ok());
+  expect_error(load_cube_map(d / "faces_*.exr"), d / "faces_nz.exr",
+               "pixel (2, 1), channel R, is +Inf");
+  // Sphere maps, through load_cube_map and load_sphere_map.
+  std::vector<glm::vec4> ball(8 * 8, glm::vec4(0.25f));
+  ball[7 * 8 + 7].g = nan;
+  ASSERT_TRUE(save_image(d / "ball.exr", image_of(ball, 8, 8)).ok());
+  expect_error(load_cube_map(d / "ball.exr"), d / "ball.exr", "pixel (7, 7), channel G, is NaN");
+  auto sphere = load_sphere_map(d / "ball.exr");
+  ASSERT_FALSE(sphere.ok());
+  EXPECT_EQ(sphere.error().file, (d / "ball.exr").string());
+  EXPECT_NE(sphere.error().message.find("pixel (7, 7), channel G, is NaN"), std::string::npos)
+      << sphere.error().to_string();
+  // The largest finite float still loads (it is a value, if an odd one).
+  ball[7 * 8 + 7].g = std::numeric_limits<float>::max();
+  ASSERT_TRUE(save_image(d / "big.exr", image_of(ball, 8, 8)).ok());
+  EXPECT_TRUE(load_sphere_map(d / "big.exr").ok());
 }
 
 TEST(EnvLayouts, SeamsOfASmoothEnvironmentAreContinuous) {
