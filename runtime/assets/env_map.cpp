@@ -11,6 +11,7 @@
 
 #include "runtime/assets/image_io.h"
 #include "runtime/core/atomic_file.h"
+#include "runtime/core/log.h"
 #include "runtime/fields/fields.h"
 
 namespace kaskad {
@@ -89,16 +90,30 @@ std::vector<glm::vec4> rgba_texels(const Image& image) {
   return out;
 }
 
+/// The largest finite half float: environments and probes live in GL_RGBA16F textures, and a
+/// larger value (a sun in a real HDRI may reach 10^5) would turn to infinity there.
+constexpr float kMaxHalf = 65504.0f;
+
 /// An environment's texels are summed into its SH coefficients and prefiltered radiance, and
 /// sampled by every reflection: one NaN or infinity spreads over the whole lighting. So each
 /// image an environment is made from is checked whole, and the first such value (in file order:
 /// rows from the top, then columns, then channels) is an error naming its pixel and channel.
-Status check_finite(const Image& image, const std::string& file) {
+/// Finite values beyond the half-float range are clamped to it, with a warning that counts them.
+Status check_finite(Image& image, const std::string& file) {
+  std::size_t clamped = 0;
+  float largest = 0.0f;
   for (int y = 0; y < image.height; ++y) {
     for (int x = 0; x < image.width; ++x) {
       for (int c = 0; c < image.channels; ++c) {
-        const float v = image.at(x, y, c);
-        if (std::isfinite(v)) continue;
+        float& v = image.at(x, y, c);
+        if (std::isfinite(v)) {
+          if (std::abs(v) > kMaxHalf) {
+            largest = std::max(largest, std::abs(v));
+            v = std::copysign(kMaxHalf, v);
+            ++clamped;
+          }
+          continue;
+        }
         const std::string channel = c < int(image.channel_names.size()) &&
                                             !image.channel_names[std::size_t(c)].empty()
                                         ? image.channel_names[std::size_t(c)]
@@ -118,6 +133,10 @@ Status check_finite(const Image& image, const std::string& file) {
       }
     }
   }
+  if (clamped > 0)
+    log::warn("%s: %zu pixel value(s) beyond the half-float range (up to %g) are clamped to %g: "
+              "environment maps are kept as half floats",
+              file.c_str(), clamped, double(largest), double(kMaxHalf));
   return {};
 }
 

@@ -643,10 +643,16 @@ TEST(EnvLayouts, NonFinitePixelsAreErrorsNamingTheFirst) {
   EXPECT_EQ(sphere.error().file, (d / "ball.exr").string());
   EXPECT_NE(sphere.error().message.find("pixel (7, 7), channel G, is NaN"), std::string::npos)
       << sphere.error().to_string();
-  // The largest finite float still loads (it is a value, if an odd one).
+  // The largest finite float still loads, clamped to the largest half float (the maps are
+  // GL_RGBA16F textures, where it would be infinite), as is a bright sun of 10^5.
   ball[7 * 8 + 7].g = std::numeric_limits<float>::max();
+  ball[0].r = -1e5f;
   ASSERT_TRUE(save_image(d / "big.exr", image_of(ball, 8, 8)).ok());
-  EXPECT_TRUE(load_sphere_map(d / "big.exr").ok());
+  auto big = load_sphere_map(d / "big.exr");
+  ASSERT_TRUE(big.ok()) << big.error().to_string();
+  EXPECT_EQ(big->at(7, 7).g, 65504.0f);
+  EXPECT_EQ(big->at(0, 0).r, -65504.0f);
+  EXPECT_EQ(big->at(3, 3).g, 0.25f);
 }
 
 TEST(EnvLayouts, SeamsOfASmoothEnvironmentAreContinuous) {
