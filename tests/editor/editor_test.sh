@@ -777,6 +777,10 @@ quit!" "$scene"
 rename sun
 quit!" "$scene"
   refused "line 2: .*duplicate entity name 'sun'" "rename to a taken name: exit 1, the readers' message"
+  printf -v blanks '%100000s' ''
+  edit "set sun.light.color=${blanks// /[}${blanks// /]}
+quit!" "$scene"
+  refused "line 1: .*nested deeper than 256 levels" "a value nested 100,000 deep: exit 1, line named"
   edit "select pole
 parent box_large
 select box_large
