@@ -7,6 +7,8 @@
 
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
+#include "runtime/core/output_paths.h"
+#include "runtime/core/output_paths.h"
 #include "components/light.h"
 #include "components/transform.h"
 #include "runtime/reference/ray_tracer.h"
@@ -36,6 +38,17 @@ int run_envmap(const EnvmapOptions& o) {
     if (auto st = check_cube_faces_output(o.faces_out); !st) return fail(st.error());
   if (!o.sphere_out.empty())
     if (auto st = check_image_output(o.sphere_out); !st) return fail(st.error());
+  // No output may replace another, or the input (a face of it, for a pattern).
+  std::vector<NamedPath> outputs, inputs = {{"IN", o.input}};
+  if (!o.faces_out.empty())
+    for (const std::string& file : cube_face_files(o.faces_out)) outputs.push_back({"--faces", file});
+  if (!o.sphere_out.empty()) outputs.push_back({"--sphere", o.sphere_out});
+  if (o.input.find('*') != std::string::npos)
+    for (const std::string& file : cube_face_files(o.input)) inputs.push_back({"IN", file});
+  if (auto st = check_distinct_outputs(outputs, inputs); !st) {
+    std::fprintf(stderr, "kaskad envmap: %s\n", st.error().to_string().c_str());
+    return 2;
+  }
   const auto t0 = std::chrono::steady_clock::now();
   EnvLayout layout = o.load.layout;
   auto cube = load_cube_map(o.input, o.load, &layout);

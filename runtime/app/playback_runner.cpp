@@ -357,6 +357,24 @@ Result<std::vector<PlayFailure>> run_playbacks(const std::vector<fs::path>& file
     else
       fail_file(sorted[i], pb.error());
   }
+  // Output folders by file name; files of the same name from different folders get their
+  // folder's name in front. Two files that still meet (p/x.json and p_x.json, or one file named
+  // twice) are refused before anything runs: one would write over the other's captures.
+  std::vector<std::string> names;
+  for (const Playback& pb : playbacks) {
+    std::string name = pb.file.stem().string();
+    for (const Playback& other : playbacks)
+      if (&other != &pb && other.file.stem() == pb.file.stem()) {
+        name = pb.file.parent_path().filename().string() + "_" + name;
+        break;
+      }
+    for (std::size_t j = 0; j < names.size(); ++j)
+      if (names[j] == name)
+        return Error{pb.file.string(), "",
+                     "writes to the same output folder as " + playbacks[j].file.string() + " (" +
+                         (options.out_dir / name).string() + "); rename one of them"};
+    names.push_back(name);
+  }
   std::error_code ec;
   fs::create_directories(options.out_dir, ec);
   if (ec) return Error{options.out_dir.string(), "", "cannot create the output folder: " + ec.message()};
@@ -369,16 +387,9 @@ Result<std::vector<PlayFailure>> run_playbacks(const std::vector<fs::path>& file
     player.emplace(std::move(made.value()));
   }
 
-  for (const Playback& pb : playbacks) {
-    // Output folders by file name; files of the same name from different folders get their
-    // folder's name in front.
-    std::string name = pb.file.stem().string();
-    for (const Playback& other : playbacks)
-      if (&other != &pb && other.file.stem() == pb.file.stem()) {
-        name = pb.file.parent_path().filename().string() + "_" + name;
-        break;
-      }
-    auto r = play_one(*player, pb, options, options.out_dir / name);
+  for (std::size_t i = 0; i < playbacks.size(); ++i) {
+    const Playback& pb = playbacks[i];
+    auto r = play_one(*player, pb, options, options.out_dir / names[i]);
     if (!r) {
       fail_file(pb.file, r.error());
       continue;

@@ -240,6 +240,18 @@ std::optional<FacePattern> face_pattern(const std::filesystem::path& path, bool 
   return std::nullopt;
 }
 
+/// Whether all six files of `pattern` exist (each by any of its face names).
+bool all_faces_present(const FacePattern& pattern, bool max) {
+  for (int f = 0; f < 6; ++f) {
+    bool found = false;
+    std::error_code ec;
+    for (const std::string& name : face_names(f, max))
+      found = found || std::filesystem::is_regular_file(pattern.prefix + name + pattern.suffix, ec);
+    if (!found) return false;
+  }
+  return true;
+}
+
 Result<CubeMap> load_faces(const std::filesystem::path& path, bool max) {
   const std::string name = path.string();
   const auto pattern = face_pattern(path, max);
@@ -465,8 +477,18 @@ Result<CubeMap> load_cube_map(const std::filesystem::path& path, const EnvLoadOp
                      "] (0 = from the image), was " + std::to_string(options.face_size)};
   }
   EnvLayout layout = options.layout;
-  if (layout == EnvLayout::auto_detect && face_pattern(path, options.z_up_3dsmax)) {
-    layout = EnvLayout::faces;
+  // A pattern or a folder is faces; so is a file named as a face (px.png, sky_px.png, sky-px.png),
+  // and one whose name only ends in a face name (sunny.hdr ends in "ny") when its five siblings
+  // are beside it: otherwise it is read as the single image it is.
+  if (layout == EnvLayout::auto_detect) {
+    std::error_code ec;
+    if (const auto pattern = face_pattern(path, options.z_up_3dsmax)) {
+      const char before = pattern->prefix.empty() ? '/' : pattern->prefix.back();
+      if (path.string().find('*') != std::string::npos || std::filesystem::is_directory(path, ec) ||
+          before == '/' || before == '_' || before == '-' || before == '.' ||
+          all_faces_present(*pattern, options.z_up_3dsmax))
+        layout = EnvLayout::faces;
+    }
   }
 
   if (detected) *detected = layout;
@@ -533,9 +555,6 @@ Result<SphereMap> load_sphere_map(const std::filesystem::path& path) {
   return sphere_from_image(*image, path.string());
 }
 
-namespace {
-
-/// The six files save_cube_faces writes for `pattern_or_dir`.
 std::array<std::string, 6> cube_face_files(const std::filesystem::path& pattern_or_dir) {
   const std::string s = pattern_or_dir.string();
   const auto star = s.find('*');
@@ -552,8 +571,6 @@ std::array<std::string, 6> cube_face_files(const std::filesystem::path& pattern_
   }
   return files;
 }
-
-}  // namespace
 
 Status check_cube_faces_output(const std::filesystem::path& pattern_or_dir) {
   const std::string s = pattern_or_dir.string();

@@ -161,6 +161,10 @@ Status save_cube_faces(const CubeMap& cube, const std::filesystem::path& pattern
 
 /// The checks of save_cube_faces without writing: the folder (made when missing), then every
 /// face file's format and path.
+/// The six files save_cube_faces() writes for `pattern_or_dir` (px nx py ny pz nz): the `*`
+/// replaced by each face name, or DIR/px.exr ... for a folder.
+std::array<std::string, 6> cube_face_files(const std::filesystem::path& pattern_or_dir);
+
 Status check_cube_faces_output(const std::filesystem::path& pattern_or_dir);
 
 /// Debug dump of a sphere map as an image (format from the extension).

@@ -534,10 +534,10 @@ Status save_image(const std::filesystem::path& path, const Image& image) {
     return Error{name, "", "cannot write this image format: " + one_line(OIIO::geterror())};
   }
 
-  // JPEG has no alpha: drop the last channel of grey+alpha and RGBA images.
-  const bool is_jpeg = std::string(out->format_name()) == "jpeg";
+  // Formats without alpha (JPEG, Radiance HDR, ...): drop the last channel of grey+alpha and RGBA
+  // images (HDR refuses a fourth channel outright).
   int channels = image.channels;
-  if (is_jpeg && (channels == 2 || channels == 4)) --channels;
+  if (!out->supports("alpha") && (channels == 2 || channels == 4)) --channels;
 
   const bool as_float = is_float_format(ext);
   OIIO::ImageSpec spec(image.width, image.height, channels,

@@ -2,6 +2,7 @@
 // renderer, material, entity), shared by scene files, `--set` and node overrides.
 #include "runtime/assets/scene_blocks.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/gtx/euler_angles.hpp>
@@ -151,6 +152,14 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
   if (!name.empty()) {
     if (name.find('.') != std::string::npos || name.find('=') != std::string::npos)
       fail(r.at("name"), "names may not contain '.' or '=' (they are used in --set keys)");
+    if (std::any_of(name.begin(), name.end(),
+                    [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
+      fail(r.at("name"), "names may not contain control characters (a newline, a tab, an escape)");
+    if (name.front() == ' ' || name.back() == ' ')
+      fail(r.at("name"), "names may not start or end with a space");
+    for (const char* section : kSettingSections)
+      if (name == section)
+        fail(r.at("name"), "'" + name + "' names a setting section of --set; an entity may not take it");
     if (by_name.count(name)) fail(r.at("name"), "duplicate entity name '" + name + "'");
     by_name[name] = e;
     w.emplace<Name>(e, Name{name});

@@ -32,6 +32,10 @@ using json_reader::ObjectReader;
 
 inline constexpr int kFormatVersion = 1;
 
+/// The scene-wide setting blocks: `--set` reads a key's first part as one of them before it
+/// looks for an entity, so no entity may take their names.
+inline constexpr std::array<const char*, 2> kSettingSections = {"render", "shadow"};
+
 /// The ways of giving a transform's rotation; a block takes any one of them.
 inline constexpr std::array<const char*, 4> kRotationKeys = {"rotation", "euler_deg", "look_at",
                                                             "direction"};

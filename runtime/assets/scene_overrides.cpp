@@ -285,7 +285,7 @@ Status apply_override(json& doc, const std::string& assignment) {
     }
     if (!node)
       return Error{"--set", key, "no setting section or entity named '" + parts[0] +
-                                     "'; sections: render, shadow; entities: " + join(names)};
+                                     "'; sections: " + join({kSettingSections.begin(), kSettingSections.end()}) + "; entities: " + join(names)};
   }
   parts.erase(parts.begin());
   return set_field(node, parts, key, text);
@@ -358,7 +358,7 @@ Result<ecs::Entity> entity_for_key(const Scene& scene, const std::string& key) {
     if (named.size() > names.size()) names.push_back("... (" + std::to_string(named.size()) +
                                                      " in all; `kaskad info SCENE` lists them)");
     return Error{"--set", key, "no setting section or entity named '" + key.substr(0, key.find('.')) +
-                                   "'; sections: render, shadow; entities: " + join(names)};
+                                   "'; sections: " + join({kSettingSections.begin(), kSettingSections.end()}) + "; entities: " + join(names)};
   }
   if (matches.size() > 1)
     return Error{"--set", key,

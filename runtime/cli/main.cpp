@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <cctype>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,6 +22,7 @@
 #include "components/shadow_settings.h"
 #include "components/transform.h"
 #include "runtime/core/file_io.h"
+#include "runtime/core/output_paths.h"
 #include "runtime/assets/env_map.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene_io.h"
@@ -211,6 +214,18 @@ Status make_named_folder(const fs::path& dir) {
   return check_output_folder(dir);
 }
 
+/// The start of a probe's file names in --probe-maps: its entity's name with every character
+/// but letters, digits, '-', '_' and '.' made '_' (an imported name may hold a '/' or be "..", and
+/// must not reach outside the folder), or probeN for an unnamed one.
+std::string probe_file_stem(const std::string& name, ecs::Entity e) {
+  if (name.empty()) return "probe" + std::to_string(e.index);
+  std::string stem = name;
+  for (char& c : stem)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+  if (stem.front() == '.') stem.front() = '_';
+  return stem;
+}
+
 /// Every output of `kaskad render`, checked before the scene is loaded or a frame rendered:
 /// writable, not a folder, a format we can write. The default colour output out/<scene>.png
 /// (docs/guide/bad_input.md, "Outputs") is the one folder made for the user.
@@ -229,7 +244,7 @@ Status check_render_outputs(const RenderArgs& a, const fs::path& out) {
       {"--shadow-map", &a.shadow_map},
       {"--reflection-reference", &a.reflection_reference},
       {"--shadow-reference", &a.shadow_reference}};
-  std::vector<std::pair<std::string, fs::path>> named = {{"-o", out}};
+  std::vector<NamedPath> named = {{"-o", out}};
   for (const auto& [flag, file] : data_outputs) {
     if (file->empty()) continue;
     KASKAD_TRY(check_image_output(*file));
@@ -240,13 +255,10 @@ Status check_render_outputs(const RenderArgs& a, const fs::path& out) {
                                   "channels"};
     named.emplace_back(flag, *file);
   }
-  // Two outputs of one path: the second would replace the first.
-  for (std::size_t i = 0; i < named.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (fs::weakly_canonical(named[i].second, ec) == fs::weakly_canonical(named[j].second, ec))
-        return Error{named[i].second.string(), "",
-                     named[j].first + " and " + named[i].first +
-                         " name the same file: one would replace the other"};
+  std::vector<NamedPath> inputs;
+  if (!a.scene.empty()) inputs.push_back({"SCENE", a.scene});
+  if (!a.env.empty()) inputs.push_back({"--env", a.env});
+  KASKAD_TRY(check_distinct_outputs(named, inputs));
   if (!a.probe_maps.empty()) KASKAD_TRY(make_named_folder(a.probe_maps));
   return {};
 }
@@ -416,6 +428,16 @@ int run_render(RenderArgs a) {
   // A frame with GL errors is not written over a previous good image.
   if (gpu::debug_error_count() > 0)
     return gpu::exit_status_for_gl_errors("kaskad", "; no output written");
+  // What can still refuse the run is settled before the first write: a failing run leaves every
+  // earlier output as it was.
+  ecs::Entity reference_light = ecs::kNullEntity;
+  if (!a.shadow_reference.empty()) {
+    const std::vector<ShadowData>& shadows = timings->last.shadows;
+    if (!shadows.empty())
+      reference_light = shadows[std::size_t(aov_shadow_index(*scene, shadows.size()))].light;
+    if (!reference_light.valid())
+      return fail(Error{"", "--shadow-reference", "the scene has no shadowed light"});
+  }
   if (a.output.empty()) {
     std::error_code ec;
     fs::create_directory(out.parent_path(), ec);  // the documented default, out/<scene>.png
@@ -435,13 +457,7 @@ int run_render(RenderArgs a) {
       return fail(s.error());
   }
   if (!a.shadow_reference.empty()) {
-    const std::vector<ShadowData>& shadows = timings->last.shadows;
-    const ecs::Entity light =
-        shadows.empty() ? ecs::kNullEntity
-                        : shadows[std::size_t(aov_shadow_index(*scene, shadows.size()))].light;
-    if (!light.valid())
-      return fail(Error{"", "--shadow-reference", "the scene has no shadowed light"});
-    if (auto s = write_shadow_reference(*scene, player->renderer->read_aovs(), light,
+    if (auto s = write_shadow_reference(*scene, player->renderer->read_aovs(), reference_light,
                                         a.shadow_reference);
         !s)
       return fail(s.error());
@@ -452,10 +468,12 @@ int run_render(RenderArgs a) {
     std::printf("wrote     %s (shadow map depth)\n", fs::absolute(a.shadow_map).string().c_str());
   }
   if (!a.probe_maps.empty()) {
+    std::set<std::string> stems;
     for (const ProbeData::Entry& p : timings->last.probes.probes) {
       const Name* name = scene->world.try_get<Name>(p.entity);
-      const std::string stem =
-          name ? name->value : "probe" + std::to_string(p.entity.index);
+      std::string stem = probe_file_stem(name ? name->value : std::string(), p.entity);
+      if (!stems.insert(stem).second) stem += "_" + std::to_string(p.entity.index);
+      stems.insert(stem);
       const fs::path dir(a.probe_maps);
       const CubeMap cube = player->renderer->read_probe_cube(p.job.handle, p.job.visible);
       if (cube.size == 0) continue;

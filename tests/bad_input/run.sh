@@ -49,6 +49,7 @@ printf '{"kaskad_scene": 1, "entities": [{"name": "m", "model": {"path": "%s", "
   "$content/models/Box/glTF-Binary/Box.glb" "$deep_array" >"$gen/deep_node_settings.json"
 printf '{"kaskad_scene": 1, "entities": [{"name": "e", "transform": {"translation": %s}}]}\n' \
   "$deep_array" >"$gen/deep_entity.json"
+cp "$content/env/equirect/venice_sunset_1k.hdr" "$gen/sky.hdr"  # an input an output may not replace
 awk 'BEGIN { n = 100000; printf "{\"kaskad_scene\": 1, \"entities\": [";
              for (i = 0; i < n; ++i) printf "%s{\"name\": \"e%d\", \"transform\": {\"parent\": \"e%d\"}}", (i ? ", " : ""), i, (i + 1) % n;
              print "]}" }' >"$gen/long_parent_cycle.json"
@@ -86,7 +87,9 @@ while IFS= read -r line; do
   fi
   shown="${first//$here\//bad_input/}" shown="${shown//$content\//content/}" shown="${shown//$out/OUT}"
   shown="${shown//|/\\|}"
-  rows+="| $n | \`${line#* | }\` | $rc | ${shown:0:240} |"$'\n'
+  shown_args="${line#* | }"
+  [ "${#shown_args}" -le 200 ] || shown_args="${shown_args:0:160}... (${#shown_args} characters)"
+  rows+="| $n | \`$shown_args\` | $rc | ${shown:0:240} |"$'\n'
 done <"$here/cases.txt"
 
 # Failed writes keep the previous output byte-identical.

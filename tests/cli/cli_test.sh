@@ -98,6 +98,29 @@ awk 'BEGIN { n = 100000; printf "{\"kaskad_scene\": 1, \"entities\": [";
   >"$tmp/long_chain.json"
 check parent_chain_100k 0 "wrote" -- timeout -k 5 300 "$KASKAD" render "$tmp/long_chain.json" --headless \
   --size 32x32 --frames 1 -o "$tmp/long_chain.png"
+# Names become file names only made safe: a reflector named "/abs/evil" writes its probe faces
+# as _abs_evil_*.png inside --probe-maps, not into /abs.
+printf '%s\n' '{"entities": [{"name": "cam", "camera": {}, "transform": {"translation": [0, 1, 5]}},' \
+  '{"name": "/abs/evil", "primitive": {"shape": "sphere"}, "reflector": {"resolution": 8}}]}' \
+  >"$tmp/slash_probe.json"
+mkdir -p "$tmp/probes"
+check probe_name_with_slash 0 "wrote .*probes/pm/_abs_evil_\*.png" -- "$KASKAD" render "$tmp/slash_probe.json" \
+  --headless --size 32x32 --frames 1 -o "$tmp/slash_probe.png" --probe-maps "$tmp/probes/pm"
+if [ -e "$tmp/probes/pm/_abs_evil_px.png" ] && [ ! -e /abs ]; then
+  echo "ok   probe_name_with_slash_files"; passed=$((passed + 1))
+else
+  echo "FAIL probe_name_with_slash_files: $(find "$tmp" -name '*evil*')"; failed=$((failed + 1))
+fi
+# Two playback files that would share an output folder (p/x.json and q/x.json write OUT/p_x and
+# OUT/q_x, and so would p_x.json) are refused before any runs.
+mkdir -p "$tmp/p" "$tmp/q"
+printf '{"kaskad_playback": 1, "scene": "%s", "size": [16, 16], "frames": 1}\n' \
+  "$KASKAD_CONTENT/scenes/default.json" | tee "$tmp/p/x.json" "$tmp/q/x.json" >"$tmp/p_x.json"
+check play_same_output_folder 1 "p_x.json: writes to the same output folder as .*p/x.json" -- \
+  "$KASKAD" play "$tmp/p/x.json" "$tmp/q/x.json" "$tmp/p_x.json" --out "$tmp/play_clash"
+# A single image whose name merely ends in a face name (sunny.hdr: "ny") is that image, not a face.
+cp "$KASKAD_CONTENT/env/equirect/venice_sunset_1k.hdr" "$tmp/sunny.hdr"
+check envmap_name_ending_in_a_face 0 "sunny.hdr: equirect" -- "$KASKAD" envmap "$tmp/sunny.hdr"
 # An option given twice takes its last value, as before CLI11 (scripts append to a base line).
 check option_given_twice 0 "wrote .*twice_b.png" -- "$KASKAD" render --headless --size 32x32 --frames 1 \
   -o "$tmp/twice_a.png" -o "$tmp/twice_b.png"

@@ -113,7 +113,9 @@ TEST(ImageIo, ExrRoundTripRgba) {
   EXPECT_EQ(loaded->pixels, image.pixels);
 }
 
-TEST(ImageIo, JpegDropsAlphaAndStaysClose) {
+// Formats without alpha keep the colour: JPEG, and Radiance HDR (which refuses a fourth
+// channel: an RGBA sphere map or face written as .hdr failed).
+TEST(ImageIo, FormatsWithoutAlphaDropItAndStayClose) {
   Image image;
   image.width = 16;
   image.height = 16;
@@ -121,14 +123,17 @@ TEST(ImageIo, JpegDropsAlphaAndStaysClose) {
   for (int i = 0; i < 16 * 16; ++i) {
     image.pixels.insert(image.pixels.end(), {0.25f, 0.5f, 0.75f, 1.0f});
   }
-  const auto path = temp_dir() / "flat.jpg";
-  ASSERT_TRUE(save_image(path, image).ok());
-  auto loaded = load_image(path);
-  ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
-  ASSERT_EQ(loaded->channels, 3);
-  EXPECT_NEAR(loaded->at(7, 7, 0), 0.25f, 0.02f);
-  EXPECT_NEAR(loaded->at(7, 7, 1), 0.5f, 0.02f);
-  EXPECT_NEAR(loaded->at(7, 7, 2), 0.75f, 0.02f);
+  for (const char* name : {"flat.jpg", "flat.hdr"}) {
+    const auto path = temp_dir() / name;
+    auto saved = save_image(path, image);
+    ASSERT_TRUE(saved.ok()) << saved.error().to_string();
+    auto loaded = load_image(path);
+    ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+    ASSERT_EQ(loaded->channels, 3) << name;
+    EXPECT_NEAR(loaded->at(7, 7, 0), 0.25f, 0.02f) << name;
+    EXPECT_NEAR(loaded->at(7, 7, 1), 0.5f, 0.02f) << name;
+    EXPECT_NEAR(loaded->at(7, 7, 2), 0.75f, 0.02f) << name;
+  }
 }
 
 TEST(ImageIo, LoadsRealJpeg) {
