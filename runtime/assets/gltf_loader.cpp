@@ -324,6 +324,14 @@ Result<std::vector<int>> root_nodes(const tinygltf::Model& model, const std::str
 
 Status check_extensions(const tinygltf::Model& model, const std::string& file,
                         std::vector<std::string>& warnings) {
+  // glTF 2.0, 3.2: a file of another major version may not be read as this one.
+  const std::string& version = model.asset.version;
+  if (version.rfind("2.", 0) != 0)
+    return Error{file, "asset.version",
+                 "glTF version '" + version + "': only 2.x files are read"};
+  if (const std::string& min = model.asset.minVersion; !min.empty() && min != "2.0")
+    return Error{file, "asset.minVersion",
+                 "the file needs glTF " + min + " at least; this reader knows 2.0"};
   for (const std::string& ext : model.extensionsRequired) {
     if (!supported_extension(ext)) {
       return Error{file, "extensionsRequired", "unsupported required extension " + ext};

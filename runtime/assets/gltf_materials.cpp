@@ -186,6 +186,8 @@ Result<Material> read_material(Importer& im, int index) {
   Material m;
   if (base.size() == 4) {
     m.base_color = {clamp01(base[0]), clamp01(base[1]), clamp01(base[2]), clamp01(base[3])};
+    if (std::any_of(base.begin(), base.end(), [](double v) { return v < 0.0 || v > 1.0; }))
+      im.report.warnings.push_back(where + ": baseColorFactor outside [0, 1], clamped to it");
   }
   m.metallic = clamp01(pbr.metallicFactor);
   m.roughness = clamp01(pbr.roughnessFactor);
@@ -248,8 +250,14 @@ Result<Material> read_material(Importer& im, int index) {
   if (g.alphaMode == "MASK") {
     m.alpha_mask = true;
     m.alpha_cutoff = float(std::clamp(g.alphaCutoff, 0.0, 1.0));
+    if (!(g.alphaCutoff >= 0.0 && g.alphaCutoff <= 1.0))
+      im.report.warnings.push_back(where + ": alphaCutoff " + std::to_string(g.alphaCutoff) +
+                                   " outside [0, 1], clamped to it");
   } else if (g.alphaMode == "BLEND") {
     ignored += " alphaMode BLEND (drawn opaque)";
+  } else if (g.alphaMode != "OPAQUE" && !g.alphaMode.empty()) {
+    im.report.warnings.push_back(where + ": unknown alphaMode '" + g.alphaMode +
+                                 "' (OPAQUE, MASK or BLEND); drawn opaque");
   }
   if (!ignored.empty()) im.report.warnings.push_back(where + ": not imported:" + ignored);
   // glTF materials map onto the same feature model as material files.

@@ -480,6 +480,24 @@ TEST(GltfLoaderErrors, DataUrisOfTheWrongMediaType) {
   expect_import_error(write_gltf("html_image_uri.gltf", doc), "/images/0/uri");
 }
 
+// A file of another major version is refused; odd material values load clamped, with a warning
+// each (glTF 2.0: baseColorFactor and alphaCutoff in [0, 1], alphaMode one of three names).
+TEST(GltfLoaderErrors, AnotherMajorVersionAndOddMaterialValues) {
+  json doc = triangle_gltf();
+  doc["asset"]["version"] = "3.0";
+  expect_import_error(write_gltf("version_3.gltf", doc), "only 2.x files are read");
+  doc = triangle_gltf();
+  doc["materials"] = {{{"alphaMode", "WEIRD"},
+                       {"pbrMetallicRoughness", {{"baseColorFactor", {2, -1, 0.5, 1}}}}}};
+  doc["meshes"][0]["primitives"][0]["material"] = 0;
+  auto s = import_file(write_gltf("odd_material.gltf", doc));
+  ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+  std::string warnings;
+  for (const std::string& w : s->report->warnings) warnings += w + "\n";
+  EXPECT_NE(warnings.find("baseColorFactor outside [0, 1], clamped"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("unknown alphaMode 'WEIRD'"), std::string::npos) << warnings;
+}
+
 TEST(GltfLoaderErrors, MissingBufferFile) {
   json doc = triangle_gltf();
   doc["buffers"][0]["uri"] = "missing.bin";
