@@ -51,19 +51,32 @@ struct ChainLink {
   WorldTransform* world;
 };
 
-// Brings e's WorldTransform up to date, parent chain first; `state` marks entities as 0 =
-// unvisited, 1 = on the current chain (cycle detection), 2 = done. The chain is walked up into
-// `chain` and computed from its top down, without recursion: a chain as long as the scene is
-// fine. The parent applied is decided exactly as when everything was recomputed each call (same
-// order, same cycle breaking); a matrix is recomputed only when that parent, its version or the
-// entity's Transform bits differ from its TransformCache. `link` is e's, its components from the
-// caller's view.
-void resolve(ecs::World& world, ChainLink link, std::uint64_t stamp,
-             std::vector<std::uint8_t>& state, std::vector<ChainLink>& chain,
-             TransformStats& stats) {
-  chain.clear();
+// Recomputes l's WorldTransform when its parent, the parent's version or its Transform bits
+// differ from its TransformCache; `parent_*` are l.parent's (null for a root), already current.
+void update_link(const ChainLink& l, const TransformCache* parent_cache,
+                 const WorldTransform* parent_world, std::uint64_t stamp, TransformStats& stats) {
+  const std::uint64_t parent_version = parent_cache ? parent_cache->version : 0;
+  TransformCache& cache = *l.cache;
+  if (cache.version != 0 && cache.parent == l.parent && cache.parent_version == parent_version &&
+      same_bits(cache.local, *l.transform))
+    return;
+  const glm::mat4 parent_matrix = parent_world ? parent_world->matrix : glm::mat4(1.0f);
+  l.world->matrix = parent_matrix * local_matrix(*l.transform);
+  cache = TransformCache{*l.transform, l.parent, parent_version, stamp};
+  ++stats.transforms;
+}
+
+// resolve() for a chain too deep to recurse along: the chain is walked up into `chain` and
+// computed from its top down, without recursion, so a chain as long as the scene is fine; the
+// same decisions and `state` marks as resolve(). `link` is the entity's.
+[[gnu::noinline]] void resolve_chain(ecs::World& world, ChainLink link, std::uint64_t stamp,
+                   std::vector<std::uint8_t>& state, std::vector<ChainLink>& chain,
+                   TransformStats& stats) {
   auto done = [&](ecs::Entity x) { return x.index < state.size() && state[x.index] == 2; };
   if (done(link.entity)) return;
+  // Up the chain while parents are not done; the last link reached (usually the entity itself:
+  // a root, or a child of an entity done before it) is not stored.
+  chain.clear();
   for (;;) {
     const ecs::Entity at = link.entity;
     if (at.index >= state.size()) state.resize(std::size_t{at.index} + 1, 0);
@@ -80,36 +93,75 @@ void resolve(ecs::World& world, ChainLink link, std::uint64_t stamp,
       }
     }
     state[at.index] = 1;
-    chain.push_back(link);
     if (!link.parent.valid() || done(link.parent)) break;
+    chain.push_back(link);
     link = {link.parent, ecs::kNullEntity, &world.get<Transform>(link.parent),
             &world.get<TransformCache>(link.parent), &world.get<WorldTransform>(link.parent)};
   }
-  // Top down: each parent is done (this walk's, the link above, or an earlier one's) before its
-  // child reads it.
+  // Top down: the top link's parent is done (or none); each stored link's parent is the link
+  // computed just before it.
+  state[link.entity.index] = 2;
+  if (link.parent.valid())
+    update_link(link, &world.get<TransformCache>(link.parent),
+                &world.get<WorldTransform>(link.parent), stamp, stats);
+  else
+    update_link(link, nullptr, nullptr, stamp, stats);
+  const ChainLink* above = &link;
   for (std::size_t i = chain.size(); i-- > 0;) {
-    const ChainLink& l = chain[i];
-    state[l.entity.index] = 2;
-    const TransformCache* parent_cache = nullptr;
-    const WorldTransform* parent_world = nullptr;
-    if (i + 1 < chain.size()) {
-      parent_cache = chain[i + 1].cache;
-      parent_world = chain[i + 1].world;
-    } else if (l.parent.valid()) {
-      parent_cache = &world.get<TransformCache>(l.parent);
-      parent_world = &world.get<WorldTransform>(l.parent);
-    }
-    const std::uint64_t parent_version = parent_cache ? parent_cache->version : 0;
-    TransformCache& cache = *l.cache;
-    if (cache.version != 0 && cache.parent == l.parent && cache.parent_version == parent_version &&
-        same_bits(cache.local, *l.transform))
-      continue;
-    const glm::mat4 parent_matrix = parent_world ? parent_world->matrix : glm::mat4(1.0f);
-    l.world->matrix = parent_matrix * local_matrix(*l.transform);
-    cache = TransformCache{*l.transform, l.parent, parent_version, stamp};
-    ++stats.transforms;
+    state[chain[i].entity.index] = 2;
+    update_link(chain[i], above->cache, above->world, stamp, stats);
+    above = &chain[i];
   }
 }
+
+// Brings one entity's WorldTransform up to date, parent chain first, and returns its version;
+// `state` marks entities as 0 = unvisited, 1 = on the current chain (cycle detection), 2 = done.
+// The parent applied is decided exactly as when everything was recomputed each call (same order,
+// same cycle breaking); the matrix is recomputed only when that parent, its version or this
+// entity's Transform bits differ from the TransformCache. `t`, `cache` and `out` are e's.
+// Recursion (the fast way for the usual shallow hierarchies) stops at kMaxRecursion levels, where
+// resolve_chain() takes the rest of the chain without recursing.
+constexpr int kMaxRecursion = 256;
+
+std::uint64_t resolve(ecs::World& world, ecs::Entity e, const Transform& t, TransformCache& cache,
+                      WorldTransform& out, std::uint64_t stamp, std::vector<std::uint8_t>& state,
+                      std::vector<ChainLink>& chain, TransformStats& stats, int depth = 0) {
+  if (e.index >= state.size()) state.resize(std::size_t{e.index} + 1, 0);
+  if (state[e.index] == 2) return cache.version;
+  if (depth >= kMaxRecursion) {
+    resolve_chain(world, {e, ecs::kNullEntity, &t, &cache, &out}, stamp, state, chain, stats);
+    return cache.version;
+  }
+  ecs::Entity parent = ecs::kNullEntity;
+  std::uint64_t parent_version = 0;
+  if (t.parent.valid()) {
+    if (!world.alive(t.parent) || !world.has<Transform>(t.parent)) {
+      log::warn_once("%s: parent (entity %u) is gone; treating it as a root",
+                     entity_label(world, e).c_str(), t.parent.index);
+    } else if (t.parent.index < state.size() && state[t.parent.index] == 1) {
+      log::warn_once("%s: parent cycle through %s; treating it as a root",
+                     entity_label(world, e).c_str(), entity_label(world, t.parent).c_str());
+    } else {
+      state[e.index] = 1;
+      parent = t.parent;
+      parent_version = resolve(world, parent, world.get<Transform>(parent),
+                               world.get<TransformCache>(parent),
+                               world.get<WorldTransform>(parent), stamp, state, chain, stats,
+                               depth + 1);
+    }
+  }
+  state[e.index] = 2;
+  if (cache.version != 0 && cache.parent == parent && cache.parent_version == parent_version &&
+      same_bits(cache.local, t))
+    return cache.version;
+  const glm::mat4 parent_matrix =
+      parent.valid() ? world.get<WorldTransform>(parent).matrix : glm::mat4(1.0f);
+  out.matrix = parent_matrix * local_matrix(t);
+  cache = TransformCache{t, parent, parent_version, stamp};
+  ++stats.transforms;
+  return cache.version;
+}
+
 
 // Recomputes e's WorldBounds when its inputs differ from the BoundsCache; world_version 0: no
 // version to compare (a WorldTransform without a Transform), always.
@@ -162,7 +214,7 @@ TransformStats update_transforms(ecs::World& world, const AssetStore& assets) {
   const std::uint64_t stamp = next_stamp();
   world.view<Transform, TransformCache, WorldTransform>().each(
       [&](ecs::Entity e, Transform& t, TransformCache& cache, WorldTransform& out) {
-        resolve(world, {e, ecs::kNullEntity, &t, &cache, &out}, stamp, state, chain, stats);
+        resolve(world, e, t, cache, out, stamp, state, chain, stats);
       });
 
   // 3. Bounds, for every MeshRenderer with a WorldTransform: structural step as in 1, then values.
