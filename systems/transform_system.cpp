@@ -42,6 +42,14 @@ static_assert(sizeof(Transform) == 3 * sizeof(glm::vec3) + sizeof(float) + sizeo
               "Transform has padding: same_bits would compare indeterminate bytes");
 static_assert(sizeof(Aabb) == 2 * sizeof(glm::vec3), "Aabb has padding");
 
+// local_matrix(): T * R * S written out (the rotation's columns scaled, the translation as the
+// last column) instead of two 4x4 products, inlined into both resolvers.
+[[gnu::always_inline]] inline glm::mat4 compose(const Transform& t) {
+  const glm::mat3 r = glm::mat3_cast(t.rotation);
+  return glm::mat4(glm::vec4(r[0] * t.scale.x, 0.0f), glm::vec4(r[1] * t.scale.y, 0.0f),
+                   glm::vec4(r[2] * t.scale.z, 0.0f), glm::vec4(t.translation, 1.0f));
+}
+
 // One entity of a parent chain being brought up to date, with the parent decided for it.
 struct ChainLink {
   ecs::Entity entity;
@@ -61,7 +69,7 @@ void update_link(const ChainLink& l, const TransformCache* parent_cache,
       same_bits(cache.local, *l.transform))
     return;
   const glm::mat4 parent_matrix = parent_world ? parent_world->matrix : glm::mat4(1.0f);
-  l.world->matrix = parent_matrix * local_matrix(*l.transform);
+  l.world->matrix = parent_matrix * compose(*l.transform);
   cache = TransformCache{*l.transform, l.parent, parent_version, stamp};
   ++stats.transforms;
 }
@@ -156,7 +164,7 @@ std::uint64_t resolve(ecs::World& world, ecs::Entity e, const Transform& t, Tran
     return cache.version;
   const glm::mat4 parent_matrix =
       parent.valid() ? world.get<WorldTransform>(parent).matrix : glm::mat4(1.0f);
-  out.matrix = parent_matrix * local_matrix(t);
+  out.matrix = parent_matrix * compose(t);
   cache = TransformCache{t, parent, parent_version, stamp};
   ++stats.transforms;
   return cache.version;
@@ -180,10 +188,7 @@ void update_bounds(const AssetStore& assets, const MeshRenderer& mr, const World
 
 }  // namespace
 
-glm::mat4 local_matrix(const Transform& t) {
-  return glm::translate(glm::mat4(1.0f), t.translation) * glm::mat4_cast(t.rotation) *
-         glm::scale(glm::mat4(1.0f), t.scale);
-}
+glm::mat4 local_matrix(const Transform& t) { return compose(t); }
 
 TransformStats update_transforms(ecs::World& world, const AssetStore& assets) {
   TransformStats stats;
