@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -167,6 +168,13 @@ int run_variants(const VariantsArgs& a) {
 int run_bench_command(const BenchArgs& a) {
   if (a.merge) {
     if (a.bench.scenes.empty()) throw cli::UsageError("bench --merge needs the shards' --out folders");
+    std::set<std::string> seen;
+    for (const std::filesystem::path& dir : a.bench.scenes) {
+      std::error_code ec;
+      const std::filesystem::path same = std::filesystem::weakly_canonical(dir, ec);
+      if (!seen.insert((ec ? dir : same).string()).second)
+        throw cli::UsageError("--merge: the shard folder " + dir.string() + " is named twice");
+    }
     if (auto st = merge_bench(a.bench.scenes, a.bench.out_dir, a.bench.chart); !st)
       return fail(st.error());
     return 0;

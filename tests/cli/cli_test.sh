@@ -311,6 +311,20 @@ check bench_merge 0 "merged +2 shard CSVs, 3 rows" -- "$KASKAD" bench --merge "$
   --out "$tmp/merged" --no-chart
 check bench_merge_missing nonzero "nope/bench.csv: cannot open" -- "$KASKAD" bench --merge "$tmp/nope" \
   --out "$tmp/merged2" --no-chart
+# A chart that cannot be written (a folder where default.png goes) fails the merge with the
+# script's own error, not a guess about matplotlib, and leaves the previous bench.csv as it was.
+mkdir -p "$tmp/merged_chart/default.png"
+cp "$tmp/shard1/bench.csv" "$tmp/merged_chart/bench.csv"
+before=$(md5sum <"$tmp/merged_chart/bench.csv")
+check bench_merge_chart_fails 1 "chart script failed: IsADirectoryError: .*default.png" -- "$KASKAD" bench \
+  --merge "$tmp/shard0" "$tmp/shard1" --out "$tmp/merged_chart"
+if [ "$(md5sum <"$tmp/merged_chart/bench.csv")" = "$before" ] &&
+   ! "$KASKAD" bench --merge "$tmp/shard0" "$tmp/shard1" --out "$tmp/merged_chart" 2>&1 | grep -q matplotlib; then
+  passed=$((passed + 1))
+else
+  echo "FAIL bench_merge_chart_keeps_csv: a failed chart replaced bench.csv or blamed matplotlib"
+  failed=$((failed + 1))
+fi
 
 # A bench that fails before its first row (here: a scene whose model is missing, found before any
 # frame) leaves the folder's previous bench.csv as it was.
