@@ -622,7 +622,15 @@ cli::RunCommand add_schema_command(CLI::App& cmd) {
       ->type_name("DIR");
   cmd.add_flag("--check", *check,
                "write nothing; fail if the files in DIR differ from what the field tables give");
-  return [out, check] { return run_schema_command(*out, *check); };
+  return [out, check] {
+    // As every output folder (add_output_option): one level made, in a folder that exists. Only
+    // when writing: --check reads the folder.
+    if (!*check)
+      if (const std::string why = cli::output_problem(out->string(), cli::OutputKind::folder);
+          !why.empty())
+        throw cli::UsageError("--out: " + why);
+    return run_schema_command(*out, *check);
+  };
 }
 
 }  // namespace

@@ -394,6 +394,10 @@ check play_jobs_bad_file 1 "merged +2 summaries, 5 files, 1 failed" -- "$KASKAD"
 check play_out_deep 2 "^kaskad play: --out: .*deep/er: cannot make this folder: its parent .*deep' does not exist" -- "$KASKAD" play "$tmp/suite/a.json" \
   --headless --out "$tmp/deep/er"
 [ ! -e "$tmp/deep" ] && passed=$((passed + 1)) || { echo "FAIL play_out_deep_made"; failed=$((failed + 1)); }
+check schema_out_deep 2 "^kaskad schema: --out: .*schema_deep/er: cannot make this folder: its parent .*schema_deep' does not exist" -- \
+  "$KASKAD" schema --out "$tmp/schema_deep/er"
+[ ! -e "$tmp/schema_deep" ] && passed=$((passed + 1)) || { echo "FAIL schema_out_deep_made"; failed=$((failed + 1)); }
+check schema_out_one_level 0 "wrote .*schema_new/settings.md" -- "$KASKAD" schema --out "$tmp/schema_new"
 # Camera keys moving a glTF's auto_frame camera in: its near and far follow it (as in the
 # editor), so the box it moves up to is not cut by the near plane framing fitted at load.
 cat >"$tmp/box_in.json" <<EOF
