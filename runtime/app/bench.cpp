@@ -6,10 +6,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -140,15 +143,54 @@ static Status draw_charts(const fs::path& csv_path, const fs::path& out_dir) {
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
+  // The script's stderr comes back through a pipe: its last line is the error shown.
+  int pipe_fds[2];
+  if (pipe(pipe_fds) != 0)
+    return Error{script.string(), "", std::string("cannot start the chart script: ") + std::strerror(errno)};
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDERR_FILENO);
+  posix_spawn_file_actions_addclose(&actions, pipe_fds[1]);
   pid_t pid = 0;
-  if (const int err = posix_spawn(&pid, python, nullptr, nullptr, argv.data(), environ); err != 0)
+  const int err = posix_spawn(&pid, python, &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  close(pipe_fds[1]);
+  if (err != 0) {
+    close(pipe_fds[0]);
     return Error{script.string(), "", std::string("cannot start ") + python + ": " + std::strerror(err)};
+  }
+  std::string errors;
+  char buf[4096];
+  for (;;) {
+    const ssize_t n = read(pipe_fds[0], buf, sizeof buf);
+    if (n > 0) {
+      errors.append(buf, std::size_t(n));
+      if (errors.size() > (1u << 16)) errors.erase(0, errors.size() - (1u << 15));  // keep the tail
+    } else if (n == 0 || errno != EINTR) {
+      break;
+    }
+  }
+  close(pipe_fds[0]);
   int status = 0;
   while (waitpid(pid, &status, 0) < 0)
     if (errno != EINTR) return Error{script.string(), "", "lost the chart script's exit status"};
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    return Error{script.string(), "", "chart script failed (is python3-matplotlib installed?)"};
-  return {};
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+    std::fputs(errors.c_str(), stderr);  // warnings, passed on
+    return {};
+  }
+  while (!errors.empty() && (errors.back() == '\n' || errors.back() == ' ')) errors.pop_back();
+  const std::string last = errors.substr(errors.find_last_of('\n') == std::string::npos
+                                             ? 0
+                                             : errors.find_last_of('\n') + 1);
+  const bool no_matplotlib = last.find("matplotlib") != std::string::npos &&
+                             (last.find("ModuleNotFoundError") != std::string::npos ||
+                              last.find("ImportError") != std::string::npos);
+  std::string why = WIFEXITED(status) ? "chart script failed"
+                                      : "chart script killed by signal " + std::to_string(WTERMSIG(status));
+  if (!last.empty()) why += ": " + last;
+  if (no_matplotlib) why += " (install python3-matplotlib)";
+  return Error{script.string(), "", why};
 }
 
 void print_progress(std::size_t done, std::size_t total, double elapsed_s,
@@ -488,32 +530,206 @@ Status run_bench(const BenchOptions& options) {
   return result;
 }
 
+namespace {
+
+// One CSV record: its fields (quotes removed) and the line it starts on (1-based).
+struct CsvRecord {
+  std::vector<std::string> fields;
+  std::size_t line = 0;
+};
+
+// The records of a CSV as csv_quote() writes it (RFC 4180: a field with a comma, quote or newline
+// is quoted, a quote inside doubled; lines end in \n or \r\n). Blank lines are skipped.
+Result<std::vector<CsvRecord>> read_csv_records(const std::string& text, const std::string& file) {
+  std::vector<CsvRecord> records;
+  std::size_t line = 1, i = 0;
+  const auto at = [&](std::size_t n) { return "line " + std::to_string(n); };
+  while (i < text.size()) {
+    if (text[i] == '\n' || (text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n')) {
+      i += text[i] == '\r' ? 2 : 1;  // a blank line
+      ++line;
+      continue;
+    }
+    CsvRecord rec{{}, line};
+    std::string field;
+    for (;;) {
+      if (i < text.size() && text[i] == '"') {  // a quoted field, to its closing quote
+        const std::size_t opened = line;
+        for (++i;; ++i) {
+          if (i >= text.size())
+            return Error{file, at(opened), "a quoted field is not closed (no closing '\"')"};
+          if (text[i] == '"') {
+            if (i + 1 < text.size() && text[i + 1] == '"') {
+              field += '"';
+              ++i;
+              continue;
+            }
+            ++i;
+            break;
+          }
+          if (text[i] == '\n') ++line;
+          field += text[i];
+        }
+        if (i < text.size() && text[i] != ',' && text[i] != '\n' &&
+            !(text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n'))
+          return Error{file, at(line), "text after a quoted field's closing quote"};
+      } else {
+        while (i < text.size() && text[i] != ',' && text[i] != '\n' &&
+               !(text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n')) {
+          if (text[i] == '"') return Error{file, at(line), "a '\"' inside an unquoted field"};
+          field += text[i++];
+        }
+      }
+      rec.fields.push_back(std::move(field));
+      field.clear();
+      if (i < text.size() && text[i] == ',') {
+        ++i;
+        continue;
+      }
+      break;  // the end of the line or of the text
+    }
+    if (i < text.size()) {
+      i += text[i] == '\r' ? 2 : 1;
+      ++line;
+    }
+    records.push_back(std::move(rec));
+  }
+  return records;
+}
+
+// What a bench.csv column holds, as run_bench writes it (change together with its row).
+enum class ColumnKind {
+  text,        // scene, config, settings
+  count,       // a non-negative integer (std::to_string of a count or size)
+  number,      // a finite number (fmt())
+  measurement  // a finite number, or nan where it was not measured (no light, no stability)
+};
+
+ColumnKind column_kind(const std::string& name) {
+  if (name == "scene" || name == "config" || name == "settings") return ColumnKind::text;
+  static const std::set<std::string> counts = {
+      "width", "height", "frames", "draw_calls", "shadow_draw_calls", "shadow_triangles",
+      "scene_triangles", "receiver_pixels", "stability_points", "stability_frames", "mesh_draws",
+      "shadow_mesh_draws"};
+  if (counts.count(name)) return ColumnKind::count;
+  static const std::set<std::string> measurements = {
+      "misclassified_pct", "false_shadow_pct", "false_light_pct", "rmse", "mae",
+      "misclassified_pct_noedge", "false_shadow_pct_noedge", "false_light_pct_noedge",
+      "rmse_noedge", "mae_noedge", "stability_step_m", "flicker", "flicker_changed_pct"};
+  return measurements.count(name) ? ColumnKind::measurement : ColumnKind::number;
+}
+
+// Why `value` cannot be in column `name`, "" when it can. Empty numeric fields are allowed.
+std::string field_problem(const std::string& name, const std::string& value) {
+  for (unsigned char c : value)
+    if (c < 0x20 || c == 0x7f) return "a control character in column '" + name + "'";
+  if (name == "scene") {
+    // The scene names a chart file, DIR/<scene>.png: a plain file-name stem only.
+    if (value.empty()) return "column 'scene' is empty";
+    if (value.find_first_of("/\\") != std::string::npos || value.front() == '.')
+      return "column 'scene' is '" + value +
+             "', not a file-name stem (no '/', '\\' or leading '.'; it names DIR/<scene>.png)";
+    if (value.size() > 200) return "column 'scene' is longer than 200 bytes";
+    return {};
+  }
+  const ColumnKind kind = column_kind(name);
+  if (kind == ColumnKind::text || value.empty()) return {};
+  if (kind == ColumnKind::measurement && (value == "nan" || value == "-nan")) return {};
+  if (kind == ColumnKind::count) {
+    if (value.find_first_not_of("0123456789") == std::string::npos && value.size() <= 19) return {};
+    return "column '" + name + "' is '" + value + "', not a non-negative integer";
+  }
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(value.c_str(), &end);
+  const bool whole = end == value.c_str() + value.size() && !std::isspace((unsigned char)value[0]);
+  if (!whole || !std::isfinite(v) || errno == ERANGE)
+    return "column '" + name + "' is '" + value + "', not a finite number" +
+           (kind == ColumnKind::measurement ? " (or nan: not measured)" : "");
+  return {};
+}
+
+}  // namespace
+
 Status merge_bench(const std::vector<fs::path>& dirs, const fs::path& out_dir, bool chart) {
-  std::string header, rows;
+  // Every shard is read and checked before anything is written: a bad row fails the merge with
+  // the folder's previous bench.csv and charts as they were.
+  const std::vector<std::string> known = bench_csv_columns();
+  std::vector<std::string> header;
+  fs::path header_file;
+  std::string rows;
   std::size_t count = 0;
   for (const fs::path& dir : dirs) {
     const fs::path file = dir / "bench.csv";
-    if (std::string why = special_file_error(file); !why.empty()) return Error{file.string(), "", why};
-    std::ifstream in(file, std::ios::binary);
-    if (!in) return Error{file.string(), "", "cannot open (is this a kaskad bench --out folder?)"};
-    std::string line;
-    if (!std::getline(in, line)) return Error{file.string(), "line 1", "empty: no header"};
-    if (header.empty()) header = line;
-    if (line != header)
-      return Error{file.string(), "line 1", "columns differ from " + (dirs.front() / "bench.csv").string()};
-    while (std::getline(in, line))
-      if (!line.empty()) {
-        rows += line + "\n";
-        ++count;
+    const std::string name = file.string();
+    if (std::string why = special_file_error(file); !why.empty()) return Error{name, "", why};
+    std::error_code ec;
+    if (!fs::is_regular_file(file, ec))
+      return Error{name, "", "cannot open (is this a kaskad bench --out folder?)"};
+    if (fs::file_size(file, ec) == 0) return Error{name, "line 1", "empty: no header"};
+    auto bytes = read_file_bytes(file, std::uintmax_t(1) << 30);
+    if (!bytes) return bytes.error();
+    const std::string text(bytes->begin(), bytes->end());
+    if (const auto nul = text.find('\0'); nul != std::string::npos)
+      return Error{name, "line " + std::to_string(1 + std::count(text.begin(), text.begin() + long(nul), '\n')),
+                   "a NUL byte: not a text CSV"};
+    auto records = read_csv_records(text, name);
+    if (!records) return records.error();
+    if (records->empty()) return Error{name, "line 1", "empty: no header"};
+    const CsvRecord& head = records->front();
+    if (header.empty()) {
+      std::set<std::string> names;
+      for (const std::string& column : head.fields) {
+        if (std::find(known.begin(), known.end(), column) == known.end())
+          return Error{name, "line " + std::to_string(head.line),
+                       "unknown column '" + column + "' (the columns: docs/guide/bench.md)"};
+        if (!names.insert(column).second)
+          return Error{name, "line " + std::to_string(head.line), "column '" + column + "' twice"};
       }
+      if (!names.count("scene")) return Error{name, "line " + std::to_string(head.line), "no 'scene' column"};
+      header = head.fields;
+      header_file = file;
+    } else if (head.fields != header) {
+      return Error{name, "line " + std::to_string(head.line), "columns differ from " + header_file.string()};
+    }
+    for (std::size_t r = 1; r < records->size(); ++r) {
+      const CsvRecord& rec = (*records)[r];
+      const std::string where = "line " + std::to_string(rec.line);
+      if (rec.fields == header) return Error{name, where, "the header repeated as a data row"};
+      if (rec.fields.size() != header.size())
+        return Error{name, where, std::to_string(rec.fields.size()) + " columns, the header has " +
+                                      std::to_string(header.size())};
+      for (std::size_t c = 0; c < header.size(); ++c)
+        if (std::string why = field_problem(header[c], rec.fields[c]); !why.empty())
+          return Error{name, where, why};
+      for (std::size_t c = 0; c < rec.fields.size(); ++c) rows += (c ? "," : "") + csv_quote(rec.fields[c]);
+      rows += "\n";
+      ++count;
+    }
   }
-  std::error_code ec;
-  fs::create_directories(out_dir, ec);
-  KASKAD_TRY(check_output_folder(out_dir));
+  std::string csv;
+  for (std::size_t c = 0; c < header.size(); ++c) csv += (c ? "," : "") + header[c];
+  csv += "\n" + rows;
   const fs::path csv_path = out_dir / "bench.csv";
-  KASKAD_TRY(write_file_atomic(csv_path, header + "\n" + rows));
+  std::error_code ec;
+  if (out_dir == BenchOptions{}.out_dir) {
+    fs::create_directories(out_dir, ec);  // the documented default, out/bench
+  } else {
+    KASKAD_TRY(check_output_folder_to_make(out_dir));  // one level, the one named
+    if (!fs::exists(out_dir, ec)) fs::create_directory(out_dir, ec);
+  }
+  KASKAD_TRY(check_output_folder(out_dir));
+  KASKAD_TRY(check_output_path(csv_path));
+  // The charts are drawn from a copy first: a chart that fails leaves bench.csv as it was.
+  if (chart && count > 0) {
+    const fs::path draft = out_dir / (".bench.csv.merging." + std::to_string(getpid()));
+    KASKAD_TRY(write_file_atomic(draft, csv));
+    const Status charted = draw_charts(draft, out_dir);
+    fs::remove(draft, ec);
+    KASKAD_TRY(charted);
+  }
+  KASKAD_TRY(write_file_atomic(csv_path, csv));
   std::printf("merged    %zu shard CSVs, %zu rows -> %s\n", dirs.size(), count, csv_path.string().c_str());
-  if (chart && count > 0) KASKAD_TRY(draw_charts(csv_path, out_dir));
   return {};
 }
 

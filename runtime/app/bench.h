@@ -89,7 +89,9 @@ Result<std::vector<BenchConfig>> parse_sweep(const std::string& spec);
 std::vector<std::string> bench_csv_columns();
 
 /// `kaskad bench --merge DIR...`: concatenates the shards' bench.csv (same columns, else an
-/// error naming the file) into OUT/bench.csv and draws the charts when `chart`.
+/// error naming the file) into OUT/bench.csv and draws the charts when `chart`. Every row is
+/// checked first (its column count, numbers, a scene that is a file-name stem); an error names
+/// the file and line, and nothing is written. bench.csv is written after the charts succeed.
 Status merge_bench(const std::vector<std::filesystem::path>& dirs,
                    const std::filesystem::path& out_dir, bool chart);
 

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
@@ -26,33 +27,117 @@ std::vector<std::size_t> shard_files(std::size_t count, int index, int n) {
   return out;
 }
 
+namespace {
+
+using json_reader::ContentError;
+using json_reader::ObjectReader;
+using json_reader::type_name;
+
+// The entries of one shard's summary.json (as run_playbacks writes it, change together), each
+// checked: errors name the file and the JSON pointer ("/files/3/ok: expected true or false").
+Result<json> read_summary(const fs::path& file) {
+  auto doc = parse_json_file(file);
+  if (!doc) {
+    Error e = doc.error();
+    e.message += " (is this a kaskad play --out folder?)";
+    return e;
+  }
+  try {
+    ObjectReader r(*doc, "");
+    if (!r.has("kaskad_play_summary") || !r.has("files"))
+      return Error{file.string(), "", "not a kaskad play summary (no kaskad_play_summary and files)"};
+    int version = 0;
+    r.integer("kaskad_play_summary", version, 1, 1000000);
+    if (version != 1)
+      json_reader::fail(r.at("kaskad_play_summary"),
+                        "version " + std::to_string(version) + " is newer than this build reads (1)");
+    if (r.has("shard")) {
+      std::string shard;
+      r.string("shard", shard);
+      // "i/n" with 0 <= i < n, as --shard takes it.
+      const auto slash = shard.find('/');
+      const std::string i = shard.substr(0, slash), n = slash == std::string::npos ? "" : shard.substr(slash + 1);
+      const auto digits = [](const std::string& s) {
+        return !s.empty() && s.size() <= 6 && s.find_first_not_of("0123456789") == std::string::npos;
+      };
+      if (!digits(i) || !digits(n) || std::stol(i) >= std::stol(n))
+        json_reader::fail(r.at("shard"), "'" + shard + "' is not a shard i/n with 0 <= i < n");
+    }
+    if (r.has("merged_from")) {
+      const json& from = r.raw("merged_from");
+      if (!from.is_array()) json_reader::fail(r.at("merged_from"), "expected an array, got " + type_name(from));
+      for (std::size_t i = 0; i < from.size(); ++i)
+        if (!from[i].is_string())
+          json_reader::fail(r.at("merged_from") + "/" + std::to_string(i),
+                            "expected a string, got " + type_name(from[i]));
+    }
+    const json& files = r.raw("files");
+    if (!files.is_array()) json_reader::fail(r.at("files"), "expected an array, got " + type_name(files));
+    r.finish();
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      const std::string at = "/files/" + std::to_string(i);
+      ObjectReader e(files[i], at);
+      std::string name;
+      if (!e.has("file")) json_reader::fail(at, "no 'file'");
+      e.string("file", name);
+      if (name.empty()) json_reader::fail(e.at("file"), "empty");
+      if (!e.has("ok")) json_reader::fail(at, "no 'ok'");
+      bool ok = false;
+      e.boolean("ok", ok);
+      int count = 0;
+      e.integer("frames", count, 0, 100000);
+      e.integer("captured", count, 0, 100000);
+      float wall_s = 0.0f;
+      e.number("wall_s", wall_s, 0.0f, 1e9f);
+      std::size_t failures = 0;
+      if (e.has("failures")) {
+        const json& list = e.raw("failures");
+        if (!list.is_array()) json_reader::fail(e.at("failures"), "expected an array, got " + type_name(list));
+        for (std::size_t k = 0; k < list.size(); ++k) {
+          ObjectReader f(list[k], e.at("failures") + "/" + std::to_string(k));
+          int frame = 0;
+          std::string message;
+          f.integer("frame", frame, -1, 100000);
+          f.string("message", message);
+          f.finish();
+        }
+        failures = list.size();
+      }
+      e.finish();
+      if (ok && failures > 0)
+        json_reader::fail(e.at("ok"), "true, but the entry lists " + std::to_string(failures) + " failure(s)");
+    }
+    return files;
+  } catch (const ContentError& e) {
+    return Error{file.string(), e.where, e.message};
+  }
+}
+
+}  // namespace
+
 Result<std::size_t> merge_summaries(const std::vector<fs::path>& dirs, const fs::path& out_dir) {
+  // Every summary is read and checked before the merged one is written.
   json merged = {{"kaskad_play_summary", 1}, {"merged_from", json::array()}, {"files", json::array()}};
   std::size_t failed = 0, files = 0;
+  std::vector<json> entries;
   for (const fs::path& dir : dirs) {
     const fs::path file = dir / "summary.json";
-    auto doc = parse_json_file(file);
-    if (!doc) {
-      Error e = doc.error();
-      e.message += " (is this a kaskad play --out folder?)";
-      return e;
-    }
-    if (!doc->is_object() || !doc->contains("files") || !(*doc)["files"].is_array())
-      return Error{file.string(), "/files", "not a kaskad play summary"};
+    auto read = read_summary(file);
+    if (!read) return read.error();
     merged["merged_from"].push_back(file.string());
-    for (const json& f : (*doc)["files"]) {
-      if (!f.is_object() || !f.contains("ok") || !f["ok"].is_boolean() || !f.contains("file"))
-        return Error{file.string(), "/files", "an entry lacks file or ok"};
+    entries.push_back(std::move(read.value()));
+  }
+  for (const json& list : entries)
+    for (const json& f : list) {
       ++files;
       if (!f["ok"].get<bool>()) {
         ++failed;
         std::printf("FAILED    %s\n", f["file"].dump().c_str());
-        if (f.contains("failures") && f["failures"].is_array())
+        if (f.contains("failures"))
           for (const json& x : f["failures"]) std::printf("  %s\n", x.dump().c_str());
       }
       merged["files"].push_back(f);
     }
-  }
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   const fs::path path = out_dir / "summary.json";
@@ -82,6 +167,13 @@ int run_play(const PlayCommandOptions& command) {
   }
   if (merge) {
     if (inputs.empty()) return usage("--merge needs the output folders of the shards");
+    std::set<std::string> seen;
+    for (const fs::path& dir : inputs) {
+      std::error_code ec;
+      const fs::path same = fs::weakly_canonical(dir, ec);
+      if (!seen.insert((ec ? dir : same).string()).second)
+        return usage("--merge: the shard folder " + dir.string() + " is named twice");
+    }
     auto failed = merge_summaries(inputs, options.out_dir);
     if (!failed) {
       std::fprintf(stderr, "kaskad: error: %s\n", failed.error().to_string().c_str());

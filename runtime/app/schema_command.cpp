@@ -19,7 +19,8 @@ int run_schema_command(const std::filesystem::path& out_dir, bool check) {
   }
   if (!check) {
     std::error_code ec;
-    std::filesystem::create_directories(out_dir, ec);
+    // One level, the folder named (its parent was checked with the command line).
+    if (!std::filesystem::exists(out_dir, ec)) std::filesystem::create_directory(out_dir, ec);
     if (ec) {
       std::fprintf(stderr, "kaskad: error: %s: cannot create the folder: %s\n",
                    out_dir.string().c_str(), ec.message().c_str());

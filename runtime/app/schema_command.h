@@ -6,7 +6,7 @@
 
 namespace kaskad {
 
-/// Writes docs/reference's generated files into `out_dir` (atomically, creating the folder), or
+/// Writes docs/reference's generated files into `out_dir` (atomically, making the folder, one level), or
 /// with `check` compares them with the files there and names each that differs or is missing.
 /// Returns the exit status: 0 written or up to date, 1 an error or a stale file.
 int run_schema_command(const std::filesystem::path& out_dir, bool check);

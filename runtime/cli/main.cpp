@@ -170,6 +170,13 @@ int run_variants(const VariantsArgs& a) {
 int run_bench_command(const BenchArgs& a) {
   if (a.merge) {
     if (a.bench.scenes.empty()) throw cli::UsageError("bench --merge needs the shards' --out folders");
+    std::set<std::string> seen;
+    for (const std::filesystem::path& dir : a.bench.scenes) {
+      std::error_code ec;
+      const std::filesystem::path same = std::filesystem::weakly_canonical(dir, ec);
+      if (!seen.insert((ec ? dir : same).string()).second)
+        throw cli::UsageError("--merge: the shard folder " + dir.string() + " is named twice");
+    }
     if (auto st = merge_bench(a.bench.scenes, a.bench.out_dir, a.bench.chart); !st)
       return fail(st.error());
     return 0;
@@ -632,7 +639,15 @@ cli::RunCommand add_schema_command(CLI::App& cmd) {
       ->type_name("DIR");
   cmd.add_flag("--check", *check,
                "write nothing; fail if the files in DIR differ from what the field tables give");
-  return [out, check] { return run_schema_command(*out, *check); };
+  return [out, check] {
+    // As every output folder (add_output_option): one level made, in a folder that exists. Only
+    // when writing: --check reads the folder.
+    if (!*check)
+      if (const std::string why = cli::output_problem(out->string(), cli::OutputKind::folder);
+          !why.empty())
+        throw cli::UsageError("--out: " + why);
+    return run_schema_command(*out, *check);
+  };
 }
 
 }  // namespace

@@ -334,6 +334,20 @@ check bench_merge 0 "merged +2 shard CSVs, 3 rows" -- "$KASKAD" bench --merge "$
   --out "$tmp/merged" --no-chart
 check bench_merge_missing nonzero "nope/bench.csv: cannot open" -- "$KASKAD" bench --merge "$tmp/nope" \
   --out "$tmp/merged2" --no-chart
+# A chart that cannot be written (a folder where default.png goes) fails the merge with the
+# script's own error, not a guess about matplotlib, and leaves the previous bench.csv as it was.
+mkdir -p "$tmp/merged_chart/default.png"
+cp "$tmp/shard1/bench.csv" "$tmp/merged_chart/bench.csv"
+before=$(md5sum <"$tmp/merged_chart/bench.csv")
+check bench_merge_chart_fails 1 "chart script failed: IsADirectoryError: .*default.png" -- "$KASKAD" bench \
+  --merge "$tmp/shard0" "$tmp/shard1" --out "$tmp/merged_chart"
+if [ "$(md5sum <"$tmp/merged_chart/bench.csv")" = "$before" ] &&
+   ! "$KASKAD" bench --merge "$tmp/shard0" "$tmp/shard1" --out "$tmp/merged_chart" 2>&1 | grep -q matplotlib; then
+  passed=$((passed + 1))
+else
+  echo "FAIL bench_merge_chart_keeps_csv: a failed chart replaced bench.csv or blamed matplotlib"
+  failed=$((failed + 1))
+fi
 
 # A bench that fails before its first row (here: a scene whose model is missing, found before any
 # frame) leaves the folder's previous bench.csv as it was.
@@ -403,6 +417,10 @@ check play_jobs_bad_file 1 "merged +2 summaries, 5 files, 1 failed" -- "$KASKAD"
 check play_out_deep 2 "^kaskad play: --out: .*deep/er: cannot make this folder: its parent .*deep' does not exist" -- "$KASKAD" play "$tmp/suite/a.json" \
   --headless --out "$tmp/deep/er"
 [ ! -e "$tmp/deep" ] && passed=$((passed + 1)) || { echo "FAIL play_out_deep_made"; failed=$((failed + 1)); }
+check schema_out_deep 2 "^kaskad schema: --out: .*schema_deep/er: cannot make this folder: its parent .*schema_deep' does not exist" -- \
+  "$KASKAD" schema --out "$tmp/schema_deep/er"
+[ ! -e "$tmp/schema_deep" ] && passed=$((passed + 1)) || { echo "FAIL schema_out_deep_made"; failed=$((failed + 1)); }
+check schema_out_one_level 0 "wrote .*schema_new/settings.md" -- "$KASKAD" schema --out "$tmp/schema_new"
 # Camera keys moving a glTF's auto_frame camera in: its near and far follow it (as in the
 # editor), so the box it moves up to is not cut by the near plane framing fitted at load.
 cat >"$tmp/box_in.json" <<EOF
