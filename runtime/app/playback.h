@@ -168,7 +168,9 @@ Result<std::vector<PlayFailure>> run_playbacks(const std::vector<std::filesystem
 std::vector<std::size_t> shard_files(std::size_t count, int index, int n);
 
 /// `kaskad play --merge DIR...`: combines the summary.json of shard output folders into
-/// OUT/summary.json and lists the failed files; returns how many failed.
+/// OUT/summary.json and lists the failed files; returns how many failed. Every summary is checked
+/// first (version, shard, each entry's fields); an error names the file and JSON pointer, and
+/// nothing is written.
 Result<std::size_t> merge_summaries(const std::vector<std::filesystem::path>& dirs,
                                     const std::filesystem::path& out_dir);
 
