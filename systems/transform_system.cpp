@@ -59,6 +59,32 @@ struct ChainLink {
   WorldTransform* world;
 };
 
+// Why an entity's parent is not applied, said once; off the hot path.
+[[gnu::cold, gnu::noinline]] void warn_root(const ecs::World& world, ecs::Entity at,
+                                            ecs::Entity parent, bool cycle) {
+  if (cycle)
+    log::warn_once("%s: parent cycle through %s; treating it as a root",
+                   entity_label(world, at).c_str(), entity_label(world, parent).c_str());
+  else
+    log::warn_once("%s: parent (entity %u) is gone; treating it as a root",
+                   entity_label(world, at).c_str(), parent.index);
+}
+
+// The parent `at` is placed under: t.parent, or none (a root) when that parent is gone or
+// already on the chain being resolved (a cycle).
+[[gnu::always_inline]] inline ecs::Entity decide_parent(const ecs::World& world, ecs::Entity at,
+                                                        const Transform& t,
+                                                        const std::vector<std::uint8_t>& state) {
+  const ecs::Entity p = t.parent;
+  if (!p.valid()) return ecs::kNullEntity;
+  const bool gone = !world.alive(p) || !world.has<Transform>(p);
+  if (gone || (p.index < state.size() && state[p.index] == 1)) {
+    warn_root(world, at, p, !gone);
+    return ecs::kNullEntity;
+  }
+  return p;
+}
+
 // Recomputes l's WorldTransform when its parent, the parent's version or its Transform bits
 // differ from its TransformCache; `parent_*` are l.parent's (null for a root), already current.
 void update_link(const ChainLink& l, const TransformCache* parent_cache,
@@ -88,18 +114,7 @@ void update_link(const ChainLink& l, const TransformCache* parent_cache,
   for (;;) {
     const ecs::Entity at = link.entity;
     if (at.index >= state.size()) state.resize(std::size_t{at.index} + 1, 0);
-    const ecs::Entity p = link.transform->parent;
-    if (p.valid()) {
-      if (!world.alive(p) || !world.has<Transform>(p)) {
-        log::warn_once("%s: parent (entity %u) is gone; treating it as a root",
-                       entity_label(world, at).c_str(), p.index);
-      } else if (p.index < state.size() && state[p.index] == 1) {
-        log::warn_once("%s: parent cycle through %s; treating it as a root",
-                       entity_label(world, at).c_str(), entity_label(world, p).c_str());
-      } else {
-        link.parent = p;
-      }
-    }
+    link.parent = decide_parent(world, at, *link.transform, state);
     state[at.index] = 1;
     if (!link.parent.valid() || done(link.parent)) break;
     chain.push_back(link);
@@ -140,23 +155,13 @@ std::uint64_t resolve(ecs::World& world, ecs::Entity e, const Transform& t, Tran
     resolve_chain(world, {e, ecs::kNullEntity, &t, &cache, &out}, stamp, state, chain, stats);
     return cache.version;
   }
-  ecs::Entity parent = ecs::kNullEntity;
+  const ecs::Entity parent = decide_parent(world, e, t, state);
   std::uint64_t parent_version = 0;
-  if (t.parent.valid()) {
-    if (!world.alive(t.parent) || !world.has<Transform>(t.parent)) {
-      log::warn_once("%s: parent (entity %u) is gone; treating it as a root",
-                     entity_label(world, e).c_str(), t.parent.index);
-    } else if (t.parent.index < state.size() && state[t.parent.index] == 1) {
-      log::warn_once("%s: parent cycle through %s; treating it as a root",
-                     entity_label(world, e).c_str(), entity_label(world, t.parent).c_str());
-    } else {
-      state[e.index] = 1;
-      parent = t.parent;
-      parent_version = resolve(world, parent, world.get<Transform>(parent),
-                               world.get<TransformCache>(parent),
-                               world.get<WorldTransform>(parent), stamp, state, chain, stats,
-                               depth + 1);
-    }
+  if (parent.valid()) {
+    state[e.index] = 1;
+    parent_version = resolve(world, parent, world.get<Transform>(parent),
+                             world.get<TransformCache>(parent), world.get<WorldTransform>(parent),
+                             stamp, state, chain, stats, depth + 1);
   }
   state[e.index] = 2;
   if (cache.version != 0 && cache.parent == parent && cache.parent_version == parent_version &&
@@ -169,7 +174,6 @@ std::uint64_t resolve(ecs::World& world, ecs::Entity e, const Transform& t, Tran
   ++stats.transforms;
   return cache.version;
 }
-
 
 // Recomputes e's WorldBounds when its inputs differ from the BoundsCache; world_version 0: no
 // version to compare (a WorldTransform without a Transform), always.
