@@ -62,6 +62,10 @@ struct NodeOverride {
 struct ModelRef {
   std::string path;
   std::vector<NodeOverride> nodes;  ///< by (node, section), in the order first set
+  /// The entity's `animation` block as the scene file gave it (JSON text), applied to the
+  /// model's Animator once it is imported, and where it was read; empty: none.
+  std::string animation;
+  std::string animation_where;
 };
 
 /// A material file (content/materials/*.json) used by this entity; path relative to the scene.

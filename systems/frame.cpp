@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "components/animation.h"
 #include "components/light.h"
 #include "components/material.h"
 #include "components/mesh_renderer.h"
@@ -11,6 +12,7 @@
 #include "components/shadow_technique.h"
 #include "components/transform.h"
 #include "runtime/core/log.h"
+#include "systems/animation_system.h"
 #include "systems/transform_system.h"
 
 namespace kaskad {
@@ -136,6 +138,26 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
                               : 0u;
         d.layer = mr.layer;
         if (const auto* wb = world.try_get<WorldBounds>(e)) d.bounds = wb->box;
+        if (const auto* def = world.try_get<Deformer>(e); def && def->posed != kNoMesh) {
+          // Drawn with its posed copy; a skinned pose is in world space already.
+          render::DeformJob job{mr.mesh, def->posed,
+                                def->skin_matrices.empty()
+                                    ? 0
+                                    : scene.assets.meshes[index(mr.mesh)].deform.influences,
+                                std::uint32_t(scene.assets.meshes[index(mr.mesh)].positions.size()),
+                                def->pose,
+                                std::uint32_t(in.skin_matrices.size()),
+                                std::uint32_t(def->skin_matrices.size()),
+                                std::uint32_t(in.morph_weights.size()),
+                                std::uint32_t(def->weights.size())};
+          in.skin_matrices.insert(in.skin_matrices.end(), def->skin_matrices.begin(),
+                                  def->skin_matrices.end());
+          in.morph_weights.insert(in.morph_weights.end(), def->weights.begin(), def->weights.end());
+          in.deforms.push_back(job);
+          d.mesh = def->posed;
+          d.pose = def->pose;
+          if (!def->skin_matrices.empty()) d.model = glm::mat4(1.0f);
+        }
         // A reflector's own draw reflects its probe's map once one is complete (S3 eq. (3)).
         d.material.features &= ~(render::VariantKey::kReflectionCube.mask() |
                                  render::VariantKey::kReflectionSphere.mask() |
@@ -192,7 +214,12 @@ bool run_systems(Scene& scene, const FrameContext& ctx, SystemState& state, bool
                  FrameReport& report, render::FrameInput& input) {
   if (state.scene != scene.assets.uid) state = SystemState{scene.assets.uid, {}};
   auto t = Clock::now();
+  update_animations(scene.world, scene.assets, commit ? ctx.dt : 0.0);
+  report.animation_ms = ms_since(t);
+
+  t = Clock::now();
   update_transforms(scene.world, scene.assets);
+  update_deformers(scene.world, scene.assets);
   report.transforms_ms = ms_since(t);
 
   t = Clock::now();

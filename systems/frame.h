@@ -1,7 +1,10 @@
 // The frame, in order. This is the one place the phases are listed (STYLE.md 3).
 //
+//   0. Animation   after it: every playing clip's nodes hold its pose (Transform, MorphWeights)
+//                  and its clock has moved on by the frame's dt.
 //   1. Transforms  after it: every Transform has a current WorldTransform and every MeshRenderer
-//                  a current WorldBounds.
+//                  a current WorldBounds; then deformed meshes are posed (skin matrices, morph
+//                  weights) and their WorldBounds hold the pose.
 //   2. Camera      after it: the active camera's view/projection for this frame's aspect.
 //   3. Cascades    after it: every shadowed light has its shadow view (ShadowData): current
 //                  splits or faces, one light matrix per layer, its layers of the shared
@@ -32,6 +35,9 @@ struct FrameContext {
   int height = 720;
   std::uint64_t index = 0;  ///< frame number since the scene was loaded
   bool write_aovs = true;   ///< render the AOV targets too (see render::FrameInput)
+  /// Seconds the animation clock moves on after this frame (a frame shows clips at their time
+  /// now). 0: still (a single render, or a re-render of the same moment).
+  double dt = 0.0;
 };
 
 /// What the systems carry from one frame of a scene to the next. Whoever runs the frames of a
@@ -44,7 +50,7 @@ struct SystemState {
 
 /// What a frame did, for stats output and tests. CPU times in milliseconds.
 struct FrameReport {
-  double transforms_ms = 0, camera_ms = 0, shadows_ms = 0, probes_ms = 0, draw_list_ms = 0,
+  double animation_ms = 0, transforms_ms = 0, camera_ms = 0, shadows_ms = 0, probes_ms = 0, draw_list_ms = 0,
          render_ms = 0;
   CameraState camera;
   std::vector<ShadowData> shadows;  ///< one per shadow view (update_shadows())

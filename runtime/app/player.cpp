@@ -137,6 +137,7 @@ Result<RenderTimings> render_frames(Player& player, Scene& scene, const RenderRu
   ctx.width = run.width > 0 ? run.width : scene.render.width;
   ctx.height = run.height > 0 ? run.height : scene.render.height;
   ctx.write_aovs = run.write_aovs;
+  ctx.dt = run.dt;
   KASKAD_TRY(player.renderer->check_target_size(ctx.width, ctx.height, run.write_aovs,
                                                 scene.render.msaa));
   if (run.prewarm) {

@@ -51,6 +51,9 @@ struct RenderRun {
   int height = 0;
   bool write_aovs = true;  ///< needed for Renderer::read_aovs(); off saves fill rate
   bool prewarm = true;     ///< compile the scene's programs before the first frame
+  /// Seconds the animation clock moves on per frame (FrameContext::dt); 0: every frame shows
+  /// the same moment.
+  double dt = 0.0;
 };
 
 struct RenderTimings {

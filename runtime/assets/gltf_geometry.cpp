@@ -313,10 +313,114 @@ std::vector<std::uint32_t> to_triangle_list(const std::vector<std::uint32_t>& id
 
 /// glTF 3.7.2.1: "When normals are not specified, client implementations MUST calculate flat
 /// normals" (and ignore tangents). Un-indexes the mesh so each triangle has its own vertices.
+/// JOINTS_n / WEIGHTS_n (4 or 8 influences, weights normalised to sum 1) and morph targets
+/// (POSITION, NORMAL, TANGENT displacements; glTF 2.0, 3.7.2.2) of a primitive. `attribute`
+/// reads a named attribute as floats (from the Draco stream where it has it).
+template <typename Attribute>
+Status read_deform(const tinygltf::Model& model, const std::string& file,
+                   const tinygltf::Primitive& prim, const tinygltf::Mesh& mesh,
+                   const std::string& where, std::size_t vertex_count, Attribute& attribute,
+                   MeshDeform& out) {
+  for (int set = 0; set < 2; ++set) {
+    const std::string jn = "JOINTS_" + std::to_string(set), wn = "WEIGHTS_" + std::to_string(set);
+    auto joints = attribute(jn, 4);
+    if (!joints) return joints.error();
+    auto weights = attribute(wn, 4);
+    if (!weights) return weights.error();
+    if (joints->empty() && weights->empty()) break;
+    if (joints->size() != vertex_count * 4 || weights->size() != vertex_count * 4)
+      return Error{file, where,
+                   jn + " and " + wn + " must both be given, one per vertex (" +
+                       std::to_string(vertex_count) + ")"};
+    if (set == 1) {  // interleave the second set after the first, 8 per vertex
+      std::vector<std::uint32_t> j8(vertex_count * 8);
+      std::vector<float> w8(vertex_count * 8);
+      for (std::size_t v = 0; v < vertex_count; ++v)
+        for (int k = 0; k < 4; ++k) {
+          j8[v * 8 + k] = out.joints[v * 4 + k];
+          w8[v * 8 + k] = out.weights[v * 4 + k];
+          j8[v * 8 + 4 + k] = std::uint32_t((*joints)[v * 4 + k]);
+          w8[v * 8 + 4 + k] = (*weights)[v * 4 + k];
+        }
+      out.joints = std::move(j8);
+      out.weights = std::move(w8);
+    } else {
+      out.joints.resize(joints->size());
+      for (std::size_t i = 0; i < joints->size(); ++i) out.joints[i] = std::uint32_t((*joints)[i]);
+      out.weights = std::move(weights.value());
+    }
+    out.influences = 4 * (set + 1);
+  }
+  if (out.skinned()) {
+    const std::size_t n = std::size_t(out.influences);
+    for (std::size_t v = 0; v < vertex_count; ++v) {
+      float sum = 0.0f;
+      for (std::size_t k = 0; k < n; ++k) {
+        const float w = out.weights[v * n + k];
+        if (!(std::isfinite(w) && w >= 0.0f))
+          return Error{file, where + " WEIGHTS",
+                       "vertex " + std::to_string(v) + " has a weight that is negative or not finite"};
+        sum += w;
+      }
+      // glTF asks for weights that sum to 1; quantised ones only approximately do. A vertex
+      // with no weight at all follows its first joint.
+      for (std::size_t k = 0; k < n; ++k)
+        out.weights[v * n + k] = sum > 0.0f ? out.weights[v * n + k] / sum : (k == 0 ? 1.0f : 0.0f);
+    }
+  }
+  for (std::size_t t = 0; t < prim.targets.size(); ++t) {
+    const std::string tw = where + " targets[" + std::to_string(t) + "]";
+    MeshDeform::Target target;
+    auto read = [&](const char* name, int components,
+                    std::vector<glm::vec3>& into) -> Status {
+      auto it = prim.targets[t].find(name);
+      into.assign(vertex_count, glm::vec3(0.0f));
+      if (it == prim.targets[t].end()) return {};
+      auto values = read_accessor<float>(model, file, it->second, {components, false},
+                                         tw + " " + name);
+      if (!values) return values.error();
+      if (values->size() != vertex_count * std::size_t(components))
+        return Error{file, tw + " " + name,
+                     "has " + std::to_string(values->size() / std::size_t(components)) +
+                         " elements but POSITION has " + std::to_string(vertex_count)};
+      for (std::size_t v = 0; v < vertex_count; ++v)
+        into[v] = glm::vec3((*values)[v * std::size_t(components)],
+                            (*values)[v * std::size_t(components) + 1],
+                            (*values)[v * std::size_t(components) + 2]);
+      return {};
+    };
+    KASKAD_TRY(read("POSITION", 3, target.positions));
+    KASKAD_TRY(read("NORMAL", 3, target.normals));
+    // Target tangents are VEC3 (glTF 3.7.2.2: no handedness).
+    KASKAD_TRY(read("TANGENT", 3, target.tangents));
+    target.delta_bounds.expand(glm::vec3(0.0f));
+    for (const auto* stream : {&target.positions, &target.normals, &target.tangents})
+      for (const glm::vec3& d : *stream)
+        if (!(std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z)))
+          return Error{file, tw, "displacements must be finite"};
+    for (const glm::vec3& d : target.positions) target.delta_bounds.expand(d);
+    out.targets.push_back(std::move(target));
+  }
+  if (!out.targets.empty()) {
+    out.default_weights.assign(out.targets.size(), 0.0f);
+    if (!mesh.weights.empty() && mesh.weights.size() != out.targets.size())
+      return Error{file, where, "mesh weights has " + std::to_string(mesh.weights.size()) +
+                                    " values for " + std::to_string(out.targets.size()) +
+                                    " morph targets"};
+    for (std::size_t t = 0; t < mesh.weights.size(); ++t) {
+      if (!std::isfinite(mesh.weights[t]))
+        return Error{file, where, "mesh weights must be finite"};
+      out.default_weights[t] = float(mesh.weights[t]);
+    }
+  }
+  return {};
+}
+
 void make_flat_normals(MeshData& m) {
   MeshData flat;
   flat.name = m.name;
   const bool has_uvs = !m.uvs.empty();
+  std::vector<std::uint32_t> flat_sources;  // the vertex each flat vertex copies
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
     const std::uint32_t i[3] = {m.indices[3 * t], m.indices[3 * t + 1], m.indices[3 * t + 2]};
     const glm::vec3 a = m.positions[i[0]], b = m.positions[i[1]], c = m.positions[i[2]];
@@ -324,16 +428,38 @@ void make_flat_normals(MeshData& m) {
     const float len = glm::length(n);
     n = len > 0.0f && std::isfinite(len) ? n / len : glm::vec3(0, 1, 0);  // degenerate: any unit
     for (std::uint32_t k : i) {
+      flat_sources.push_back(k);
       flat.indices.push_back(std::uint32_t(flat.positions.size()));
       flat.positions.push_back(m.positions[k]);
       flat.normals.push_back(n);
       if (has_uvs) flat.uvs.push_back(m.uvs[k]);
+      const std::size_t j = std::size_t(m.deform.influences);
+      flat.deform.joints.insert(flat.deform.joints.end(), m.deform.joints.begin() + k * j,
+                                m.deform.joints.begin() + (k + 1) * j);
+      flat.deform.weights.insert(flat.deform.weights.end(), m.deform.weights.begin() + k * j,
+                                 m.deform.weights.begin() + (k + 1) * j);
     }
+  }
+  // Skins and morph targets follow their vertices (a target's normals stay zero: flat normals
+  // are not morphed).
+  flat.deform.influences = m.deform.influences;
+  flat.deform.default_weights = m.deform.default_weights;
+  for (const MeshDeform::Target& t : m.deform.targets) {
+    MeshDeform::Target& ft = flat.deform.targets.emplace_back();
+    ft.delta_bounds = t.delta_bounds;
+    for (std::uint32_t k : flat_sources) ft.positions.push_back(t.positions[k]);
+    ft.normals.assign(ft.positions.size(), glm::vec3(0.0f));
   }
   m = std::move(flat);
 }
 
 }  // namespace
+
+Result<std::vector<float>> read_float_accessor(const tinygltf::Model& model,
+                                               const std::string& file, int index,
+                                               int components, const std::string& where) {
+  return read_accessor<float>(model, file, index, {components, false}, where);
+}
 
 Result<const std::uint8_t*> locate(const tinygltf::Model& model, const std::string& file,
                                    int view_index, std::uint64_t offset, std::uint64_t count,
@@ -386,7 +512,6 @@ Result<std::optional<MeshData>> read_primitive(const tinygltf::Model& model,
   if (prim.mode < TINYGLTF_MODE_TRIANGLES || prim.mode > TINYGLTF_MODE_TRIANGLE_FAN) {
     return Error{file, where, "invalid mode " + std::to_string(prim.mode)};
   }
-  if (!prim.targets.empty()) warnings.push_back(where + ": morph targets ignored");
 
   std::optional<DracoPrimitive> draco;
   if (auto ext = prim.extensions.find("KHR_draco_mesh_compression"); ext != prim.extensions.end()) {
@@ -476,6 +601,7 @@ Result<std::optional<MeshData>> read_primitive(const tinygltf::Model& model,
     std::memcpy(m.uvs.data(), uvs->data(), uvs->size() * sizeof(float));
   }
   m.indices = std::move(indices);
+  KASKAD_TRY(read_deform(model, file, prim, mesh, where, vertex_count, attribute, m.deform));
   if (normals->empty()) {
     make_flat_normals(m);
   } else {

@@ -64,6 +64,11 @@ Result<const std::uint8_t*> locate(const tinygltf::Model& model, const std::stri
                                    int view_index, std::uint64_t offset, std::uint64_t count,
                                    std::uint64_t element_size, std::uint64_t stride,
                                    const std::string& where);
+/// Accessor `index` as `components` floats per element (normalised integers mapped, sparse
+/// values substituted), every range checked; `where` names the use in errors.
+Result<std::vector<float>> read_float_accessor(const tinygltf::Model& model,
+                                               const std::string& file, int index,
+                                               int components, const std::string& where);
 /// Converts one primitive. nullopt (with a warning) for primitives that are skipped: points,
 /// lines, or no triangles at all.
 Result<std::optional<MeshData>> read_primitive(const tinygltf::Model& model,
@@ -94,7 +99,23 @@ struct Importer {
   std::map<std::pair<int, bool>, TextureId> textures;  ///< (image, srgb) -> texture
   std::set<int> failed_images;                         ///< warned about once
   bool camera_activated = false;
+  /// Entity of each glTF node (null for nodes outside the imported scene): skin joints and
+  /// animation channels name nodes.
+  std::vector<ecs::Entity> node_entities;
+  /// Primitive entities of skinned nodes, bound to their skin once every node exists.
+  struct SkinnedPrimitive {
+    ecs::Entity entity;
+    int node = -1;
+    MeshId mesh = kNoMesh;
+  };
+  std::vector<SkinnedPrimitive> skinned;
 };
+
+// --- gltf_animation.cpp
+/// Binds the skinned primitives to their skins (AssetStore::skins, converted once each) and
+/// imports the file's animations into AssetStore::animations with an Animator on the model
+/// entity. After every node has its entity.
+Status import_skins_and_animations(Importer& im);
 
 // --- gltf_materials.cpp
 /// glTF metallic-roughness material -> Material. -1 gives glTF's default material (3.9.6).

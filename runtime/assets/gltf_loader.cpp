@@ -11,7 +11,8 @@
 //   3. refuse files that require extensions we do not implement;
 //   4. validate the node hierarchy (indices, single parent) and pick the root nodes;
 //   5. walk the hierarchy parents-first, creating node entities, primitive child entities (meshes
-//      and materials are converted once, on first use) and lights and cameras.
+//      and materials are converted once, on first use) and lights and cameras;
+//   6. bind skinned primitives to their skins and import animations (gltf_animation.cpp).
 #include "runtime/assets/gltf_loader.h"
 
 #include <cmath>
@@ -20,6 +21,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "components/animation.h"
 #include "components/camera.h"
 #include "components/light.h"
 #include "components/model.h"
@@ -263,11 +265,40 @@ Result<ecs::Entity> import_node(Importer& im, int index, ecs::Entity parent) {
       im.world.emplace<Material>(child, material.value());
       im.world.emplace<Imported>(child, Imported{im.source});
       ++im.report.mesh_entities;
+      const MeshDeform& deform = im.assets.meshes[kaskad::index(p.mesh)].deform;
+      if (deform.skinned() && node.skin >= 0) {
+        im.skinned.push_back({child, index, p.mesh});
+      } else if (deform.skinned()) {
+        im.report.warnings.push_back(where + ": mesh has joint weights but the node no skin; "
+                                             "drawn in its bind pose");
+      }
+      if (deform.morphed()) {
+        ++im.report.morphed;
+        if (!(deform.skinned() && node.skin >= 0)) im.world.emplace<Deformer>(child);
+      }
+    }
+    // The node's morph weights: its own, else its mesh's (glTF 2.0, 3.7.2.2).
+    const tinygltf::Mesh& mesh = im.model.meshes[std::size_t(node.mesh)];
+    std::size_t targets = 0;
+    for (const auto& prim : mesh.primitives) targets = std::max(targets, prim.targets.size());
+    if (targets > 0) {
+      MorphWeights w;
+      w.weights.assign(targets, 0.0f);
+      const std::vector<double>& given = node.weights.empty() ? mesh.weights : node.weights;
+      if (!given.empty() && given.size() != targets)
+        return Error{im.file, where, "weights has " + std::to_string(given.size()) +
+                                         " values for " + std::to_string(targets) +
+                                         " morph targets"};
+      for (std::size_t t = 0; t < given.size(); ++t) {
+        if (!std::isfinite(given[t])) return Error{im.file, where, "weights must be finite"};
+        w.weights[t] = float(given[t]);
+      }
+      im.world.emplace<MorphWeights>(entity, std::move(w));
     }
   }
-  if (node.skin >= 0) {
-    im.report.warnings.push_back(where + ": skin ignored; the mesh is imported in its bind pose");
-  }
+  if (node.skin >= 0 && node.mesh < 0)
+    im.report.warnings.push_back(where + ": skin without a mesh ignored");
+  im.node_entities[std::size_t(index)] = entity;
   if (node.camera >= 0) KASKAD_TRY(add_camera(im, entity, node.camera));
   if (auto ext = node.extensions.find("KHR_lights_punctual"); ext != node.extensions.end())
     KASKAD_TRY(add_light(im, entity, index, ext->second));
@@ -341,9 +372,6 @@ Status check_extensions(const tinygltf::Model& model, const std::string& file,
   for (const std::string& ext : model.extensionsUsed)
     if (!supported_extension(ext)) ignored += " " + ext;
   if (!ignored.empty()) warnings.push_back("extensions ignored:" + ignored);
-  if (!model.animations.empty()) {
-    warnings.push_back(std::to_string(model.animations.size()) + " animation(s) ignored");
-  }
   return {};
 }
 
@@ -368,7 +396,9 @@ Result<GltfImportReport> import(const std::filesystem::path& path, ecs::World& w
               {},
               {},
               {},
-              false};
+              false,
+              {},
+              {}};
   // 3. Extensions.
   KASKAD_TRY(check_extensions(im.model, im.file, im.report.warnings));
   // 4. Hierarchy.
@@ -376,6 +406,7 @@ Result<GltfImportReport> import(const std::filesystem::path& path, ecs::World& w
   if (!roots) return roots.error();
 
   // 5. Parents before children (depth-first, explicit stack: hierarchies can be deep).
+  im.node_entities.assign(im.model.nodes.size(), ecs::kNullEntity);
   std::vector<std::pair<int, ecs::Entity>> stack;
   for (auto it = roots->rbegin(); it != roots->rend(); ++it) stack.emplace_back(*it, parent);
   while (!stack.empty()) {
@@ -387,6 +418,8 @@ Result<GltfImportReport> import(const std::filesystem::path& path, ecs::World& w
     for (auto it = children.rbegin(); it != children.rend(); ++it)
       stack.emplace_back(*it, entity.value());
   }
+  // 6. Skins and animations name nodes: every node has its entity now.
+  KASKAD_TRY(import_skins_and_animations(im));
   return std::move(im.report);
 }
 

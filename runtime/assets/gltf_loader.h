@@ -15,6 +15,9 @@ struct GltfImportReport {
   int mesh_entities = 0;  ///< one entity per glTF primitive instance (triangles only)
   int lights = 0;
   int cameras = 0;
+  int skins = 0;       ///< skins bound to a mesh
+  int animations = 0;  ///< clips imported
+  int morphed = 0;     ///< primitive entities with morph targets
   /// Triangles of the meshes added to the AssetStore; a mesh used by several nodes counts once.
   std::size_t triangles = 0;
   /// Skipped primitives (points, lines), unsupported features, textures that failed to load.

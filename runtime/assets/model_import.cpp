@@ -26,6 +26,11 @@ std::vector<ecs::Entity> copy_import(ecs::World& w, const FirstImport& from, ecs
   std::map<std::uint64_t, ecs::Entity> copy_of;  // every copy first, so any parent maps
   std::vector<ecs::Entity> copies;
   for (ecs::Entity original : originals) copies.push_back(copy_of[key(original)] = w.create());
+  // An entity of the first import as its copy here (others, and null, as they are).
+  auto remap = [&](ecs::Entity x) {
+    const auto it = copy_of.find(key(x));
+    return it == copy_of.end() ? x : it->second;
+  };
   for (ecs::Entity original : originals) {
     const ecs::Entity c = copy_of[key(original)];
     w.emplace<Imported>(c, Imported{e});
@@ -48,6 +53,19 @@ std::vector<ecs::Entity> copy_import(ecs::World& w, const FirstImport& from, ecs
       copy.active = false;
       w.emplace<Camera>(c, copy);
     }
+    if (const auto* mw = w.try_get<MorphWeights>(original)) w.emplace<MorphWeights>(c, *mw);
+    if (const auto* d = w.try_get<Deformer>(original)) {
+      Deformer copy = *d;
+      for (ecs::Entity& j : copy.joints) j = remap(j);
+      copy.posed = kNoMesh;  // each instance poses its own copy
+      w.emplace<Deformer>(c, std::move(copy));
+    }
+  }
+  // The model's clips play on each instance's own nodes.
+  if (const auto* a = w.try_get<Animator>(first)) {
+    Animator copy = *a;
+    for (ecs::Entity& n : copy.nodes) n = remap(n);
+    w.emplace<Animator>(e, std::move(copy));
   }
   return copies;
 }
@@ -112,6 +130,20 @@ Result<std::vector<ecs::Entity>> import_model(
 // name no node has is kept as it is for saving: the file may have changed since.
 Status apply_node_overrides(Scene& scene, ecs::Entity e, const std::vector<ecs::Entity>& made) {
   ecs::World& w = scene.world;
+  if (const ModelRef& ref = w.get<ModelRef>(e); !ref.animation.empty()) {
+    const std::string where = ref.animation_where;
+    if (!w.has<Animator>(e))
+      return Error{scene.file.string(), where, ref.path + " has no animations"};
+    const json block = json::parse(ref.animation, nullptr, /*allow_exceptions=*/false);
+    try {
+      Animator a = w.get<Animator>(e);
+      ObjectReader r(block, where);
+      read_animation(r, a);
+      w.get<Animator>(e) = std::move(a);
+    } catch (const ContentError& err) {
+      return Error{scene.file.string(), err.where, err.message};
+    }
+  }
   const fs::path path = scene.file.parent_path() / w.get<ModelRef>(e).path;
   const std::string model_name = w.has<Name>(e) ? w.get<Name>(e).value : std::string();
   const std::vector<NodeOverride> overrides = w.get<ModelRef>(e).nodes;  // a copy: pools move

@@ -199,7 +199,16 @@ void parse_entity(const json& j, const std::string& path, Scene& scene,
     if (mr.has("nodes")) m.nodes = read_node_overrides(mr.raw("nodes"), mr.at("nodes"));
     mr.finish();
     if (m.path.empty()) fail(r.at("model") + "/path", "a model needs a path");
+    if (r.has("animation")) {
+      if (!r.raw("animation").is_object())
+        fail(r.at("animation"), "expected an object of clip names, got " +
+                                    json_reader::type_name(r.raw("animation")));
+      m.animation = r.raw("animation").dump();
+      m.animation_where = r.at("animation");
+    }
     w.emplace<ModelRef>(e, m);
+  } else if (r.has("animation")) {
+    fail(r.at("animation"), "animation needs a model (the clips are a glTF file's)");
   }
   if (r.has("renderer")) {
     if (!has_primitive && !has_model) fail(r.at("renderer"), "renderer needs a primitive or model");
@@ -268,6 +277,31 @@ std::string rebase_path(const Scene& scene, const fs::path& base, const std::str
   return abs.lexically_relative(fs::absolute(base).lexically_normal()).generic_string();
 }
 
+void read_animation(ObjectReader& r, Animator& a) {
+  a.pose_pending.resize(a.clips.size(), false);
+  for (auto it = r.raw_object().begin(); it != r.raw_object().end(); ++it) {
+    const std::string& clip = it.key();
+    const auto found = std::find(a.names.begin(), a.names.end(), clip);
+    if (found == a.names.end()) {
+      std::string names;
+      for (const std::string& n : a.names) names += (names.empty() ? "" : ", ") + n;
+      fail(r.at(clip.c_str()), "no clip named '" + clip + "'; the model's clips: " + names);
+    }
+    const std::size_t k = std::size_t(found - a.names.begin());
+    ObjectReader cr(it.value(), r.at(clip.c_str()));
+    read_fields(cr, a.clips[k]);
+    cr.finish();
+    a.pose_pending[k] = true;
+  }
+}
+
+json write_animation(const Animator& a) {
+  json j = json::object();
+  for (std::size_t k = 0; k < a.clips.size() && k < a.names.size(); ++k)
+    j[a.names[k]] = write_fields(a.clips[k]);
+  return j;
+}
+
 json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
   const ecs::World& w = scene.world;
   json j = json::object();
@@ -290,6 +324,7 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
     j["model"] = {{"path", rebase(m->path)}};
     if (!m->nodes.empty()) j["model"]["nodes"] = write_node_overrides(scene, e);
   }
+  if (const auto* a = w.try_get<Animator>(e)) j["animation"] = write_animation(*a);
   if (const auto* mr = w.try_get<MeshRenderer>(e))
     j["renderer"] = write_fields(*mr);
   if (const auto* ref = w.try_get<MaterialRef>(e)) {

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "components/animation.h"
 #include "components/camera.h"
 #include "components/light.h"
 #include "components/limits.h"
@@ -92,6 +93,11 @@ std::vector<ecs::Entity> nodes_named(const ecs::World& w, ecs::Entity model,
                                      const std::string& node);
 /// A model's `nodes` block: node name -> section -> fields, checked for shape; the values are
 /// read when the model is imported, over what its file gives.
+/// A model entity's `animation` block: clip name -> AnimationState fields (those given set;
+/// a clip given is posed at its time next frame). Errors name an unknown clip with the valid ones.
+void read_animation(ObjectReader& r, Animator& a);
+/// Every clip with every field (the canonical form --set acts on).
+json write_animation(const Animator& a);
 std::vector<NodeOverride> read_node_overrides(const json& nodes, const std::string& where);
 /// The `nodes` block written for model entity `model`.
 json write_node_overrides(const Scene& scene, ecs::Entity model);

@@ -172,6 +172,8 @@ bool read_section(ecs::World& w, ecs::Entity e, const std::string& section, cons
     reread<MeshRenderer>(w, e, block, where, read_renderer);
   } else if (section == "reflector" && w.has<Reflector>(e)) {
     reread<Reflector>(w, e, block, where, read_reflector);
+  } else if (section == "animation" && w.has<Animator>(e)) {
+    reread<Animator>(w, e, block, where, read_animation);
   } else {
     return false;
   }
@@ -388,7 +390,8 @@ Status apply_entity_override(Scene& scene, const std::string& assignment) {
       return Error{"--set", key,
                    "'" + section + "' of '" + name +
                        "' cannot be set on a loaded entity; it takes transform, "
-                       "light, shadow, camera, renderer and reflector"};
+                       "light, shadow, camera, renderer, reflector and (a model with clips) "
+                       "animation"};
   } catch (const ContentError& err) {
     return Error{"--set", err.where, err.message};
   }

@@ -1,6 +1,8 @@
 #include "runtime/cli/options.h"
 
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <optional>
 
@@ -145,6 +147,30 @@ CLI::Option* add_integer_option(CLI::App& cmd, const std::string& name, int& int
       ->type_name("N")
       ->allow_extra_args(false)
       ->check(CLI::Range(lo, hi).description(""));
+}
+
+CLI::Option* add_number_option(CLI::App& cmd, const std::string& name, double& into, double lo,
+                               double hi, const std::string& description) {
+  auto text = [](double v) {
+    std::string s = std::to_string(v);
+    s.erase(s.find_last_not_of('0') + 1);
+    if (!s.empty() && s.back() == '.') s.pop_back();
+    return s;
+  };
+  const std::string range = "[" + text(lo) + ", " + text(hi) + "]";
+  return cmd.add_option(name, into, description + "; S in " + range)
+      ->type_name("S")
+      ->allow_extra_args(false)
+      ->check(CLI::Validator(
+          [lo, hi, range](std::string& v) -> std::string {
+            char* end = nullptr;
+            const double x = std::strtod(v.c_str(), &end);
+            if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(x))
+              return "'" + v + "' is not a number";
+            if (x < lo || x > hi) return "'" + v + "' is outside " + range;
+            return "";
+          },
+          ""));
 }
 
 CLI::Option* add_jobs_option(CLI::App& cmd, int& jobs, const std::string& description) {

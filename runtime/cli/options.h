@@ -78,6 +78,10 @@ CLI::Option* add_output_option(CLI::App& cmd, const std::string& name, T& into, 
 CLI::Option* add_integer_option(CLI::App& cmd, const std::string& name, int& into, int lo, int hi,
                                 const std::string& description);
 
+/// An option with one finite number in [lo, hi] ("S in [lo, hi]").
+CLI::Option* add_number_option(CLI::App& cmd, const std::string& name, double& into, double lo,
+                               double hi, const std::string& description);
+
 /// `--size WxH`: width and height in pixels, each in [lo, hi].
 CLI::Option* add_size_option(CLI::App& cmd, int& width, int& height, int lo, int hi,
                              const std::string& description);

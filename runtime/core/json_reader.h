@@ -133,6 +133,8 @@ class ObjectReader {
     return j_.contains(key);
   }
   const json& raw(const char* key) { return j_.at(key); }
+  /// The whole object, for blocks keyed by names the content chooses (animation clips).
+  const json& raw_object() const { return j_; }
   std::string at(const char* key) const { return path_ + "/" + key; }
 
   void number(const char* key, float& out, float lo, float hi) {

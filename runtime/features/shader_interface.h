@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -22,6 +23,30 @@ inline constexpr unsigned kAttrNormalMatrix = 7;  ///< mat3: locations 7..9
 inline constexpr unsigned kAttrLayer = 10;        ///< uint: the layered shadow pass's layer
 /// vec4 per vertex: tangent xyz and bitangent sign w (glTF TANGENT, or generate_tangents()).
 inline constexpr unsigned kAttrTangent = 11;
+
+/// One vertex of the GPU cache's shared geometry (runtime/render/gpu_cache.h): the vertex
+/// arrays read it by attribute, and the deform pass (deform.comp) as floats, at the offsets
+/// below (VERTEX_* defines).
+struct Vertex {
+  glm::vec3 position{0.0f}, normal{0.0f};
+  glm::vec2 uv{0.0f};
+  glm::vec4 tangent{0.0f};
+};
+static_assert(sizeof(Vertex) == 48);
+inline constexpr int kVertexFloats = int(sizeof(Vertex) / sizeof(float));
+inline constexpr int kVertexPosition = int(offsetof(Vertex, position) / sizeof(float)),
+                     kVertexNormal = int(offsetof(Vertex, normal) / sizeof(float)),
+                     kVertexTangent = int(offsetof(Vertex, tangent) / sizeof(float));
+
+/// The deform pass's shader storage bindings: the shared vertices (read and written), a source
+/// mesh's joints, weights and morph displacements, the frame's skin matrices and morph weights.
+inline constexpr int kBufVertices = 0, kBufJoints = 1, kBufJointWeights = 2, kBufMorphDeltas = 3,
+                     kBufSkinMatrices = 4, kBufMorphWeights = 5;
+/// The deform pass's uniforms: ivec4 (source base vertex, posed base vertex, vertex count,
+/// first skin matrix) and ivec4 (first morph weight, morph targets, 0, 0).
+inline constexpr int kLocDeformJob = 0, kLocDeformMorph = 1;
+/// Floats per vertex and morph target in the displacement buffer: position, normal, tangent.
+inline constexpr int kMorphDeltaFloats = 9;
 
 /// One drawn instance, read by the vertex shaders through instanced attributes (divisor 1) from
 /// the frame's instance buffer: the model matrix, its normal matrix (columns, w unused) and,
@@ -75,8 +100,21 @@ inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
 
 /// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...), and
 /// the light types (LIGHT_DIRECTIONAL, ...: u_light_info[i].x holds a LightType).
-inline std::array<std::pair<const char*, int>, 53> shader_interface_defines() {
+inline std::array<std::pair<const char*, int>, 66> shader_interface_defines() {
   return {{{"LIGHT_DIRECTIONAL", int(LightType::directional)},
+           {"VERTEX_FLOATS", kVertexFloats},
+           {"VERTEX_POSITION", kVertexPosition},
+           {"VERTEX_NORMAL", kVertexNormal},
+           {"VERTEX_TANGENT", kVertexTangent},
+           {"BUF_VERTICES", kBufVertices},
+           {"BUF_JOINTS", kBufJoints},
+           {"BUF_JOINT_WEIGHTS", kBufJointWeights},
+           {"BUF_MORPH_DELTAS", kBufMorphDeltas},
+           {"BUF_SKIN_MATRICES", kBufSkinMatrices},
+           {"BUF_MORPH_WEIGHTS", kBufMorphWeights},
+           {"LOC_DEFORM_JOB", kLocDeformJob},
+           {"LOC_DEFORM_MORPH", kLocDeformMorph},
+           {"MORPH_DELTA_FLOATS", kMorphDeltaFloats},
            {"LIGHT_SPOT", int(LightType::spot)},
            {"LIGHT_POINT", int(LightType::point)},
            {"LIGHT_AREA", int(LightType::area)},

@@ -2,7 +2,8 @@
 // and small integer fields (Filament's Variant, Bevy's MeshPipelineKey), split into
 //   material features  (bits 0-15)  what a material uses      -> MATERIAL_* defines
 //   frame features     (bits 16-47) what the frame needs      -> VARIANT_* defines
-// (bits 48-63 stay free: the shader library keeps the pass there). 32 bits ran out when the
+//   deform features    (bits 48-55) what the deform pass does  -> DEFORM_* defines
+// (bits 56-63 stay free: the shader library keeps the pass there). 32 bits ran out when the
 // soft-shadow techniques and PCF kernels arrived.
 //
 // kFeatureTable below is the one place a feature is declared: its name, define, stages, bit
@@ -51,7 +52,8 @@ enum class Pass : std::uint8_t {
   depth = 1,
   shadow_points = 2,
   lom_occlusion = 3,
-  vsm_moments = 4
+  vsm_moments = 4,
+  deform = 5
 };
 
 constexpr const char* pass_name(Pass pass) {
@@ -60,14 +62,16 @@ constexpr const char* pass_name(Pass pass) {
     case Pass::shadow_points: return "points";
     case Pass::lom_occlusion: return "lom";
     case Pass::vsm_moments: return "moments";
+    case Pass::deform: return "deform";
     case Pass::forward: break;
   }
   return "forward";
 }
 
-/// material: from the material (MATERIAL_* defines); frame: from frame settings (VARIANT_*).
-enum class FeatureKind : std::uint8_t { material, frame };
-enum class ShaderStage : std::uint8_t { vertex = 1, fragment = 2 };
+/// material: from the material (MATERIAL_* defines); frame: from frame settings (VARIANT_*);
+/// deform: from a deformed mesh (DEFORM_*; the deform pass's compute programs only).
+enum class FeatureKind : std::uint8_t { material, frame, deform };
+enum class ShaderStage : std::uint8_t { vertex = 1, fragment = 2, compute = 4 };
 
 /// Where a feature's value lives in the key: bit offset and width.
 struct KeyField {
@@ -115,6 +119,7 @@ struct FeatureSpec {
 
 inline constexpr std::uint8_t kVertexStage = std::uint8_t(ShaderStage::vertex);
 inline constexpr std::uint8_t kFragmentStage = std::uint8_t(ShaderStage::fragment);
+inline constexpr std::uint8_t kComputeStage = std::uint8_t(ShaderStage::compute);
 
 /// Every shader feature, in the order defines and descriptions list them.
 inline constexpr FeatureSpec kFeatureTable[] = {
@@ -215,6 +220,12 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     {.name = "shadow_reuse", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_REUSE",
      .stages = kFragmentStage, .offset = 44, .values = {"off", "store", "load"},
      .requires_ = {"shadow"}},
+    // Deform features (bits 48-55): how the deform pass poses a mesh (runtime/assets/
+    // mesh_pose.h): skinned by 4 or 8 joints a vertex (glTF JOINTS_0, JOINTS_1), and morphed.
+    {.name = "skin", .kind = FeatureKind::deform, .define = "DEFORM_SKIN",
+     .stages = kComputeStage, .offset = 48, .values = {"none", "joints4", "joints8"}},
+    {.name = "morph", .kind = FeatureKind::deform, .define = "DEFORM_MORPH",
+     .stages = kComputeStage, .offset = 50},
 };
 inline constexpr int kFeatureCount = int(std::size(kFeatureTable));
 
@@ -263,13 +274,18 @@ consteval std::array<Rule, kFeatureCount> make_rules() {
     if (f.name.empty() || f.define.empty() || f.stages == 0) throw "feature without name, define or stage";
     if (feature_index(f.name) != i) throw "duplicate feature name";
     if (f.value_max() < f.min || field.width == 0) throw "empty value range";
-    if (unsigned(field.offset) + field.width > 48u) throw "field past bit 47";
+    if (unsigned(field.offset) + field.width > 56u) throw "field past bit 55";
     if (taken & field.mask()) throw "features overlap in the key";
-    const bool material = f.kind == FeatureKind::material;
-    if (material ? (field.mask() & ~std::uint64_t(0xffffu)) : (field.mask() & 0xffffu))
-      throw "material features live in bits 0-15, frame features in bits 16-47";
-    if (!f.define.starts_with(material ? "MATERIAL_" : "VARIANT_"))
-      throw "material defines start with MATERIAL_, frame defines with VARIANT_";
+    const std::uint64_t home = f.kind == FeatureKind::material ? 0x000000000000ffffu
+                               : f.kind == FeatureKind::frame  ? 0x0000ffffffff0000u
+                                                               : 0x00ff000000000000u;
+    if (field.mask() & ~home)
+      throw "material features live in bits 0-15, frame features in 16-47, deform ones in 48-55";
+    const std::string_view prefix = f.kind == FeatureKind::material ? "MATERIAL_"
+                                    : f.kind == FeatureKind::frame  ? "VARIANT_"
+                                                                    : "DEFORM_";
+    if (!f.define.starts_with(prefix))
+      throw "defines start with MATERIAL_, VARIANT_ or DEFORM_ as their feature's kind";
     taken |= field.mask();
     r.mask = field.mask();
     r.offset = field.offset;
@@ -346,6 +362,11 @@ class VariantKey {
   static constexpr Field kShadowReuse = feature_field("shadow_reuse");
   static constexpr std::uint32_t kReuseStore = 1, kReuseLoad = 2;
   static constexpr std::uint64_t kFrameMask = 0x0000ffffffff0000u;
+  // Deform features.
+  /// 0 none, 1 four joints a vertex, 2 eight.
+  static constexpr Field kSkin = feature_field("skin");
+  static constexpr Field kMorph = feature_field("morph");
+  static constexpr std::uint64_t kDeformMask = 0x00ff000000000000u;
 
   constexpr VariantKey() = default;
   constexpr explicit VariantKey(std::uint64_t bits) : bits_(bits) {}
@@ -389,6 +410,7 @@ class VariantKey {
   /// frame features (a receiver, without AOVs or the debug tint); the forward pass needs
   /// everything but alpha_to_coverage on draws without alpha_mask (it changes nothing there).
   constexpr VariantKey filtered_for(Pass pass) const {
+    if (pass == Pass::deform) return VariantKey(bits_ & kDeformMask);
     if (pass == Pass::depth) {
       const std::uint64_t projection = get(kShadowProjection) == kProjectionDualParaboloid
                                            ? kShadowProjection.mask() | kShadow.mask()

@@ -1,6 +1,7 @@
 #include "runtime/gpu/shader.h"
 
 #include <algorithm>
+#include <initializer_list>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -107,19 +108,22 @@ std::string map_shader_log(const std::string& log, const std::vector<std::string
   return rewrite(rewrite(log, mesa_re, true), nv_re, false);
 }
 
-Result<Program> build_program(const ShaderSource& vertex, const ShaderSource& fragment,
-                              bool retrievable) {
-  auto vs = compile_stage(GL_VERTEX_SHADER, vertex);
-  if (!vs) return vs.error();
-  auto fs = compile_stage(GL_FRAGMENT_SHADER, fragment);
-  if (!fs) return fs.error();
+namespace {
+
+/// Compiles each stage and links them into one program.
+Result<Program> link_stages(std::initializer_list<std::pair<GLenum, const ShaderSource*>> stages,
+                            bool retrievable) {
+  std::vector<Shader> shaders;
+  for (const auto& [type, source] : stages) {
+    auto shader = compile_stage(type, *source);
+    if (!shader) return shader.error();
+    shaders.push_back(std::move(shader.value()));
+  }
   Program program(glCreateProgram());
-  glAttachShader(program.id(), vs->id());
-  glAttachShader(program.id(), fs->id());
+  for (const Shader& sh : shaders) glAttachShader(program.id(), sh.id());
   if (retrievable) glProgramParameteri(program.id(), GL_PROGRAM_BINARY_RETRIEVABLE_HINT, GL_TRUE);
   glLinkProgram(program.id());
-  glDetachShader(program.id(), vs->id());
-  glDetachShader(program.id(), fs->id());
+  for (const Shader& sh : shaders) glDetachShader(program.id(), sh.id());
   GLint ok = 0;
   glGetProgramiv(program.id(), GL_LINK_STATUS, &ok);
   if (!ok) {
@@ -127,10 +131,22 @@ Result<Program> build_program(const ShaderSource& vertex, const ShaderSource& fr
     glGetProgramiv(program.id(), GL_INFO_LOG_LENGTH, &len);
     std::string log(std::size_t(std::max(len, 1)), '\0');
     glGetProgramInfoLog(program.id(), len, nullptr, log.data());
-    return Error{vertex.files.empty() ? "" : vertex.files[0], "link",
-                 map_shader_log(log.c_str(), vertex.files)};
+    const ShaderSource& first = *stages.begin()->second;
+    return Error{first.files.empty() ? "" : first.files[0], "link",
+                 map_shader_log(log.c_str(), first.files)};
   }
   return program;
+}
+
+}  // namespace
+
+Result<Program> build_program(const ShaderSource& vertex, const ShaderSource& fragment,
+                              bool retrievable) {
+  return link_stages({{GL_VERTEX_SHADER, &vertex}, {GL_FRAGMENT_SHADER, &fragment}}, retrievable);
+}
+
+Result<Program> build_compute_program(const ShaderSource& compute, bool retrievable) {
+  return link_stages({{GL_COMPUTE_SHADER, &compute}}, retrievable);
 }
 
 std::vector<std::uint8_t> program_binary(const Program& program, GLenum& format) {

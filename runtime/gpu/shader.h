@@ -34,6 +34,9 @@ std::string map_shader_log(const std::string& log, const std::vector<std::string
 Result<Program> build_program(const ShaderSource& vertex, const ShaderSource& fragment,
                               bool retrievable = false);
 
+/// Compiles and links a compute program (the deform pass's).
+Result<Program> build_compute_program(const ShaderSource& compute, bool retrievable = false);
+
 /// A linked program's binary (GL_ARB_get_program_binary); empty when the driver gives none.
 std::vector<std::uint8_t> program_binary(const Program& program, GLenum& format);
 

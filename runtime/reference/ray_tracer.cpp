@@ -23,9 +23,11 @@
 #include <thread>
 #include <vector>
 
+#include "components/animation.h"
 #include "components/material.h"
 #include "components/mesh_renderer.h"
 #include "components/transform.h"
+#include "runtime/assets/mesh_pose.h"
 #include "runtime/reference/row_workers.h"
 
 namespace kaskad::reference {
@@ -390,17 +392,21 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
     MeshRenderer renderer;
     glm::mat4 matrix;
     const Material* material;  // null: opaque
+    const Deformer* deformer;  // null: drawn as stored
   };
   std::vector<Item> items;
   world.view<MeshRenderer, WorldTransform>().each(
       [&](ecs::Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
-        if (mr.mesh != kNoMesh) items.push_back({e, mr, wt.matrix, world.try_get<Material>(e)});
+        if (mr.mesh != kNoMesh)
+          items.push_back(
+              {e, mr, wt.matrix, world.try_get<Material>(e), world.try_get<Deformer>(e)});
       });
 
   // 2. One world-space triangle geometry per entity.
   std::vector<glm::vec3> world_positions;
   std::vector<std::uint32_t> kept;
   std::vector<std::uint32_t> kept_triangle;  // mesh triangle of each kept triangle
+  MeshData posed;  // a deformed mesh in its pose of this frame, as the deform pass draws it
   for (const Item& item : items) {
     const std::string where = "entity " + std::to_string(item.entity.index);
     if (index(item.renderer.mesh) >= assets.meshes.size()) {
@@ -408,10 +414,18 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
                    "MeshRenderer names mesh " + std::to_string(index(item.renderer.mesh)) +
                        " but the asset store has " + std::to_string(assets.meshes.size())};
     }
-    const MeshData& mesh = assets.meshes[index(item.renderer.mesh)];
+    const MeshData* stored = &assets.meshes[index(item.renderer.mesh)];
+    glm::mat4 matrix = item.matrix;
+    if (item.deformer != nullptr && stored->deform.any()) {
+      posed = *stored;
+      pose_mesh(*stored, item.deformer->weights, item.deformer->skin_matrices, posed);
+      stored = &posed;
+      if (!item.deformer->skin_matrices.empty()) matrix = glm::mat4(1.0f);  // world space
+    }
+    const MeshData& mesh = *stored;
     world_positions.resize(mesh.positions.size());
     for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
-      const glm::vec3 p = glm::vec3(item.matrix * glm::vec4(mesh.positions[i], 1.0f));
+      const glm::vec3 p = glm::vec3(matrix * glm::vec4(mesh.positions[i], 1.0f));
       world_positions[i] = p;
     }
     kept.clear();

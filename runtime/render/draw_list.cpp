@@ -67,6 +67,13 @@ VariantKey material_variant(const DrawItem& d) {
   return k;
 }
 
+VariantKey deform_variant(const DeformJob& job) {
+  VariantKey k;
+  k.set(VariantKey::kSkin, job.influences > 4 ? 2u : job.influences > 0 ? 1u : 0u);
+  k.set(VariantKey::kMorph, job.weight_count > 0 ? 1u : 0u);
+  return k;
+}
+
 std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   const VariantKey fk = frame_variant(frame);
   // Probe captures draw without AOVs; a reflector's draw gets its map feature once its first
@@ -83,6 +90,7 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   // The technique's own pass (none without shadows: the key then holds pcf).
   const ShadowExtraPass extra_pass = shadow_technique_of(fk).extra_pass;
   std::vector<ProgramRequest> out;
+  for (const DeformJob& job : frame.deforms) out.push_back({Pass::deform, deform_variant(job)});
   for (const DrawItem& d : frame.draws) {
     const VariantKey k = material_variant(d) | fk;
     for (const VariantKey main : main_fks)

@@ -37,6 +37,8 @@ VariantKey capture_frame_variant(VariantKey frame);
 /// The frame features of the multisampled colour pass (FrameInput::msaa > 1) of a frame with
 /// features `frame`: no AOVs (a single-sample pass draws them), and alpha to coverage.
 VariantKey msaa_frame_variant(VariantKey frame);
+/// The deform features of a deform job (DEFORM_*: the deform pass's program).
+VariantKey deform_variant(const DeformJob& job);
 /// The material features of a draw (MATERIAL_* part): from the material's data.
 VariantKey material_variant(const DrawItem& draw);
 /// The order of materials within draws of one program key (DrawList's orders): textures first

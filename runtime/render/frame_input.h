@@ -47,6 +47,23 @@ struct DrawItem {
   /// probe's visible map, scaled by `reflection_scale` = k_s * p_r (S3 eq. (3)).
   ProbeHandle probe;
   float reflection_scale = 0.0f;
+  /// A deformed draw (skin or morph targets): `mesh` is its entity's own copy that the deform
+  /// pass writes this frame, and `pose` a hash of what posed it (changes whenever the shape
+  /// does; the shadow and visibility caches compare it). 0 for a mesh drawn as stored.
+  std::uint64_t pose = 0;
+};
+
+/// One deformed mesh's GPU work this frame (the deform pass, runtime/render/deform_pass.h):
+/// `source`'s vertices posed into `posed` with skin matrices first_matrix .. + matrix_count of
+/// FrameInput::skin_matrices (none: not skinned) and morph weights first_weight .. +
+/// weight_count of FrameInput::morph_weights (runtime/assets/mesh_pose.h defines the pose).
+struct DeformJob {
+  MeshId source = kNoMesh, posed = kNoMesh;
+  int influences = 0;  ///< joints a vertex (MeshDeform::influences); 0 when not skinned
+  std::uint32_t vertex_count = 0;
+  std::uint64_t pose = 0;  ///< DrawItem::pose of its draw
+  std::uint32_t first_matrix = 0, matrix_count = 0;
+  std::uint32_t first_weight = 0, weight_count = 0;
 };
 
 /// One reflection probe's GPU work this frame (systems/environment_probe_system.h). Each probe
@@ -172,6 +189,10 @@ struct FrameInput {
   /// The view whose visibility and cascade the AOV shows (an index into shadow_views).
   int aov_shadow_view = 0;
   std::vector<ProbeJob> probes;
+  /// Meshes to pose before any pass draws (skins and morph targets) and their inputs.
+  std::vector<DeformJob> deforms;
+  std::vector<glm::mat4> skin_matrices;
+  std::vector<float> morph_weights;
   /// Light from the surroundings (components/ibl.h): the environment map when there is one
   /// (not owned; prefiltered once per `environment_key`), its radiance times
   /// `environment_intensity`; else the uniform ambient radiance.

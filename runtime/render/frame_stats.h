@@ -20,6 +20,7 @@ struct FrameStats {
   /// Forward pass of the main view; with render.msaa > 1 and AOVs, its multisampled colour
   /// and single-sample AOV draws together (each object twice).
   int draw_calls = 0;
+  int deformed_meshes = 0;            ///< meshes the deform pass posed (skins, morph targets)
   int mesh_draws = 0;                 ///< the instanced draws within them (one per mesh)
   int instances = 0;                  ///< objects drawn by them
   int frustum_culled = 0;             ///< draws outside the main view's frustum, not drawn

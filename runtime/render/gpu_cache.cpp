@@ -21,13 +21,6 @@ namespace {
 constexpr GLuint kVertexBinding = 0;
 constexpr GLuint kInstanceBinding = 1;
 
-// One vertex of the shared geometry.
-struct Vertex {
-  glm::vec3 position{0.0f}, normal{0.0f};
-  glm::vec2 uv{0.0f};
-  glm::vec4 tangent{0.0f};
-};
-static_assert(sizeof(Vertex) == 48);
 
 void add_instance_attributes(GLuint vao, GLuint buffer) {
   for (GLuint i = 0; i < 4; ++i) {
@@ -96,6 +89,7 @@ void GpuCache::use(const AssetStore& assets) {
   assets_ = &assets;
   if (assets.uid == assets_uid_) return;
   meshes_.clear();
+  deforms_.clear();
   vertices_used_ = indices_used_ = 0;  // the buffers stay, for the next store's meshes
   textures_.clear();
   probes_->clear();
@@ -176,6 +170,43 @@ const GpuMesh& GpuCache::mesh(MeshId id) {
   vertices_used_ += n;
   indices_used_ += src.indices.size();
   return m;
+}
+
+const GpuDeform& GpuCache::deform(MeshId source) {
+  const std::size_t at = index(source);
+  KASKAD_CHECK(assets_ && at < assets_->meshes.size(), "mesh id out of range");
+  if (at >= deforms_.size()) deforms_.resize(at + 1);
+  std::unique_ptr<GpuDeform>& slot = deforms_[at];
+  if (slot) return *slot;
+  const MeshDeform& d = assets_->meshes[at].deform;
+  const std::size_t n = assets_->meshes[at].positions.size();
+  auto upload = [](gpu::Buffer& buffer, const void* data, std::size_t bytes) {
+    buffer = gpu::make_buffer();
+    // Storage of at least a vec4: a mesh without skin or targets still binds something.
+    glNamedBufferStorage(buffer.id(), GLsizeiptr(std::max<std::size_t>(bytes, 16)),
+                         bytes > 0 ? data : nullptr, GL_DYNAMIC_STORAGE_BIT);
+    if (bytes == 0) {
+      const float zero[4] = {0, 0, 0, 0};
+      glNamedBufferSubData(buffer.id(), 0, sizeof zero, zero);
+    }
+  };
+  slot = std::make_unique<GpuDeform>();
+  upload(slot->joints, d.joints.data(), d.joints.size() * sizeof(std::uint32_t));
+  upload(slot->weights, d.weights.data(), d.weights.size() * sizeof(float));
+  // Target k's vertex v: position, normal and tangent displacements at (k n + v) * 9 floats.
+  std::vector<float> deltas(d.targets.size() * n * kMorphDeltaFloats, 0.0f);
+  for (std::size_t k = 0; k < d.targets.size(); ++k)
+    for (std::size_t v = 0; v < n; ++v) {
+      float* out = &deltas[(k * n + v) * kMorphDeltaFloats];
+      const MeshDeform::Target& t = d.targets[k];
+      for (int c = 0; c < 3; ++c) {
+        out[c] = t.positions[v][c];
+        out[3 + c] = t.normals[v][c];
+        out[6 + c] = t.tangents.empty() ? 0.0f : t.tangents[v][c];
+      }
+    }
+  upload(slot->deltas, deltas.data(), deltas.size() * sizeof(float));
+  return *slot;
 }
 
 void GpuCache::draw_batch(std::span<const MeshDraw> draws) {

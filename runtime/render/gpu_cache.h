@@ -29,6 +29,13 @@ struct GpuMesh {
   bool uploaded = false;
 };
 
+/// A deformed mesh's inputs on the GPU (MeshDeform), read by the deform pass: joints and weights
+/// (MeshDeform::influences a vertex) and morph displacements (kMorphDeltaFloats a vertex and
+/// target, targets one after another).
+struct GpuDeform {
+  gpu::Buffer joints, weights, deltas;
+};
+
 /// Vertices (and indices) the shared geometry's buffers first hold; each growth doubles them.
 inline constexpr std::size_t kGeometryFirstCapacity = 4096;
 
@@ -58,6 +65,10 @@ class GpuCache {
   /// first use; a 1x1 white (or flat normal) texture for kNoTexture or an unknown id.
   gpu::TextureRef texture(TextureId id, bool is_normal_map);
   ProbeMaps& probes() { return *probes_; }
+  /// The deform inputs of mesh `source`, uploaded on first use. Precondition: a valid id.
+  const GpuDeform& deform(MeshId source);
+  /// The shared vertex buffer (every mesh's Vertex records; mesh() may replace it when it grows).
+  GLuint vertex_buffer() const { return vertices_.id(); }
 
   /// Instance records for this frame's draws: begin_frame() starts the frame; upload() stores
   /// `records` after the ones stored earlier in the frame and returns the index of the first,
@@ -73,6 +84,7 @@ class GpuCache {
   void reserve_geometry(std::size_t vertices, std::size_t indices);
 
   std::vector<GpuMesh> meshes_;                        // indexed by MeshId
+  std::vector<std::unique_ptr<GpuDeform>> deforms_;     // indexed by MeshId; null: not yet
   gpu::VertexArray vao_;  // every mesh's vertices and indices, and the instance records
   gpu::Buffer vertices_, indices_;
   std::size_t vertices_used_ = 0, vertices_capacity_ = 0;  // in Vertex

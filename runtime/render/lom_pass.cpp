@@ -109,7 +109,7 @@ Status LomPass::prepare(const FrameInput& frame, const DrawList& list, const Sha
   Hash receivers;
   for (std::uint32_t i : list.depth_order) {
     const DrawItem& d = frame.draws[i];
-    if (d.receive_shadows && !d.cast_shadows) receivers.add(d.mesh).add(d.model);
+    if (d.receive_shadows && !d.cast_shadows) receivers.add(d.mesh).add(d.model).add(d.pose);
   }
   inputs_.assign(std::size_t(total), 0);
   for (const ShadowView& v : views)

@@ -1,4 +1,5 @@
 // The renderer's passes, in the order Renderer::render() runs them (renderer.h):
+//   DeformPass         skinned and morphed meshes posed (compute)          deform_pass.h
 //   ShadowMapPass      the depth layers of every shadow view (S0, S4)       shadow_map_pass.h
 //   LomPass            S1's layered occlusion map (technique lom)           lom_pass.h
 //   MomentsPass        the blurred, mipmapped moments of vsm/evsm           moments_pass.h
@@ -12,6 +13,7 @@
 // texture_storage.h (the driver's texture limits, border samplers, read-back).
 #pragma once
 
+#include "runtime/render/deform_pass.h"
 #include "runtime/render/draw_state.h"
 #include "runtime/render/forward_pass.h"
 #include "runtime/render/lom_pass.h"

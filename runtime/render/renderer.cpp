@@ -34,6 +34,7 @@ struct Renderer::Impl {
   gpu::Buffer frame_ubo;  // FrameBlock of the main view (frame_uniforms.h)
 
   // The passes, in order (passes.h).
+  DeformPass deform;
   ShadowMapPass shadow;
   LomPass lom;
   MomentsPass moments;
@@ -186,7 +187,7 @@ std::uint64_t visibility_inputs(const FrameInput& frame, const DrawList& list,
   for (std::uint32_t i : list.forward_order) {
     const DrawItem& d = frame.draws[i];
     const Material& m = d.material;
-    h.add(d.mesh).add(d.model).add(d.receive_shadows).add(list.keys[i].bits());
+    h.add(d.mesh).add(d.model).add(d.pose).add(d.receive_shadows).add(list.keys[i].bits());
     h.add(m.double_sided).add(m.alpha_mask).add(m.alpha_cutoff).add(m.base_color.a);
     h.add(m.base_color_texture).add(m.base_color_transform);
   }
@@ -287,6 +288,9 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   const DrawList list = build_draw_list(frame, im.supported(frame_variant(frame)));
   im.frame_key = list.frame_key;
   DrawState state(*im.shaders, *im.cache, stats_);
+
+  // 0. Deformed meshes. After it: every posed mesh holds this frame's pose.
+  KASKAD_TRY(im.deform.record(frame, assets.uid, *im.cache, *im.shaders, stats_));
 
   // 1. Shadow maps. After it: every layer of every shadow view holds its casters' depth.
   KASKAD_TRY(im.shadow.prepare(frame, list, assets, list.frame_key.has(VariantKey::kShadowLayered),

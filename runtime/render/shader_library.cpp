@@ -22,12 +22,15 @@ using Clock = std::chrono::steady_clock;
 constexpr char kMagic[4] = {'K', 'S', 'K', 'B'};
 constexpr std::uint32_t kCacheVersion = 1;
 
+/// A pass's stages: vertex and fragment, or one compute shader.
 struct PassFiles {
   const char* vertex;
   const char* fragment;
+  const char* compute = nullptr;
 };
 PassFiles files_for(Pass pass) {
   switch (pass) {
+    case Pass::deform: return {nullptr, nullptr, "deform.comp"};
     case Pass::depth: return {"shadow_depth.vert", "shadow_depth.frag"};
     case Pass::shadow_points: return {"shadow_points.vert", "shadow_points.frag"};
     case Pass::lom_occlusion: return {"fullscreen.vert", "lom_occlusion.frag"};
@@ -141,14 +144,19 @@ Result<ShaderLibrary::Entry> ShaderLibrary::build(Pass pass, VariantKey key, boo
     if (oracle_) d.emplace_back("KASKAD_UBER_ORACLE", "1");
     return d;
   };
-  auto vs = gpu::preprocess_shader(dir_, pf.vertex, defines_for(ShaderStage::vertex));
-  if (!vs) return vs.error();
-  auto fs_src = gpu::preprocess_shader(dir_, pf.fragment, defines_for(ShaderStage::fragment));
-  if (!fs_src) return fs_src.error();
+  std::vector<gpu::ShaderSource> stages;
+  for (const auto& [file, stage] : {std::pair{pf.vertex, ShaderStage::vertex},
+                                    std::pair{pf.fragment, ShaderStage::fragment},
+                                    std::pair{pf.compute, ShaderStage::compute}}) {
+    if (file == nullptr) continue;
+    auto src = gpu::preprocess_shader(dir_, file, defines_for(stage));
+    if (!src) return src.error();
+    stages.push_back(std::move(src.value()));
+  }
 
   Entry entry;
-  for (const auto* src : {&vs.value(), &fs_src.value()})
-    for (const auto& f : src->files) {
+  for (const gpu::ShaderSource& src : stages)
+    for (const auto& f : src.files) {
       entry.files.push_back(dir_ / f);
       std::error_code ec;
       entry.newest = std::max(entry.newest, fs::last_write_time(dir_ / f, ec));
@@ -156,8 +164,8 @@ Result<ShaderLibrary::Entry> ShaderLibrary::build(Pass pass, VariantKey key, boo
 
   // Cache key: driver + both preprocessed sources. Editing any included file changes the text,
   // so stale binaries are never used (they are simply not found).
-  const std::uint64_t hash =
-      hash_bytes(fs_src->text, hash_bytes(vs->text, hash_bytes(driver_)));
+  std::uint64_t hash = hash_bytes(driver_);
+  for (const gpu::ShaderSource& src : stages) hash = hash_bytes(src.text, hash);
   const bool use_cache = !cache_dir_.empty() && binary_formats_ > 0;
   const fs::path cache_file = cache_dir_ / (hex(hash) + ".bin");
   if (use_cache) {
@@ -175,7 +183,8 @@ Result<ShaderLibrary::Entry> ShaderLibrary::build(Pass pass, VariantKey key, boo
                  p.error().message.c_str());
     }
   }
-  auto program = gpu::build_program(*vs, *fs_src, use_cache);
+  auto program = stages.size() == 1 ? gpu::build_compute_program(stages[0], use_cache)
+                                    : gpu::build_program(stages[0], stages[1], use_cache);
   if (!program) return program.error();
   entry.program = std::move(program.value());
   ++stats_.programs_compiled;
