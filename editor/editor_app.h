@@ -5,6 +5,8 @@
 // script_runner.cpp the --script actions and the widgets they click.
 #pragma once
 
+#include <chrono>
+
 #include <algorithm>
 #include <array>
 #include <cfloat>
@@ -236,6 +238,9 @@ class Editor {
   bool planes_follow_ = false;    ///< the camera was auto_frame: its near and far follow it
   bool prewarm_ = true;           ///< compile the scene's programs before its first frame
   bool changed_since_frame_ = true;
+  /// When the viewport last rendered: playing clips advance by the time since (a script's
+  /// frames by 1/60 s each, so its screenshots do not depend on the machine's speed).
+  std::chrono::steady_clock::time_point last_render_{};
   bool viewport_hovered_ = false;
   bool ask_quit_ = false;
   gpu::Texture view_texture_;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "components/animation.h"
 #include "components/camera.h"
 #include "components/light.h"
 #include "components/model.h"
@@ -305,6 +306,9 @@ void Editor::inspector() {
       json sections = *ent;
       if (const auto e = find(selected_); e && scene_.world.has<ShadowSettings>(*e))
         sections["shadow"] = live_entity_sections(scene_, *e)["shadow"];
+      // A model's clips as they play now (time moves on while a clip plays): the timeline.
+      if (const auto e = find(selected_); e && scene_.world.has<Animator>(*e))
+        sections["animation"] = live_entity_sections(scene_, *e)["animation"];
       for (auto it = sections.begin(); it != sections.end(); ++it)
         if (it.key() != "name" && it.value().is_object())
           section(selected_ + "." + it.key(), it.key(), it.value(), true);
@@ -342,8 +346,22 @@ void Editor::section(const std::string& key, const std::string& label, const jso
       label.c_str(), open_at_first ? ImGuiTreeNodeFlags_DefaultOpen : ImGuiTreeNodeFlags_None);
   name_item(key);
   if (open)
-    for (auto f = fields.begin(); f != fields.end(); ++f)
-      field(key + "." + f.key(), f.key(), f.value());
+    for (auto f = fields.begin(); f != fields.end(); ++f) {
+      if (!f.value().is_object()) {
+        field(key + "." + f.key(), f.key(), f.value());
+        continue;
+      }
+      // A block of blocks (a model's animation clips): one tree node each, with its fields
+      // (a clip's playing is play/pause, its time the scrubber).
+      const std::string sub = key + "." + f.key();
+      const bool sub_open = ImGui::TreeNodeEx(sub.c_str(), ImGuiTreeNodeFlags_DefaultOpen, "%s",
+                                              f.key().c_str());
+      name_item(sub);
+      if (!sub_open) continue;
+      for (auto g = f.value().begin(); g != f.value().end(); ++g)
+        field(sub + "." + g.key(), g.key(), g.value());
+      ImGui::TreePop();
+    }
 }
 
 }  // namespace kaskad::editor

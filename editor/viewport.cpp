@@ -20,6 +20,12 @@ Status Editor::render_viewport(int w, int h) {
   // The AOV targets cost fill rate: only for the views that show them.
   run.write_aovs = is_aov_view(view_);
   run.prewarm = prewarm_;
+  const auto now = std::chrono::steady_clock::now();
+  if (!opt_.script.empty())
+    run.dt = 1.0 / 60.0;
+  else if (last_render_.time_since_epoch().count() != 0)
+    run.dt = std::min(0.1, std::chrono::duration<double>(now - last_render_).count());
+  last_render_ = now;
   auto t = render_frames(player_, scene_, run);
   if (!t) return t.error();
   // Nothing drawn while the scene has meshes: the viewport says why it may be.

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -231,21 +232,23 @@ constexpr const char* kCsvHeader =
     "frame,t,frame_ms,cpu_transforms_ms,cpu_camera_ms,cpu_shadows_ms,cpu_probes_ms,"
     "cpu_draw_list_ms,cpu_render_ms,gpu_shadow_ms,gpu_forward_ms,gpu_probe_ms,draw_calls,"
     "shadow_draw_calls,shadow_triangles,probe_faces,probe_captures,compiles_after_prewarm,"
-    "misclassified_pct,rss_mib,gl_objects,mesh_draws,shadow_mesh_draws\n";
+    "misclassified_pct,rss_mib,gl_objects,mesh_draws,shadow_mesh_draws,shadow_layers_rendered,"
+    "deformed_meshes\n";
 
 // 4. The frame's row of frames.csv.
 std::string csv_row(const FrameRow& row, const FrameReport& report) {
   const auto& st = report.stats;
   char line[640];
   std::snprintf(line, sizeof line,
-                "%d,%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%d,%zu,%d,%d,%d,%s,%.2f,%ld,%d,%d\n",
+                "%d,%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%d,%zu,%d,%d,%d,%s,%.2f,%ld,%d,%d,%d,%d\n",
                 row.frame, row.t, row.frame_ms, report.transforms_ms, report.camera_ms,
                 report.shadows_ms, report.probes_ms, report.draw_list_ms, report.render_ms,
                 st.shadow_gpu_ms, st.forward_gpu_ms, st.probe_gpu_ms, st.draw_calls,
                 st.shadow_draw_calls, st.shadow_triangles, st.probe_faces,
                 report.probes.captures_this_frame, row.compiles,
                 row.misclassified_pct < 0 ? "" : std::to_string(row.misclassified_pct).c_str(),
-                row.rss_mib, row.gl_objects, st.mesh_draws, st.shadow_mesh_draws);
+                row.rss_mib, row.gl_objects, st.mesh_draws, st.shadow_mesh_draws,
+                std::popcount(st.shadow_layers_rendered), st.deformed_meshes);
   return line;
 }
 
@@ -273,6 +276,7 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
   // The output size the camera allows (an own aspect fits inside the playback's size).
   ctx.width = scene->render.width;
   ctx.height = scene->render.height;
+  ctx.dt = pb.dt;  // frame n shows the scene's clips n * dt seconds in, as the timeline counts
   player.renderer->shaders().first_frame_done();
 
   Run run{pb, options, out, player, *scene, ctx};

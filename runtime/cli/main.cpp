@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "components/animation.h"
 #include "components/camera.h"
 #include "components/light.h"
 #include "components/mesh_renderer.h"
@@ -119,6 +120,16 @@ int run_info(const InfoArgs& a) {
       if (w.has<Reflector>(e)) parts += " reflector";
       if (w.has<ModelRef>(e)) parts += " model";
       if (w.has<PrimitiveMesh>(e)) parts += " primitive";
+      if (const auto* an = w.try_get<Animator>(e)) {
+        parts += " animation (clips:";
+        for (const std::string& clip : an->names) {
+          parts += ' ';
+          parts += clip;
+        }
+        parts += ")";
+      }
+      if (const auto* d = w.try_get<Deformer>(e))
+        parts += d->skin != Deformer::kNoSkin ? " skinned" : " morphed";
       const Transform& t = w.get<Transform>(e);
       const auto* pn = t.parent.valid() && w.alive(t.parent) ? w.try_get<Name>(t.parent) : nullptr;
       std::printf("  %-32s transform%s%s%s%s\n", n ? n->value.c_str() : "(unnamed)", parts.c_str(),

@@ -172,6 +172,18 @@ const GpuMesh& GpuCache::mesh(MeshId id) {
   return m;
 }
 
+std::vector<glm::vec3> GpuCache::read_positions(MeshId id) const {
+  const std::size_t at = index(id);
+  if (at >= meshes_.size() || !meshes_[at].uploaded) return {};
+  const std::size_t n = assets_->meshes[at].positions.size();
+  std::vector<Vertex> vertices(n);
+  glGetNamedBufferSubData(vertices_.id(), GLintptr(std::size_t(meshes_[at].base_vertex) * sizeof(Vertex)),
+                          GLsizeiptr(n * sizeof(Vertex)), vertices.data());
+  std::vector<glm::vec3> out(n);
+  for (std::size_t i = 0; i < n; ++i) out[i] = vertices[i].position;
+  return out;
+}
+
 const GpuDeform& GpuCache::deform(MeshId source) {
   const std::size_t at = index(source);
   KASKAD_CHECK(assets_ && at < assets_->meshes.size(), "mesh id out of range");

@@ -67,6 +67,9 @@ class GpuCache {
   ProbeMaps& probes() { return *probes_; }
   /// The deform inputs of mesh `source`, uploaded on first use. Precondition: a valid id.
   const GpuDeform& deform(MeshId source);
+  /// The positions of mesh `id` as its vertices in the shared buffer hold them now (empty when
+  /// it was not uploaded); waits for the GPU.
+  std::vector<glm::vec3> read_positions(MeshId id) const;
   /// The shared vertex buffer (every mesh's Vertex records; mesh() may replace it when it grows).
   GLuint vertex_buffer() const { return vertices_.id(); }
 

@@ -574,6 +574,10 @@ std::array<std::size_t, kMaxCascades> Renderer::cascade_pixel_counts() const {
 }
 
 Image Renderer::read_shadow_map() const { return impl_->shadow.read(); }
+
+std::vector<glm::vec3> Renderer::read_mesh_positions(MeshId id) const {
+  return impl_->cache->read_positions(id);
+}
 Image Renderer::read_lom_depths() const { return impl_->lom.read_depths(); }
 Image Renderer::read_lom_factors() const { return impl_->lom.read_factors(); }
 

@@ -81,6 +81,9 @@ class Renderer {
   /// Depth of the shadow map of the last frame (one channel, [0,1]), rows top to bottom; with
   /// cascades the layers are stacked top to bottom (cascade 0 first), map_size rows each.
   Image read_shadow_map() const;
+  /// The positions mesh `id` holds on the GPU now (a posed mesh: the deform pass's last pose);
+  /// empty when it was never uploaded. For tests that compare the GPU pose with the CPU's.
+  std::vector<glm::vec3> read_mesh_positions(MeshId id) const;
   /// Technique lom: the signed depths of every depth peel and the occlusion factors, stacked as
   /// read_shadow_map() (lom_layers + 1 slices per shadow-map layer; empty before the first).
   Image read_lom_depths() const;

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "components/animation.h"
 #include "components/camera.h"
 #include "components/light.h"
 #include "components/material.h"
@@ -265,10 +266,148 @@ TEST(GltfLoader, MilkTruckTexturesAreDecodedThroughOiio) {
     EXPECT_EQ(m.metallic, 0.0f);  // the file's metallicFactor
   });
   EXPECT_GE(textured, 1);
-  // The truck has an animation, which is reported, not imported.
-  bool warned = false;
-  for (const auto& w : s->report->warnings) warned |= w.find("animation") != std::string::npos;
-  EXPECT_TRUE(warned);
+  // The truck's wheels turn: its one animation is imported onto the model entity.
+  EXPECT_EQ(s->report->animations, 1);
+  ASSERT_TRUE(s->world.has<Animator>(s->root));
+  const Animator& a = s->world.get<Animator>(s->root);
+  ASSERT_EQ(a.clips.size(), 1u);
+  EXPECT_TRUE(a.clips[0].playing);
+  for (const auto& w : s->report->warnings) EXPECT_EQ(w.find("animation"), std::string::npos) << w;
+}
+
+TEST(GltfLoader, FoxImportsItsSkinAndThreeClips) {
+  auto s = import_file(content_path("models/Fox/glTF/Fox.gltf"));
+  ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+  for (const auto& w : s->report->warnings) EXPECT_EQ(w.find("skin"), std::string::npos) << w;
+  EXPECT_EQ(s->report->skins, 1);
+  EXPECT_EQ(s->report->animations, 3);
+  ASSERT_EQ(s->assets.skins.size(), 1u);
+  ASSERT_EQ(s->assets.skins[0].inverse_bind.size(), 24u);
+  int deformers = 0;
+  s->world.view<Deformer, MeshRenderer>().each([&](ecs::Entity, Deformer& d, MeshRenderer& mr) {
+    ++deformers;
+    EXPECT_EQ(d.skin, 0u);
+    ASSERT_EQ(d.joints.size(), 24u);
+    for (ecs::Entity j : d.joints) EXPECT_TRUE(s->world.has<Transform>(j));
+    const MeshDeform& m = s->assets.meshes[index(mr.mesh)].deform;
+    ASSERT_EQ(m.influences, 4);
+    const std::size_t n = s->assets.meshes[index(mr.mesh)].positions.size();
+    ASSERT_EQ(m.weights.size(), 4 * n);
+    for (std::size_t v = 0; v < n; ++v) {
+      const float sum = m.weights[4 * v] + m.weights[4 * v + 1] + m.weights[4 * v + 2] + m.weights[4 * v + 3];
+      ASSERT_NEAR(sum, 1.0f, 1e-5f) << v;
+    }
+  });
+  EXPECT_EQ(deformers, 1);
+  ASSERT_TRUE(s->world.has<Animator>(s->root));
+  const Animator& a = s->world.get<Animator>(s->root);
+  EXPECT_EQ(a.names, (std::vector<std::string>{"Survey", "Walk", "Run"}));
+  EXPECT_TRUE(a.clips[0].playing);
+  EXPECT_FALSE(a.clips[1].playing);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const AnimationClip& clip = s->assets.animations[a.first_clip + k];
+    EXPECT_GT(clip.duration, 0.5f) << clip.name;
+    EXPECT_GT(clip.channels.size(), 20u) << clip.name;
+    for (const auto& ch : clip.channels) EXPECT_TRUE(a.nodes[ch.node].valid());
+  }
+}
+
+/// triangle_gltf() with one morph target (vertex 1 moves +1 in y), mesh weights [0.25] and a
+/// STEP animation of the node's weights (0 at t = 0, 1 from t = 1).
+json morphed_triangle_gltf() {
+  json doc = triangle_gltf();
+  std::vector<std::uint8_t> extra;
+  append<float>(extra, {0, 0, 0, 0, 1, 0, 0, 0, 0});  // target POSITION (36 bytes)
+  append<float>(extra, {0, 1});                       // times (8 bytes)
+  append<float>(extra, {0, 1});                       // weights (8 bytes)
+  std::vector<std::uint8_t> buffer;
+  append<float>(buffer, {0, 0, 0, 1, 0, 0, 0, 1, 0});
+  append<std::uint16_t>(buffer, {0, 1, 2, 0});
+  buffer.insert(buffer.end(), extra.begin(), extra.end());
+  doc["buffers"][0] = {{"byteLength", buffer.size()},
+                       {"uri", "data:application/octet-stream;base64," + base64(buffer)}};
+  doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 44}, {"byteLength", 36}});
+  doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 80}, {"byteLength", 8}});
+  doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 88}, {"byteLength", 8}});
+  doc["accessors"].push_back({{"bufferView", 2}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"}});
+  doc["accessors"].push_back({{"bufferView", 3}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}});
+  doc["accessors"].push_back({{"bufferView", 4}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}});
+  doc["meshes"][0]["primitives"][0]["targets"] = {{{"POSITION", 2}}};
+  doc["meshes"][0]["weights"] = {0.25};
+  doc["animations"] = {{{"name", "open"},
+                        {"samplers", {{{"input", 3}, {"output", 4}, {"interpolation", "STEP"}}}},
+                        {"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "weights"}}}}}}}};
+  return doc;
+}
+
+TEST(GltfLoader, MorphTargetsAndTheirWeightsAnimation) {
+  auto s = import_file(write_gltf("morph.gltf", morphed_triangle_gltf()));
+  ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+  EXPECT_EQ(s->report->morphed, 1);
+  EXPECT_EQ(s->report->animations, 1);
+  const auto by_name = entities_by_name(s->world);
+  ASSERT_TRUE(by_name.count("tri"));
+  const ecs::Entity tri = by_name.at("tri");
+  ASSERT_TRUE(s->world.has<MorphWeights>(tri));
+  EXPECT_EQ(s->world.get<MorphWeights>(tri).weights, std::vector<float>{0.25f});
+  int deformers = 0;
+  s->world.view<Deformer, MeshRenderer>().each([&](ecs::Entity, Deformer& d, MeshRenderer& mr) {
+    ++deformers;
+    EXPECT_EQ(d.skin, Deformer::kNoSkin);
+    const MeshDeform& m = s->assets.meshes[index(mr.mesh)].deform;
+    ASSERT_EQ(m.targets.size(), 1u);
+    EXPECT_EQ(m.targets[0].positions[1], glm::vec3(0, 1, 0));
+    EXPECT_EQ(m.default_weights, std::vector<float>{0.25f});
+    // Flat normals were generated (the file has none): the target still follows its vertices.
+    EXPECT_EQ(m.targets[0].positions.size(), s->assets.meshes[index(mr.mesh)].positions.size());
+  });
+  EXPECT_EQ(deformers, 1);
+  const AnimationClip& clip = s->assets.animations.at(0);
+  ASSERT_EQ(clip.channels.size(), 1u);
+  EXPECT_EQ(clip.channels[0].path, AnimatedPath::weights);
+  EXPECT_EQ(clip.channels[0].tracks[0].interpolation, KeyInterpolation::step);
+  EXPECT_FLOAT_EQ(clip.duration, 1.0f);
+}
+
+TEST(GltfLoader, BadAnimationsAndMorphTargetsAreErrorsNamingThePlace) {
+  {
+    json doc = morphed_triangle_gltf();
+    doc["animations"][0]["samplers"][0]["interpolation"] = "SMOOTH";
+    auto s = import_file(write_gltf("bad_interp.gltf", doc));
+    ASSERT_FALSE(s->report.ok());
+    EXPECT_TRUE(mentions(s->report.error(), "animations[0] \"open\" samplers[0]")) << s->report.error().to_string();
+    EXPECT_TRUE(mentions(s->report.error(), "unknown interpolation 'SMOOTH'"));
+  }
+  {
+    json doc = morphed_triangle_gltf();
+    doc["animations"][0]["samplers"][0]["output"] = 2;  // the target's VEC3 accessor
+    auto s = import_file(write_gltf("bad_output.gltf", doc));
+    ASSERT_FALSE(s->report.ok());
+    EXPECT_TRUE(mentions(s->report.error(), "expected 1 components")) << s->report.error().to_string();
+  }
+  {
+    json doc = morphed_triangle_gltf();
+    doc["meshes"][0]["weights"] = {0.25, 0.5};
+    auto s = import_file(write_gltf("bad_weights.gltf", doc));
+    ASSERT_FALSE(s->report.ok());
+    EXPECT_TRUE(mentions(s->report.error(), "2 values for 1 morph targets")) << s->report.error().to_string();
+  }
+  {
+    json doc = morphed_triangle_gltf();
+    doc["animations"][0]["channels"][0]["target"]["node"] = 7;
+    auto s = import_file(write_gltf("bad_target.gltf", doc));
+    ASSERT_FALSE(s->report.ok());
+    EXPECT_TRUE(mentions(s->report.error(), "target node 7 out of range")) << s->report.error().to_string();
+  }
+  {
+    json doc = morphed_triangle_gltf();
+    doc["animations"][0]["channels"][0]["target"]["path"] = "pointer";
+    auto s = import_file(write_gltf("unknown_path.gltf", doc));
+    ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+    bool warned = false;
+    for (const auto& w : s->report->warnings) warned |= w.find("path 'pointer'") != std::string::npos;
+    EXPECT_TRUE(warned);
+  }
 }
 
 // ---- A file written by the test: lights, cameras, transforms, generated normals -------------

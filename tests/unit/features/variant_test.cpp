@@ -50,8 +50,10 @@ bool documented_rules_hold(VariantKey k) {
       V::kShadowKernel.mask() | V::kToneMapping.mask() | V::kOcclusionTexture.mask() |
       V::kEmissiveTexture.mask() | V::kTextureTransform.mask() | V::kShadowPeel.mask() |
       V::kReflectionPbr.mask() | V::kEnvironment.mask() |
-      V::kAlphaToCoverage.mask() | V::kMetallicRoughnessTexture.mask() | V::kShadowReuse.mask();
+      V::kAlphaToCoverage.mask() | V::kMetallicRoughnessTexture.mask() | V::kShadowReuse.mask() |
+      V::kSkin.mask() | V::kMorph.mask();
   if (k.bits() & ~used) return false;
+  if (k.get(V::kSkin) > 2) return false;             // none, 4 joints, 8 joints
   if (k.get(V::kToneMapping) > 2) return false;      // none, khr_pbr_neutral, aces
   if (k.get(V::kShadowFilter) > 2) return false;     // none, bilinear, pcf3x3
   // one per row of the technique table (components/shadow_technique.h)
@@ -75,9 +77,11 @@ bool documented_rules_hold(VariantKey k) {
 
 TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   const FeatureManifest m = manifest();
-  std::uint64_t material_used = 0, frame_used = 0;
+  std::uint64_t material_used = 0, frame_used = 0, deform_used = 0;
   for (const auto& f : m.features())
-    (f.kind == FeatureKind::material ? material_used : frame_used) |= f.field.mask();
+    (f.kind == FeatureKind::material ? material_used
+     : f.kind == FeatureKind::frame  ? frame_used
+                                     : deform_used) |= f.field.mask();
   int disagree = 0;
   // valid() (kFeatureTable's rules) agrees with the rules written out above, the manifest names
   // a broken rule exactly when valid() is false, and a valid key filters to itself for the
@@ -137,6 +141,18 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
     valid_materials += n > 0 ? 1 : 0;
     if (bits == material_used) break;
   }
+  // Deform keys (the deform pass's alone: no rule links them to the others): 3 skins x morph.
+  int valid_deforms = 0;
+  for (std::uint64_t bits = 0;; bits = ((bits | ~deform_used) + 1) & deform_used) {
+    const VariantKey k(bits);
+    if (check(k)) {
+      ++valid_deforms;
+      EXPECT_EQ(k.filtered_for(Pass::deform), k);
+      EXPECT_EQ((k | some_frames[1]).filtered_for(Pass::deform), k);
+    }
+    if (bits == deform_used) break;
+  }
+  EXPECT_EQ(valid_deforms, 6);
   EXPECT_EQ(disagree, 0);
   // Material keys: 2^7 free bits x 3 of the 4 emissive/emissive_texture combinations x 6 of the
   // 16 reflection cube/sphere/box/pbr combinations (none, sphere, cube with or without box and

@@ -1,0 +1,111 @@
+// Living content on the GPU: the deform pass's pose (content/shaders/deform.comp) against the
+// CPU's (runtime/assets/mesh_pose.h), the pose's bounds, and the shadow of an animated character
+// against the ray-traced reference at several times (the reference poses the mesh on the CPU).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+
+#include "components/animation.h"
+#include "components/light.h"
+#include "components/mesh_renderer.h"
+#include "components/transform.h"
+#include "runtime/app/player.h"
+#include "runtime/assets/mesh_pose.h"
+#include "runtime/reference/ray_tracer.h"
+#include "runtime/reference/shadow_metrics.h"
+#include "systems/animation_system.h"
+#include "tests/render/player_fixture.h"
+
+namespace kaskad {
+namespace {
+
+class DeformTest : public PlayerTest {};
+
+const std::filesystem::path kFoxScene = std::filesystem::path(KASKAD_CONTENT_DIR) / "scenes/fox_walk.json";
+
+struct Posed {
+  ecs::Entity entity;
+  const Deformer* deformer = nullptr;
+  MeshId mesh = kNoMesh;
+};
+
+Posed fox_mesh(Scene& scene) {
+  Posed p;
+  scene.world.view<Deformer, MeshRenderer>().each([&](ecs::Entity e, Deformer& d, MeshRenderer& mr) {
+    p = {e, &d, mr.mesh};
+  });
+  return p;
+}
+
+TEST_F(DeformTest, GpuPoseMatchesTheCpuPoseAndStaysInItsBounds) {
+  auto scene = load_scene(kFoxScene, {"render.width=320", "render.height=180"});
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  float moved = 0.0f;
+  std::vector<glm::vec3> first;
+  for (float t : {0.0f, 0.37f, 0.81f}) {
+    SCOPED_TRACE("t = " + std::to_string(t));
+    set_animation_time(scene->world, scene->assets, t);
+    RenderRun run;
+    auto frames = render_frames(*player_, *scene, run);
+    ASSERT_TRUE(frames.ok()) << frames.error().to_string();
+    EXPECT_EQ(frames->last.stats.deformed_meshes, 1);
+    const Posed p = fox_mesh(*scene);
+    ASSERT_NE(p.deformer, nullptr);
+    ASSERT_NE(p.deformer->posed, kNoMesh);
+    const std::vector<glm::vec3> gpu = player_->renderer->read_mesh_positions(p.deformer->posed);
+    const MeshData& base = scene->assets.meshes[index(p.mesh)];
+    ASSERT_EQ(gpu.size(), base.positions.size());
+    MeshData cpu = base;
+    pose_mesh(base, p.deformer->weights, p.deformer->skin_matrices, cpu);
+    const Aabb bounds = scene->world.get<WorldBounds>(p.entity).box;
+    const float size = glm::length(bounds.extent());
+    ASSERT_GT(size, 0.1f);
+    float worst = 0.0f;
+    for (std::size_t v = 0; v < gpu.size(); ++v) {
+      worst = std::max(worst, glm::length(gpu[v] - cpu.positions[v]));
+      // Bounds hold the pose (a thousandth of the size for rounding).
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_GE(gpu[v][c], bounds.min[c] - 1e-3f * size) << v;
+        EXPECT_LE(gpu[v][c], bounds.max[c] + 1e-3f * size) << v;
+      }
+    }
+    EXPECT_LT(worst, 1e-5f * size) << "GPU and CPU poses differ by " << worst << " m";
+    if (first.empty()) first = gpu;
+    else
+      for (std::size_t v = 0; v < gpu.size(); ++v) moved = std::max(moved, glm::length(gpu[v] - first[v]));
+  }
+  // The clip moves the fox: a pose that never changed would pass the comparisons above.
+  EXPECT_GT(moved, 0.05f);
+}
+
+TEST_F(DeformTest, AnimatedShadowAgreesWithTheReferenceAtSeveralTimes) {
+  auto scene = load_scene(kFoxScene, {"render.width=400", "render.height=225"});
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  for (float t : {0.1f, 0.45f, 0.9f}) {
+    SCOPED_TRACE("t = " + std::to_string(t));
+    set_animation_time(scene->world, scene->assets, t);
+    RenderRun run;
+    auto frames = render_frames(*player_, *scene, run);
+    ASSERT_TRUE(frames.ok()) << frames.error().to_string();
+    const Image aov = player_->renderer->read_aovs();
+    const ecs::Entity light = frames->last.shadow().light;
+    ASSERT_TRUE(light.valid());
+    auto tracer = reference::RayTracer::build(*scene);
+    ASSERT_TRUE(tracer.ok()) << tracer.error().to_string();
+    const auto rlight = reference::reference_light(scene->world.get<Light>(light),
+                                                   scene->world.get<WorldTransform>(light).matrix);
+    auto ref = tracer->shadow_reference(aov, rlight, {});
+    ASSERT_TRUE(ref.ok()) << ref.error().to_string();
+    auto m = reference::compare_shadows(aov, ref->image);
+    ASSERT_TRUE(m.ok()) << m.error().to_string();
+    const auto& s = m->outside_edges;
+    std::printf("fox_walk t=%.2f: %zu of %zu misclassified away from edges (%.3f%%)\n", t,
+                s.misclassified, s.pixels, s.misclassified_pct);
+    EXPECT_GT(s.pixels, 10000u);
+    EXPECT_LT(s.misclassified_pct, 0.5);
+  }
+}
+
+}  // namespace
+}  // namespace kaskad
