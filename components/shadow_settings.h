@@ -16,9 +16,42 @@
 
 namespace kaskad {
 
+/// The faces of single-sided casters that a light's shadow leaves out (ShadowSettings::cull);
+/// caster_face_blocks() is the whole rule.
 enum class CullMode { back, front, none };
 constexpr std::array<std::string_view, 3> enum_names(CullMode) { return {"back", "front", "none"}; }
 static_assert(enum_names(CullMode{}).size() == std::size_t(CullMode::none) + 1);
+
+/// The faces the shadow pass culls for a caster whose material has Material::double_sided =
+/// `double_sided`, under a light with ShadowSettings::cull = `cull`: none for double-sided
+/// materials (glTF 2.0 "Double Sided": back-face culling is disabled), else the light's.
+constexpr CullMode caster_cull(CullMode cull, bool double_sided) {
+  return double_sided ? CullMode::none : cull;
+}
+
+/// Which caster faces block a light, the one rule of the shadow pass (depth_draws.cpp: GL face
+/// culling by caster_cull()) and of the ray-traced references (ray_tracer.cpp: an occlusion
+/// filter) (docs/guide/scenes.md, "Which faces cast shadows"):
+///   A triangle of a double-sided material blocks the light with both faces. A triangle of a
+///   single-sided material blocks it only with its front face when the light's cull is back
+///   (the default), only with its back face when cull is front, and with both when cull is
+///   none. The front face is the one whose vertices wind counter-clockwise as authored, after
+///   the world transform: a mirroring transform (negative determinant) swaps the faces (glTF
+///   2.0 "Transformations"). A face faces the light when the light lies on the side of the
+///   triangle's plane its normal points to: its normal points against a directional light's
+///   direction, or towards a spot or point light's position. For a light with a size, the
+///   shadow map (drawn from the light's centre) decides by the centre and the reference by each
+///   point of the emitter it samples: the same for closed meshes, different only for open
+///   single-sided faces nearly edge-on to the light.
+/// `front_faces_light`: whether the triangle's front face faces the light.
+constexpr bool caster_face_blocks(CullMode cull, bool double_sided, bool front_faces_light) {
+  switch (caster_cull(cull, double_sided)) {
+    case CullMode::back: return front_faces_light;
+    case CullMode::front: return !front_faces_light;
+    case CullMode::none: break;
+  }
+  return true;
+}
 /// none: one hardware-compared tap (nearest); bilinear: one tap with GL_LINEAR compare
 /// (hardware 2x2 PCF); pcf3x3: average of a 3x3 neighbourhood of compares (S4).
 enum class ShadowFilter { none, bilinear, pcf3x3 };
@@ -157,8 +190,11 @@ struct ShadowSettings {
                                   ///< where depth changes by up to 1.5 (|dz/dx| + |dz/dy|), at most
                                   ///< 3x the max slope that glPolygonOffset scales by; 2 leaves acne
                                   ///< rings on the default scene's ground plane
-  CullMode cull = CullMode::back; ///< back is the default for the shadow pass (S2); front reduces
-                                  ///< acne but loses single-sided casters (S4, S2)
+  /// Faces of single-sided casters left out of this light's shadow (caster_face_blocks(), the
+  /// shadow pass and the references alike; double-sided materials cast from both faces). back
+  /// is the default for the shadow pass (S2); front reduces acne but loses single-sided casters
+  /// that face the light, such as planes and open meshes (S4, S2); none casts from both faces.
+  CullMode cull = CullMode::back;
   ShadowFilter filter = ShadowFilter::pcf3x3;  ///< S4's 3x3 PCF by default
   /// pcf: today's hard-edged PCF (the default); pcss: soft shadows from the light's size.
   ShadowTechnique technique = ShadowTechnique::pcf;
@@ -263,7 +299,8 @@ constexpr auto field_table(fields::Of<ShadowSettings>) {
              "Depth bias in glPolygonOffset units (multiples of the depth resolution)"),
       number("slope_bias", &S::slope_bias, 0, 100,
              "Depth bias scaled by the depth slope (glPolygonOffset factor)"),
-      choice("cull", &S::cull, "Faces the shadow pass culls (back loses no single-sided caster)"),
+      choice("cull", &S::cull,
+             "Faces of single-sided casters that cast no shadow (shadow pass and references)"),
       choice("filter", &S::filter, "Depth compares per lookup: one, hardware 2x2, or a kernel",
              kShared),
       choice("technique", &S::technique, "How visibility is estimated from the map", kShared),

@@ -53,4 +53,11 @@ struct WorldTransform {
   glm::mat4 matrix{1.0f};
 };
 
+/// Whether `model` mirrors (negative determinant): its triangles wind the other way, so the
+/// front face is the clockwise one (glTF 2.0, "Transformations"). The passes flip glFrontFace
+/// for such draws; the ray-traced reference reverses their triangles' normals.
+inline bool mirrors(const glm::mat4& model) {
+  return glm::determinant(glm::mat3(model)) < 0.0f;
+}
+
 }  // namespace kaskad

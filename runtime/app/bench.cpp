@@ -436,8 +436,7 @@ Status run_bench(const BenchOptions& options) {
           tracer.emplace(std::move(built.value()));
           tracer_signature = signature;
         }
-        const auto rlight = reference::reference_light(scene->world.get<Light>(light),
-                                                       scene->world.get<WorldTransform>(light).matrix);
+        const auto rlight = reference::reference_light(scene->world, light);
         auto ref = tracer->shadow_reference(aov, rlight, {});
         if (!ref) {
           result = ref.error();

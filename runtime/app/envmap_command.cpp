@@ -99,8 +99,7 @@ Status write_shadow_reference(const Scene& scene, const Image& aov, ecs::Entity 
                               const std::string& out) {
   auto tracer = reference::RayTracer::build(scene);
   if (!tracer) return tracer.error();
-  const auto rlight = reference::reference_light(scene.world.get<Light>(light),
-                                                 scene.world.get<WorldTransform>(light).matrix);
+  const auto rlight = reference::reference_light(scene.world, light);
   auto ref = tracer->shadow_reference(aov, rlight, {});
   if (!ref) return ref.error();
   auto metrics = reference::compare_shadows(aov, ref->image);

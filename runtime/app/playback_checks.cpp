@@ -75,8 +75,7 @@ Result<double> check_misclassified(const Playback& pb, int f, const Scene& scene
   // The light whose visibility the AOV shows.
   const ecs::Entity shown =
       report.shadows[std::size_t(aov_shadow_index(scene, report.shadows.size()))].light;
-  const auto light = reference::reference_light(scene.world.get<Light>(shown),
-                                                scene.world.get<WorldTransform>(shown).matrix);
+  const auto light = reference::reference_light(scene.world, shown);
   auto ref = tracer->shadow_reference(aov, light, {});
   if (!ref) return ref.error();
   auto m = reference::compare_shadows(aov, ref->image);

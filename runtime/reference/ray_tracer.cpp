@@ -1,7 +1,8 @@
 // The Embree reference tracer. Procedure of a shadow reference (shadow_reference):
 //   1. build: every MeshRenderer's triangles, transformed to world space on the CPU (the same
 //      WorldTransform the renderer uploads), into one Embree triangle geometry per entity; casters
-//      are attached to the occluder scene, every geometry to the surface scene;
+//      are attached to the occluder scene, every geometry to the surface scene; single-sided and
+//      alpha-masked geometries get an occlusion filter (caster_face_blocks(), the cut-out);
 //   2. per AOV pixel: the rasterised position P and normal N, the origin P + offset * N;
 //   3. punctual lights: one shadow ray, traced 16 at a time (rtcOccluded16) along an image row;
 //      area lights: sqrt(M) x sqrt(M) jittered strata over the emitter, 16 samples per packet;
@@ -17,15 +18,19 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <memory>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "components/animation.h"
 #include "components/material.h"
 #include "components/mesh_renderer.h"
+#include "components/shadow_settings.h"
 #include "components/transform.h"
 #include "runtime/assets/mesh_pose.h"
 #include "runtime/reference/row_workers.h"
@@ -75,13 +80,60 @@ struct AlphaCutout {
   }
 };
 
-/// Embree filter function (intersection and occlusion): rejects hits in the cut-out.
-void alpha_cutout_filter(const RTCFilterFunctionNArguments* args) {
-  const auto* cutout = static_cast<const AlphaCutout*>(args->geometryUserPtr);
+/// What the filter functions need to know of one geometry (its Embree user data).
+struct GeometryRules {
+  bool double_sided = false;  // Material::double_sided
+  bool mirrored = false;      // the world transform mirrors: front faces wind clockwise
+  std::optional<AlphaCutout> cutout;
+};
+
+/// The context of every occlusion query on the occluder scene: the cull of the light its rays
+/// go to, for caster_face_blocks() in occlusion_filter(). Embree hands filters the pointer to
+/// `embree`, the first member (standard layout, so the pointer is the context's).
+struct ShadowContext {
+  RTCIntersectContext embree;
+  CullMode cull = CullMode::back;
+};
+static_assert(std::is_standard_layout_v<ShadowContext>);
+
+/// Whether the hit of ray i of a filter call is on a front face that faces the light. Every
+/// shadow ray runs from a receiver towards the light (or towards its sample of an area light),
+/// so the light lies on the side of the triangle's plane the ray leaves it to: the face faces
+/// the light when its normal points along the ray. The front face's normal is Embree's
+/// geometric normal Ng = (v1 - v0) x (v2 - v0) of the world-space triangle (counter-clockwise),
+/// reversed for mirroring transforms.
+bool front_faces_light(const RTCFilterFunctionNArguments* args, unsigned i,
+                       const GeometryRules& g) {
+  const unsigned n = args->N;
+  const glm::vec3 ng{RTCHitN_Ng_x(args->hit, n, i), RTCHitN_Ng_y(args->hit, n, i),
+                     RTCHitN_Ng_z(args->hit, n, i)};
+  const glm::vec3 d{RTCRayN_dir_x(args->ray, n, i), RTCRayN_dir_y(args->ray, n, i),
+                    RTCRayN_dir_z(args->ray, n, i)};
+  return (glm::dot(ng, d) > 0.0f) != g.mirrored;
+}
+
+/// Embree occlusion filter: rejects hits on faces that do not block the light
+/// (caster_face_blocks()) and hits in the alpha cut-out.
+void occlusion_filter(const RTCFilterFunctionNArguments* args) {
+  const auto& g = *static_cast<const GeometryRules*>(args->geometryUserPtr);
+  const auto& c = *reinterpret_cast<const ShadowContext*>(args->context);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
-    if (cutout->cut(RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i),
-                    RTCHitN_v(args->hit, args->N, i)))
+    if (!caster_face_blocks(c.cull, g.double_sided, front_faces_light(args, i, g)) ||
+        (g.cutout && g.cutout->cut(RTCHitN_primID(args->hit, args->N, i),
+                                   RTCHitN_u(args->hit, args->N, i),
+                                   RTCHitN_v(args->hit, args->N, i))))
+      args->valid[i] = 0;
+  }
+}
+
+/// Embree intersection filter (mirror rays, receiver look-ups): rejects hits in the cut-out.
+void alpha_cutout_filter(const RTCFilterFunctionNArguments* args) {
+  const AlphaCutout& cutout = *static_cast<const GeometryRules*>(args->geometryUserPtr)->cutout;
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    if (cutout.cut(RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i),
+                   RTCHitN_v(args->hit, args->N, i)))
       args->valid[i] = 0;
   }
 }
@@ -110,7 +162,7 @@ struct RayTracer::Impl {
   std::size_t surface_triangles = 0;
 
   ErrorLog errors;  // filled by Embree's error callback
-  std::vector<std::unique_ptr<AlphaCutout>> cutouts;  // user data of alpha-masked geometries
+  std::vector<std::unique_ptr<GeometryRules>> rules;  // user data of filtered geometries
   std::size_t cutout_geometries = 0;
 
   Impl() = default;
@@ -236,11 +288,19 @@ struct ShadowRay {
   float tmax;
 };
 
-/// occluded[i] (0 or 1) for each ray, traced in packets of 16 (rtcOccluded16). Rays must be valid
-/// (finite, tmax > 0): Embree is built without its invalid-ray filter.
-void trace_occluded(RTCScene scene, std::span<const ShadowRay> rays, std::uint8_t* occluded) {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+/// The occlusion context of rays towards `light`.
+ShadowContext shadow_context(const ReferenceLight& light) {
+  ShadowContext c;
+  rtcInitIntersectContext(&c.embree);
+  c.cull = light.cull;
+  return c;
+}
+
+/// occluded[i] (0 or 1) for each ray towards `light`, traced in packets of 16 (rtcOccluded16).
+/// Rays must be valid (finite, tmax > 0): Embree is built without its invalid-ray filter.
+void trace_occluded(RTCScene scene, const ReferenceLight& light, std::span<const ShadowRay> rays,
+                    std::uint8_t* occluded) {
+  ShadowContext context = shadow_context(light);
   for (std::size_t first = 0; first < rays.size(); first += kPacket) {
     const int n = int(std::min<std::size_t>(kPacket, rays.size() - first));
     alignas(64) int valid[kPacket];
@@ -261,7 +321,7 @@ void trace_occluded(RTCScene scene, std::span<const ShadowRay> rays, std::uint8_
       packet.id[i] = unsigned(i);
       packet.flags[i] = 0;
     }
-    rtcOccluded16(valid, scene, &context, &packet);
+    rtcOccluded16(valid, scene, &context.embree, &packet);
     // Embree sets tfar to -inf for occluded rays.
     for (int i = 0; i < n; ++i) occluded[first + std::size_t(i)] = packet.tfar[i] < 0.0f ? 1 : 0;
   }
@@ -331,13 +391,32 @@ bool hard_shadow_ray(const glm::vec3& position, const glm::vec3& n, const Refere
   return true;
 }
 
+/// Whether an occluder blocks origin + t * direction, 0 < t < tmax, towards `light` (prepared()).
+bool occluded_towards(RTCScene occluders, const ReferenceLight& light, const glm::vec3& origin,
+                      const glm::vec3& direction, float tmax) {
+  ShadowContext context = shadow_context(light);
+  RTCRay ray{};
+  ray.org_x = origin.x;
+  ray.org_y = origin.y;
+  ray.org_z = origin.z;
+  ray.dir_x = direction.x;
+  ray.dir_y = direction.y;
+  ray.dir_z = direction.z;
+  ray.tnear = 0.0f;
+  ray.tfar = tmax;
+  ray.mask = 0xffffffffu;
+  rtcOccluded1(occluders, &context.embree, &ray);
+  return ray.tfar < 0.0f;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
 
-ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix) {
+ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix, CullMode cull) {
   ReferenceLight r;
   r.type = light.type;
+  r.cull = cull;
   r.position = glm::vec3(world_matrix[3]);
   r.direction = light_direction(world_matrix);
   r.right = perpendicular(r.direction, glm::vec3(world_matrix[0]));
@@ -352,6 +431,13 @@ ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix
     r.height = light.size.y;
   }
   return r;
+}
+
+ReferenceLight reference_light(const ecs::World& world, ecs::Entity light) {
+  // No ShadowSettings: the defaults, as the shadow systems use them.
+  const auto* settings = world.try_get<ShadowSettings>(light);
+  return reference_light(world.get<Light>(light), world.get<WorldTransform>(light).matrix,
+                         settings ? settings->cull : ShadowSettings{}.cull);
 }
 
 RayTracer::RayTracer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -473,8 +559,13 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
       vertices[3 * i + 2] = p.z;
     }
     std::copy(kept.begin(), kept.end(), indices);
+    // Filters: caster_face_blocks() for single-sided materials (none means the default Material,
+    // as the renderer draws it), the cut-out of alpha-masked ones.
+    auto rules = std::make_unique<GeometryRules>();
+    rules->double_sided = item.material && item.material->double_sided;
+    rules->mirrored = mirrors(item.matrix);
     if (item.material && item.material->alpha_mask && mesh.uvs.size() == mesh.positions.size()) {
-      auto cutout = std::make_unique<AlphaCutout>();
+      AlphaCutout* cutout = &rules->cutout.emplace();
       cutout->uvs = mesh.uvs;
       cutout->indices = kept;
       cutout->factor = item.material->base_color.a;
@@ -490,11 +581,13 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
           for (std::size_t i = 0; i < cutout->alpha.size(); ++i) cutout->alpha[i] = t.rgba8[i * 4 + 3];
         }
       }
-      rtcSetGeometryUserData(geometry, cutout.get());
       rtcSetGeometryIntersectFilterFunction(geometry, alpha_cutout_filter);
-      rtcSetGeometryOccludedFilterFunction(geometry, alpha_cutout_filter);
-      impl->cutouts.push_back(std::move(cutout));
       ++impl->cutout_geometries;
+    }
+    if (!rules->double_sided || rules->cutout) {
+      rtcSetGeometryUserData(geometry, rules.get());
+      rtcSetGeometryOccludedFilterFunction(geometry, occlusion_filter);
+      impl->rules.push_back(std::move(rules));
     }
     rtcCommitGeometry(geometry);
     const unsigned id = rtcAttachGeometry(impl->surfaces, geometry);
@@ -531,26 +624,16 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
   return RayTracer(std::move(impl));
 }
 
-bool RayTracer::occluded(const glm::vec3& origin, const glm::vec3& direction, float tmax) const {
+bool RayTracer::occluded(const glm::vec3& origin, const glm::vec3& direction, float tmax,
+                         CullMode cull) const {
   KASKAD_CHECK(impl_, "RayTracer used after being moved from");
   if (!finite(origin) || !finite(direction) || glm::dot(direction, direction) == 0.0f ||
       !(tmax > 0.0f)) {
     return false;
   }
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  RTCRay ray{};
-  ray.org_x = origin.x;
-  ray.org_y = origin.y;
-  ray.org_z = origin.z;
-  ray.dir_x = direction.x;
-  ray.dir_y = direction.y;
-  ray.dir_z = direction.z;
-  ray.tnear = 0.0f;
-  ray.tfar = tmax;
-  ray.mask = 0xffffffffu;
-  rtcOccluded1(impl_->occluders, &context, &ray);
-  return ray.tfar < 0.0f;
+  ReferenceLight light;
+  light.cull = cull;
+  return occluded_towards(impl_->occluders, light, origin, direction, tmax);
 }
 
 std::optional<SurfaceHit> RayTracer::intersect(const glm::vec3& origin, const glm::vec3& direction,
@@ -588,9 +671,9 @@ float RayTracer::hard_visibility(const glm::vec3& position, const glm::vec3& n,
   KASKAD_CHECK(impl_, "RayTracer used after being moved from");
   ShadowRay ray;
   bool lit = false;
-  if (!hard_shadow_ray(position, n, prepared(light), impl_->offset, ray, lit))
-    return lit ? 1.0f : 0.0f;
-  return occluded(ray.origin, ray.direction, ray.tmax) ? 0.0f : 1.0f;
+  const ReferenceLight l = prepared(light);
+  if (!hard_shadow_ray(position, n, l, impl_->offset, ray, lit)) return lit ? 1.0f : 0.0f;
+  return occluded_towards(impl_->occluders, l, ray.origin, ray.direction, ray.tmax) ? 0.0f : 1.0f;
 }
 
 namespace {
@@ -616,7 +699,7 @@ float area_visibility(RTCScene occluders, float offset, const glm::vec3& positio
   int pending = 0;
   int visible = 0;
   auto flush = [&] {
-    trace_occluded(occluders, std::span(batch.data(), std::size_t(pending)), hit.data());
+    trace_occluded(occluders, light, std::span(batch.data(), std::size_t(pending)), hit.data());
     for (int i = 0; i < pending; ++i) visible += hit[std::size_t(i)] ? 0 : 1;
     rays += std::uint64_t(pending);
     pending = 0;
@@ -797,7 +880,7 @@ Result<ShadowReference> RayTracer::shadow_reference(const Image& aov,
     }
     if (!rays.empty()) {
       occluded.resize(rays.size());
-      trace_occluded(im.occluders, rays, occluded.data());
+      trace_occluded(im.occluders, light, rays, occluded.data());
       for (std::size_t i = 0; i < rays.size(); ++i)
         out.image.at(ray_x[i], y, 0) = occluded[i] ? 0.0f : 1.0f;
       count += rays.size();

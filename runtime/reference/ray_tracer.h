@@ -16,6 +16,7 @@
 
 #include "components/bounds.h"
 #include "components/light.h"
+#include "components/shadow_settings.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/assets/scene.h"
 #include "runtime/result/result.h"
@@ -45,6 +46,9 @@ struct ReferenceLight {
   float angular_size_deg = 0.0f;
   float outer_cone_deg = 180.0f;  ///< spot: no light outside this half-angle (degrees)
   float range = 0.0f;             ///< spot/point: no light beyond this distance; 0 = infinite
+  /// The faces of single-sided occluders that do not block this light, as in its shadow pass
+  /// (ShadowSettings::cull; the rule is caster_face_blocks(), components/shadow_settings.h).
+  CullMode cull = CullMode::back;
 
   /// True when visibility is a fraction (Monte Carlo over the emitter), not a single ray.
   bool is_area() const {
@@ -57,8 +61,12 @@ struct ReferenceLight {
 /// from its +X, position from its translation; a directional light's angular_size_deg from the
 /// component (an area light when > 0); a spot or point light's size = 2 Light::radius (a square
 /// emitter of side 2 radius; punctual when the radius is 0); an area light's size and height
-/// its Light::size, and its cone outer_cone_deg.
-ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix);
+/// its Light::size, and its cone outer_cone_deg; `cull` its ShadowSettings::cull.
+ReferenceLight reference_light(const Light& light, const glm::mat4& world_matrix,
+                               CullMode cull = CullMode::back);
+/// The reference light of light entity `light` of `world` (Light, WorldTransform, and its
+/// ShadowSettings' cull, the defaults' without one): what the references compare a shadow with.
+ReferenceLight reference_light(const ecs::World& world, ecs::Entity light);
 
 /// The first surface a ray hits.
 struct SurfaceHit {
@@ -105,8 +113,11 @@ struct ShadowReference {
 };
 
 /// Owns an Embree device and two scenes built from a Scene's MeshRenderers: the occluders
-/// (cast_shadows = true) and every surface (for mirror rays and receiver look-ups). Alpha-masked
-/// materials (glTF MASK) cut holes where the rasteriser discards (alpha_masked_geometries()).
+/// (cast_shadows = true) and every surface (for mirror rays and receiver look-ups). Occluders
+/// block a light with the faces caster_face_blocks() says, for the light's cull
+/// (ReferenceLight::cull): the shadow pass's rule, Material::double_sided and mirroring world
+/// transforms included. Alpha-masked materials (glTF MASK) cut holes where the rasteriser
+/// discards (alpha_masked_geometries()).
 /// Triangles are transformed to world space when built; later changes to the Scene are not seen.
 /// Move-only.
 /// Thread safety: all const member functions may be called from any number of threads at once.
@@ -126,9 +137,11 @@ class RayTracer {
   ~RayTracer();
 
   /// Whether an occluder lies on the ray origin + t * direction, 0 < t < tmax (t in units of
-  /// direction's length). The origin is used as given: offset it off its surface first. Rays
-  /// with non-finite or zero direction, or tmax <= 0, are never occluded.
-  bool occluded(const glm::vec3& origin, const glm::vec3& direction, float tmax) const;
+  /// direction's length), the ray a shadow ray towards a light farther along it whose cull is
+  /// `cull` (caster_face_blocks()). The origin is used as given: offset it off its surface
+  /// first. Rays with non-finite or zero direction, or tmax <= 0, are never occluded.
+  bool occluded(const glm::vec3& origin, const glm::vec3& direction, float tmax,
+                CullMode cull = CullMode::back) const;
 
   /// First surface (any MeshRenderer, caster or not) hit by origin + t * direction,
   /// 0 < t < tmax; direction need not be unit (distance is still in metres).

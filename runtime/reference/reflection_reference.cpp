@@ -111,10 +111,11 @@ ReflectionScene reflection_scene(const Scene& scene, const CubeMap* environment)
   out.environment = environment;
   // The same light_shading() as the renderer's lights (systems/frame.cpp).
   scene.world.view<Light, WorldTransform>().each(
-      [&](ecs::Entity, const Light& l, const WorldTransform& wt) {
+      [&](ecs::Entity e, const Light& l, const WorldTransform& wt) {
         ShadingLight s;
         static_cast<LightShading&>(s) = light_shading(l, wt.matrix);
         s.shadowed = l.cast_shadows;
+        s.cull = reference_light(scene.world, e).cull;
         out.lights.push_back(s);
       });
   return out;
@@ -166,6 +167,7 @@ glm::vec3 shade_point(const RayTracer& tracer, const ReflectionScene& scene,
       ref.type = light.type;
       ref.position = light.position;
       ref.direction = dir;
+      ref.cull = light.cull;
       shadow = tracer.hard_visibility(position, n, ref);
       if (rays) ++*rays;
     }

@@ -38,6 +38,9 @@ namespace kaskad::reference {
 /// the reference traces its shadow.
 struct ShadingLight : LightShading {
   bool shadowed = false;  ///< trace a hard shadow ray (Light::cast_shadows)
+  /// The faces of single-sided occluders that do not block its shadow ray: its
+  /// ShadowSettings::cull, as in the shadow pass (caster_face_blocks()).
+  CullMode cull = CullMode::back;
 };
 
 /// Everything the reference needs besides the geometry.

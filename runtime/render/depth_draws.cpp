@@ -49,13 +49,27 @@ std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list
       records);
 }
 
-void set_depth_state(const ShadowView& v) {
-  if (v.cull == CullMode::none) {
+namespace {
+
+// GL's face culling for `cull`: the faces caster_face_blocks() says do not block are not drawn.
+// GL's front faces are the counter-clockwise ones in the map (glFrontFace per batch turns that
+// round for mirroring transforms), which are the faces that face the light: every view looks
+// from the light through a right-handed look-at and a projection that keeps x and y the right
+// way round (cascades, spot maps, cube faces and the paraboloid hemispheres, whose second view
+// is a rotation: local_light_math.h).
+void set_cull(CullMode cull) {
+  if (cull == CullMode::none) {
     glDisable(GL_CULL_FACE);
   } else {
     glEnable(GL_CULL_FACE);
-    glCullFace(v.cull == CullMode::front ? GL_FRONT : GL_BACK);
+    glCullFace(cull == CullMode::front ? GL_FRONT : GL_BACK);
   }
+}
+
+}  // namespace
+
+void set_depth_state(const ShadowView& v) {
+  set_cull(v.cull);
   glPolygonOffset(v.slope_bias, v.constant_bias);
   // Paraboloid hemispheres end at a clip distance (shadow_depth.vert).
   if (v.projection == ShadowProjection::dual_paraboloid) {
@@ -95,10 +109,12 @@ Status draw_runs(const FrameInput& frame, const DrawList& list, GpuCache& cache,
                                 &v.view_proj[0][0][0]);
     }
     glFrontFace(run.mirrored ? GL_CW : GL_CCW);
+    set_cull(caster_cull(v.cull, d.material.double_sided));  // a batch shares it (depth_runs())
     draw_batch(frame, cache, batch, stats.shadow_draw_calls, stats.shadow_mesh_draws);
     first = end;
   }
   glFrontFace(GL_CCW);
+  set_cull(v.cull);
   return {};
 }
 

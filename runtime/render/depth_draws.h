@@ -23,13 +23,13 @@ std::uint32_t caster_mask(const ShadowView& v, const DrawItem& d);
 
 /// Casters of one shadow view drawn by one instanced draw: draw list entry `draw` gives the
 /// mesh, program and material; records first .. first + count - 1 the instances. Consecutive
-/// runs with the same program, material (where it reads one) and winding are one batch (one
-/// multi-draw).
+/// runs with the same program, material (where it reads one), winding and face culling
+/// (caster_cull(): double-sided materials cast from both faces) are one batch (one multi-draw).
 struct CasterRun {
   std::uint32_t draw;
   std::size_t first, count;
   bool mirrored;      ///< the casters' transforms mirror (negative determinant): reversed winding
-  bool starts_batch;  ///< its program, material or winding differs from the run before's
+  bool starts_batch;  ///< its program, material, winding or culling differs from the run before's
 };
 
 /// The depth program's key of draw i in view `view`; `peel`: a LomPass depth peel (one layer per
@@ -50,6 +50,8 @@ std::vector<CasterRun> depth_runs(const FrameInput& frame, const DrawList& list,
     const DrawItem& a = frame.draws[i];
     const DrawItem& b = frame.draws[j];
     if (mirrors(a.model) != mirrors(b.model) ||
+        caster_cull(v.cull, a.material.double_sided) !=
+            caster_cull(v.cull, b.material.double_sided) ||
         depth_program_key(list, view, i, peel).filtered_for(Pass::depth) !=
             depth_program_key(list, view, j, peel).filtered_for(Pass::depth))
       return false;
@@ -85,7 +87,8 @@ std::vector<CasterRun> caster_runs(const FrameInput& frame, const DrawList& list
                                    const glm::mat4* light_vp = nullptr,
                                    const glm::vec4* rect = nullptr, int* rect_culled = nullptr);
 
-/// Culling, polygon offset and clipping of view `v`'s depth pass.
+/// Culling (the view's; draw_runs() sets each batch's caster_cull()), polygon offset and
+/// clipping of view `v`'s depth pass.
 void set_depth_state(const ShadowView& v);
 
 /// Records instanced depth draws of `runs` of view `view` (their records uploaded first);

@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "components/shadow_technique.h"
+#include "components/transform.h"
 #include "runtime/render/frame_input.h"
 #include "runtime/features/variant_key.h"
 
@@ -45,12 +46,7 @@ VariantKey material_variant(const DrawItem& draw);
 /// (the costliest binds), then the factors. Materials that compare equal (operator==) are
 /// neither before the other.
 bool material_sorts_before(const Material& a, const Material& b);
-/// Whether `model` mirrors (negative determinant): its triangles wind the other way on screen, so
-/// the front face is the clockwise one (glTF 2.0, "Transformations"). Draws that mirror and draws
-/// that do not are never one call.
-inline bool mirrors(const glm::mat4& model) {
-  return glm::determinant(glm::mat3(model)) < 0.0f;
-}
+// mirrors(): components/transform.h. Draws that mirror and draws that do not are never one call.
 
 /// Every (pass, key) a frame draws with, sorted and unique: what prewarm compiles and what
 /// `kaskad variants` lists. Pure: no GL.

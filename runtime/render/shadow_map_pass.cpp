@@ -134,13 +134,15 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   ensure_storage(map.map_size, total, map.depth_format, map.filter);
 
   // A layer's inputs: its matrix (and paraboloid data), bias and culling, pass mode, and the
-  // casters (mesh, model matrix, pose, depth program, alpha-mask parameters) in order. A moved caster
+  // casters (mesh, model matrix, pose, depth program, double-sidedness, alpha-mask parameters)
+  // in order. A moved caster
   // changes its matrix, a moved camera the layer's matrix or casters; other assets (another
   // scene) change assets.uid. New storage invalidated every layer.
   auto add_caster = [&](Hash& h, std::size_t view, std::uint32_t i) {
     const DrawItem& d = frame.draws[i];
     const VariantKey key = list.depth_key(view, i);
     h.add(d.mesh).add(d.model).add(d.pose).add(key.filtered_for(Pass::depth).bits());
+    h.add(d.material.double_sided);  // its faces culled (caster_cull())
     if (key.has(VariantKey::kAlphaMask) || features_by_uniform)
       h.add(d.material.base_color.a)
           .add(d.material.alpha_cutoff)

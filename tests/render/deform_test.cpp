@@ -93,8 +93,7 @@ TEST_F(DeformTest, AnimatedShadowAgreesWithTheReferenceAtSeveralTimes) {
     ASSERT_TRUE(light.valid());
     auto tracer = reference::RayTracer::build(*scene);
     ASSERT_TRUE(tracer.ok()) << tracer.error().to_string();
-    const auto rlight = reference::reference_light(scene->world.get<Light>(light),
-                                                   scene->world.get<WorldTransform>(light).matrix);
+    const auto rlight = reference::reference_light(scene->world, light);
     auto ref = tracer->shadow_reference(aov, rlight, {});
     ASSERT_TRUE(ref.ok()) << ref.error().to_string();
     auto m = reference::compare_shadows(aov, ref->image);

@@ -65,8 +65,7 @@ class LocalLightTest : public PlayerTest {
     auto tracer = reference::RayTracer::build(*scene);
     EXPECT_TRUE(tracer.ok()) << tracer.error().to_string();
     if (!tracer.ok()) return out;
-    const auto rlight = reference::reference_light(scene->world.get<Light>(light),
-                                                   scene->world.get<WorldTransform>(light).matrix);
+    const auto rlight = reference::reference_light(scene->world, light);
     auto ref = tracer->shadow_reference(out.aov, rlight, {});
     EXPECT_TRUE(ref.ok()) << ref.error().to_string();
     if (!ref.ok()) return out;

@@ -57,8 +57,7 @@ TEST_P(ScaleSweepTest, ShadowsAgreeWithTheReferenceAtDefaultSettings) {
   const Image aov = player_->renderer->read_aovs();
   auto tracer = reference::RayTracer::build(*scene);
   ASSERT_TRUE(tracer.ok()) << tracer.error().to_string();
-  const auto light = reference::reference_light(scene->world.get<Light>(sh.light),
-                                                scene->world.get<WorldTransform>(sh.light).matrix);
+  const auto light = reference::reference_light(scene->world, sh.light);
   auto ref = tracer->shadow_reference(aov, light, {});
   ASSERT_TRUE(ref.ok()) << ref.error().to_string();
   auto m = reference::compare_shadows(aov, ref->image);

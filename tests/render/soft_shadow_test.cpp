@@ -499,8 +499,7 @@ TEST_F(SoftShadowTest, PcssBeatsHardPcfAgainstTheAreaLightReference) {
       ASSERT_TRUE(light.valid());
       auto tracer = reference::RayTracer::build(scene);
       ASSERT_TRUE(tracer.ok()) << tracer.error().to_string();
-      const auto rlight = reference::reference_light(scene.world.get<Light>(light),
-                                                     scene.world.get<WorldTransform>(light).matrix);
+      const auto rlight = reference::reference_light(scene.world, light);
       ASSERT_TRUE(rlight.is_area()) << c.name;
       auto ref = tracer->shadow_reference(aov, rlight, {});
       ASSERT_TRUE(ref.ok()) << ref.error().to_string();

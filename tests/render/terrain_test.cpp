@@ -60,8 +60,7 @@ class TerrainTest : public PlayerTest {
     auto tracer = reference::RayTracer::build(*scene);
     EXPECT_TRUE(tracer.ok()) << tracer.error().to_string();
     if (!tracer.ok()) return out;
-    const auto light = reference::reference_light(
-        scene->world.get<Light>(sh.light), scene->world.get<WorldTransform>(sh.light).matrix);
+    const auto light = reference::reference_light(scene->world, sh.light);
     auto ref = tracer->shadow_reference(aov, light, {});
     EXPECT_TRUE(ref.ok());
     if (!ref.ok()) return out;

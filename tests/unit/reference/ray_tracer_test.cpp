@@ -764,5 +764,168 @@ TEST(RayTracerAlpha, CutOutsLetRaysThroughWhereTheRasteriserDiscards) {
   }
 }
 
+// Caster faces (caster_face_blocks(), components/shadow_settings.h) ---------------------------
+
+/// A 2 x 2 plane at height `y` whose front face (the primitive's +Y) points `up` or down,
+/// single- or double-sided, under `matrix` (after the placement).
+Scene plane_scene(float y, bool up, bool double_sided, const glm::mat4& matrix = glm::mat4(1.0f)) {
+  Scene scene;
+  const glm::mat4 turn =
+      up ? glm::mat4(1.0f) : glm::rotate(glm::mat4(1.0f), glm::pi<float>(), glm::vec3(1, 0, 0));
+  const ecs::Entity e = add(scene, PrimitiveShape::plane, matrix * trs({0, y, 0}, {2, 1, 2}) * turn);
+  Material m;
+  m.double_sided = double_sided;
+  scene.world.emplace<Material>(e, m);
+  return scene;
+}
+
+ReferenceLight culled(ReferenceLight light, CullMode cull) {
+  light.cull = cull;
+  return light;
+}
+
+TEST(RayTracerCasterFaces, SingleSidedPlanesBlockWithTheFacesTheCullLeaves) {
+  const ReferenceLight sun = directional({0, -1, 0});  // above: shadow rays go up
+  const glm::vec3 p(0, 0, 0), n(0, 1, 0);
+  for (const bool up : {true, false}) {
+    const RayTracer tracer = build(plane_scene(1.0f, up, false));
+    // Facing up, the plane's front face faces the sun.
+    EXPECT_EQ(tracer.hard_visibility(p, n, culled(sun, CullMode::back)), up ? 0.0f : 1.0f) << up;
+    EXPECT_EQ(tracer.hard_visibility(p, n, culled(sun, CullMode::front)), up ? 1.0f : 0.0f) << up;
+    EXPECT_EQ(tracer.hard_visibility(p, n, culled(sun, CullMode::none)), 0.0f) << up;
+    // The same through the public ray query (a light along the ray) and the image path.
+    EXPECT_EQ(tracer.occluded({0, 0.5f, 0}, {0, 1, 0}, 10.0f), up);
+    EXPECT_EQ(tracer.occluded({0, 0.5f, 0}, {0, 1, 0}, 10.0f, CullMode::front), !up);
+    const Image aov = ground_aov(5, 0.5f);  // every point under the plane
+    for (const CullMode cull : {CullMode::back, CullMode::front, CullMode::none}) {
+      const ShadowReference ref = reference(tracer, aov, culled(sun, cull));
+      const float expected = caster_face_blocks(cull, false, up) ? 0.0f : 1.0f;
+      for (int y = 0; y < aov.height; ++y)
+        for (int x = 0; x < aov.width; ++x) EXPECT_EQ(ref.image.at(x, y, 0), expected);
+    }
+  }
+}
+
+TEST(RayTracerCasterFaces, DoubleSidedMaterialsBlockWithBothFaces) {
+  const ReferenceLight sun = directional({0, -1, 0});
+  for (const bool up : {true, false}) {
+    const RayTracer tracer = build(plane_scene(1.0f, up, true));
+    for (const CullMode cull : {CullMode::back, CullMode::front, CullMode::none})
+      EXPECT_EQ(tracer.hard_visibility({0, 0, 0}, {0, 1, 0}, culled(sun, cull)), 0.0f) << up;
+  }
+}
+
+// A mirroring transform (negative determinant) swaps the faces as in the shadow pass
+// (glFrontFace(GL_CW)): the front face is the one its transformed normal points to.
+TEST(RayTracerCasterFaces, MirroringTransformsKeepTheFrontFaceOfTheTransformedNormal) {
+  const ReferenceLight sun = directional({0, -1, 0});
+  const glm::vec3 p(0, 0, 0), n(0, 1, 0);
+  // Mirrored in x: the plane's normal still points up, its front face still faces the sun.
+  const glm::mat4 mirror_x = glm::scale(glm::mat4(1.0f), glm::vec3(-1, 1, 1));
+  ASSERT_TRUE(mirrors(mirror_x));
+  EXPECT_EQ(build(plane_scene(1.0f, true, false, mirror_x)).hard_visibility(p, n, sun), 0.0f);
+  EXPECT_EQ(build(plane_scene(1.0f, false, false, mirror_x)).hard_visibility(p, n, sun), 1.0f);
+  // Mirrored in y about the plane's own height: the same triangles, the winding reversed, so
+  // now the face towards the ground is the front one and the sun's side casts nothing.
+  const glm::mat4 mirror_y = glm::translate(glm::mat4(1.0f), glm::vec3(0, 2, 0)) *
+                             glm::scale(glm::mat4(1.0f), glm::vec3(1, -1, 1));
+  EXPECT_EQ(build(plane_scene(1.0f, true, false, mirror_y)).hard_visibility(p, n, sun), 1.0f);
+  EXPECT_EQ(build(plane_scene(1.0f, false, false, mirror_y)).hard_visibility(p, n, sun), 0.0f);
+}
+
+// Spot and point lights: a face faces the light when the light's position is on its side of
+// the plane, whatever way the light points.
+TEST(RayTracerCasterFaces, LocalLightsDecideByTheirPosition) {
+  for (const LightType type : {LightType::point, LightType::spot}) {
+    // Points sideways: by its direction, no face would face it.
+    ReferenceLight lamp = positional(type, {0, 4, 0}, {1, 0, 0});
+    lamp.outer_cone_deg = 180.0f;
+    EXPECT_EQ(build(plane_scene(2.0f, true, false)).hard_visibility({0, 0, 0}, {0, 1, 0}, lamp),
+              0.0f);
+    EXPECT_EQ(build(plane_scene(2.0f, false, false)).hard_visibility({0, 0, 0}, {0, 1, 0}, lamp),
+              1.0f);
+    // Off to the side: the ray crosses the plane at a slant, the rule is the same.
+    EXPECT_EQ(build(plane_scene(2.0f, true, false)).hard_visibility({0.6f, 0, 0}, {0, 1, 0},
+                                                                    positional(type, {-0.6f, 4, 0})),
+              0.0f);
+  }
+}
+
+// A closed mesh blocks whatever the cull, for punctual and area lights: every ray through it
+// crosses a face of each orientation (the area reference tests each emitter sample's ray).
+TEST(RayTracerCasterFaces, ClosedMeshesBlockUnderEveryCull) {
+  Scene scene;
+  add(scene, PrimitiveShape::sphere, trs({0, 3, 0}, {2, 2, 2}));
+  const RayTracer tracer = build(scene);
+  ReferenceLight square = positional(LightType::point, {0, 6, 0});
+  square.size = 0.5f;
+  ReferenceLight cone = directional({0, -1, 0});
+  cone.angular_size_deg = 5.0f;
+  for (const CullMode cull : {CullMode::back, CullMode::front, CullMode::none}) {
+    EXPECT_EQ(tracer.hard_visibility({0, 0, 0}, {0, 1, 0}, culled(directional({0, -1, 0}), cull)),
+              0.0f);
+    EXPECT_EQ(tracer.area_light_visibility({0, 0, 0}, {0, 1, 0}, culled(square, cull), 64, 1),
+              0.0f);
+    EXPECT_EQ(tracer.area_light_visibility({0, 0, 0}, {0, 1, 0}, culled(cone, cull), 64, 1), 0.0f);
+  }
+}
+
+// An inverted hull (a sphere with every triangle reversed, the toon outline) around a body: the
+// hull's half towards the light faces away from it, so with cull back the body's top is lit and
+// the ground below still in the shadow of the body and the hull's lower half.
+TEST(RayTracerCasterFaces, InvertedHullLetsTheLightOntoTheBodyInside) {
+  Scene scene;
+  add(scene, PrimitiveShape::sphere, trs({0, 2, 0}));  // the body, radius 0.5
+  MeshData hull = make_primitive(PrimitiveShape::sphere, 32);
+  for (std::size_t t = 0; t + 2 < hull.indices.size(); t += 3)
+    std::swap(hull.indices[t + 1], hull.indices[t + 2]);
+  for (glm::vec3& nrm : hull.normals) nrm = -nrm;
+  const MeshId hull_mesh = scene.assets.add_mesh(hull);
+  const ecs::Entity e = scene.world.create();
+  scene.world.emplace<MeshRenderer>(e, MeshRenderer{hull_mesh, true, true});
+  scene.world.emplace<WorldTransform>(e, WorldTransform{trs({0, 2, 0}, glm::vec3(1.1f))});
+  const RayTracer tracer = build(scene);
+  const ReferenceLight sun = directional({0, -1, 0});
+  const glm::vec3 body_top(0, 2.5f, 0), ground(0, 0, 0), n(0, 1, 0);
+  EXPECT_EQ(tracer.hard_visibility(body_top, n, sun), 1.0f);
+  EXPECT_EQ(tracer.hard_visibility(ground, n, sun), 0.0f);
+  EXPECT_EQ(tracer.hard_visibility(body_top, n, culled(sun, CullMode::front)), 0.0f);
+  EXPECT_EQ(tracer.hard_visibility(body_top, n, culled(sun, CullMode::none)), 0.0f);
+}
+
+// Alpha-masked single-sided geometry: both filters apply (a face the cull leaves out never
+// blocks; a kept face still lets rays through its cut-out).
+TEST(RayTracerCasterFaces, CutOutsAndFacesTogether) {
+  Scene scene = plane_scene(1.0f, true, false);
+  TextureData tex;
+  tex.width = 2;
+  tex.height = 1;
+  tex.rgba8 = {255, 255, 255, 0, 255, 255, 255, 255};  // u < 0.5 cut away
+  scene.assets.textures.push_back(tex);
+  scene.world.view<Material>().each([](ecs::Entity, Material& m) {
+    m.alpha_mask = true;
+    m.base_color_texture = TextureId{0};
+    m.features = derive_material_features(m);
+  });
+  const RayTracer tracer = build(scene);
+  EXPECT_EQ(tracer.alpha_masked_geometries(), 1u);
+  const ReferenceLight sun = directional({0, -1, 0});
+  EXPECT_EQ(tracer.hard_visibility({-0.6f, 0, 0}, {0, 1, 0}, sun), 1.0f);  // cut away
+  EXPECT_EQ(tracer.hard_visibility({0.6f, 0, 0}, {0, 1, 0}, sun), 0.0f);   // opaque, front
+  EXPECT_EQ(tracer.hard_visibility({0.6f, 0, 0}, {0, 1, 0}, culled(sun, CullMode::front)), 1.0f);
+}
+
+TEST(RayTracerCasterFaces, ReferenceLightTakesTheLightsCull) {
+  Scene scene;
+  const ecs::Entity sun = scene.world.create();
+  scene.world.emplace<Light>(sun, Light{});
+  scene.world.emplace<WorldTransform>(sun, WorldTransform{});
+  EXPECT_EQ(reference_light(scene.world, sun).cull, ShadowSettings{}.cull);
+  ShadowSettings s;
+  s.cull = CullMode::front;
+  scene.world.emplace<ShadowSettings>(sun, s);
+  EXPECT_EQ(reference_light(scene.world, sun).cull, CullMode::front);
+}
+
 }  // namespace
 }  // namespace kaskad::reference
