@@ -43,6 +43,26 @@ enum class ReflectionModel : std::uint8_t { s3, pbr };
 constexpr std::array<std::string_view, 2> enum_names(ReflectionModel) { return {"s3", "pbr"}; }
 static_assert(enum_names(ReflectionModel{}).size() == std::size_t(ReflectionModel::pbr) + 1);
 
+/// glTF alphaMode: what the base colour's alpha (factor x texture) does (docs/guide/materials.md,
+/// "Transparency"). opaque: nothing. mask: a cut-out, discarded where alpha < alpha_cutoff.
+/// blend: drawn after the opaque draws, back to front, over what is behind it (premultiplied:
+/// colour x alpha + behind x (1 - alpha)); it casts shadows where alpha >= alpha_cutoff, in the
+/// shadow maps and the ray-traced reference alike.
+enum class AlphaMode : std::uint8_t { opaque, mask, blend };
+constexpr std::array<std::string_view, 3> enum_names(AlphaMode) { return {"opaque", "mask", "blend"}; }
+static_assert(enum_names(AlphaMode{}).size() == std::size_t(AlphaMode::blend) + 1);
+
+/// KHR_materials_transmission drawn as blending (there is no refraction): the opacity of a
+/// surface with base colour alpha `base_alpha` and transmissionFactor `transmission`, which
+/// falls linearly from base_alpha at no transmission to kTransmissionOpacityFloor x base_alpha
+/// at full transmission. The floor keeps a fully transmissive surface (glass) visible: blending
+/// scales the whole shading, highlights and reflections included, by the opacity, so at 0 the
+/// surface would vanish.
+inline constexpr float kTransmissionOpacityFloor = 0.2f;
+constexpr float transmission_opacity(float base_alpha, float transmission) {
+  return base_alpha * (1.0f - transmission * (1.0f - kTransmissionOpacityFloor));
+}
+
 struct Material {
   glm::vec4 base_color{1.0f};                  ///< linear RGBA factor (glTF baseColorFactor)
   TextureId base_color_texture = kNoTexture;   ///< sRGB texture, multiplied by base_color
@@ -60,8 +80,10 @@ struct Material {
   TextureTransform base_color_transform, normal_transform, occlusion_transform, emissive_transform,
       metallic_roughness_transform;
   bool double_sided = false;                   ///< glTF doubleSided: light both faces
-  bool alpha_mask = false;                     ///< glTF alphaMode MASK: discard below alpha_cutoff
-  float alpha_cutoff = 0.5f;                   ///< glTF alphaCutoff
+  AlphaMode alpha_mode = AlphaMode::opaque;    ///< glTF alphaMode
+  /// glTF alphaCutoff of a mask; a blended material casts shadows where alpha >= it (glTF
+  /// ignores alphaCutoff outside MASK: imported blended materials keep 0.5).
+  float alpha_cutoff = 0.5f;
   /// S3's k_s, the specular level that scales a reflection map's colour (eq. (3)), in [0, 1].
   /// Used only on entities with a Reflector. 1: a mirror.
   float k_s = 1.0f;
@@ -85,6 +107,10 @@ constexpr auto field_table(fields::Of<Material>) {
       number("roughness", &M::roughness, 0, 1, "Perceptual roughness"),
       vector("emissive", &M::emissive, 0, 1.0e6, "Linear emitted radiance"),
       flag("double_sided", &M::double_sided, "Lights both faces"),
+      choice("alpha_mode", &M::alpha_mode,
+             "What the base colour's alpha does: nothing, a cut-out at alpha_cutoff, or blending"),
+      number("alpha_cutoff", &M::alpha_cutoff, 0, 1,
+             "Mask: alpha below it is cut away; blend: alpha at or above it casts shadows"),
       number("k_s", &M::k_s, 0, 1, "Specular level scaling a reflection map's colour (S3's k_s)"),
       choice("reflection_model", &M::reflection_model,
              "How a reflector's probe reaches the surface: S3's mirror term or the PBR BRDF"),

@@ -39,7 +39,7 @@ void hash_material(Hash& h, const Material& m) {
   h.add(m.normal_scale);
   h.add(m.emissive);
   h.add(m.double_sided);
-  h.add(m.alpha_mask);
+  h.add(m.alpha_mode);
   h.add(m.alpha_cutoff);
   h.add(m.k_s);
   h.add(m.features);

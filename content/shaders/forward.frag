@@ -304,6 +304,14 @@ void main() {
 #endif
   // Tone mapped here, per sample under MSAA: the resolve averages displayable values.
   o_color = vec4(tone_map(color * u_frame.x), coverage);
+#if MATERIAL_HAS_ALPHA_BLEND
+  // glTF BLEND, premultiplied: the transparent phase blends (GL_ONE, GL_ONE_MINUS_SRC_ALPHA),
+  // the over operator, in linear light (the sRGB target), on tone-mapped values.
+  if (ENABLED(BIT_ALPHA_BLEND)) {
+    float alpha = clamp(base.a, 0.0, 1.0);
+    o_color = vec4(o_color.rgb * alpha, alpha);
+  }
+#endif
 #if VARIANT_HAS_AOVS
   o_position = vec4(v_world_pos, 1.0);
   o_normal = vec4(geometric_n, view_depth);

@@ -1,5 +1,7 @@
 // Depth only: colour writes are off; the rasteriser writes depth (with glPolygonOffset bias).
-// Alpha-masked materials discard their cut-out texels so they cast cut-out shadows.
+// Alpha-masked materials discard their cut-out texels so they cast cut-out shadows; blended
+// materials come here as alpha-masked ones (VariantKey::filtered_for()): they cast where
+// alpha >= alpha_cutoff.
 //
 // Peeling (VARIANT_SHADOW_PEEL, S1's multi-layer depth map, LomPass): layer j keeps the nearest
 // surface strictly behind layer j - 1 (u_peel_previous, read at the same texel): fragments at or

@@ -118,7 +118,7 @@ std::uint64_t geometry_signature(const Scene& scene) {
         mix(&mr.mesh, sizeof mr.mesh);
         mix(&flags, 1);
         mix(&wt.matrix, sizeof wt.matrix);
-        if (const Material* m = scene.world.try_get<Material>(e); m && m->alpha_mask) {
+        if (const Material* m = scene.world.try_get<Material>(e); m && m->alpha_mode != AlphaMode::opaque) {
           const float cut[2] = {m->alpha_cutoff, m->base_color.a};
           mix(cut, sizeof cut);
           mix(&m->base_color_texture, sizeof m->base_color_texture);

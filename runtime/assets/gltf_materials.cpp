@@ -246,20 +246,43 @@ Result<Material> read_material(Importer& im, int index) {
   m.metallic_roughness_texture = mr_slot->texture;
   m.metallic_roughness_transform = mr_slot->transform;
 
-  std::string ignored;
   if (g.alphaMode == "MASK") {
-    m.alpha_mask = true;
+    m.alpha_mode = AlphaMode::mask;
     m.alpha_cutoff = float(std::clamp(g.alphaCutoff, 0.0, 1.0));
     if (!(g.alphaCutoff >= 0.0 && g.alphaCutoff <= 1.0))
       im.report.warnings.push_back(where + ": alphaCutoff " + std::to_string(g.alphaCutoff) +
                                    " outside [0, 1], clamped to it");
   } else if (g.alphaMode == "BLEND") {
-    ignored += " alphaMode BLEND (drawn opaque)";
+    m.alpha_mode = AlphaMode::blend;  // alphaCutoff is ignored (glTF 3.9.4): 0.5 for shadows
   } else if (g.alphaMode != "OPAQUE" && !g.alphaMode.empty()) {
     im.report.warnings.push_back(where + ": unknown alphaMode '" + g.alphaMode +
                                  "' (OPAQUE, MASK or BLEND); drawn opaque");
   }
-  if (!ignored.empty()) im.report.warnings.push_back(where + ": not imported:" + ignored);
+  // KHR_materials_transmission: no refraction; a transmissive surface is blended, its opacity
+  // transmission_opacity() of its alpha (components/material.h). A MASK material stays a
+  // cut-out without transmission (its alpha is the mask's; a warning says so).
+  if (auto ext = g.extensions.find("KHR_materials_transmission"); ext != g.extensions.end()) {
+    const std::string ext_where = where + " KHR_materials_transmission";
+    if (!ext->second.IsObject()) return Error{im.file, ext_where, "must be an object"};
+    double t = 0.0;
+    if (const tinygltf::Value* v = member(ext->second, "transmissionFactor")) {
+      if (!v->IsNumber() || !(v->GetNumberAsDouble() >= 0.0 && v->GetNumberAsDouble() <= 1.0))
+        return Error{im.file, ext_where, "transmissionFactor must be a number in [0, 1]"};
+      t = v->GetNumberAsDouble();
+    }
+    if (member(ext->second, "transmissionTexture"))
+      im.report.warnings.push_back(ext_where + ": transmissionTexture not imported (the factor "
+                                               "applies everywhere)");
+    if (t > 0.0) {
+      if (m.alpha_mode == AlphaMode::mask) {
+        im.report.warnings.push_back(ext_where + ": on an alphaMode MASK material; drawn as a "
+                                                 "cut-out without transmission");
+      } else {
+        m.alpha_mode = AlphaMode::blend;
+        m.base_color.a = transmission_opacity(m.base_color.a, float(t));
+      }
+    }
+  }
   // glTF materials map onto the same feature model as material files.
   m.features = derive_material_features(m);
 

@@ -116,7 +116,11 @@ Result<Material> load_material_file(const std::filesystem::path& file,
     }
     m.normal_transform = m.occlusion_transform = m.emissive_transform =
         m.metallic_roughness_transform = m.base_color_transform;
-    m.alpha_mask = std::find(features.begin(), features.end(), "alpha_mask") != features.end();
+    // The alpha mode follows the features (they exclude each other).
+    if (std::find(features.begin(), features.end(), "alpha_mask") != features.end())
+      m.alpha_mode = AlphaMode::mask;
+    if (std::find(features.begin(), features.end(), "alpha_blend") != features.end())
+      m.alpha_mode = AlphaMode::blend;
     // 3. Textures: declared slot, its feature listed; listed texture features need their texture.
     std::vector<std::string> given;
     if (root.has("textures")) {

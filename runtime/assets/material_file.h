@@ -21,7 +21,7 @@ Result<Material> load_material_file(const std::filesystem::path& file,
                                     const render::FeatureManifest& manifest, AssetStore& assets);
 
 /// VariantKey material bits implied by a material's data (loaders without a material file: glTF,
-/// inline scene materials): textures present, alpha mask, non-zero emission; the emissive
+/// inline scene materials): textures present, alpha mode (mask or blend), non-zero emission; the emissive
 /// texture only with emission (it multiplies the factor); the texture transform when a texture
 /// in use has a non-identity one.
 inline std::uint32_t derive_material_features(const Material& m) {
@@ -40,7 +40,8 @@ inline std::uint32_t derive_material_features(const Material& m) {
     bits |= VariantKey::kOcclusionTexture.mask();
   if (uses(m.metallic_roughness_texture, m.metallic_roughness_transform))
     bits |= VariantKey::kMetallicRoughnessTexture.mask();
-  if (m.alpha_mask) bits |= VariantKey::kAlphaMask.mask();
+  if (m.alpha_mode == AlphaMode::mask) bits |= VariantKey::kAlphaMask.mask();
+  if (m.alpha_mode == AlphaMode::blend) bits |= VariantKey::kAlphaBlend.mask();
   if (m.emissive.r > 0.0f || m.emissive.g > 0.0f || m.emissive.b > 0.0f) {
     bits |= VariantKey::kEmissive.mask();
     if (uses(m.emissive_texture, m.emissive_transform)) bits |= VariantKey::kEmissiveTexture.mask();

@@ -25,11 +25,14 @@
 //   shadow_technique != pcf, shadow_kernel != k3x3 and shadow_peel need shadow
 //   emissive_texture needs emissive
 //   reflection_pbr needs reflection_cube
+//   alpha_mask and alpha_blend exclude each other
 //   alpha_to_coverage is kept by the forward pass only with alpha_mask (filtered_for())
-//   shadow_reuse needs shadow; the forward pass keeps it only with receive_shadows
+//   shadow_reuse needs shadow; the forward pass keeps it only with receive_shadows and without
+//   alpha_blend (a blended pixel shows two surfaces, the cache holds one value per pixel)
 // filtered_for(Pass::depth) keeps only what the depth pass uses (alpha_mask with its
 // texture_transform, peeling, and the projection when it is dual_paraboloid: its vertex shader
-// differs), so every material shares one or two shadow programs.
+// differs), so every material shares one or two shadow programs; alpha_blend becomes alpha_mask
+// there (the shadow rule of blended casters, docs/guide/materials.md "Transparency").
 #pragma once
 
 #include <array>
@@ -130,7 +133,7 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     {.name = "normal_map", .define = "MATERIAL_HAS_NORMAL_MAP",
      .stages = kVertexStage | kFragmentStage, .offset = 1},
     {.name = "alpha_mask", .define = "MATERIAL_HAS_ALPHA_MASK",
-     .stages = kVertexStage | kFragmentStage, .offset = 2},
+     .stages = kVertexStage | kFragmentStage, .offset = 2, .excludes = {"alpha_blend"}},
     {.name = "emissive", .define = "MATERIAL_HAS_EMISSIVE", .stages = kFragmentStage, .offset = 3},
     {.name = "reflection_cube", .define = "MATERIAL_HAS_REFLECTION_CUBE", .stages = kFragmentStage,
      .offset = 4, .excludes = {"reflection_sphere"}},
@@ -157,6 +160,13 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // prefiltered cube, components/ibl.h) instead of S3's I + k_s p_r C_t. Set with the cube.
     {.name = "reflection_pbr", .define = "MATERIAL_HAS_REFLECTION_PBR", .stages = kFragmentStage,
      .offset = 12, .requires_ = {"reflection_cube"}},
+    // glTF alphaMode BLEND (Material::alpha_mode): the draw is drawn in the forward pass's
+    // transparent phase, after the opaque draws, back to front, blended over what is behind.
+    // The colour output is premultiplied: (tone-mapped colour x alpha, alpha), blended with
+    // (GL_ONE, GL_ONE_MINUS_SRC_ALPHA), i.e. the over operator glTF asks for. The depth pass sees
+    // it as alpha_mask (filtered_for()): a blended caster casts where alpha >= alpha_cutoff.
+    {.name = "alpha_blend", .define = "MATERIAL_HAS_ALPHA_BLEND",
+     .stages = kFragmentStage, .offset = 13, .excludes = {"alpha_mask"}},
     // Frame features (bits 16-31).
     {.name = "shadow", .kind = FeatureKind::frame, .define = "VARIANT_HAS_SHADOW",
      .stages = kFragmentStage, .offset = 16},
@@ -329,6 +339,7 @@ class VariantKey {
   static constexpr Field kTextureTransform = feature_field("texture_transform");
   static constexpr Field kMetallicRoughnessTexture = feature_field("metallic_roughness_texture");
   static constexpr Field kReflectionPbr = feature_field("reflection_pbr");
+  static constexpr Field kAlphaBlend = feature_field("alpha_blend");
   static constexpr std::uint64_t kMaterialMask = 0x0000ffffu;
   // Frame features.
   static constexpr Field kShadow = feature_field("shadow");
@@ -406,7 +417,7 @@ class VariantKey {
   constexpr bool valid() const { return broken_rule().kind == BrokenRule::none; }
 
   /// The part of the key a pass's shaders read. The depth pass only needs alpha masking (and
-  /// peeling); the shadow-points, LOM occlusion and VSM moments passes only the shadow lookup's
+  /// peeling; a blended draw is alpha-masked there); the shadow-points, LOM occlusion and VSM moments passes only the shadow lookup's
   /// frame features (a receiver, without AOVs or the debug tint); the forward pass needs
   /// everything but alpha_to_coverage on draws without alpha_mask (it changes nothing there).
   constexpr VariantKey filtered_for(Pass pass) const {
@@ -418,9 +429,12 @@ class VariantKey {
       const std::uint64_t layered =
           has(kShadowLayered) ? kShadowLayered.mask() | kShadow.mask() : 0u;
       const std::uint64_t peel = has(kShadowPeel) ? kShadowPeel.mask() | kShadow.mask() : 0u;
+      // Blended casters cast as cut-outs at alpha_cutoff (the rule the reference follows too).
+      const bool cutout = has(kAlphaMask) || has(kAlphaBlend);
       // A cut-out reads the base colour texture through its transform.
-      const std::uint64_t transform = has(kAlphaMask) ? kTextureTransform.mask() : 0u;
-      return VariantKey(bits_ & (kAlphaMask.mask() | projection | layered | peel | transform));
+      const std::uint64_t transform = cutout ? kTextureTransform.mask() : 0u;
+      return VariantKey((bits_ & (projection | layered | peel | transform)) |
+                        (cutout ? kAlphaMask.mask() : 0u));
     }
     if (pass == Pass::shadow_points || pass == Pass::lom_occlusion || pass == Pass::vsm_moments)
       return VariantKey((bits_ & kFrameMask & ~kAovs.mask() & ~kDebugCascades.mask() &
@@ -428,8 +442,10 @@ class VariantKey {
                          ~kEnvironment.mask() & ~kAlphaToCoverage.mask() &
                          ~kShadowReuse.mask()) |
                         kReceiveShadows.mask());
-    // Programs without a shadow lookup have no visibility to store or load.
-    const std::uint64_t reuse = has(kReceiveShadows) ? 0u : kShadowReuse.mask();
+    // Programs without a shadow lookup have no visibility to store or load; blended ones are
+    // never the pixel's one surface.
+    const std::uint64_t reuse =
+        has(kReceiveShadows) && !has(kAlphaBlend) ? 0u : kShadowReuse.mask();
     if (!has(kAlphaMask)) return VariantKey(bits_ & ~kAlphaToCoverage.mask() & ~reuse);
     return VariantKey(bits_ & ~reuse);
   }
@@ -451,6 +467,16 @@ static_assert(VariantKey().set(VariantKey::kTextureTransform, 1).filtered_for(Pa
 static_assert(VariantKey().set(VariantKey::kTextureTransform, 1).set(VariantKey::kAlphaMask, 1)
                   .filtered_for(Pass::depth) ==
               VariantKey().set(VariantKey::kTextureTransform, 1).set(VariantKey::kAlphaMask, 1));
+static_assert(!VariantKey().set(VariantKey::kAlphaMask, 1).set(VariantKey::kAlphaBlend, 1).valid());
+static_assert(VariantKey().set(VariantKey::kAlphaBlend, 1).filtered_for(Pass::depth) ==
+              VariantKey().set(VariantKey::kAlphaMask, 1));
+static_assert(!VariantKey()
+                   .set(VariantKey::kAlphaBlend, 1)
+                   .set(VariantKey::kReceiveShadows, 1)
+                   .set(VariantKey::kShadow, 1)
+                   .set(VariantKey::kShadowReuse, VariantKey::kReuseStore)
+                   .filtered_for(Pass::forward)
+                   .has(VariantKey::kShadowReuse));
 static_assert(!VariantKey().set(VariantKey::kShadowProjection, 1).valid());
 static_assert(!VariantKey().set(VariantKey::kShadowLightsMinus1, 1).valid());
 static_assert(VariantKey()

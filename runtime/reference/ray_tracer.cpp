@@ -39,7 +39,8 @@ namespace kaskad::reference {
 namespace {
 
 /// An alpha-masked (glTF MASK) geometry's cut-out: what the forward and depth passes discard,
-/// alpha = base_color.a x texture alpha < cutoff. Hits there are rejected by Embree filter
+/// alpha = base_color.a x texture alpha < cutoff. A blended (glTF BLEND) caster is cut the same
+/// way: it casts where alpha >= cutoff, as the depth pass draws it (Material::alpha_mode). Hits there are rejected by Embree filter
 /// functions, so the reference sees the same holes as the rasteriser. The texture is sampled
 /// bilinearly at level 0 with repeat wrapping (the GPU may pick a coarser mip level: edges of
 /// cut-outs can differ by a texel there).
@@ -564,7 +565,8 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
     auto rules = std::make_unique<GeometryRules>();
     rules->double_sided = item.material && item.material->double_sided;
     rules->mirrored = mirrors(item.matrix);
-    if (item.material && item.material->alpha_mask && mesh.uvs.size() == mesh.positions.size()) {
+    if (item.material && item.material->alpha_mode != AlphaMode::opaque &&
+         mesh.uvs.size() == mesh.positions.size()) {
       AlphaCutout* cutout = &rules->cutout.emplace();
       cutout->uvs = mesh.uvs;
       cutout->indices = kept;

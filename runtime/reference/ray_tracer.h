@@ -117,7 +117,7 @@ struct ShadowReference {
 /// block a light with the faces caster_face_blocks() says, for the light's cull
 /// (ReferenceLight::cull): the shadow pass's rule, Material::double_sided and mirroring world
 /// transforms included. Alpha-masked materials (glTF MASK) cut holes where the rasteriser
-/// discards (alpha_masked_geometries()).
+/// discards, and blended ones (glTF BLEND) where the depth pass does (alpha_masked_geometries()).
 /// Triangles are transformed to world space when built; later changes to the Scene are not seen.
 /// Move-only.
 /// Thread safety: all const member functions may be called from any number of threads at once.
@@ -184,8 +184,9 @@ class RayTracer {
   Aabb bounds() const;                     ///< of every surface triangle kept
   std::size_t occluder_triangles() const;  ///< triangles in the occluder BVH
   std::size_t surface_triangles() const;   ///< triangles in the all-surfaces BVH
-  /// Geometries with an alpha cut-out (Material::alpha_mask and uvs): rays pass through where
-  /// base_color.a x texture alpha < alpha_cutoff, as the rasteriser discards there.
+  /// Geometries with an alpha cut-out (Material::alpha_mode mask or blend, and uvs): rays pass
+  /// through where base_color.a x texture alpha < alpha_cutoff, as the rasteriser discards
+  /// there (and as the depth pass draws blended casters).
   std::size_t alpha_masked_geometries() const;
 
  private:

@@ -155,7 +155,7 @@ namespace {
 // operator== decides), they just need not sort next to each other.
 auto material_fields(const Material& m) {
   return std::tie(m.base_color_texture, m.normal_texture, m.occlusion_texture,
-                  m.emissive_texture, m.metallic_roughness_texture, m.occlusion_strength, m.double_sided, m.alpha_mask,
+                  m.emissive_texture, m.metallic_roughness_texture, m.occlusion_strength, m.double_sided, m.alpha_mode,
                   m.metallic, m.roughness, m.base_color.r, m.base_color.g, m.base_color.b,
                   m.base_color.a, m.normal_scale, m.emissive.r, m.emissive.g, m.emissive.b,
                   m.alpha_cutoff, m.k_s, m.features);
@@ -228,10 +228,12 @@ std::vector<std::uint32_t> sorted_by(const FrameInput& frame, Pass pass,
     MeshId mesh;
   };
   std::vector<SortKey> k(frame.draws.size());
-  for (std::size_t i = 0; i < k.size(); ++i)
-    k[i] = {by[i].filtered_for(pass), mirrors(frame.draws[i].model),
-            pass == Pass::depth && !by[i].has(VariantKey::kAlphaMask), material_rank[i],
+  for (std::size_t i = 0; i < k.size(); ++i) {
+    const VariantKey key = by[i].filtered_for(pass);
+    k[i] = {key, mirrors(frame.draws[i].model),
+            pass == Pass::depth && !key.has(VariantKey::kAlphaMask), material_rank[i],
             frame.draws[i].mesh};
+  }
   std::vector<std::uint32_t> order(frame.draws.size());
   for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
@@ -262,6 +264,11 @@ DrawList build_draw_list(const FrameInput& frame, VariantKey frame_key) {
   if (!frame.shadow_views.empty())
     list.depth_order = sorted_by(frame, Pass::depth, list.keys, material_rank);
   list.forward_order = sorted_by(frame, Pass::forward, list.keys, material_rank);
+  // Blended draws leave the forward orders for the transparent phase.
+  auto blended = [&](std::uint32_t i) { return list.keys[i].has(VariantKey::kAlphaBlend); };
+  for (std::uint32_t i = 0; i < frame.draws.size(); ++i)
+    if (blended(i)) list.blend_draws.push_back(i);
+  if (!list.blend_draws.empty()) std::erase_if(list.forward_order, blended);
   if (frame.msaa > 1) {
     const VariantKey msaa = msaa_frame_variant(frame_key);
     list.msaa_keys.resize(frame.draws.size());
@@ -274,8 +281,29 @@ DrawList build_draw_list(const FrameInput& frame, VariantKey frame_key) {
     for (std::size_t i = 0; i < frame.draws.size(); ++i)
       list.capture_keys[i] = material_variant(frame.draws[i]) | capture;
     list.capture_order = sorted_by(frame, Pass::forward, list.capture_keys, material_rank);
+    if (!list.blend_draws.empty()) std::erase_if(list.capture_order, blended);
   }
   return list;
+}
+
+std::vector<std::uint32_t> back_to_front(const FrameInput& frame,
+                                         std::span<const std::uint32_t> draws,
+                                         const glm::vec4& depth_plane) {
+  std::vector<std::pair<float, std::uint32_t>> by_distance;
+  by_distance.reserve(draws.size());
+  for (std::uint32_t i : draws) {
+    const DrawItem& d = frame.draws[i];
+    const glm::vec3 centre = d.bounds.empty() ? glm::vec3(d.model[3]) : d.bounds.center();
+    by_distance.emplace_back(glm::dot(depth_plane, glm::vec4(centre, 1.0f)), i);
+  }
+  // Stable: equal distances keep draw order (and a NaN distance, which breaks the ordering,
+  // cannot make it run out of bounds).
+  std::stable_sort(by_distance.begin(), by_distance.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<std::uint32_t> out;
+  out.reserve(by_distance.size());
+  for (const auto& [distance, i] : by_distance) out.push_back(i);
+  return out;
 }
 
 std::vector<std::uint32_t> visible_draws(const FrameInput& frame,

@@ -61,8 +61,12 @@ struct DrawList {
   std::vector<VariantKey> keys, capture_keys, msaa_keys;
   /// Draw indices in submission order: sorted by the pass's program key, then by winding
   /// (mirrors()), material and mesh, so program and material state change as rarely as possible
-  /// and draws that may be one call are neighbours (stable: ties keep draw order).
+  /// and draws that may be one call are neighbours (stable: ties keep draw order). The forward
+  /// and capture orders hold the opaque and alpha-masked draws only; the depth order every draw.
   std::vector<std::uint32_t> depth_order, forward_order, capture_order;
+  /// The blended draws (VariantKey::kAlphaBlend), in draw order: each view draws them after its
+  /// opaque draws, sorted for it by back_to_front().
+  std::vector<std::uint32_t> blend_draws;
 
   /// The depth-pass key of draw i in shadow view `view`: views after the first are cascades and
   /// use the plain depth program whatever the first view's projection is.
@@ -72,6 +76,26 @@ struct DrawList {
 /// Keys and orders of `frame` with frame features `frame_key` (capture keys and order only
 /// when the frame has probes).
 DrawList build_draw_list(const FrameInput& frame, VariantKey frame_key);
+
+/// The plane whose value at a point (dot(plane, (p, 1))) is its distance in front of the camera
+/// of world-to-view matrix `view`, along the view direction.
+inline glm::vec4 view_depth_plane(const glm::mat4& view) {
+  return -glm::vec4(view[0][2], view[1][2], view[2][2], view[3][2]);
+}
+/// The same plane of a perspective view-projection `view_proj` (a probe face's): its clip w
+/// is the distance along the view direction.
+inline glm::vec4 clip_depth_plane(const glm::mat4& view_proj) {
+  return glm::vec4(view_proj[0][3], view_proj[1][3], view_proj[2][3], view_proj[3][3]);
+}
+
+/// `draws` (DrawList::blend_draws) in the order a view draws them: back to front by the
+/// distance of each draw's bounds' centre (its model's origin without bounds) along the view
+/// direction, dot(depth_plane, (centre, 1)), farthest first; equal distances keep their order.
+/// Per object, not per triangle: objects that interpenetrate or overlap in depth may blend in
+/// the wrong order (docs/guide/materials.md, "Transparency").
+std::vector<std::uint32_t> back_to_front(const FrameInput& frame,
+                                         std::span<const std::uint32_t> draws,
+                                         const glm::vec4& depth_plane);
 
 /// The draws of `order` that a view with `view_proj` can see, in order: those whose bounds
 /// overlap its clip volume (draws without bounds always). `capture`: a probe face's view, which

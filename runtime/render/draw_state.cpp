@@ -73,7 +73,9 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
 }
 
 bool DrawState::depth_reads_material(VariantKey key) const {
-  return key.has(VariantKey::kAlphaMask) || features_by_uniform_;
+  // Blended draws are alpha-masked there (VariantKey::filtered_for()).
+  return key.has(VariantKey::kAlphaMask) || key.has(VariantKey::kAlphaBlend) ||
+         features_by_uniform_;
 }
 
 void draw_batch(const FrameInput& frame, GpuCache& cache, std::span<const MeshDraw> batch,

@@ -26,7 +26,8 @@ class DrawState {
   /// The material of draw `d` on the current program; `key`: the key that program was compiled
   /// for (its material features say which optional uniforms exist).
   void bind_material(const DrawItem& d, VariantKey key);
-  /// Whether a draw with `key` reads its material in the depth pass: alpha-masked draws do, and
+  /// Whether a draw with `key` reads its material in the depth pass: alpha-masked and blended
+  /// draws do, and
   /// every draw when the library's programs select material features by uniform (the test
   /// oracle's über-programs).
   bool depth_reads_material(VariantKey key) const;

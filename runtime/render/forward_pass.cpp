@@ -34,16 +34,22 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
   auto reflective = [&](std::uint32_t i) {
     return keys[i].has(VariantKey::kReflectionCube) || keys[i].has(VariantKey::kReflectionSphere);
   };
+  // A blended double-sided draw: its back faces, then its front faces (a closed convex mesh
+  // then blends in depth order within itself).
+  auto two_passes = [&](std::uint32_t i) {
+    return keys[i].has(VariantKey::kAlphaBlend) && frame.draws[i].material.double_sided;
+  };
   // Runs of visible draws with the same program, material and winding become one batch: one
   // instanced draw per mesh, all in one multi-draw; a reflective draw (its own probe map and
-  // k_s * p_r) stays alone. The draw list orders a batch's draws by mesh.
+  // k_s * p_r) and a two-pass one stay alone. The draw list orders a batch's draws by mesh; a
+  // batch keeps the order of its draws (a blended view's back to front).
   std::vector<MeshDraw> batch;
   for (std::size_t first = 0; first < visible.size();) {
     const std::uint32_t i = visible[first];
     const DrawItem& d = frame.draws[i];
     const bool mirrored = mirrors(d.model);
     std::size_t end = first + 1;
-    if (!reflective(i))
+    if (!reflective(i) && !two_passes(i))
       while (end < visible.size() && keys[visible[end]] == keys[i] &&
              frame.draws[visible[end]].material == d.material &&
              mirrors(frame.draws[visible[end]].model) == mirrored)
@@ -94,12 +100,39 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
         break;
       }
     }
+    if (two_passes(i)) {
+      glEnable(GL_CULL_FACE);
+      glCullFace(GL_FRONT);
+      draw_batch(frame, cache, batch, stats.draw_calls, stats.mesh_draws);
+      glCullFace(GL_BACK);
+    }
     draw_batch(frame, cache, batch, stats.draw_calls, stats.mesh_draws);
     stats.instances += int(end - first);
     first = end;
   }
   glFrontFace(GL_CCW);
   return {};
+}
+
+Status draw_transparent(const FrameInput& frame, const DrawList& list,
+                        const std::vector<VariantKey>& keys, const ProbeJob* capture, int round,
+                        const glm::mat4& view_proj, const glm::vec4& depth_plane,
+                        int draw_buffers, GpuCache& cache, DrawState& state, FrameStats& stats) {
+  if (list.blend_draws.empty()) return {};
+  const std::vector<std::uint32_t> order = back_to_front(frame, list.blend_draws, depth_plane);
+  // Depth tested against the opaque draws, not written: blended draws never hide each other.
+  // Premultiplied over (forward.frag); the target's alpha is kept. Only colour (buffer 0) is
+  // blended: the AOVs and the stored visibility keep the opaque surface behind.
+  glDepthMask(GL_FALSE);
+  glEnable(GL_BLEND);
+  glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+  for (int b = 1; b < draw_buffers; ++b) glColorMaski(GLuint(b), GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  const Status st =
+      draw_forward(frame, order, keys, capture, round, view_proj, cache, state, stats);
+  for (int b = 1; b < draw_buffers; ++b) glColorMaski(GLuint(b), GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
+  return st;
 }
 
 std::span<const ForwardPass::Target> ForwardPass::targets() {
@@ -173,6 +206,7 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list,
   const float zero[4] = {0, 0, 0, 0};
   const float one = 1.0f;
   const glm::mat4 view_proj = frame.camera.proj * frame.camera.view;
+  const glm::vec4 depth_plane = view_depth_plane(frame.camera.view);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
@@ -186,10 +220,14 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list,
     glClearBufferfv(GL_DEPTH, 0, &one);
     glEnable(GL_SAMPLE_ALPHA_TO_COVERAGE);
     glEnable(GL_SAMPLE_ALPHA_TO_ONE);
-    const Status st = draw_forward(frame, list.forward_order, list.msaa_keys, nullptr, 0,
-                                   view_proj, cache, state, stats);
+    Status st = draw_forward(frame, list.forward_order, list.msaa_keys, nullptr, 0,
+                             view_proj, cache, state, stats);
     glDisable(GL_SAMPLE_ALPHA_TO_ONE);
     glDisable(GL_SAMPLE_ALPHA_TO_COVERAGE);
+    // The blended draws, per sample (their alpha is opacity, not coverage).
+    if (st)
+      st = draw_transparent(frame, list, list.msaa_keys, nullptr, 0, view_proj, depth_plane, 1,
+                            cache, state, stats);
     // b. The resolve: the samples' average, taken in linear space (GL_FRAMEBUFFER_SRGB).
     glNamedFramebufferDrawBuffers(fbo_.id(), 1, bufs);
     glBlitNamedFramebuffer(msaa_fbo_.id(), fbo_.id(), 0, 0, width_, height_, 0, 0, width_, height_,
@@ -233,8 +271,14 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list,
   glClearBufferfv(GL_DEPTH, 0, &one);
   // The AOV pass draws what the colour pass drew: its culling is counted once.
   const int culled = stats.frustum_culled;
-  const Status st = draw_forward(frame, list.forward_order, keys, nullptr, 0, view_proj,
-                                 cache, state, stats);
+  Status st = draw_forward(frame, list.forward_order, keys, nullptr, 0, view_proj,
+                           cache, state, stats);
+  // The blended draws over the colour; the AOV-only pass beside a multisampled colour pass has
+  // no colour to blend into: the AOVs show the opaque surfaces either way.
+  const int draw_buffers = reuse == VariantKey::kReuseStore ? 2 : frame.write_aovs ? 5 : 1;
+  if (st && single_colour)
+    st = draw_transparent(frame, list, keys, nullptr, 0, view_proj, depth_plane, draw_buffers,
+                          cache, state, stats);
   if (!single_colour) stats.frustum_culled = culled;
   if (reuse == VariantKey::kReuseStore) glNamedFramebufferTexture(fbo_.id(), visibility_attachment, 0, 0);
   glDisable(GL_FRAMEBUFFER_SRGB);

@@ -21,7 +21,9 @@ namespace kaskad::render {
 /// by a second, single-sample pass with DrawList::keys whose colour output goes nowhere, so they
 /// are those of a frame without MSAA, bit for bit. Each sample is tone mapped by forward.frag
 /// before the resolve averages them (in linear space: GL_FRAMEBUFFER_SRGB is on for the blit),
-/// so a bright background does not darken the edges in front of it.
+/// so a bright background does not darken the edges in front of it. Blended draws follow the
+/// opaque ones in each colour pass (draw_transparent()); the AOVs show the opaque surface behind
+/// them (docs/guide/materials.md, "Transparency").
 class ForwardPass {
  public:
   /// The colour, AOV and depth targets at the frame's size, and with `samples` > 1 the
@@ -78,5 +80,16 @@ Status draw_forward(const FrameInput& frame, std::span<const std::uint32_t> orde
                     const std::vector<VariantKey>& keys, const ProbeJob* capture, int round,
                     const glm::mat4& view_proj, GpuCache& cache, DrawState& state,
                     FrameStats& stats);
+
+/// The transparent phase of a view, after its opaque draws: DrawList::blend_draws sorted by
+/// back_to_front() for `depth_plane`, drawn by draw_forward() with the depth test on and depth
+/// writes off, blended premultiplied over (GL_ONE, GL_ONE_MINUS_SRC_ALPHA) into draw buffer 0;
+/// draw buffers 1 .. draw_buffers - 1 (the AOVs, the stored visibility) are masked off, so
+/// they keep the opaque surface behind. A double-sided blended draw draws its back faces, then
+/// its front faces. Leaves blending off and depth writes on.
+Status draw_transparent(const FrameInput& frame, const DrawList& list,
+                        const std::vector<VariantKey>& keys, const ProbeJob* capture, int round,
+                        const glm::mat4& view_proj, const glm::vec4& depth_plane,
+                        int draw_buffers, GpuCache& cache, DrawState& state, FrameStats& stats);
 
 }  // namespace kaskad::render

@@ -68,6 +68,10 @@ Status ProbeCapturePass::record(const FrameInput& frame, const DrawList& list,
         const std::size_t triangles_before = stats.triangles;
         status = draw_forward(frame, list.capture_order, list.capture_keys, &job, round,
                               face.view_proj, cache, state, stats);
+        // Then the blended draws, back to front for this face's camera.
+        if (status)
+          status = draw_transparent(frame, list, list.capture_keys, &job, round, face.view_proj,
+                                    clip_depth_plane(face.view_proj), 1, cache, state, stats);
         // Draws into faces are counted apart from the main view's.
         stats.probe_draw_calls += stats.draw_calls - before;
         stats.probe_instances += stats.instances - instances_before;

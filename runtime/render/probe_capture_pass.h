@@ -14,7 +14,8 @@ class ProbeCapturePass {
   void prepare(const FrameInput& frame, const AssetStore& assets, GpuCache& cache);
   /// Each scheduled face of a probe's back cube is drawn by a 90° camera at the probe centre
   /// through the forward path (shadows included, no AOVs, no exposure: cubes hold linear
-  /// radiance, with cascades selected by map bounds), then mips and sphere maps. `ubo` holds
+  /// radiance, with cascades selected by map bounds), its blended draws after its opaque ones,
+  /// back to front for the face's camera (draw_transparent()), then mips and sphere maps. `ubo` holds
   /// `main`, the main view's block, before and after. After it: every probe's visible buffer
   /// is the map draws shade with this frame.
   Status record(const FrameInput& frame, const DrawList& list, const FrameBlock& main,

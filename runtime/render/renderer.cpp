@@ -177,7 +177,7 @@ std::string gib(double bytes) {
 /// depths: the frame block (camera, lights, shadow views' matrices, splits and parameters), the
 /// frame's features, the target size, the shaders (a reload of an edited file looks up again),
 /// and every draw of the forward pass with what decides which of its fragments end up in front
-/// (mesh, matrix, program, sidedness, alpha mask).
+/// (mesh, matrix, program, sidedness, alpha mode).
 std::uint64_t visibility_inputs(const FrameInput& frame, const DrawList& list,
                                 const AssetStore& assets, const FrameBlock& block,
                                 int shader_reloads) {
@@ -188,7 +188,7 @@ std::uint64_t visibility_inputs(const FrameInput& frame, const DrawList& list,
     const DrawItem& d = frame.draws[i];
     const Material& m = d.material;
     h.add(d.mesh).add(d.model).add(d.pose).add(d.receive_shadows).add(list.keys[i].bits());
-    h.add(m.double_sided).add(m.alpha_mask).add(m.alpha_cutoff).add(m.base_color.a);
+    h.add(m.double_sided).add(m.alpha_mode).add(m.alpha_cutoff).add(m.base_color.a);
     h.add(m.base_color_texture).add(m.base_color_transform);
   }
   return h.value();

@@ -140,10 +140,10 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   // scene) change assets.uid. New storage invalidated every layer.
   auto add_caster = [&](Hash& h, std::size_t view, std::uint32_t i) {
     const DrawItem& d = frame.draws[i];
-    const VariantKey key = list.depth_key(view, i);
-    h.add(d.mesh).add(d.model).add(d.pose).add(key.filtered_for(Pass::depth).bits());
+    const VariantKey key = list.depth_key(view, i).filtered_for(Pass::depth);
+    h.add(d.mesh).add(d.model).add(d.pose).add(key.bits());
     h.add(d.material.double_sided);  // its faces culled (caster_cull())
-    if (key.has(VariantKey::kAlphaMask) || features_by_uniform)
+    if (key.has(VariantKey::kAlphaMask) || features_by_uniform)  // blended casters too
       h.add(d.material.base_color.a)
           .add(d.material.alpha_cutoff)
           .add(d.material.base_color_texture)

@@ -117,7 +117,7 @@ TEST_F(BatchingTest, MultiDrawsGiveTheFrameOfOneCallPerMesh) {
     render::FrameInput first = frame;
     std::erase_if(first.draws, [&](const render::DrawItem& d) {
       return scene->assets.meshes[index(d.mesh)].positions.size() < 8000 &&
-             !d.material.alpha_mask;
+             d.material.alpha_mode == AlphaMode::opaque;
     });
     ASSERT_EQ(first.draws.size(), 3u);
 

@@ -819,6 +819,56 @@ bool warns(const GltfImportReport& report, const std::string& text) {
   return false;
 }
 
+// alphaMode BLEND is a blended material (its alphaCutoff ignored: 0.5, the shadow threshold),
+// MASK a cut-out, and KHR_materials_transmission blends with transmission_opacity() of the
+// base alpha (components/material.h); each maps onto its material feature.
+TEST(GltfLoader, AlphaModesAndTransmissionBecomeAlphaModes) {
+  using render::VariantKey;
+  auto material_of = [](const json& material, const std::string& name) {
+    json doc = triangle_gltf();
+    doc["materials"] = {material};
+    doc["meshes"][0]["primitives"][0]["material"] = 0;
+    doc["extensionsUsed"] = {"KHR_materials_transmission"};
+    auto s = import_file(write_gltf(name, doc));
+    EXPECT_TRUE(s->report.ok()) << s->report.error().to_string();
+    EXPECT_FALSE(warns(*s->report, "BLEND")) << "no longer drawn opaque";
+    EXPECT_FALSE(warns(*s->report, "KHR_materials_transmission"));  // supported
+    return only_material(*s);
+  };
+  const Material blend = material_of(
+      {{"alphaMode", "BLEND"}, {"alphaCutoff", 0.2},
+       {"pbrMetallicRoughness", {{"baseColorFactor", {1, 0, 0, 0.4}}}}},
+      "blend.gltf");
+  EXPECT_EQ(blend.alpha_mode, AlphaMode::blend);
+  EXPECT_FLOAT_EQ(blend.alpha_cutoff, 0.5f);
+  EXPECT_FLOAT_EQ(blend.base_color.a, 0.4f);
+  EXPECT_EQ(blend.features, VariantKey::kAlphaBlend.mask());
+  const Material mask = material_of({{"alphaMode", "MASK"}, {"alphaCutoff", 0.3}}, "mask.gltf");
+  EXPECT_EQ(mask.alpha_mode, AlphaMode::mask);
+  EXPECT_FLOAT_EQ(mask.alpha_cutoff, 0.3f);
+  EXPECT_EQ(mask.features, VariantKey::kAlphaMask.mask());
+  const Material glass = material_of(
+      {{"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 0.5}}}},
+       {"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 0.5}}}}}},
+      "transmission.gltf");
+  EXPECT_EQ(glass.alpha_mode, AlphaMode::blend);
+  EXPECT_FLOAT_EQ(glass.base_color.a, 0.5f * (1.0f - 0.5f * (1.0f - kTransmissionOpacityFloor)));
+  EXPECT_EQ(glass.features, VariantKey::kAlphaBlend.mask());
+  EXPECT_FLOAT_EQ(transmission_opacity(1.0f, 1.0f), kTransmissionOpacityFloor);
+  EXPECT_FLOAT_EQ(transmission_opacity(0.8f, 0.0f), 0.8f);
+  // No transmission: opaque stays opaque.
+  const Material none = material_of(
+      {{"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 0.0}}}}}},
+      "no_transmission.gltf");
+  EXPECT_EQ(none.alpha_mode, AlphaMode::opaque);
+  EXPECT_EQ(none.features, 0u);
+  json doc = triangle_gltf();
+  doc["materials"] = {
+      {{"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 2.0}}}}}}};
+  doc["meshes"][0]["primitives"][0]["material"] = 0;
+  expect_import_error(write_gltf("bad_transmission.gltf", doc), "transmissionFactor");
+}
+
 TEST(GltfLoader, OcclusionTextureIsReadWithItsStrength) {
   json doc = textured_triangle({{"occlusionTexture", {{"index", 1}, {"strength", 0.25}}}});
   auto s = import_file(write_gltf("occlusion.gltf", doc));

@@ -51,7 +51,7 @@ bool documented_rules_hold(VariantKey k) {
       V::kEmissiveTexture.mask() | V::kTextureTransform.mask() | V::kShadowPeel.mask() |
       V::kReflectionPbr.mask() | V::kEnvironment.mask() |
       V::kAlphaToCoverage.mask() | V::kMetallicRoughnessTexture.mask() | V::kShadowReuse.mask() |
-      V::kSkin.mask() | V::kMorph.mask();
+      V::kAlphaBlend.mask() | V::kSkin.mask() | V::kMorph.mask();
   if (k.bits() & ~used) return false;
   if (k.get(V::kSkin) > 2) return false;             // none, 4 joints, 8 joints
   if (k.get(V::kToneMapping) > 2) return false;      // none, khr_pbr_neutral, aces
@@ -64,6 +64,7 @@ bool documented_rules_hold(VariantKey k) {
   if (k.has(V::kReflectionBox) && !k.has(V::kReflectionCube)) return false;
   if (k.has(V::kReflectionPbr) && !k.has(V::kReflectionCube)) return false;
   if (k.has(V::kEmissiveTexture) && !k.has(V::kEmissive)) return false;
+  if (k.has(V::kAlphaMask) && k.has(V::kAlphaBlend)) return false;
   const bool needs_shadow = k.has(V::kShadowFilter) || k.has(V::kCascadeCountMinus1) ||
                             k.has(V::kDebugCascades) || k.has(V::kCascadeSelection) ||
                             k.has(V::kShadowProjection) || k.has(V::kShadowLayered) ||
@@ -86,7 +87,8 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   // valid() (kFeatureTable's rules) agrees with the rules written out above, the manifest names
   // a broken rule exactly when valid() is false, and a valid key filters to itself for the
   // forward pass (it reads everything, but alpha_to_coverage only with alpha_mask and
-  // shadow_reuse only with receive_shadows) and to valid keys for the others.
+  // shadow_reuse only with receive_shadows and without alpha_blend) and to valid keys for the
+  // others.
   auto check = [&](VariantKey k) {
     if ((k.valid() != documented_rules_hold(k) || k.valid() != m.check(k).empty()) &&
         disagree++ < 5)
@@ -96,7 +98,8 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
     if (!k.valid()) return false;
     std::uint64_t forward = k.bits();
     if (!k.has(VariantKey::kAlphaMask)) forward &= ~VariantKey::kAlphaToCoverage.mask();
-    if (!k.has(VariantKey::kReceiveShadows)) forward &= ~VariantKey::kShadowReuse.mask();
+    if (!k.has(VariantKey::kReceiveShadows) || k.has(VariantKey::kAlphaBlend))
+      forward &= ~VariantKey::kShadowReuse.mask();
     EXPECT_EQ(k.filtered_for(Pass::forward), VariantKey(forward));
     EXPECT_TRUE(k.filtered_for(Pass::depth).valid());
     EXPECT_TRUE(k.filtered_for(Pass::shadow_points).valid());
@@ -154,16 +157,16 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   }
   EXPECT_EQ(valid_deforms, 6);
   EXPECT_EQ(disagree, 0);
-  // Material keys: 2^7 free bits x 3 of the 4 emissive/emissive_texture combinations x 6 of the
-  // 16 reflection cube/sphere/box/pbr combinations (none, sphere, cube with or without box and
-  // pbr) = 2304.
+  // Material keys: 2^6 free bits x 3 of the 4 alpha_mask/alpha_blend combinations x 3 of the 4
+  // emissive/emissive_texture combinations x 6 of the 16 reflection cube/sphere/box/pbr
+  // combinations (none, sphere, cube with or without box and pbr) = 3456.
   // Frame keys: 2 without shadow (aovs), and with shadow 3 filters x 2 aovs x 2 debug x
   // 2 selection x 2 layered x 4 shadowed-light counts x (8 ortho cascade counts + 3 other
   // projections) x the techniques (6 today: pcf, pcss, backprojection, lom, vsm, evsm) x
   // 5 kernels x 2 peel = 126720; all of them x 3 tone mappings x 2 environments x
   // 2 alpha_to_coverage.
   const int shadowed = 3 * 2 * 2 * 2 * 2 * 4 * (8 + 3) * int(kShadowTechniqueCount) * 5 * 2;
-  EXPECT_EQ(valid_materials, 2304);
+  EXPECT_EQ(valid_materials, 3456);
   EXPECT_EQ(valid_frames, 2 * 2 * 3 * (2 + shadowed));
   // shadow_reuse store and load on every frame key with shadow; "3" is past its values.
   EXPECT_EQ(valid_reuse, 2 * 2 * 2 * 3 * shadowed);
@@ -194,7 +197,7 @@ TEST(VariantKey, FeatureTableDrivesTheManifestAndTheGlslBits) {
       EXPECT_EQ(value, std::to_string(VariantKey::kReflectionBox.offset));
     }
   }
-  EXPECT_EQ(bits, 13);  // every material feature, in every stage
+  EXPECT_EQ(bits, 14);  // every material feature, in every stage
 }
 
 TEST(VariantKey, DefinesComeFromOneFunctionForBothKinds) {

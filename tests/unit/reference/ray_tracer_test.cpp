@@ -721,7 +721,7 @@ TEST(RayTracer, ReferenceComparedWithItselfHasNoErrors) {
 // (u < 0.5) and opaque on its right half; rays straight up from the ground pass through the left
 // half only. The base colour's alpha scales the texture's, as in forward.frag.
 TEST(RayTracerAlpha, CutOutsLetRaysThroughWhereTheRasteriserDiscards) {
-  auto card_scene = [](bool alpha_mask, float factor_alpha) {
+  auto card_scene = [](AlphaMode mode, float factor_alpha) {
     Scene scene;
     TextureData tex;
     tex.name = "half";
@@ -731,7 +731,7 @@ TEST(RayTracerAlpha, CutOutsLetRaysThroughWhereTheRasteriserDiscards) {
     scene.assets.textures.push_back(tex);
     const ecs::Entity card = add(scene, PrimitiveShape::plane, trs({0, 1, 0}, {2, 1, 2}));
     Material m;
-    m.alpha_mask = alpha_mask;
+    m.alpha_mode = mode;
     m.alpha_cutoff = 0.5f;
     m.base_color = {1, 1, 1, factor_alpha};
     m.base_color_texture = TextureId{0};
@@ -743,7 +743,7 @@ TEST(RayTracerAlpha, CutOutsLetRaysThroughWhereTheRasteriserDiscards) {
   above.direction = {0, -1, 0};  // shines down: shadow rays go up
   const glm::vec3 up(0, 1, 0);
   {
-    const Scene scene = card_scene(true, 1.0f);
+    const Scene scene = card_scene(AlphaMode::mask, 1.0f);
     const RayTracer tracer = build(scene);
     EXPECT_EQ(tracer.alpha_masked_geometries(), 1u);
     EXPECT_EQ(tracer.hard_visibility({-0.6f, 0, 0.3f}, up, above), 1.0f);  // u = 0.2: cut away
@@ -752,15 +752,29 @@ TEST(RayTracerAlpha, CutOutsLetRaysThroughWhereTheRasteriserDiscards) {
     EXPECT_TRUE(tracer.intersect({0.6f, 0, 0}, up).has_value());
   }
   {
-    const Scene scene = card_scene(true, 0.4f);  // 0.4 x 1 < cutoff: the whole card is cut
+    const Scene scene = card_scene(AlphaMode::mask, 0.4f);  // 0.4 x 1 < cutoff: the whole card is cut
     const RayTracer tracer = build(scene);
     EXPECT_EQ(tracer.hard_visibility({0.6f, 0, 0}, up, above), 1.0f);
   }
   {
-    const Scene scene = card_scene(false, 1.0f);  // opaque material: the texture's alpha is unused
+    const Scene scene = card_scene(AlphaMode::opaque, 1.0f);  // opaque material: the texture's alpha is unused
     const RayTracer tracer = build(scene);
     EXPECT_EQ(tracer.alpha_masked_geometries(), 0u);
     EXPECT_EQ(tracer.hard_visibility({-0.6f, 0, 0}, up, above), 0.0f);
+  }
+  // A blended caster casts where alpha >= alpha_cutoff, as the depth pass draws it (the
+  // shadow rule of components/material.h's AlphaMode).
+  {
+    const Scene scene = card_scene(AlphaMode::blend, 1.0f);
+    const RayTracer tracer = build(scene);
+    EXPECT_EQ(tracer.alpha_masked_geometries(), 1u);
+    EXPECT_EQ(tracer.hard_visibility({-0.6f, 0, 0.3f}, up, above), 1.0f);  // alpha 0: no shadow
+    EXPECT_EQ(tracer.hard_visibility({0.6f, 0, -0.3f}, up, above), 0.0f);  // alpha 1: shadow
+  }
+  {
+    const Scene scene = card_scene(AlphaMode::blend, 0.4f);  // 0.4 < 0.5 everywhere
+    const RayTracer tracer = build(scene);
+    EXPECT_EQ(tracer.hard_visibility({0.6f, 0, 0}, up, above), 1.0f);
   }
 }
 

@@ -8,6 +8,8 @@
 #include <tuple>
 #include <vector>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "runtime/render/draw_list.h"
 
 namespace kaskad::render {
@@ -20,7 +22,7 @@ std::vector<Material> materials() {
   out[2].roughness = 0.9f;
   out[3].metallic = 0.0f;
   out[4].metallic = -0.0f;  // equal to out[3]
-  out[5].alpha_mask = true;
+  out[5].alpha_mode = AlphaMode::mask;
   out[5].features = VariantKey().set(VariantKey::kAlphaMask, 1).bits();
   out[5].alpha_cutoff = 0.3f;
   out[6].double_sided = true;
@@ -136,16 +138,61 @@ TEST(DrawList, TheOrderOfClassesIsTheSameWhateverOrderDrawsArriveIn) {
   std::reverse(b.draws.begin(), b.draws.end());
   auto classes = [](const FrameInput& f) {
     const DrawList list = build_draw_list(f, frame_variant(f));
-    std::vector<std::tuple<std::uint64_t, bool, std::uint32_t, bool, float, float, float>> out;
+    std::vector<std::tuple<std::uint64_t, bool, std::uint32_t, AlphaMode, float, float, float>> out;
     for (std::uint32_t i : list.forward_order) {
       const DrawItem& d = f.draws[i];
       out.emplace_back(list.keys[i].bits(), mirrors(d.model), std::uint32_t(d.mesh),
-                       d.material.alpha_mask, d.material.roughness, d.material.base_color.r,
+                       d.material.alpha_mode, d.material.roughness, d.material.base_color.r,
                        d.material.metallic == 0.0f ? 0.0f : d.material.metallic);
     }
     return out;
   };
   EXPECT_EQ(classes(a), classes(b));
+}
+
+// Blended draws leave the forward and capture orders (the depth order keeps them: they cast as
+// cut-outs), and back_to_front() sorts them farthest first along the view direction, equal
+// distances in draw order, with bounds' centres or, without bounds, the model's origin.
+TEST(DrawList, BlendedDrawsAreDrawnApartAndBackToFront) {
+  FrameInput frame;
+  const float z[] = {-2.0f, -8.0f, -5.0f, -8.0f, -1.0f};  // view depths 2, 8, 5, 8 and an opaque 1
+  for (int i = 0; i < 5; ++i) {
+    DrawItem d;
+    d.mesh = MeshId{0};
+    if (i < 4) {
+      d.material.alpha_mode = AlphaMode::blend;
+      d.material.features = VariantKey::kAlphaBlend.mask();
+    }
+    if (i == 2) {
+      d.model[3] = glm::vec4(0, 0, z[i], 1);  // no bounds: its origin
+    } else {
+      d.bounds = Aabb::from_corners(glm::vec3(-1, -1, z[i] - 0.5f), glm::vec3(1, 1, z[i] + 0.5f));
+      d.model[3] = glm::vec4(100, 0, 100, 1);  // far from its bounds: not used
+    }
+    frame.draws.push_back(d);
+  }
+  frame.shadow_views.push_back(ShadowView{});
+  frame.probes.push_back(ProbeJob{});
+  const DrawList list = build_draw_list(frame, frame_variant(frame));
+  EXPECT_EQ(list.forward_order, std::vector<std::uint32_t>{4});
+  EXPECT_EQ(list.capture_order, std::vector<std::uint32_t>{4});
+  EXPECT_EQ(list.blend_draws, (std::vector<std::uint32_t>{0, 1, 2, 3}));
+  EXPECT_EQ(list.depth_order.size(), 5u);
+  // Blended casters use the alpha-masked depth program.
+  EXPECT_TRUE(list.keys[0].filtered_for(Pass::depth).has(VariantKey::kAlphaMask));
+  // A camera at the origin looking down -z: view depth -z.
+  const glm::mat4 view(1.0f);
+  EXPECT_EQ(back_to_front(frame, list.blend_draws, view_depth_plane(view)),
+            (std::vector<std::uint32_t>{1, 3, 2, 0}));
+  // Turned round (looking down +z from z = -10): the order reverses, ties still in draw order.
+  const glm::mat4 behind = glm::lookAt(glm::vec3(0, 0, -10), glm::vec3(0, 0, 0), glm::vec3(0, 1, 0));
+  EXPECT_EQ(back_to_front(frame, list.blend_draws, view_depth_plane(behind)),
+            (std::vector<std::uint32_t>{0, 2, 1, 3}));
+  // A perspective view-projection's clip w is the same distance (probe faces).
+  const glm::mat4 proj = glm::perspective(glm::radians(90.0f), 1.0f, 0.1f, 100.0f);
+  const glm::vec4 plane = clip_depth_plane(proj * behind);
+  EXPECT_NEAR(glm::dot(plane, glm::vec4(0, 0, -5, 1)), 5.0f, 1e-4f);
+  EXPECT_EQ(back_to_front(frame, list.blend_draws, plane), (std::vector<std::uint32_t>{0, 2, 1, 3}));
 }
 
 }  // namespace
