@@ -917,7 +917,7 @@ TEST(RayTracerCasterFaces, CutOutsAndFacesTogether) {
   tex.rgba8 = {255, 255, 255, 0, 255, 255, 255, 255};  // u < 0.5 cut away
   scene.assets.textures.push_back(tex);
   scene.world.view<Material>().each([](ecs::Entity, Material& m) {
-    m.alpha_mask = true;
+    m.alpha_mode = AlphaMode::mask;
     m.base_color_texture = TextureId{0};
     m.features = derive_material_features(m);
   });
