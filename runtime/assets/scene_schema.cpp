@@ -1,5 +1,6 @@
 #include "runtime/assets/scene_schema.h"
 
+#include "components/animation.h"
 #include "components/camera.h"
 #include "components/light.h"
 #include "components/limits.h"
@@ -115,6 +116,9 @@ json entity_schema() {
                                       {"description", "Overrides of imported nodes, by name"}}}},
                           "A glTF model");
   props["model"]["required"] = {"path"};
+  props["animation"] = {{"type", "object"},
+                        {"additionalProperties", table_object<AnimationState>("One clip of the model")},
+                        {"description", "The model's clips by name: how each plays"}};
   props["material"] = {
       {"description", "A material file, or the built-in parameters inline"},
       {"anyOf",
