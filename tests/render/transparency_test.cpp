@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "components/light.h"
+#include "tests/unit/assets/asset_test_util.h"
 #include "components/transform.h"
 #include "runtime/app/player.h"
 #include "runtime/reference/ray_tracer.h"
@@ -28,25 +29,11 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using test::base64;
 
 constexpr int kSize = 64;  // square test frames
 
 // ---- A small glTF writer: boxes and quads with normals and uvs, one material each ----------
-
-std::string base64(const std::vector<std::uint8_t>& bytes) {
-  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    std::uint32_t v = std::uint32_t(bytes[i]) << 16;
-    if (i + 1 < bytes.size()) v |= std::uint32_t(bytes[i + 1]) << 8;
-    if (i + 2 < bytes.size()) v |= bytes[i + 2];
-    out += kAlphabet[(v >> 18) & 63];
-    out += kAlphabet[(v >> 12) & 63];
-    out += i + 1 < bytes.size() ? kAlphabet[(v >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? kAlphabet[v & 63] : '=';
-  }
-  return out;
-}
 
 /// Meshes of axis-aligned quads, each mesh under one node with a translation.
 class Gltf {

@@ -15,6 +15,22 @@
 
 namespace kaskad::test {
 
+/// RFC 4648 base64 of `bytes` (data: URIs of the glTF files tests write).
+inline std::string base64(const std::vector<std::uint8_t>& bytes) {
+  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    std::uint32_t v = std::uint32_t(bytes[i]) << 16;
+    if (i + 1 < bytes.size()) v |= std::uint32_t(bytes[i + 1]) << 8;
+    if (i + 2 < bytes.size()) v |= bytes[i + 2];
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? kAlphabet[(v >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? kAlphabet[v & 63] : '=';
+  }
+  return out;
+}
+
 /// Path of a file under content/, e.g. content_path("models/Box/glTF-Binary/Box.glb").
 inline std::filesystem::path content_path(const std::string& relative) {
   return std::filesystem::path(KASKAD_CONTENT_DIR) / relative;

@@ -31,6 +31,7 @@ namespace {
 
 using nlohmann::json;
 using test::content_path;
+using test::base64;
 using test::read_bytes;
 using test::temp_dir;
 using test::write_bytes;
@@ -89,21 +90,6 @@ void expect_valid_meshes(const AssetStore& assets) {
       ASSERT_TRUE(len == 0.0f || std::abs(len - 1.0f) < 1e-4f) << len;
     }
   }
-}
-
-std::string base64(const std::vector<std::uint8_t>& bytes) {
-  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    std::uint32_t v = std::uint32_t(bytes[i]) << 16;
-    if (i + 1 < bytes.size()) v |= std::uint32_t(bytes[i + 1]) << 8;
-    if (i + 2 < bytes.size()) v |= bytes[i + 2];
-    out += kAlphabet[(v >> 18) & 63];
-    out += kAlphabet[(v >> 12) & 63];
-    out += i + 1 < bytes.size() ? kAlphabet[(v >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? kAlphabet[v & 63] : '=';
-  }
-  return out;
 }
 
 template <class T>
