@@ -49,8 +49,14 @@ struct Animator {
   std::vector<AnimationState> clips;
   std::vector<std::string> names;  ///< each clip's name (unique: AnimationClip::name)
   std::vector<ecs::Entity> nodes;
-  /// A clip whose time was set (a scene file, --set) is applied once even when stopped.
-  std::vector<bool> pose_pending;
+  /// Per clip, what a scene file or --set last gave it: the time it was set to, which a save
+  /// writes for a playing clip (its clock is not authored: save, load, save is the same file),
+  /// and whether that pose is still to be shown once (a stopped clip posed where it was set).
+  struct Cue {
+    float time = 0.0f;
+    bool pending = false;
+  };
+  std::vector<Cue> cues;
 };
 
 /// Morph-target weights of a glTF node (node.weights, else its mesh's weights); animations

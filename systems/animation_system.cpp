@@ -56,7 +56,7 @@ void apply(ecs::World& world, const Animator& animator, const AnimationClip& cli
 
 void update_animations(ecs::World& world, const AssetStore& assets, double dt) {
   world.view<Animator>().each([&](ecs::Entity, Animator& a) {
-    a.pose_pending.resize(a.clips.size(), false);
+    a.cues.resize(a.clips.size());
     // In file order, so that the later clip wins where two drive one node.
     for (std::size_t k = 0; k < a.clips.size(); ++k) {
       const std::size_t at = a.first_clip + k;
@@ -65,8 +65,8 @@ void update_animations(ecs::World& world, const AssetStore& assets, double dt) {
       const AnimationClip& clip = assets.animations[at];
       // The frame shows the clip at its time now; the clock then moves on for the next frame
       // (so frame n of a run shows n * dt, as playback files count time).
-      if (s.playing || a.pose_pending[k]) apply(world, a, clip, s.time);
-      a.pose_pending[k] = false;
+      if (s.playing || a.cues[k].pending) apply(world, a, clip, s.time);
+      a.cues[k].pending = false;
       if (s.playing && dt != 0.0) advance(s, clip.duration, dt);
     }
   });
@@ -74,7 +74,7 @@ void update_animations(ecs::World& world, const AssetStore& assets, double dt) {
 
 void set_animation_time(ecs::World& world, const AssetStore& assets, float seconds) {
   world.view<Animator>().each([&](ecs::Entity, Animator& a) {
-    a.pose_pending.resize(a.clips.size(), false);
+    a.cues.resize(a.clips.size());
     for (std::size_t k = 0; k < a.clips.size(); ++k) {
       if (!a.clips[k].playing) continue;
       const std::size_t at = a.first_clip + k;
@@ -82,7 +82,7 @@ void set_animation_time(ecs::World& world, const AssetStore& assets, float secon
       AnimationState& s = a.clips[k];
       s.time = 0.0f;
       advance(s, duration, double(seconds));  // scene seconds times the clip's speed
-      a.pose_pending[k] = true;
+      a.cues[k].pending = true;
     }
   });
 }

@@ -12,7 +12,7 @@ namespace kaskad {
 
 /// Advances every playing clip by `dt` seconds times its speed (looping clips wrap, others stop
 /// at their end) and writes the pose of every playing clip, and of any whose time was set since
-/// (Animator::pose_pending), into its nodes' Transform and MorphWeights. dt 0 poses without
+/// (Animator::cues), into its nodes' Transform and MorphWeights. dt 0 poses without
 /// advancing. Clips later in the file win where two drive the same node.
 void update_animations(ecs::World& world, const AssetStore& assets, double dt);
 

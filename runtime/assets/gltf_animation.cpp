@@ -207,7 +207,7 @@ Status import_animations(Importer& im) {
   for (std::size_t k = 0; k < animator.clips.size(); ++k)
     animator.names.push_back(im.assets.animations[first + k].name);
   animator.clips[0].playing = true;  // a model plays its first clip unless the scene says not
-  animator.pose_pending.assign(animator.clips.size(), false);
+  animator.cues.resize(animator.clips.size());
   animator.nodes = im.node_entities;
   im.world.emplace<Animator>(im.source, std::move(animator));
   return {};

@@ -278,7 +278,7 @@ std::string rebase_path(const Scene& scene, const fs::path& base, const std::str
 }
 
 void read_animation(ObjectReader& r, Animator& a) {
-  a.pose_pending.resize(a.clips.size(), false);
+  a.cues.resize(a.clips.size());
   for (auto it = r.raw_object().begin(); it != r.raw_object().end(); ++it) {
     const std::string& clip = it.key();
     const auto found = std::find(a.names.begin(), a.names.end(), clip);
@@ -291,14 +291,17 @@ void read_animation(ObjectReader& r, Animator& a) {
     ObjectReader cr(it.value(), r.at(clip.c_str()));
     read_fields(cr, a.clips[k]);
     cr.finish();
-    a.pose_pending[k] = true;
+    a.cues[k] = {a.clips[k].time, true};
   }
 }
 
-json write_animation(const Animator& a) {
+json write_animation(const Animator& a, ClipTime time) {
   json j = json::object();
-  for (std::size_t k = 0; k < a.clips.size() && k < a.names.size(); ++k)
-    j[a.names[k]] = write_fields(a.clips[k]);
+  for (std::size_t k = 0; k < a.clips.size() && k < a.names.size(); ++k) {
+    AnimationState s = a.clips[k];
+    if (time == ClipTime::as_set && s.playing && k < a.cues.size()) s.time = a.cues[k].time;
+    j[a.names[k]] = write_fields(s);
+  }
   return j;
 }
 
@@ -324,7 +327,12 @@ json entity_to_json(const Scene& scene, ecs::Entity e, const fs::path& base) {
     j["model"] = {{"path", rebase(m->path)}};
     if (!m->nodes.empty()) j["model"]["nodes"] = write_node_overrides(scene, e);
   }
-  if (const auto* a = w.try_get<Animator>(e)) j["animation"] = write_animation(*a);
+  if (const auto* a = w.try_get<Animator>(e)) {
+    j["animation"] = write_animation(*a, ClipTime::as_set);
+  } else if (const auto* m = w.try_get<ModelRef>(e); m && !m->animation.empty()) {
+    // A scene read but not loaded (kaskad save): the block as the file gave it.
+    j["animation"] = json::parse(m->animation, nullptr, /*allow_exceptions=*/false);
+  }
   if (const auto* mr = w.try_get<MeshRenderer>(e))
     j["renderer"] = write_fields(*mr);
   if (const auto* ref = w.try_get<MaterialRef>(e)) {

@@ -91,13 +91,16 @@ bool read_section(ecs::World& w, ecs::Entity e, const std::string& section, cons
 /// The entities imported for model entity `model` that are named `node`.
 std::vector<ecs::Entity> nodes_named(const ecs::World& w, ecs::Entity model,
                                      const std::string& node);
-/// A model's `nodes` block: node name -> section -> fields, checked for shape; the values are
-/// read when the model is imported, over what its file gives.
 /// A model entity's `animation` block: clip name -> AnimationState fields (those given set;
 /// a clip given is posed at its time next frame). Errors name an unknown clip with the valid ones.
 void read_animation(ObjectReader& r, Animator& a);
-/// Every clip with every field (the canonical form --set acts on).
-json write_animation(const Animator& a);
+/// Which time write_animation() gives a playing clip: its clock now (the editor's timeline,
+/// --set acting on the live state) or the time it was last set to (a saved file).
+enum class ClipTime { now, as_set };
+/// Every clip with every field.
+json write_animation(const Animator& a, ClipTime time);
+/// A model's `nodes` block: node name -> section -> fields, checked for shape; the values are
+/// read when the model is imported, over what its file gives.
 std::vector<NodeOverride> read_node_overrides(const json& nodes, const std::string& where);
 /// The `nodes` block written for model entity `model`.
 json write_node_overrides(const Scene& scene, ecs::Entity model);

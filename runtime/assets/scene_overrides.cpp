@@ -120,6 +120,9 @@ json settable_sections(const Scene& scene, ecs::Entity e) {
     ej["shadow"] = write_shadow(*s, nullptr);
   ej.erase("name");
   if (ej.contains("transform")) ej["transform"].erase("parent");
+  // Clips as they play now: a --set of one field keeps the others where the clock has them.
+  if (const auto* a = scene.world.try_get<Animator>(e))
+    ej["animation"] = write_animation(*a, ClipTime::now);
   return ej;
 }
 
@@ -290,6 +293,15 @@ Status apply_override(json& doc, const std::string& assignment) {
                                      "'; sections: " + join({kSettingSections.begin(), kSettingSections.end()}) + "; entities: " + join(names)};
   }
   parts.erase(parts.begin());
+  // A model's clips are known once it is imported: ENTITY.animation.CLIP.FIELD makes its block
+  // for any clip and field name, which the import then checks (read_animation() names the
+  // model's clips, read_fields() the valid fields).
+  if (parts.size() == 3 && parts[0] == "animation" && node->is_object() && node->contains("model") &&
+      (!node->contains("animation") || (*node)["animation"].is_object())) {
+    json& clip = (*node)["animation"][parts[1]];
+    if (clip.is_null()) clip = json::object();
+    if (clip.is_object() && !clip.contains(parts[2])) clip[parts[2]] = nullptr;
+  }
   return set_field(node, parts, key, text);
 }
 

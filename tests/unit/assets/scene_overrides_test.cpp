@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "components/animation.h"
 #include "components/camera.h"
 #include "components/light.h"
 #include "components/name.h"
@@ -260,6 +261,60 @@ TEST(SceneIo, LiveOverridesChangeALoadedSceneAsAFileWould) {
   EXPECT_NE(bad.error().to_string().find("cascade_count"), std::string::npos);
   EXPECT_EQ(s->shadow_defaults.cascade_count, 2);
   EXPECT_EQ(s->world.get<ShadowSettings>(find(*s, "a")).cascade_count, 2);
+}
+
+// A model's clips: a save writes a playing clip's time as it was last set (its clock is not
+// authored, so save -> load -> save is the same file) and a stopped clip's where it stopped;
+// --set of one field acts on the live state and keeps the clock; the document takes
+// ENTITY.animation.CLIP.FIELD before the import knows the clips (which then checks the name);
+// a scene read but not loaded saves the block as given.
+TEST(SceneIo, AnimationBlocksSaveTheTimeAsSetAndTakeOverrides) {
+  const fs::path fox = kContent / "scenes" / "fox_walk.json";
+  auto s = read_scene(fox);
+  ASSERT_TRUE(s.ok()) << s.error().to_string();
+  EXPECT_TRUE(scene_to_json(*s)["entities"].dump().find("\"Survey\"") != std::string::npos)
+      << "read but not loaded: the block as the file gave it";
+  ASSERT_TRUE(instantiate_scene(*s).ok());
+  Animator& a = s->world.get<Animator>(find(*s, "walker"));
+  const auto clip = [&](const std::string& name) {
+    return std::size_t(std::find(a.names.begin(), a.names.end(), name) - a.names.begin());
+  };
+  const std::size_t walk = clip("Walk"), survey = clip("Survey");
+  ASSERT_LT(walk, a.clips.size());
+  ASSERT_LT(survey, a.clips.size());
+  ASSERT_TRUE(a.clips[walk].playing);
+  a.clips[walk].time = 0.7f;    // the clock moved on
+  a.clips[survey].time = 1.25f;  // a stopped clip, put there
+  auto saved_clip = [&](const char* name) {
+    const nlohmann::json doc = scene_to_json(*s);
+    for (const auto& e : doc["entities"])
+      if (e.value("name", "") == "walker") return e["animation"][name];
+    return nlohmann::json();
+  };
+  EXPECT_FLOAT_EQ(saved_clip("Walk")["time"].get<float>(), 0.0f);
+  EXPECT_FLOAT_EQ(saved_clip("Survey")["time"].get<float>(), 1.25f);
+  EXPECT_FLOAT_EQ(live_entity_sections(*s, find(*s, "walker"))["animation"]["Walk"]["time"].get<float>(), 0.7f);
+  // One field set live: the others stay where the clock has them.
+  ASSERT_TRUE(apply_live_override(*s, "walker.animation.Walk.speed=2").ok());
+  EXPECT_FLOAT_EQ(a.clips[walk].speed, 2.0f);
+  EXPECT_NEAR(a.clips[walk].time, 0.7f, 1e-6f);
+  ASSERT_TRUE(apply_live_override(*s, "walker.animation.Walk.time=0.3").ok());
+  a.clips[walk].time = 0.9f;
+  EXPECT_FLOAT_EQ(saved_clip("Walk")["time"].get<float>(), 0.3f);
+  EXPECT_FLOAT_EQ(saved_clip("Walk")["speed"].get<float>(), 2.0f);
+
+  // The document: a glTF file wrapped into a scene has no animation block until --set makes one.
+  const fs::path truck = kContent / "models" / "CesiumMilkTruck" / "glTF" / "CesiumMilkTruck.gltf";
+  auto stopped = read_scene(truck, {"model.animation.animation_0.playing=false"});
+  ASSERT_TRUE(stopped.ok()) << stopped.error().to_string();
+  ASSERT_TRUE(instantiate_scene(*stopped).ok());
+  EXPECT_FALSE(stopped->world.get<Animator>(find(*stopped, "model")).clips[0].playing);
+  auto wrong = read_scene(truck, {"model.animation.wheels.playing=false"});
+  ASSERT_TRUE(wrong.ok()) << wrong.error().to_string();
+  auto st = instantiate_scene(*wrong);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().to_string().find("no clip named 'wheels'"), std::string::npos) << st.error().to_string();
+  EXPECT_NE(st.error().to_string().find("animation_0"), std::string::npos);
 }
 
 }  // namespace

@@ -34,7 +34,7 @@ struct OneClip {
     a.clips[0].playing = true;
     a.names = {"slide"};
     a.nodes = {node};
-    a.pose_pending = {false};
+    a.cues.resize(1);
     world.emplace<Animator>(model, a);
   }
   float x() { return world.get<Transform>(node).translation.x; }
