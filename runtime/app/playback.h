@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "components/bounds.h"
 #include "runtime/result/result.h"
 
 namespace kaskad {
@@ -80,6 +81,9 @@ struct FlickerExpect {
   /// Bound on StabilityStats::changed_pct: samples that changed by more than an 8-bit step
   /// (the blend band's float rounding, ~1e-10, does not count).
   std::optional<double> max_changed_pct;
+  /// Only the receiver points inside this world box (`within`; none: every point seen): the
+  /// static receivers of a scene with moving casters, whose shadows may rightly change.
+  std::optional<Aabb> within;
 };
 
 struct RatioExpect {

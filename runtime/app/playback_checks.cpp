@@ -100,6 +100,11 @@ Status check_flicker(const Playback& pb, int f, render::Renderer& renderer,
     auto p = stability_points(renderer.read_aovs());
     if (!p) return p.error();
     samples.points = std::move(p.value());
+    if (q.within) keep_points_within(samples.points, *q.within);
+    if (samples.points.positions.empty())
+      return Error{pb.file.string(), "expect.flicker",
+                   "no receiver point seen on frame " + std::to_string(f) +
+                       (q.within ? " lies within the box" : "")};
   }
   auto v = visibility_at_seen_points(renderer, report.camera, samples.points);
   if (!v) return v.error();

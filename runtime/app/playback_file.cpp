@@ -168,6 +168,17 @@ void read_expect(ObjectReader& r, Playback& pb, const fs::path& base) {
     }
     if (!f.max && !f.min && !f.max_changed_pct)
       fail(r.at("flicker"), "give max, min or max_changed_pct");
+    if (fr.has("within")) {
+      ObjectReader wr(fr.raw("within"), fr.at("within"));
+      Aabb box;
+      wr.vector<3>("min", box.min, kCoordinate.lo, kCoordinate.hi);
+      wr.vector<3>("max", box.max, kCoordinate.lo, kCoordinate.hi);
+      if (!wr.has("min") || !wr.has("max")) fail(fr.at("within"), "give min and max (world corners)");
+      if (glm::any(glm::lessThan(box.max, box.min)))
+        fail(wr.at("max"), "every coordinate of max must be at least min's");
+      wr.finish();
+      f.within = box;
+    }
     fr.finish();
     pb.flicker = f;
   }

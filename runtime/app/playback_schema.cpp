@@ -129,7 +129,14 @@ json expectations() {
        {"to", frame("Last frame of the range, after from")},
        {"max", number(kFlicker, "Most flicker")},
        {"min", number(kFlicker, "Flicker must be above this")},
-       {"max_changed_pct", number(kPercent, "% of samples that may change by more than an 8-bit step")}},
+       {"max_changed_pct", number(kPercent, "% of samples that may change by more than an 8-bit step")},
+       {"within", [] {
+          json box = object({{"min", numbers(3, kCoordinate, "World corner, least x, y, z")},
+                             {"max", numbers(3, kCoordinate, "World corner, greatest x, y, z")}},
+                            "Only the receiver points inside this world box");
+          box["required"] = {"min", "max"};
+          return box;
+        }()}},
       "Shadow flicker over a frame range");
   flicker["anyOf"] = {{{"required", {"max"}}}, {{"required", {"min"}}}, {{"required", {"max_changed_pct"}}}};
   json probes = object({{"count", integer(kRepeat, "Captures completed over the run, all probes")},

@@ -9,6 +9,18 @@
 
 namespace kaskad {
 
+void keep_points_within(StabilityPoints& points, const Aabb& box) {
+  StabilityPoints kept;
+  for (std::size_t i = 0; i < points.positions.size(); ++i) {
+    const glm::vec3 p = points.positions[i];
+    if (glm::any(glm::lessThan(p, box.min)) || glm::any(glm::greaterThan(p, box.max))) continue;
+    kept.positions.push_back(p);
+    kept.normals.push_back(points.normals[i]);
+    kept.pixels.push_back(points.pixels[i]);
+  }
+  points = std::move(kept);
+}
+
 Result<StabilityPoints> stability_points(const Image& aov, int max_points) {
   auto channel = [&](const char* name) {
     const auto it = std::find(aov.channel_names.begin(), aov.channel_names.end(), name);

@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "components/bounds.h"
 #include "runtime/assets/image_io.h"
 #include "runtime/app/player.h"
 #include "runtime/reference/shadow_metrics.h"
@@ -22,6 +23,8 @@ struct StabilityPoints {
   std::vector<glm::ivec2> pixels;  ///< where each point was taken from (x right, y down)
 };
 Result<StabilityPoints> stability_points(const Image& aov, int max_points = 4096);
+/// Drops the points outside `box` (world space, faces included).
+void keep_points_within(StabilityPoints& points, const Aabb& box);
 
 /// The camera path: `frames` frames; frame f moves the camera by f * step along its own right
 /// and up axes (step * (right + 0.5 up)), so every point keeps its view depth and no point

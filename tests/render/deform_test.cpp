@@ -12,6 +12,7 @@
 #include "components/transform.h"
 #include "runtime/app/player.h"
 #include "runtime/assets/mesh_pose.h"
+#include "runtime/assets/scene_io.h"
 #include "runtime/reference/ray_tracer.h"
 #include "runtime/reference/shadow_metrics.h"
 #include "systems/animation_system.h"
@@ -71,6 +72,13 @@ TEST_F(DeformTest, GpuPoseMatchesTheCpuPoseAndStaysInItsBounds) {
       }
     }
     EXPECT_LT(worst, 1e-5f * size) << "GPU and CPU poses differ by " << worst << " m";
+    // ... and are tight: no side more than 1.5 times the pose's own (the bind pose's box, or one in
+    // the mesh's units, would hold it too).
+    Aabb own;
+    for (const glm::vec3& v : gpu) own.expand(v);
+    const glm::vec3 ratio = bounds.extent() / glm::max(own.extent(), glm::vec3(1e-3f * size));
+    std::printf("t=%.2f: bounds / pose extent %.2f %.2f %.2f\n", t, ratio.x, ratio.y, ratio.z);
+    EXPECT_LT(std::max({ratio.x, ratio.y, ratio.z}), 1.5f);
     if (first.empty()) first = gpu;
     else
       for (std::size_t v = 0; v < gpu.size(); ++v) moved = std::max(moved, glm::length(gpu[v] - first[v]));
@@ -103,6 +111,51 @@ TEST_F(DeformTest, AnimatedShadowAgreesWithTheReferenceAtSeveralTimes) {
                 s.misclassified, s.pixels, s.misclassified_pct);
     EXPECT_GT(s.pixels, 10000u);
     EXPECT_LT(s.misclassified_pct, 0.5);
+  }
+}
+
+// The kept-layer cache with an animated caster: the Fox walks far off, in some of the shadow
+// map's layers but not all. Each frame poses it anew, so from the second frame on exactly the
+// layers that hold it are drawn again; with its clip stopped, none is. (Breaking the pose hash
+// in the layer's inputs, or drawing every layer for any deformed caster, fails it.)
+TEST_F(DeformTest, AnAnimatedCasterRedrawsOnlyTheLayersThatHoldIt) {
+  const std::vector<std::string> far = {"render.width=320", "render.height=180",
+                                        "walker.transform.translation=[-4,0,-7]"};
+  std::vector<std::string> hidden = far;
+  hidden.push_back("walker.renderer.cast_shadows=false");
+  auto without = load_scene(kFoxScene, hidden);
+  ASSERT_TRUE(without.ok()) << without.error().to_string();
+  RenderRun run;
+  run.dt = 0.05;
+  auto base = render_frames(*player_, *without, run);
+  ASSERT_TRUE(base.ok()) << base.error().to_string();
+  auto scene = load_scene(kFoxScene, far);
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  auto first = render_frames(*player_, *scene, run);
+  ASSERT_TRUE(first.ok()) << first.error().to_string();
+  const render::FrameStats& a = first->last.stats;
+  const int layers = a.shadow_layers;
+  ASSERT_GE(layers, 2);
+  EXPECT_EQ(a.shadow_layers_rendered, (1u << layers) - 1u);
+  std::uint32_t holding = 0;  // the layers with the Fox among their casters
+  for (int l = 0; l < layers; ++l)
+    if (a.layer_casters[std::size_t(l)] != base->last.stats.layer_casters[std::size_t(l)]) holding |= 1u << l;
+  std::printf("Fox far off: in layers 0x%x of %d\n", holding, layers);
+  ASSERT_NE(holding, 0u) << "the Fox casts into no layer: the test proves nothing";
+  ASSERT_NE(holding, (1u << layers) - 1u) << "the Fox is in every layer: the test proves nothing";
+  for (int frame = 0; frame < 3; ++frame) {
+    auto next = render_frames(*player_, *scene, run);
+    ASSERT_TRUE(next.ok()) << next.error().to_string();
+    EXPECT_EQ(next->last.stats.shadow_layers_rendered, holding) << "frame " << frame;
+  }
+  // Stopped: the next frame shows the clip where its clock stopped (its last move), then the
+  // pose holds and every layer keeps its depth.
+  ASSERT_TRUE(apply_live_override(*scene, "walker.animation.Walk.playing=false").ok());
+  for (int frame = 0; frame < 3; ++frame) {
+    auto still = render_frames(*player_, *scene, run);
+    ASSERT_TRUE(still.ok()) << still.error().to_string();
+    EXPECT_EQ(still->last.stats.shadow_layers_rendered, frame == 0 ? holding : 0u)
+        << "stopped, frame " << frame;
   }
 }
 

@@ -28,7 +28,8 @@ TEST(Playback, AFullFileParses) {
                  {"entity": "box", "keys": [{"t": 0, "move": [0, 0, 0]}, {"t": 1, "move": [1, 0, 0]}]}],
     "capture": {"frames": [19, 0, 0], "every": 10, "aovs": true},
     "expect": {"golden": {"fail_percent": 1}, "misclassified_pct": {"frames": [0], "max": 0.5},
-               "flicker": {"from": 0, "to": 19, "max_changed_pct": 0}, "compiles_after_prewarm": 0,
+               "flicker": {"from": 0, "to": 19, "max_changed_pct": 0,
+                           "within": {"min": [-1, 0, -1], "max": [1, 2, 1]}}, "compiles_after_prewarm": 0,
                "probe_captures": {"count": 2, "frames": [0, 10]}, "gl_errors": 0,
                "frame_time_ratio": {"a": [1, 9], "b": [10, 19], "max": 2}}})");
   ASSERT_TRUE(pb.ok()) << pb.error().to_string();
@@ -43,6 +44,8 @@ TEST(Playback, AFullFileParses) {
   EXPECT_EQ(pb->capture, (std::vector<int>{0, 10, 19}));
   EXPECT_EQ(pb->golden->dir, std::filesystem::path("dir/goldens/test"));
   EXPECT_EQ(pb->probes->frames, (std::vector<int>{0, 10}));
+  ASSERT_TRUE(pb->flicker && pb->flicker->within);
+  EXPECT_EQ(pb->flicker->within->max, glm::vec3(1, 2, 1));
 }
 
 TEST(Playback, AFileMayNameItsSchema) {
@@ -67,6 +70,10 @@ TEST(Playback, ErrorsNameTheFileThePathAndTheValidKeys) {
   expect_error(R"({"scene": "a.json", "expect": {"golden": {}}})", {"/expect/golden", "capture"});
   expect_error(R"({"scene": "a.json", "expect": {"flicker": {"from": 0, "to": 0, "max": 0}}})",
                {"/expect/flicker/to"});
+  expect_error(R"({"scene": "a.json", "frames": 6, "expect": {"flicker": {"to": 5, "max": 0, "within": {"min": [0, 0, 0], "max": [1, -1, 1]}}}})",
+               {"/expect/flicker/within/max", "at least min's"});
+  expect_error(R"({"scene": "a.json", "frames": 6, "expect": {"flicker": {"to": 5, "max": 0, "within": {"min": [0, 0, 0]}}}})",
+               {"/expect/flicker/within", "min and max"});
   expect_error(R"({"scene": "a.json",)", {"dir/test.json", "line 1", "malformed JSON"});
   expect_error(R"({"scene": "a.json", "frames": 1e999})", {"dir/test.json"});
 }

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "components/animation.h"
+#include "components/bounds.h"
+#include "components/mesh_renderer.h"
 #include "components/transform.h"
 
 namespace kaskad {
@@ -75,6 +77,39 @@ TEST(AnimationSystem, SetTimeScalesBySpeedAndPosesNextFrame) {
   EXPECT_FLOAT_EQ(s.x(), 1.5f);
   // dt 0 (a plan, a still re-render) poses without advancing.
   EXPECT_FLOAT_EQ(s.state().time, 1.5f);
+}
+
+// A morphed mesh's bounds hold the displaced vertices: one target lifts vertex 1 of a unit
+// triangle by 2 in y, so at weight 0.75 the pose reaches y = 1.5 (above the mesh's own box).
+// (Bounds without the morph growth fail it.)
+TEST(DeformSystem, MorphedBoundsHoldTheWeightedDisplacement) {
+  ecs::World world;
+  AssetStore assets;
+  MeshData mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  mesh.normals.assign(3, glm::vec3(0, 0, 1));
+  mesh.indices = {0, 1, 2};
+  mesh.compute_bounds();
+  MeshDeform::Target target;
+  target.positions = {{0, 0, 0}, {0, 2, 0}, {0, 0, 0}};
+  target.normals.assign(3, glm::vec3(0));
+  target.delta_bounds = Aabb::from_corners(glm::vec3(0), glm::vec3(0, 2, 0));
+  mesh.deform.targets.push_back(target);
+  mesh.deform.default_weights = {0.75f};
+  const MeshId id = assets.add_mesh(mesh);
+  const ecs::Entity e = world.create();
+  world.emplace<Transform>(e);
+  world.emplace<WorldTransform>(e);
+  MeshRenderer mr;
+  mr.mesh = id;
+  world.emplace<MeshRenderer>(e, mr);
+  world.emplace<Deformer>(e);
+  update_deformers(world, assets);
+  const Aabb box = world.get<WorldBounds>(e).box;
+  EXPECT_GE(box.max.y, 1.5f - 1e-6f);
+  // Conservative, no more: the mesh's box grown by the weighted target's box (1 + 0.75 x 2).
+  EXPECT_LE(box.max.y, 2.5f + 1e-6f);
+  EXPECT_FLOAT_EQ(box.min.y, 0.0f);
 }
 
 }  // namespace
