@@ -16,12 +16,14 @@
 
 namespace kaskad {
 
-/// KHR_texture_transform of one texture slot: uv' = T(offset) R(rotation) S(scale) uv, i.e.
+/// Which uvs one texture slot reads: the mesh's uv set `tex_coord` (glTF texCoord: TEXCOORD_0 or
+/// TEXCOORD_1), through KHR_texture_transform's uv' = T(offset) R(rotation) S(scale) uv, i.e.
 /// u' = s.x cos(r) u + s.y sin(r) v + offset.x, v' = -s.x sin(r) u + s.y cos(r) v + offset.y.
 struct TextureTransform {
   glm::vec2 offset{0.0f};  ///< uv units
   float rotation = 0.0f;   ///< radians, counter-clockwise in uv space
   glm::vec2 scale{1.0f};
+  std::uint8_t tex_coord = 0;  ///< the uv set (MeshData::uv_set())
 
   bool operator==(const TextureTransform&) const = default;
 };
@@ -31,6 +33,12 @@ inline std::array<glm::vec3, 2> uv_transform_rows(const TextureTransform& t) {
   const float c = std::cos(t.rotation), s = std::sin(t.rotation);
   return {glm::vec3(c * t.scale.x, s * t.scale.y, t.offset.x),
           glm::vec3(-s * t.scale.x, c * t.scale.y, t.offset.y)};
+}
+
+/// t's affine map applied to uv (of the set t.tex_coord), as the shaders' slot_uv() does.
+inline glm::vec2 transform_uv(const TextureTransform& t, glm::vec2 uv) {
+  const auto r = uv_transform_rows(t);
+  return {glm::dot(r[0], glm::vec3(uv, 1.0f)), glm::dot(r[1], glm::vec3(uv, 1.0f))};
 }
 
 /// How a reflector's probe map reaches the surface (docs/guide/materials.md, "What a material's

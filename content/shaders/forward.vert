@@ -4,6 +4,10 @@
 layout(location = ATTR_POSITION) in vec3 a_position;
 layout(location = ATTR_NORMAL) in vec3 a_normal;
 layout(location = ATTR_UV) in vec2 a_uv;
+#if MATERIAL_HAS_TEXTURE_TRANSFORM
+layout(location = ATTR_UV1) in vec2 a_uv1;  // slots on TEXCOORD_1 (features.glsl, slot_uv)
+out vec2 v_uv1;
+#endif
 #if MATERIAL_HAS_NORMAL_MAP
 layout(location = ATTR_TANGENT) in vec4 a_tangent;  // xyz tangent, w bitangent sign
 #endif
@@ -20,6 +24,9 @@ void main() {
   v_world_pos = world.xyz;
   v_world_normal = a_normal_matrix * a_normal;
   v_uv = a_uv;
+#if MATERIAL_HAS_TEXTURE_TRANSFORM
+  v_uv1 = a_uv1;
+#endif
 #if MATERIAL_HAS_NORMAL_MAP
   // A tangent lies in the surface: it goes through the model matrix, not the normal matrix. A
   // mirroring transform reverses cross(n, t), so the bitangent's sign follows the determinant.

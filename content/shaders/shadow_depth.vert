@@ -28,10 +28,17 @@ layout(location = ATTR_POSITION) in vec3 a_position;
 layout(location = ATTR_UV) in vec2 a_uv;
 out vec2 v_uv;
 #endif
+#if MATERIAL_HAS_TEXTURE_TRANSFORM
+layout(location = ATTR_UV1) in vec2 a_uv1;  // a cut-out on TEXCOORD_1 (features.glsl, slot_uv)
+out vec2 v_uv1;
+#endif
 
 void main() {
 #if MATERIAL_HAS_ALPHA_MASK
   v_uv = a_uv;
+#endif
+#if MATERIAL_HAS_TEXTURE_TRANSFORM
+  v_uv1 = a_uv1;
 #endif
 #if VARIANT_SHADOW_PEEL
   v_receiver_only = a_layer;

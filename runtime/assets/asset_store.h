@@ -40,19 +40,25 @@ struct MeshDeform {
   bool any() const { return skinned() || morphed(); }
 };
 
-/// Indexed triangle list. positions, normals and uvs have one entry per vertex (uvs may be empty);
-/// tangents are optional (xyz tangent, w handedness, glTF convention).
+/// Indexed triangle list. positions, normals and uvs have one entry per vertex (uvs and uvs1 may
+/// be empty); tangents are optional (xyz tangent, w handedness, glTF convention).
 struct MeshData {
   std::string name;
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
-  std::vector<glm::vec2> uvs;
+  std::vector<glm::vec2> uvs;   ///< TEXCOORD_0
+  std::vector<glm::vec2> uvs1;  ///< TEXCOORD_1
   std::vector<glm::vec4> tangents;
   std::vector<std::uint32_t> indices;  ///< 3 per triangle, each < positions.size()
   Aabb bounds;                         ///< of positions (computed, never taken from accessor min/max)
   MeshDeform deform;                   ///< skin weights and morph targets (none for most meshes)
 
   std::size_t triangle_count() const { return indices.size() / 3; }
+  /// The uvs a texture slot of set `set` (TextureTransform::tex_coord) reads: set 1 is uvs1 when
+  /// the mesh has them, else uvs (a mesh without TEXCOORD_1 gives every slot its first set).
+  const std::vector<glm::vec2>& uv_set(int set) const {
+    return set == 1 && uvs1.size() == positions.size() ? uvs1 : uvs;
+  }
   void compute_bounds() {
     bounds = Aabb{};
     for (const auto& p : positions) bounds.expand(p);

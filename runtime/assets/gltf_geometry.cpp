@@ -419,7 +419,7 @@ Status read_deform(const tinygltf::Model& model, const std::string& file,
 void make_flat_normals(MeshData& m) {
   MeshData flat;
   flat.name = m.name;
-  const bool has_uvs = !m.uvs.empty();
+  const bool has_uvs = !m.uvs.empty(), has_uvs1 = !m.uvs1.empty();
   std::vector<std::uint32_t> flat_sources;  // the vertex each flat vertex copies
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
     const std::uint32_t i[3] = {m.indices[3 * t], m.indices[3 * t + 1], m.indices[3 * t + 2]};
@@ -433,6 +433,7 @@ void make_flat_normals(MeshData& m) {
       flat.positions.push_back(m.positions[k]);
       flat.normals.push_back(n);
       if (has_uvs) flat.uvs.push_back(m.uvs[k]);
+      if (has_uvs1) flat.uvs1.push_back(m.uvs1[k]);
       const std::size_t j = std::size_t(m.deform.influences);
       flat.deform.joints.insert(flat.deform.joints.end(), m.deform.joints.begin() + k * j,
                                 m.deform.joints.begin() + (k + 1) * j);
@@ -542,10 +543,13 @@ Result<std::optional<MeshData>> read_primitive(const tinygltf::Model& model,
   if (!normals) return normals.error();
   auto uvs = attribute("TEXCOORD_0", 2);
   if (!uvs) return uvs.error();
+  auto uvs1 = attribute("TEXCOORD_1", 2);
+  if (!uvs1) return uvs1.error();
   auto tangents = attribute("TANGENT", 4);
   if (!tangents) return tangents.error();
   const std::pair<const char*, std::size_t> counts[] = {{"NORMAL", normals->size() / 3},
                                                         {"TEXCOORD_0", uvs->size() / 2},
+                                                        {"TEXCOORD_1", uvs1->size() / 2},
                                                         {"TANGENT", tangents->size() / 4}};
   for (const auto& [name, count] : counts) {
     if (count != 0 && count != vertex_count) {
@@ -599,6 +603,10 @@ Result<std::optional<MeshData>> read_primitive(const tinygltf::Model& model,
   if (!uvs->empty()) {
     m.uvs.resize(vertex_count);
     std::memcpy(m.uvs.data(), uvs->data(), uvs->size() * sizeof(float));
+  }
+  if (!uvs1->empty()) {
+    m.uvs1.resize(vertex_count);
+    std::memcpy(m.uvs1.data(), uvs1->data(), uvs1->size() * sizeof(float));
   }
   m.indices = std::move(indices);
   KASKAD_TRY(read_deform(model, file, prim, mesh, where, vertex_count, attribute, m.deform));

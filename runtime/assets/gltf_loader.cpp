@@ -364,6 +364,10 @@ Status check_extensions(const tinygltf::Model& model, const std::string& file,
     return Error{file, "asset.minVersion",
                  "the file needs glTF " + min + " at least; this reader knows 2.0"};
   for (const std::string& ext : model.extensionsRequired) {
+    if (ext == "EXT_texture_avif")
+      return Error{file, "extensionsRequired",
+                   "the file requires EXT_texture_avif: AVIF images are not decoded here and it "
+                   "gives no fallback images; convert its textures to PNG, JPEG or WebP"};
     if (!supported_extension(ext)) {
       return Error{file, "extensionsRequired", "unsupported required extension " + ext};
     }

@@ -33,14 +33,28 @@ Result<TextureId> texture_for(Importer& im, int texture_index, int tex_coord, bo
                  "texture " + std::to_string(texture_index) + " out of range (" +
                      std::to_string(model.textures.size()) + " textures)"};
   }
-  if (tex_coord != 0) {
+  if (tex_coord > 1) {
     im.report.warnings.push_back(where + ": uses TEXCOORD_" + std::to_string(tex_coord) +
-                                 "; only TEXCOORD_0 is imported");
+                                 "; only TEXCOORD_0 and TEXCOORD_1 are imported (reads TEXCOORD_0)");
   }
-  const int source = model.textures[std::size_t(texture_index)].source;
+  // The image: EXT_texture_webp's (OpenImageIO reads WebP), else the texture's own source, which
+  // is also the fallback of a texture with an EXT_texture_avif image (AVIF is not decoded).
+  const tinygltf::Texture& gtex = model.textures[std::size_t(texture_index)];
+  int source = gtex.source;
+  if (auto webp = gtex.extensions.find("EXT_texture_webp"); webp != gtex.extensions.end()) {
+    const tinygltf::Value* s = member(webp->second, "source");
+    if (!s || !s->IsInt() || s->GetNumberAsInt() < 0)
+      return Error{im.file, label("textures", texture_index) + " EXT_texture_webp",
+                   "source must be an image index >= 0"};
+    source = s->GetNumberAsInt();
+  }
   if (source < 0) {
-    im.report.warnings.push_back(where + ": " + label("textures", texture_index) +
-                                 " has no source image (extension images are not supported)");
+    const bool avif = gtex.extensions.count("EXT_texture_avif") != 0;
+    im.report.warnings.push_back(
+        where + ": " + label("textures", texture_index) +
+        (avif ? " has only an EXT_texture_avif image, which is not decoded here, and no "
+                "fallback source: drawn without it"
+              : " has no source image"));
     return kNoTexture;
   }
   if (std::size_t(source) >= model.images.size()) {
@@ -141,6 +155,7 @@ Result<TextureSlot> read_slot(Importer& im, int index, int tex_coord,
   auto transform = read_texture_transform(im, extensions, tex_coord, where);
   if (!transform) return transform.error();
   slot.transform = transform.value();
+  slot.transform.tex_coord = tex_coord == 1 ? 1 : 0;
   auto texture = texture_for(im, index, tex_coord, srgb, where);
   if (!texture) return texture.error();
   slot.texture = texture.value();

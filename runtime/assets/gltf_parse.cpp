@@ -24,7 +24,7 @@ constexpr std::string_view kSupportedExtensions[] = {"KHR_draco_mesh_compression
                                                      "KHR_lights_punctual", "KHR_mesh_quantization",
                                                      "KHR_materials_emissive_strength",
                                                      "KHR_materials_transmission",
-                                                     "KHR_texture_transform"};
+                                                     "KHR_texture_transform", "EXT_texture_webp"};
 
 // ---- Naming places in the file for messages -------------------------------------------------
 

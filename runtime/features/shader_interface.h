@@ -23,6 +23,8 @@ inline constexpr unsigned kAttrNormalMatrix = 7;  ///< mat3: locations 7..9
 inline constexpr unsigned kAttrLayer = 10;        ///< uint: the layered shadow pass's layer
 /// vec4 per vertex: tangent xyz and bitangent sign w (glTF TANGENT, or generate_tangents()).
 inline constexpr unsigned kAttrTangent = 11;
+/// vec2 per vertex: the second uv set (MeshData::uv_set(1)), read by texture_transform programs.
+inline constexpr unsigned kAttrUv1 = 12;
 
 /// One vertex of the GPU cache's shared geometry (runtime/render/gpu_cache.h): the vertex
 /// arrays read it by attribute, and the deform pass (deform.comp) as floats, at the offsets
@@ -31,8 +33,9 @@ struct Vertex {
   glm::vec3 position{0.0f}, normal{0.0f};
   glm::vec2 uv{0.0f};
   glm::vec4 tangent{0.0f};
+  glm::vec2 uv1{0.0f};
 };
-static_assert(sizeof(Vertex) == 48);
+static_assert(sizeof(Vertex) == 56);
 inline constexpr int kVertexFloats = int(sizeof(Vertex) / sizeof(float));
 inline constexpr int kVertexPosition = int(offsetof(Vertex, position) / sizeof(float)),
                      kVertexNormal = int(offsetof(Vertex, normal) / sizeof(float)),
@@ -74,6 +77,7 @@ inline constexpr int kLocBaseColor = 8, kLocMaterial = 9, kLocEmissive = 10,
 inline constexpr int kLocMaterialExtra = 24;
 /// vec4[10]: per texture slot (kUvSlot*) two rows (a, b, c) of its uv transform
 /// u' = a.x u + a.y v + a.z, v' = b.x u + b.y v + b.z (MATERIAL_HAS_TEXTURE_TRANSFORM); 25..34.
+/// a.w is the uv set the slot reads (TextureTransform::tex_coord: 0 or 1).
 inline constexpr int kLocUvTransform = 25;
 /// Texture slots in kLocUvTransform's array.
 inline constexpr int kUvSlotBaseColor = 0, kUvSlotNormal = 1, kUvSlotOcclusion = 2,
@@ -125,6 +129,7 @@ inline std::array<std::pair<const char*, int>, 66> shader_interface_defines() {
            {"ATTR_NORMAL_MATRIX", kAttrNormalMatrix},
            {"ATTR_LAYER", kAttrLayer},
            {"ATTR_TANGENT", kAttrTangent},
+           {"ATTR_UV1", kAttrUv1},
            {"LOC_BASE_COLOR", kLocBaseColor},
            {"LOC_MATERIAL", kLocMaterial},
            {"LOC_EMISSIVE", kLocEmissive},

@@ -149,10 +149,11 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     // glTF emissiveTexture: multiplies the emissive factor, so it needs `emissive`.
     {.name = "emissive_texture", .define = "MATERIAL_HAS_EMISSIVE_TEXTURE",
      .stages = kFragmentStage, .offset = 9, .requires_ = {"emissive"}},
-    // KHR_texture_transform: each texture slot's uvs go through its own offset, rotation and
-    // scale (Material::*_transform). The depth pass keeps it with alpha_mask (cut-outs).
+    // KHR_texture_transform and TEXCOORD_1: each texture slot's uvs are its own uv set through
+    // its own offset, rotation and scale (Material::*_transform); the vertex stage passes the
+    // second set on. The depth pass keeps it with alpha_mask (cut-outs).
     {.name = "texture_transform", .define = "MATERIAL_HAS_TEXTURE_TRANSFORM",
-     .stages = kFragmentStage, .offset = 10},
+     .stages = kVertexStage | kFragmentStage, .offset = 10},
     // glTF metallicRoughnessTexture (linear; B metallic, G roughness): multiplies the factors.
     {.name = "metallic_roughness_texture", .define = "MATERIAL_HAS_METALLIC_ROUGHNESS_TEXTURE",
      .stages = kFragmentStage, .offset = 11},

@@ -566,9 +566,13 @@ Result<RayTracer> RayTracer::build(const ecs::World& world, const AssetStore& as
     rules->double_sided = item.material && item.material->double_sided;
     rules->mirrored = mirrors(item.matrix);
     if (item.material && item.material->alpha_mode != AlphaMode::opaque &&
-         mesh.uvs.size() == mesh.positions.size()) {
+        mesh.uv_set(item.material->base_color_transform.tex_coord).size() ==
+            mesh.positions.size()) {
       AlphaCutout* cutout = &rules->cutout.emplace();
-      cutout->uvs = mesh.uvs;
+      // The base colour slot's uvs, as the shadow pass's slot_uv() gives them (the transform is
+      // affine: applied at the vertices, it interpolates to the same uv).
+      const TextureTransform& t = item.material->base_color_transform;
+      for (const glm::vec2& uv : mesh.uv_set(t.tex_coord)) cutout->uvs.push_back(transform_uv(t, uv));
       cutout->indices = kept;
       cutout->factor = item.material->base_color.a;
       cutout->cutoff = item.material->alpha_cutoff;

@@ -83,16 +83,18 @@ glm::vec4 hit_base_color(const ReflectionScene& scene, const Material& material,
   if (!mr || index(mr->mesh) >= scene.assets->meshes.size()) return material.base_color;
   const MeshData& mesh = scene.assets->meshes[index(mr->mesh)];
   const std::size_t first = 3 * std::size_t(hit.triangle);
-  if (mesh.uvs.size() != mesh.positions.size() || first + 2 >= mesh.indices.size())
+  const TextureTransform& t = material.base_color_transform;
+  const std::vector<glm::vec2>& uvs = mesh.uv_set(t.tex_coord);
+  if (uvs.size() != mesh.positions.size() || first + 2 >= mesh.indices.size())
     return material.base_color;
   std::array<glm::vec2, 3> uv;
   for (std::size_t k = 0; k < 3; ++k) {
     const std::uint32_t i = mesh.indices[first + k];
-    if (i >= mesh.uvs.size()) return material.base_color;
-    uv[k] = mesh.uvs[i];
+    if (i >= uvs.size()) return material.base_color;
+    uv[k] = uvs[i];
   }
   const glm::vec2 b = hit.barycentric;
-  const glm::vec2 at = (1.0f - b.x - b.y) * uv[0] + b.x * uv[1] + b.y * uv[2];
+  const glm::vec2 at = transform_uv(t, (1.0f - b.x - b.y) * uv[0] + b.x * uv[1] + b.y * uv[2]);
   return material.base_color *
          sample_texture(scene.assets->textures[index(material.base_color_texture)], at);
 }

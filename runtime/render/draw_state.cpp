@@ -65,7 +65,7 @@ void DrawState::bind_material(const DrawItem& d, VariantKey key) {
     slots[kUvSlotMetallicRoughness] = &m.metallic_roughness_transform;
     for (int i = 0; i < kUvSlotCount; ++i) {
       const auto r = uv_transform_rows(*slots[i]);
-      rows[std::size_t(2 * i)] = glm::vec4(r[0], 0.0f);
+      rows[std::size_t(2 * i)] = glm::vec4(r[0], float(slots[i]->tex_coord));
       rows[std::size_t(2 * i + 1)] = glm::vec4(r[1], 0.0f);
     }
     glProgramUniform4fv(program_.id(), kLocUvTransform, GLsizei(rows.size()), &rows[0][0]);

@@ -100,11 +100,12 @@ void GpuCache::reserve_geometry(std::size_t vertices, std::size_t indices) {
   if (!vao_) {
     vao_ = gpu::make_vertex_array();
     const GLuint vao = vao_.id();
-    const GLuint attrs[4] = {kAttrPosition, kAttrNormal, kAttrUv, kAttrTangent};
-    const GLuint offsets[4] = {offsetof(Vertex, position), offsetof(Vertex, normal),
-                               offsetof(Vertex, uv), offsetof(Vertex, tangent)};
-    const GLint sizes[4] = {3, 3, 2, 4};
-    for (int i = 0; i < 4; ++i) {
+    const GLuint attrs[5] = {kAttrPosition, kAttrNormal, kAttrUv, kAttrTangent, kAttrUv1};
+    const GLuint offsets[5] = {offsetof(Vertex, position), offsetof(Vertex, normal),
+                               offsetof(Vertex, uv), offsetof(Vertex, tangent),
+                               offsetof(Vertex, uv1)};
+    const GLint sizes[5] = {3, 3, 2, 4, 2};
+    for (int i = 0; i < 5; ++i) {
       glEnableVertexArrayAttrib(vao, attrs[i]);
       glVertexArrayAttribFormat(vao, attrs[i], sizes[i], GL_FLOAT, GL_FALSE, offsets[i]);
       glVertexArrayAttribBinding(vao, attrs[i], kVertexBinding);
@@ -139,7 +140,7 @@ const GpuMesh& GpuCache::mesh(MeshId id) {
   if (m.uploaded) return m;
   const MeshData& src = assets_->meshes[at];
   const std::size_t n = src.positions.size();
-  // Uvs are zero when the mesh has none; tangents are the mesh's own, else generated
+  // Uvs are zero when the mesh has none (uv1: uv_set(1)'s rule); tangents are the mesh's own, else generated
   // (MikkTSpace's rule), zero without uvs.
   const std::vector<glm::vec4> generated = src.tangents.size() == n ? std::vector<glm::vec4>()
                                                                       : generate_tangents(src);
@@ -149,6 +150,7 @@ const GpuMesh& GpuCache::mesh(MeshId id) {
     vertices[i].position = src.positions[i];
     if (src.normals.size() == n) vertices[i].normal = src.normals[i];
     if (src.uvs.size() == n) vertices[i].uv = src.uvs[i];
+    if (src.uv_set(1).size() == n) vertices[i].uv1 = src.uv_set(1)[i];
     if (tangents.size() == n) vertices[i].tangent = tangents[i];
   }
   // The draws' base vertex is a GLint, their first index a GLuint.

@@ -954,11 +954,17 @@ TEST(GltfLoader, TextureTransformsArePerSlotWithTexCoordOverride) {
   const auto rows = uv_transform_rows(m.base_color_transform);
   EXPECT_NEAR(glm::dot(rows[0], glm::vec3(1, 0, 1)), 0.5f, 1e-6f);
   EXPECT_NEAR(glm::dot(rows[1], glm::vec3(1, 0, 1)), -2.25f, 1e-6f);
-  // An override to a set that is not imported keeps the warning.
+  // An override to the second set is that set; to a set that is not imported, a warning.
   doc["materials"][0]["normalTexture"]["extensions"]["KHR_texture_transform"]["texCoord"] = 1;
   auto t1 = import_file(write_gltf("transform_uv1.gltf", doc));
   ASSERT_TRUE(t1->report.ok()) << t1->report.error().to_string();
-  EXPECT_TRUE(warns(*t1->report, "TEXCOORD_1"));
+  EXPECT_FALSE(warns(*t1->report, "TEXCOORD"));
+  EXPECT_EQ(only_material(*t1).normal_transform.tex_coord, 1);
+  doc["materials"][0]["normalTexture"]["extensions"]["KHR_texture_transform"]["texCoord"] = 2;
+  auto t2 = import_file(write_gltf("transform_uv2.gltf", doc));
+  ASSERT_TRUE(t2->report.ok()) << t2->report.error().to_string();
+  EXPECT_TRUE(warns(*t2->report, "TEXCOORD_2"));
+  EXPECT_EQ(only_material(*t2).normal_transform.tex_coord, 0);
   // An identity transform is no feature.
   doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]
      ["KHR_texture_transform"] = json::object();
@@ -976,6 +982,103 @@ TEST(GltfLoader, TextureTransformsArePerSlotWithTexCoordOverride) {
   doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]
      ["KHR_texture_transform"] = {{"rotation", "fast"}};
   expect_import_error(write_gltf("transform_bad_rotation.gltf", doc), "rotation");
+}
+
+// ---- Second uv set, WebP and AVIF textures --------------------------------------------------
+
+/// textured_triangle(material) whose triangle has TEXCOORD_0 `uv0` and TEXCOORD_1 `uv1` (3 each).
+json two_uv_triangle(const json& material, const std::vector<float>& uv0,
+                     const std::vector<float>& uv1) {
+  json doc = textured_triangle(material);
+  std::vector<std::uint8_t> uvs;
+  append<float>(uvs, uv0);
+  append<float>(uvs, uv1);
+  doc["buffers"].push_back({{"byteLength", uvs.size()},
+                            {"uri", "data:application/octet-stream;base64," + base64(uvs)}});
+  doc["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 0}, {"byteLength", 24}});
+  doc["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 24}, {"byteLength", 24}});
+  doc["accessors"].push_back({{"bufferView", 2}, {"componentType", 5126}, {"count", 3}, {"type", "VEC2"}});
+  doc["accessors"].push_back({{"bufferView", 3}, {"componentType", 5126}, {"count", 3}, {"type", "VEC2"}});
+  doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = 2;
+  doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = 3;
+  return doc;
+}
+
+// A slot that names texCoord 1 reads TEXCOORD_1 (occlusion maps usually do): the mesh keeps the
+// set, the slot's transform records it, and the material takes the texture_transform feature
+// (whose programs pass the second set on). A mesh without TEXCOORD_1 gives such slots its first.
+TEST(GltfLoader, SecondUvSetIsImportedForTheSlotsThatNameIt) {
+  json doc = two_uv_triangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}},
+                              {"occlusionTexture", {{"index", 1}, {"texCoord", 1}}}},
+                             {0, 0, 1, 0, 0, 1}, {0.5f, 0.5f, 0.75f, 0.5f, 0.5f, 0.75f});
+  auto s = import_file(write_gltf("uv1.gltf", doc));
+  ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+  EXPECT_FALSE(warns(*s->report, "TEXCOORD"));
+  ASSERT_EQ(s->assets.meshes.size(), 1u);
+  const MeshData& mesh = s->assets.meshes[0];
+  ASSERT_EQ(mesh.uvs1.size(), 3u);
+  EXPECT_EQ(mesh.uvs1[1], glm::vec2(0.75f, 0.5f));
+  EXPECT_EQ(mesh.uvs[1], glm::vec2(1.0f, 0.0f));
+  EXPECT_EQ(&mesh.uv_set(1), &mesh.uvs1);
+  EXPECT_EQ(&mesh.uv_set(0), &mesh.uvs);
+  const Material m = only_material(*s);
+  EXPECT_EQ(m.occlusion_transform.tex_coord, 1);
+  EXPECT_EQ(m.base_color_transform.tex_coord, 0);
+  EXPECT_TRUE(m.features & render::VariantKey::kTextureTransform.mask());
+  // Without TEXCOORD_1 the slot reads TEXCOORD_0.
+  MeshData no_uv1 = mesh;
+  no_uv1.uvs1.clear();
+  EXPECT_EQ(&no_uv1.uv_set(1), &no_uv1.uvs);
+  // A TEXCOORD_1 of the wrong length is an error naming it.
+  doc["accessors"][3]["count"] = 2;
+  expect_import_error(write_gltf("uv1_short.gltf", doc), "TEXCOORD_1");
+}
+
+// EXT_texture_webp: the texture shows its WebP image (OpenImageIO decodes it), not the fallback
+// source; a file that requires the extension loads. EXT_texture_avif is not decoded: its
+// fallback source is shown, a texture with no fallback is drawn without it (a warning naming
+// it), and a file that requires the extension is refused with the reason.
+TEST(GltfLoader, WebpTexturesAreDecodedAndAvifFallsBack) {
+  Image webp;
+  webp.width = webp.height = 2;
+  webp.channels = 4;
+  webp.pixels.assign(16, 1.0f);  // white; the PNG fallback is grey
+  for (std::size_t i = 0; i < 16; i += 4) webp.pixels[i + 1] = 0.0f;  // magenta
+  const Status saved = save_image(temp_dir() / "tex_c.webp", webp);
+  ASSERT_TRUE(saved.ok()) << saved.error().to_string();
+  json doc = textured_triangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+  doc["images"].push_back({{"uri", "tex_c.webp"}});
+  doc["textures"][0]["extensions"]["EXT_texture_webp"] = {{"source", 2}};
+  doc["extensionsUsed"] = {"EXT_texture_webp"};
+  doc["extensionsRequired"] = {"EXT_texture_webp"};
+  auto s = import_file(write_gltf("webp.gltf", doc));
+  ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+  const Material m = only_material(*s);
+  ASSERT_NE(m.base_color_texture, kNoTexture);
+  const TextureData& t = s->assets.textures[index(m.base_color_texture)];
+  ASSERT_EQ(t.rgba8.size(), 16u);
+  EXPECT_EQ(t.rgba8[0], 255);  // the WebP's magenta
+  EXPECT_EQ(t.rgba8[1], 0);
+  EXPECT_EQ(t.rgba8[2], 255);
+  doc["textures"][0]["extensions"]["EXT_texture_webp"] = {{"source", -1}};
+  expect_import_error(write_gltf("webp_bad.gltf", doc), "EXT_texture_webp");
+
+  json avif = textured_triangle({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+  avif["images"].push_back({{"uri", "tex_c.avif"}});  // never read
+  avif["textures"][0]["extensions"]["EXT_texture_avif"] = {{"source", 2}};
+  avif["extensionsUsed"] = {"EXT_texture_avif"};
+  auto fallback = import_file(write_gltf("avif_fallback.gltf", avif));
+  ASSERT_TRUE(fallback->report.ok()) << fallback->report.error().to_string();
+  const Material fm = only_material(*fallback);
+  ASSERT_NE(fm.base_color_texture, kNoTexture);
+  EXPECT_GT(fallback->assets.textures[index(fm.base_color_texture)].rgba8[1], 100);  // grey PNG
+  avif["textures"][0].erase("source");
+  auto none = import_file(write_gltf("avif_only.gltf", avif));
+  ASSERT_TRUE(none->report.ok()) << none->report.error().to_string();
+  EXPECT_EQ(only_material(*none).base_color_texture, kNoTexture);
+  EXPECT_TRUE(warns(*none->report, "only an EXT_texture_avif image"));
+  avif["extensionsRequired"] = {"EXT_texture_avif"};
+  expect_import_error(write_gltf("avif_required.gltf", avif), "AVIF images are not decoded");
 }
 
 }  // namespace
