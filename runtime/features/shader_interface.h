@@ -104,7 +104,7 @@ inline constexpr unsigned kTexBaseColor = 0, kTexNormal = 1, kTexShadow = 2,
 
 /// Every name above as the shaders see it (ATTR_POSITION, LOC_BASE_COLOR, UNIT_SHADOW, ...), and
 /// the light types (LIGHT_DIRECTIONAL, ...: u_light_info[i].x holds a LightType).
-inline std::array<std::pair<const char*, int>, 66> shader_interface_defines() {
+inline std::array<std::pair<const char*, int>, 67> shader_interface_defines() {
   return {{{"LIGHT_DIRECTIONAL", int(LightType::directional)},
            {"VERTEX_FLOATS", kVertexFloats},
            {"VERTEX_POSITION", kVertexPosition},

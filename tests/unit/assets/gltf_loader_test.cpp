@@ -987,12 +987,13 @@ TEST(GltfLoader, TextureTransformsArePerSlotWithTexCoordOverride) {
 // ---- Second uv set, WebP and AVIF textures --------------------------------------------------
 
 /// textured_triangle(material) whose triangle has TEXCOORD_0 `uv0` and TEXCOORD_1 `uv1` (3 each).
-json two_uv_triangle(const json& material, const std::vector<float>& uv0,
-                     const std::vector<float>& uv1) {
+json two_uv_triangle(const json& material, std::initializer_list<float> uv0,
+                     std::initializer_list<float> uv1) {
   json doc = textured_triangle(material);
-  std::vector<std::uint8_t> uvs;
-  append<float>(uvs, uv0);
-  append<float>(uvs, uv1);
+  std::vector<float> floats(uv0);
+  floats.insert(floats.end(), uv1);
+  const auto* bytes = reinterpret_cast<const std::uint8_t*>(floats.data());
+  const std::vector<std::uint8_t> uvs(bytes, bytes + floats.size() * sizeof(float));
   doc["buffers"].push_back({{"byteLength", uvs.size()},
                             {"uri", "data:application/octet-stream;base64," + base64(uvs)}});
   doc["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 0}, {"byteLength", 24}});
@@ -1057,9 +1058,9 @@ TEST(GltfLoader, WebpTexturesAreDecodedAndAvifFallsBack) {
   ASSERT_NE(m.base_color_texture, kNoTexture);
   const TextureData& t = s->assets.textures[index(m.base_color_texture)];
   ASSERT_EQ(t.rgba8.size(), 16u);
-  EXPECT_EQ(t.rgba8[0], 255);  // the WebP's magenta
-  EXPECT_EQ(t.rgba8[1], 0);
-  EXPECT_EQ(t.rgba8[2], 255);
+  EXPECT_GT(t.rgba8[0], 239);  // the WebP's magenta (WebP is lossy: near it)
+  EXPECT_LT(t.rgba8[1], 16);
+  EXPECT_GT(t.rgba8[2], 239);
   doc["textures"][0]["extensions"]["EXT_texture_webp"] = {{"source", -1}};
   expect_import_error(write_gltf("webp_bad.gltf", doc), "EXT_texture_webp");
 
