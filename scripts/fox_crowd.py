@@ -12,7 +12,7 @@ with open(os.path.join(here, "..", "content", "scenes", "fox_walk.json")) as f:
 model = os.path.relpath(os.path.join(here, "..", "content", "models", "Fox", "glTF", "Fox.gltf"),
                         os.path.dirname(os.path.abspath(out)))
 side = max(1, math.ceil(math.sqrt(n)))
-entities = [e for e in scene["entities"] if e["name"] not in ("fox", "crate")]
+entities = [e for e in scene["entities"] if e["name"] not in ("walker", "crate")]
 for k in range(n):
     x, z = (k % side - (side - 1) / 2) * 1.2, (k // side - (side - 1) / 2) * 1.6
     entities.append({"name": f"fox{k}", "transform": {"translation": [x, 0, z], "euler_deg": [0, 90, 0],
