@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
 """Writes a scene of N Foxes in a grid (content/scenes/fox_walk.json's light and ground), for the
-skinning cost benchmark: python3 scripts/fox_crowd.py N OUT.json [--still]. --still stops every
-clip (the same meshes, posed once and then kept)."""
+skinning cost benchmark: python3 scripts/fox_crowd.py N OUT.json [--still] [--no-shadows]. --still
+stops every clip (the same meshes, posed once and then kept); --no-shadows makes the Foxes cast no
+shadow, so that playing and still differ by posing alone, not by shadow layers drawn again."""
 import json, math, os, sys
 
 n, out = int(sys.argv[1]), sys.argv[2]
 still = "--still" in sys.argv[3:]
+no_shadows = "--no-shadows" in sys.argv[3:]
 here = os.path.dirname(os.path.abspath(__file__))
 with open(os.path.join(here, "..", "content", "scenes", "fox_walk.json")) as f:
     scene = json.load(f)
@@ -20,6 +22,8 @@ for k in range(n):
                      "model": {"path": model},
                      "animation": {"Survey": {"playing": False},
                                    "Walk": {"playing": not still, "time": 0.1 * k}}})
+    if no_shadows:
+        entities[-1]["renderer"] = {"cast_shadows": False}
 for e in entities:
     if e["name"] == "ground":
         e["transform"]["scale"] = [max(20, side * 2.5)] * 3

@@ -227,29 +227,67 @@ Status check_frame(Run& run, int f, FrameRow& row) {
 }
 
 // Rows are kept in memory and written atomically at the end (and when a run fails midway,
-// nothing half-written is left behind). Change together with csv_row().
-constexpr const char* kCsvHeader =
-    "frame,t,frame_ms,cpu_transforms_ms,cpu_camera_ms,cpu_shadows_ms,cpu_probes_ms,"
-    "cpu_draw_list_ms,cpu_render_ms,gpu_shadow_ms,gpu_forward_ms,gpu_probe_ms,draw_calls,"
-    "shadow_draw_calls,shadow_triangles,probe_faces,probe_captures,compiles_after_prewarm,"
-    "misclassified_pct,rss_mib,gl_objects,mesh_draws,shadow_mesh_draws,shadow_layers_rendered,"
-    "deformed_meshes\n";
+// nothing half-written is left behind).
+
+// The columns of frames.csv, once: each name with the value it writes (docs/guide/playback.md).
+struct CsvColumn {
+  const char* name;
+  std::string (*value)(const FrameRow&, const FrameReport&);
+};
+std::string number(double v, const char* format = "%.4f") {
+  char text[64];
+  std::snprintf(text, sizeof text, format, v);
+  return text;
+}
+std::string count(long long v) { return std::to_string(v); }
+constexpr CsvColumn kCsvColumns[] = {
+    {"frame", [](const FrameRow& r, const FrameReport&) { return count(r.frame); }},
+    {"t", [](const FrameRow& r, const FrameReport&) { return number(r.t, "%.6g"); }},
+    {"frame_ms", [](const FrameRow& r, const FrameReport&) { return number(r.frame_ms); }},
+    {"cpu_animation_ms", [](const FrameRow&, const FrameReport& f) { return number(f.animation_ms); }},
+    {"cpu_transforms_ms", [](const FrameRow&, const FrameReport& f) { return number(f.transforms_ms); }},
+    {"cpu_camera_ms", [](const FrameRow&, const FrameReport& f) { return number(f.camera_ms); }},
+    {"cpu_shadows_ms", [](const FrameRow&, const FrameReport& f) { return number(f.shadows_ms); }},
+    {"cpu_probes_ms", [](const FrameRow&, const FrameReport& f) { return number(f.probes_ms); }},
+    {"cpu_draw_list_ms", [](const FrameRow&, const FrameReport& f) { return number(f.draw_list_ms); }},
+    {"cpu_render_ms", [](const FrameRow&, const FrameReport& f) { return number(f.render_ms); }},
+    {"gpu_shadow_ms", [](const FrameRow&, const FrameReport& f) { return number(f.stats.shadow_gpu_ms); }},
+    {"gpu_forward_ms", [](const FrameRow&, const FrameReport& f) { return number(f.stats.forward_gpu_ms); }},
+    {"gpu_probe_ms", [](const FrameRow&, const FrameReport& f) { return number(f.stats.probe_gpu_ms); }},
+    {"draw_calls", [](const FrameRow&, const FrameReport& f) { return count(f.stats.draw_calls); }},
+    {"shadow_draw_calls", [](const FrameRow&, const FrameReport& f) { return count(f.stats.shadow_draw_calls); }},
+    {"shadow_triangles", [](const FrameRow&, const FrameReport& f) { return count((long long)f.stats.shadow_triangles); }},
+    {"probe_faces", [](const FrameRow&, const FrameReport& f) { return count(f.stats.probe_faces); }},
+    {"probe_captures", [](const FrameRow&, const FrameReport& f) { return count(f.probes.captures_this_frame); }},
+    {"compiles_after_prewarm", [](const FrameRow& r, const FrameReport&) { return count(r.compiles); }},
+    {"misclassified_pct", [](const FrameRow& r, const FrameReport&) {
+       return r.misclassified_pct < 0 ? std::string() : number(r.misclassified_pct, "%.6f"); }},
+    {"rss_mib", [](const FrameRow& r, const FrameReport&) { return number(r.rss_mib, "%.2f"); }},
+    {"gl_objects", [](const FrameRow& r, const FrameReport&) { return count(r.gl_objects); }},
+    {"mesh_draws", [](const FrameRow&, const FrameReport& f) { return count(f.stats.mesh_draws); }},
+    {"shadow_mesh_draws", [](const FrameRow&, const FrameReport& f) { return count(f.stats.shadow_mesh_draws); }},
+    {"shadow_layers_rendered", [](const FrameRow&, const FrameReport& f) {
+       return count(std::popcount(f.stats.shadow_layers_rendered)); }},
+    {"deformed_meshes", [](const FrameRow&, const FrameReport& f) { return count(f.stats.deformed_meshes); }},
+};
+
+std::string csv_header() {
+  std::string line;
+  for (const CsvColumn& c : kCsvColumns) {
+    if (&c != kCsvColumns) line += ',';
+    line += c.name;
+  }
+  return line + "\n";
+}
 
 // 4. The frame's row of frames.csv.
 std::string csv_row(const FrameRow& row, const FrameReport& report) {
-  const auto& st = report.stats;
-  char line[640];
-  std::snprintf(line, sizeof line,
-                "%d,%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%d,%zu,%d,%d,%d,%s,%.2f,%ld,%d,%d,%d,%d\n",
-                row.frame, row.t, row.frame_ms, report.transforms_ms, report.camera_ms,
-                report.shadows_ms, report.probes_ms, report.draw_list_ms, report.render_ms,
-                st.shadow_gpu_ms, st.forward_gpu_ms, st.probe_gpu_ms, st.draw_calls,
-                st.shadow_draw_calls, st.shadow_triangles, st.probe_faces,
-                report.probes.captures_this_frame, row.compiles,
-                row.misclassified_pct < 0 ? "" : std::to_string(row.misclassified_pct).c_str(),
-                row.rss_mib, row.gl_objects, st.mesh_draws, st.shadow_mesh_draws,
-                std::popcount(st.shadow_layers_rendered), st.deformed_meshes);
-  return line;
+  std::string line;
+  for (const CsvColumn& c : kCsvColumns) {
+    if (&c != kCsvColumns) line += ',';
+    line += c.value(row, report);
+  }
+  return line + "\n";
 }
 
 struct FileResult {
@@ -288,7 +326,7 @@ Result<FileResult> play_one(Player& player, const Playback& pb, const PlayOption
   run.failures.file = pb.file.string();
 
   std::ostringstream csv;
-  csv << kCsvHeader;
+  csv << csv_header();
   for (int f = 0; f < pb.frames; ++f) {
     FrameRow row;
     row.frame = f;
