@@ -173,12 +173,7 @@ TEST_F(MaterialInputsTest, MetallicRoughnessTextureSetsMetallicFromBAndRoughness
 // features its program has (alpha_mask, and texture_transform when the material has it), so no
 // uniform of the others may be set there (a GL error, which fails the test through the fixture).
 TEST_F(MaterialInputsTest, CutOutsWithTheNewInputsCastShadowsWithoutGlErrors) {
-  Image mask;  // opaque | transparent
-  mask.width = 2;
-  mask.height = 1;
-  mask.channels = 4;
-  mask.pixels = {1, 1, 1, 1, 1, 1, 1, 0};
-  ASSERT_TRUE(save_image(dir() / "mask.png", mask).ok());
+  write_texels(dir() / "mask.png", {1, 1, 1, 1, 1, 1, 1, 0});  // opaque | transparent
   texture("ao2.png", {glm::vec3(0.5f)});
   for (const char* transform : {"", R"(, "texture_transform")"}) {
     const std::string material = std::string(R"({ "features": ["base_color_texture", "alpha_mask",

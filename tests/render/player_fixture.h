@@ -16,6 +16,7 @@
 
 #include "components/limits.h"
 #include "runtime/app/player.h"
+#include "runtime/assets/image_io.h"
 #include "runtime/gpu/context.h"
 #include "tests/test_tmp.h"
 
@@ -49,6 +50,17 @@ class PlayerTest : public ::testing::Test {
   void TearDown() override { EXPECT_EQ(gpu::debug_error_count(), 0) << "GL errors were logged"; }
 
   static inline Player* player_ = nullptr;  ///< the suite's player (suites run one at a time)
+
+  /// Writes a row of RGBA texels (4 values each, in [0, 1]) as the image `path`: a test texture.
+  static void write_texels(const std::filesystem::path& path, std::vector<float> rgba) {
+    Image image;
+    image.width = int(rgba.size() / 4);
+    image.height = 1;
+    image.channels = 4;
+    image.pixels = std::move(rgba);
+    const Status saved = save_image(path, image);
+    ASSERT_TRUE(saved.ok()) << saved.error().to_string();
+  }
 
   /// Folder `name` of the running test's scratch folder (tests/test_tmp.h), created.
   static std::filesystem::path test_dir(const std::string& name) {

@@ -104,18 +104,8 @@ class UvSetsTest : public PlayerTest {
   }
 
   static void write_textures() {
-    Image cut;  // opaque | cut away
-    cut.width = 2;
-    cut.height = 1;
-    cut.channels = 4;
-    cut.pixels = {1, 1, 1, 1, 1, 1, 1, 0};
-    ASSERT_TRUE(save_image(dir() / "cut.png", cut).ok());
-    Image halves;  // red | green
-    halves.width = 2;
-    halves.height = 1;
-    halves.channels = 4;
-    halves.pixels = {1, 0, 0, 1, 0, 1, 0, 1};
-    ASSERT_TRUE(save_image(dir() / "halves.png", halves).ok());
+    write_texels(dir() / "cut.png", {1, 1, 1, 1, 1, 1, 1, 0});     // opaque | cut away
+    write_texels(dir() / "halves.png", {1, 0, 0, 1, 0, 1, 0, 1});  // red | green
   }
 
   /// The largest difference of any channel of any pixel.
