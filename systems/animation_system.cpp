@@ -63,6 +63,9 @@ void update_animations(ecs::World& world, const AssetStore& assets, double dt) {
       if (at >= assets.animations.size()) break;
       AnimationState& s = a.clips[k];
       const AnimationClip& clip = assets.animations[at];
+      // A time set past either end (a scene file, --set) is where the clock would put it:
+      // wrapped when the clip loops, else at that end, stopped.
+      if (s.time > clip.duration || s.time < 0.0f) advance(s, clip.duration, 0.0);
       // The frame shows the clip at its time now; the clock then moves on for the next frame
       // (so frame n of a run shows n * dt, as playback files count time).
       if (s.playing || a.cues[k].pending) apply(world, a, clip, s.time);
@@ -72,7 +75,7 @@ void update_animations(ecs::World& world, const AssetStore& assets, double dt) {
   });
 }
 
-void set_animation_time(ecs::World& world, const AssetStore& assets, float seconds) {
+void set_animation_time(ecs::World& world, const AssetStore& assets, double seconds) {
   world.view<Animator>().each([&](ecs::Entity, Animator& a) {
     a.cues.resize(a.clips.size());
     for (std::size_t k = 0; k < a.clips.size(); ++k) {
@@ -81,7 +84,7 @@ void set_animation_time(ecs::World& world, const AssetStore& assets, float secon
       const float duration = at < assets.animations.size() ? assets.animations[at].duration : 0.0f;
       AnimationState& s = a.clips[k];
       s.time = 0.0f;
-      advance(s, duration, double(seconds));  // scene seconds times the clip's speed
+      advance(s, duration, seconds);  // scene seconds times the clip's speed
       a.cues[k].pending = true;
     }
   });

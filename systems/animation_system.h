@@ -18,7 +18,7 @@ void update_animations(ecs::World& world, const AssetStore& assets, double dt);
 
 /// Puts every playing clip where `seconds` of play from its start take it (times its speed,
 /// wrapped or clamped as advancing would): `kaskad render --time`. Posed there next frame.
-void set_animation_time(ecs::World& world, const AssetStore& assets, float seconds);
+void set_animation_time(ecs::World& world, const AssetStore& assets, double seconds);
 
 /// After the transforms: every Deformer entity gets its posed mesh (allocated on first use, a
 /// copy of its MeshRenderer's mesh), this frame's skin matrices and weights and their hash, and

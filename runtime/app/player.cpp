@@ -9,6 +9,7 @@
 #include "components/light.h"
 #include "runtime/core/file_io.h"
 #include "runtime/core/log.h"
+#include "systems/animation_system.h"
 #include "systems/camera_system.h"
 #include "systems/transform_system.h"
 
@@ -57,7 +58,15 @@ Result<Scene> finish_load(Result<Scene> scene, const std::filesystem::path& file
   auto manifest = render::FeatureManifest::load(content_dir() / "shaders" / "features.json");
   if (!manifest) return manifest.error();
   KASKAD_TRY(instantiate_scene(*scene, &manifest.value()));
-  update_transforms(scene->world, scene->assets);
+  // Animated models as the first frame shows them (clips at their time, not advanced), and the
+  // bounds of their skinned and morphed meshes from that pose: a skinned mesh is placed by its
+  // joints, not by its node's transform, which framing must not read either.
+  const auto pose = [&] {
+    update_animations(scene->world, scene->assets, 0.0);
+    update_transforms(scene->world, scene->assets);
+    update_deformers(scene->world, scene->assets);
+  };
+  pose();
   // The models' bounds, before a ground is added: what auto_frame cameras frame.
   const Aabb models = scene_bounds(scene->world);
   // Resolved here, not written back: the scene keeps "auto", so saving it (the editor) writes
@@ -69,7 +78,7 @@ Result<Scene> finish_load(Result<Scene> scene, const std::filesystem::path& file
     ground_entity = add_ground(*scene, ground_extent(models, sun_direction(scene->world)));
   // Overrides of imported entities (glTF nodes by name) and of the ground.
   for (const std::string& o : later) KASKAD_TRY(apply_entity_override(*scene, o));
-  if (!later.empty() || ground_entity.valid()) update_transforms(scene->world, scene->assets);
+  if (!later.empty() || ground_entity.valid()) pose();
   // Cameras frame the models; their near/far also take in the ground.
   Aabb framed;
   scene->world.view<WorldBounds>().each([&](ecs::Entity e, const WorldBounds& b) {

@@ -1,6 +1,7 @@
 // glTF import, step 6: skins bound to their primitives and animations into clips (glTF 2.0,
 // 3.7.3 "Skins" and 3.11 "Animations"). Runs after the node walk, since joints and channel
 // targets name nodes anywhere in the file.
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -22,6 +23,15 @@ Result<std::uint32_t> convert_skin(Importer& im, int index) {
   if (g.joints.size() > kMaxJoints)
     return Error{im.file, where, std::to_string(g.joints.size()) + " joints exceed the limit of " +
                                      std::to_string(kMaxJoints)};
+  if (g.skeleton >= 0 && std::size_t(g.skeleton) >= im.model.nodes.size())
+    return Error{im.file, where, "skeleton " + std::to_string(g.skeleton) + " out of range (" +
+                                     std::to_string(im.model.nodes.size()) + " nodes)"};
+  for (std::size_t j = 1; j < g.joints.size(); ++j)
+    if (std::find(g.joints.begin(), g.joints.begin() + std::ptrdiff_t(j), g.joints[j]) !=
+        g.joints.begin() + std::ptrdiff_t(j))
+      return Error{im.file, where,
+                   "joint node " + std::to_string(g.joints[j]) + " is listed twice (joints " +
+                       "must be unique)"};
   SkinData skin;
   skin.name = g.name;
   skin.inverse_bind.assign(g.joints.size(), glm::mat4(1.0f));
@@ -40,6 +50,12 @@ Result<std::uint32_t> convert_skin(Importer& im, int index) {
           return Error{im.file, where + " inverseBindMatrices",
                        "matrix " + std::to_string(j) + " is not finite"};
         skin.inverse_bind[j][c / 4][c % 4] = v;
+      }
+    for (std::size_t j = 0; j < g.joints.size(); ++j)
+      if (std::abs(glm::determinant(skin.inverse_bind[j])) < 1e-12f) {
+        im.report.warnings.push_back(where + " inverseBindMatrices: matrix " + std::to_string(j) +
+                                     " is singular (the vertices it moves collapse)");
+        break;
       }
   }
   im.assets.skins.push_back(std::move(skin));

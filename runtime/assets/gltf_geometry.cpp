@@ -330,7 +330,9 @@ Status read_deform(const tinygltf::Model& model, const std::string& file,
     if (joints->empty() && weights->empty()) break;
     if (joints->size() != vertex_count * 4 || weights->size() != vertex_count * 4)
       return Error{file, where,
-                   jn + " and " + wn + " must both be given, one per vertex (" +
+                   jn + " has " + std::to_string(joints->size() / 4) + " and " + wn + " " +
+                       std::to_string(weights->size() / 4) +
+                       " elements; both must be given, one per vertex (" +
                        std::to_string(vertex_count) + ")"};
     if (set == 1) {  // interleave the second set after the first, 8 per vertex
       std::vector<std::uint32_t> j8(vertex_count * 8);

@@ -298,6 +298,13 @@ Result<ecs::Entity> import_node(Importer& im, int index, ecs::Entity parent) {
   }
   if (node.skin >= 0 && node.mesh < 0)
     im.report.warnings.push_back(where + ": skin without a mesh ignored");
+  if (node.skin >= 0 && node.mesh >= 0) {
+    bool any = false;
+    for (const auto& s : im.skinned) any = any || s.node == index;
+    if (!any)
+      im.report.warnings.push_back(where + ": skin ignored: its mesh has no JOINTS_0 and WEIGHTS_0 "
+                                           "(drawn in its bind pose)");
+  }
   im.node_entities[std::size_t(index)] = entity;
   if (node.camera >= 0) KASKAD_TRY(add_camera(im, entity, node.camera));
   if (auto ext = node.extensions.find("KHR_lights_punctual"); ext != node.extensions.end())

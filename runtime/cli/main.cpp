@@ -322,7 +322,7 @@ int run_render(RenderArgs a) {
   std::printf("context   %s, %s (%.1f ms)\n", player->context->platform().c_str(),
               player->context->description().c_str(), ms_since(t0));
 
-  if (a.time >= 0.0) set_animation_time(scene->world, scene->assets, float(a.time));
+  if (a.time >= 0.0) set_animation_time(scene->world, scene->assets, a.time);
   RenderRun run;
   run.frames = a.frames;
   run.dt = a.dt;

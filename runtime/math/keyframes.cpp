@@ -36,6 +36,8 @@ std::string validate_track(const KeyTrack& track) {
   if (track.times.empty()) return "no keys";
   for (std::size_t i = 0; i < track.times.size(); ++i) {
     if (!std::isfinite(track.times[i])) return "key " + std::to_string(i) + ": time is not finite";
+    if (track.times[i] < 0.0f)
+      return "key " + std::to_string(i) + ": time is negative (times start at 0 or later)";
     if (i > 0 && !(track.times[i] > track.times[i - 1]))
       return "key " + std::to_string(i) + ": times must increase strictly";
   }

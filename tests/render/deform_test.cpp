@@ -7,8 +7,10 @@
 #include <cstdio>
 
 #include "components/animation.h"
+#include "components/camera.h"
 #include "components/light.h"
 #include "components/mesh_renderer.h"
+#include "components/name.h"
 #include "components/transform.h"
 #include "runtime/app/player.h"
 #include "runtime/assets/mesh_pose.h"
@@ -157,6 +159,34 @@ TEST_F(DeformTest, AnAnimatedCasterRedrawsOnlyTheLayersThatHoldIt) {
     EXPECT_EQ(still->last.stats.shadow_layers_rendered, frame == 0 ? holding : 0u)
         << "stopped, frame " << frame;
   }
+}
+
+// A glTF opened directly frames its camera and ground on the first frame's pose: a skinned mesh
+// is placed by its joints, so its node's own transform (here a parent scaled 1000x, as exporters
+// put meshes under armatures) must not make the view 1000 times too large. The bar is 2 m tall.
+TEST_F(DeformTest, AutoFramingUsesThePosedBoundsOfSkinnedMeshes) {
+  const auto file = std::filesystem::path(KASKAD_TEST_DATA) / "skinned_under_scaled_parent.gltf";
+  auto scene = load_scene(file, {"render.width=320", "render.height=180"});
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  const Posed bar = fox_mesh(*scene);
+  ASSERT_TRUE(bar.entity.valid());
+  const Aabb posed = scene->world.get<WorldBounds>(bar.entity).box;
+  EXPECT_LT(glm::length(posed.extent()), 5.0f) << "the bar's bounds, from its joints";
+  Aabb ground;
+  glm::vec3 eye(0.0f);
+  scene->world.view<Name, WorldBounds>().each([&](ecs::Entity, const Name& n, const WorldBounds& b) {
+    if (n.value == "ground") ground = b.box;
+  });
+  scene->world.view<Camera, WorldTransform>().each(
+      [&](ecs::Entity, const Camera&, const WorldTransform& wt) { eye = glm::vec3(wt.matrix[3]); });
+  ASSERT_FALSE(ground.empty());
+  EXPECT_LT(glm::length(ground.extent()), 50.0f);
+  EXPECT_LT(glm::distance(eye, posed.center()), 30.0f);
+  // And it is seen: a frame's shadow pass and main view draw it.
+  RenderRun run;
+  auto frames = render_frames(*player_, *scene, run);
+  ASSERT_TRUE(frames.ok()) << frames.error().to_string();
+  EXPECT_EQ(frames->last.stats.frustum_culled, 0);
 }
 
 }  // namespace

@@ -59,6 +59,12 @@ bool mentions(const Error& error, const std::string& text) {
   return error.to_string().find(text) != std::string::npos;
 }
 
+bool warns(const GltfImportReport& report, const std::string& text) {
+  for (const auto& w : report.warnings)
+    if (w.find(text) != std::string::npos) return true;
+  return false;
+}
+
 /// Every entity with a Name, by name (names are unique in the files used here).
 std::map<std::string, ecs::Entity> entities_by_name(ecs::World& world) {
   std::map<std::string, ecs::Entity> out;
@@ -326,6 +332,40 @@ json morphed_triangle_gltf() {
   return doc;
 }
 
+// Skins the reader cannot trust are errors naming the skin (a joint listed twice, a skeleton
+// out of range); a singular inverse bind matrix and a skin on a mesh without joint weights are
+// warnings. The Fox, its skin changed, next to copies of its buffer and texture.
+TEST(GltfLoader, BadSkinsAreErrorsOrWarningsNamingTheSkin) {
+  const auto dir = content_path("models/Fox/glTF");
+  for (const char* f : {"Fox.bin", "Texture.png"}) write_bytes(temp_dir() / f, read_bytes(dir / f));
+  const json fox = json::parse(read_bytes(dir / "Fox.gltf"));
+  {
+    json doc = fox;
+    doc["skins"][0]["joints"][1] = doc["skins"][0]["joints"][0];
+    auto s = import_file(write_gltf("fox_dup_joint.gltf", doc));
+    ASSERT_FALSE(s->report.ok());
+    EXPECT_TRUE(mentions(s->report.error(), "skins[0]")) << s->report.error().to_string();
+    EXPECT_TRUE(mentions(s->report.error(), "listed twice"));
+  }
+  {
+    json doc = fox;
+    doc["skins"][0]["skeleton"] = 999;
+    auto s = import_file(write_gltf("fox_bad_skeleton.gltf", doc));
+    ASSERT_FALSE(s->report.ok());
+    EXPECT_TRUE(mentions(s->report.error(), "skeleton 999 out of range")) << s->report.error().to_string();
+  }
+  {
+    json doc = fox;
+    for (auto& p : doc["meshes"][0]["primitives"]) {
+      p["attributes"].erase("JOINTS_0");
+      p["attributes"].erase("WEIGHTS_0");
+    }
+    auto s = import_file(write_gltf("fox_no_weights.gltf", doc));
+    ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+    EXPECT_TRUE(warns(*s->report, "skin ignored: its mesh has no JOINTS_0 and WEIGHTS_0"));
+  }
+}
+
 TEST(GltfLoader, MorphTargetsAndTheirWeightsAnimation) {
   auto s = import_file(write_gltf("morph.gltf", morphed_triangle_gltf()));
   ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
@@ -384,6 +424,20 @@ TEST(GltfLoader, BadAnimationsAndMorphTargetsAreErrorsNamingThePlace) {
     auto s = import_file(write_gltf("bad_target.gltf", doc));
     ASSERT_FALSE(s->report.ok());
     EXPECT_TRUE(mentions(s->report.error(), "target node 7 out of range")) << s->report.error().to_string();
+  }
+  {
+    // Keyframe times start at 0 or later (glTF 3.11).
+    json doc = morphed_triangle_gltf();
+    std::vector<std::uint8_t> buffer;
+    append<float>(buffer, {0, 0, 0, 1, 0, 0, 0, 1, 0});
+    append<std::uint16_t>(buffer, {0, 1, 2, 0});
+    append<float>(buffer, {0, 0, 0, 0, 1, 0, 0, 0, 0});
+    append<float>(buffer, {-1, 1});  // times
+    append<float>(buffer, {0, 1});
+    doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(buffer);
+    auto s = import_file(write_gltf("negative_time.gltf", doc));
+    ASSERT_FALSE(s->report.ok());
+    EXPECT_TRUE(mentions(s->report.error(), "time is negative")) << s->report.error().to_string();
   }
   {
     json doc = morphed_triangle_gltf();
@@ -799,11 +853,6 @@ Material only_material(Imported3d& s) {
   return out;
 }
 
-bool warns(const GltfImportReport& report, const std::string& text) {
-  for (const auto& w : report.warnings)
-    if (w.find(text) != std::string::npos) return true;
-  return false;
-}
 
 // alphaMode BLEND is a blended material (its alphaCutoff ignored: 0.5, the shadow threshold),
 // MASK a cut-out, and KHR_materials_transmission blends with transmission_opacity() of the

@@ -79,6 +79,26 @@ TEST(AnimationSystem, SetTimeScalesBySpeedAndPosesNextFrame) {
   EXPECT_FLOAT_EQ(s.state().time, 1.5f);
 }
 
+// A time set past the clip's end is where the clock would put it: wrapped for a looping clip
+// (3.9 s of a 2 s clip shows 1.9 s), at the end for one that does not loop. --time is seconds in
+// double precision: 999999.9 s of a 2 s loop is 1.9 s, not a float's 1.875.
+TEST(AnimationSystem, TimesPastTheEndWrapOrStopAndLongTimesStayPrecise) {
+  OneClip s;
+  s.state().time = 3.9f;
+  s.world.get<Animator>(s.model).cues[0].pending = true;
+  update_animations(s.world, s.assets, 0.0);
+  EXPECT_NEAR(s.x(), 1.9f, 1e-5f);
+  s.state().loop = false;
+  s.state().time = 3.9f;
+  s.world.get<Animator>(s.model).cues[0].pending = true;
+  update_animations(s.world, s.assets, 0.0);
+  EXPECT_FLOAT_EQ(s.x(), 2.0f);
+  EXPECT_FALSE(s.state().playing);
+  OneClip t;
+  set_animation_time(t.world, t.assets, 999999.9);
+  EXPECT_NEAR(t.state().time, 1.9f, 1e-4f);
+}
+
 // A morphed mesh's bounds hold the displaced vertices: one target lifts vertex 1 of a unit
 // triangle by 2 in y, so at weight 0.75 the pose reaches y = 1.5 (above the mesh's own box).
 // (Bounds without the morph growth fail it.)
