@@ -268,6 +268,9 @@ constexpr CsvColumn kCsvColumns[] = {
     {"shadow_mesh_draws", [](const FrameRow&, const FrameReport& f) { return count(f.stats.shadow_mesh_draws); }},
     {"shadow_layers_rendered", [](const FrameRow&, const FrameReport& f) {
        return count(std::popcount(f.stats.shadow_layers_rendered)); }},
+    {"shadow_layers_scrolled", [](const FrameRow&, const FrameReport& f) {
+       return count(std::popcount(f.stats.shadow_layers_scrolled)); }},
+    {"shadow_texels_drawn", [](const FrameRow&, const FrameReport& f) { return count(f.stats.shadow_texels_drawn); }},
     {"deformed_meshes", [](const FrameRow&, const FrameReport& f) { return count(f.stats.deformed_meshes); }},
 };
 
