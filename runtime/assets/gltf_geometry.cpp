@@ -320,9 +320,25 @@ template <typename Attribute>
 Status read_deform(const tinygltf::Model& model, const std::string& file,
                    const tinygltf::Primitive& prim, const tinygltf::Mesh& mesh,
                    const std::string& where, std::size_t vertex_count, Attribute& attribute,
-                   MeshDeform& out) {
+                   MeshDeform& out, std::vector<std::string>& warnings) {
   for (int set = 0; set < 2; ++set) {
     const std::string jn = "JOINTS_" + std::to_string(set), wn = "WEIGHTS_" + std::to_string(set);
+    // glTF 3.7.3.3: joints are unsigned bytes or shorts, weights floats or normalized unsigned
+    // bytes or shorts. Other types are read as they come, with a warning.
+    const auto accessor = [&](const std::string& name) -> const tinygltf::Accessor* {
+      const auto it = prim.attributes.find(name);
+      return it == prim.attributes.end() || it->second < 0 ||
+                     std::size_t(it->second) >= model.accessors.size()
+                 ? nullptr
+                 : &model.accessors[std::size_t(it->second)];
+    };
+    if (const auto* a = accessor(jn); a && a->componentType == TINYGLTF_COMPONENT_TYPE_FLOAT)
+      warnings.push_back(where + ": " + jn + " are floats (glTF: unsigned byte or short); read as "
+                                            "whole joint numbers");
+    if (const auto* a = accessor(wn); a && a->componentType != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+                                      !a->normalized)
+      warnings.push_back(where + ": " + wn + " are integers without normalized: true (glTF: floats "
+                                            "or normalized integers); read as fractions of their range");
     auto joints = attribute(jn, 4);
     if (!joints) return joints.error();
     auto weights = attribute(wn, 4);
@@ -611,7 +627,7 @@ Result<std::optional<MeshData>> read_primitive(const tinygltf::Model& model,
     std::memcpy(m.uvs1.data(), uvs1->data(), uvs1->size() * sizeof(float));
   }
   m.indices = std::move(indices);
-  KASKAD_TRY(read_deform(model, file, prim, mesh, where, vertex_count, attribute, m.deform));
+  KASKAD_TRY(read_deform(model, file, prim, mesh, where, vertex_count, attribute, m.deform, warnings));
   if (normals->empty()) {
     make_flat_normals(m);
   } else {

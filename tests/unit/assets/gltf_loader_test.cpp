@@ -366,6 +366,27 @@ TEST(GltfLoader, BadSkinsAreErrorsOrWarningsNamingTheSkin) {
   }
 }
 
+// Joint and weight types glTF does not allow are read as they come, with a warning naming them:
+// float joints, integer weights that are not normalized.
+TEST(GltfLoader, OffTypeJointsAndWeightsAreWarnings) {
+  json doc = triangle_gltf();
+  std::vector<std::uint8_t> extra;
+  append<float>(extra, {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0});  // JOINTS_0 as floats (48 bytes)
+  for (int v = 0; v < 3; ++v) extra.insert(extra.end(), {1, 0, 0, 0});  // WEIGHTS_0 bytes (12)
+  doc["buffers"].push_back({{"byteLength", extra.size()},
+                            {"uri", "data:application/octet-stream;base64," + base64(extra)}});
+  doc["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 0}, {"byteLength", 48}});
+  doc["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 48}, {"byteLength", 12}});
+  doc["accessors"].push_back({{"bufferView", 2}, {"componentType", 5126}, {"count", 3}, {"type", "VEC4"}});
+  doc["accessors"].push_back({{"bufferView", 3}, {"componentType", 5121}, {"count", 3}, {"type", "VEC4"}});
+  doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = 2;
+  doc["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] = 3;
+  auto s = import_file(write_gltf("off_type_skin.gltf", doc));
+  ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
+  EXPECT_TRUE(warns(*s->report, "JOINTS_0 are floats"));
+  EXPECT_TRUE(warns(*s->report, "WEIGHTS_0 are integers without normalized"));
+}
+
 TEST(GltfLoader, MorphTargetsAndTheirWeightsAnimation) {
   auto s = import_file(write_gltf("morph.gltf", morphed_triangle_gltf()));
   ASSERT_TRUE(s->report.ok()) << s->report.error().to_string();
