@@ -140,16 +140,17 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
         if (const auto* wb = world.try_get<WorldBounds>(e)) d.bounds = wb->box;
         if (const auto* def = world.try_get<Deformer>(e); def && def->posed != kNoMesh) {
           // Drawn with its posed copy; a skinned pose is in world space already.
-          render::DeformJob job{mr.mesh, def->posed,
-                                def->skin_matrices.empty()
-                                    ? 0
-                                    : scene.assets.meshes[index(mr.mesh)].deform.influences,
-                                std::uint32_t(scene.assets.meshes[index(mr.mesh)].positions.size()),
-                                def->pose,
-                                std::uint32_t(in.skin_matrices.size()),
-                                std::uint32_t(def->skin_matrices.size()),
-                                std::uint32_t(in.morph_weights.size()),
-                                std::uint32_t(def->weights.size())};
+          const MeshData& source = scene.assets.meshes[index(mr.mesh)];
+          const render::DeformJob job{
+              .source = mr.mesh,
+              .posed = def->posed,
+              .influences = def->skin_matrices.empty() ? 0 : source.deform.influences,
+              .vertex_count = std::uint32_t(source.positions.size()),
+              .pose = def->pose,
+              .first_matrix = std::uint32_t(in.skin_matrices.size()),
+              .matrix_count = std::uint32_t(def->skin_matrices.size()),
+              .first_weight = std::uint32_t(in.morph_weights.size()),
+              .weight_count = std::uint32_t(def->weights.size())};
           in.skin_matrices.insert(in.skin_matrices.end(), def->skin_matrices.begin(),
                                   def->skin_matrices.end());
           in.morph_weights.insert(in.morph_weights.end(), def->weights.begin(), def->weights.end());

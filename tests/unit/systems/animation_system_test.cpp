@@ -41,6 +41,11 @@ struct OneClip {
   }
   float x() { return world.get<Transform>(node).translation.x; }
   AnimationState& state() { return world.get<Animator>(model).clips[0]; }
+  /// The clip's time as a scene file or --set gives it: shown on the next frame.
+  void set_time(float t) {
+    state().time = t;
+    world.get<Animator>(model).cues[0].pending = true;
+  }
 };
 
 TEST(AnimationSystem, AFrameShowsTheClipNowThenTheClockMovesOn) {
@@ -84,13 +89,11 @@ TEST(AnimationSystem, SetTimeScalesBySpeedAndPosesNextFrame) {
 // double precision: 999999.9 s of a 2 s loop is 1.9 s, not a float's 1.875.
 TEST(AnimationSystem, TimesPastTheEndWrapOrStopAndLongTimesStayPrecise) {
   OneClip s;
-  s.state().time = 3.9f;
-  s.world.get<Animator>(s.model).cues[0].pending = true;
+  s.set_time(3.9f);
   update_animations(s.world, s.assets, 0.0);
   EXPECT_NEAR(s.x(), 1.9f, 1e-5f);
   s.state().loop = false;
-  s.state().time = 3.9f;
-  s.world.get<Animator>(s.model).cues[0].pending = true;
+  s.set_time(3.9f);
   update_animations(s.world, s.assets, 0.0);
   EXPECT_FLOAT_EQ(s.x(), 2.0f);
   EXPECT_FALSE(s.state().playing);
