@@ -23,7 +23,14 @@
 namespace kaskad {
 namespace {
 
-class DeformTest : public PlayerTest {};
+class DeformTest : public PlayerTest {
+ protected:
+  /// One frame of `scene` with every playing clip `t` seconds in (kaskad render --time).
+  static Result<RenderTimings> render_at(Scene& scene, float t) {
+    set_animation_time(scene.world, scene.assets, t);
+    return render_frames(*player_, scene, RenderRun{});
+  }
+};
 
 const std::filesystem::path kFoxScene = std::filesystem::path(KASKAD_CONTENT_DIR) / "scenes/fox_walk.json";
 
@@ -48,9 +55,7 @@ TEST_F(DeformTest, GpuPoseMatchesTheCpuPoseAndStaysInItsBounds) {
   std::vector<glm::vec3> first;
   for (float t : {0.0f, 0.37f, 0.81f}) {
     SCOPED_TRACE("t = " + std::to_string(t));
-    set_animation_time(scene->world, scene->assets, t);
-    RenderRun run;
-    auto frames = render_frames(*player_, *scene, run);
+    auto frames = render_at(*scene, t);
     ASSERT_TRUE(frames.ok()) << frames.error().to_string();
     EXPECT_EQ(frames->last.stats.deformed_meshes, 1);
     const Posed p = fox_mesh(*scene);
@@ -94,9 +99,7 @@ TEST_F(DeformTest, AnimatedShadowAgreesWithTheReferenceAtSeveralTimes) {
   ASSERT_TRUE(scene.ok()) << scene.error().to_string();
   for (float t : {0.1f, 0.45f, 0.9f}) {
     SCOPED_TRACE("t = " + std::to_string(t));
-    set_animation_time(scene->world, scene->assets, t);
-    RenderRun run;
-    auto frames = render_frames(*player_, *scene, run);
+    auto frames = render_at(*scene, t);
     ASSERT_TRUE(frames.ok()) << frames.error().to_string();
     const Image aov = player_->renderer->read_aovs();
     const ecs::Entity light = frames->last.shadow().light;
