@@ -100,6 +100,7 @@ render::FrameInput build_frame_input(const Scene& scene, const FrameContext& ctx
   in.shadow_scroll = scene.render.shadow_scroll;
   in.multi_draw = scene.render.multi_draw;
   in.visibility_cache = scene.render.visibility_cache;
+  in.visibility_reproject = scene.render.visibility_reproject;
   if (!shadows.empty()) {
     in.shadow_settings = shadows.front().settings;  // its shared fields are every view's
     in.aov_shadow_view = aov_shadow_index(scene, shadows.size());

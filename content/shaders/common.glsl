@@ -33,6 +33,8 @@ layout(std140, binding = 0) uniform FrameBlock {
   vec4 u_light_pos[MAX_LIGHTS];     // xyz: world position, w: cos(outer cone)
   vec4 u_light_cone[MAX_LIGHTS];    // x: cos(inner cone)
   ShadowView u_shadow_views[MAX_SHADOW_VIEWS];
+  mat4 u_previous_view_proj;        // a reprojecting frame: the camera of the visibility it reads
+  vec4 u_previous_camera_pos;       // xyz: that camera's world position
 };
 
 float view_split(int k, int i) { return u_shadow_views[k].splits[i >> 2][i & 3]; }

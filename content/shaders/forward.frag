@@ -30,13 +30,51 @@ layout(location = 4) out vec4 o_reflection;  // rgb reflected colour C_t, a 1 wi
 
 // render.visibility_cache (Renderer::render()): a frame that stores writes each pixel's shadow
 // visibility per shadow view; a frame that sees what the frame before saw reads it back, so the
-// pixel that ends up in front reads its own value and the image is the same, bit for bit.
+// pixel that ends up in front reads its own value and the image is the same, bit for bit. With
+// one shadow view, a frame whose camera alone moved reprojects it (reprojected_visibility()).
+// Stored per pixel: channel k the visibility of view k (-1 where the surface faces away from its
+// light: visibility 0, no lookup); with one view, channel 1 the reprojection code: the distance
+// from the camera to the surface's plane where the visibility is 1, minus it where 0, and 0
+// elsewhere (partly lit, or facing away). Points of one plane share that distance, so a
+// neighbour across a crease or a silhouette does not pass for the surface.
 #define SHADOW_REUSE (VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS && !VARIANT_HAS_AOVS)
-#if SHADOW_REUSE && VARIANT_SHADOW_REUSE == VARIANT_SHADOW_REUSE_STORE
-layout(location = 1) out vec4 o_cached_visibility;  // x, y, z, w: shadow views 0..3
+#define SHADOW_REUSE_IS(mode) (SHADOW_REUSE && VARIANT_SHADOW_REUSE == VARIANT_SHADOW_REUSE_##mode)
+#define SHADOW_STORES (SHADOW_REUSE_IS(STORE) || SHADOW_REUSE_IS(REPROJECT))
+#if SHADOW_STORES
+layout(location = 1) out vec4 o_cached_visibility;
 #endif
-#if SHADOW_REUSE && VARIANT_SHADOW_REUSE == VARIANT_SHADOW_REUSE_LOAD
+#if SHADOW_REUSE_IS(LOAD) || SHADOW_REUSE_IS(REPROJECT)
 layout(binding = UNIT_CACHED_VISIBILITY) uniform sampler2D u_cached_visibility;
+#endif
+
+#if SHADOW_STORES
+// The distance from camera position c to the plane through p facing n, the surface's side of it
+// (the camera sees the side its geometric normal faces: positive).
+float plane_distance(vec3 p, vec3 n, vec3 c) { return dot(n, c - p); }
+#endif
+
+#if SHADOW_REUSE_IS(REPROJECT)
+// The visibility stored under the previous camera around world point p (geometric normal n),
+// when the four stored pixels around where that camera saw p all show this surface (their
+// planes' distances from that camera within `tolerance` of p's) and agree on 1 or on 0: inside a lit area or a shadow. -1 otherwise
+// (a shadow edge, a surface newly in view, a silhouette): the frame's second forward pass looks
+// such pixels up (ForwardPass::record()).
+float reprojected_visibility(vec3 p, vec3 n, float tolerance) {
+#if SHADOW_VIEWS == 1
+  const vec4 clip = u_previous_view_proj * vec4(p, 1.0);
+  if (clip.w <= 0.0) return -1.0;
+  const vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+  const vec2 size = vec2(textureSize(u_cached_visibility, 0));
+  if (any(lessThan(uv * size, vec2(0.5))) || any(greaterThan(uv * size, size - 0.5))) return -1.0;
+  const vec4 code = textureGather(u_cached_visibility, uv, 1);
+  const float expected = plane_distance(p, n, u_previous_camera_pos.xyz);
+  const vec4 off = abs(abs(code) - expected);
+  if (max(max(off.x, off.y), max(off.z, off.w)) > tolerance) return -1.0;
+  if (all(greaterThan(code, vec4(0.0)))) return 1.0;
+  if (all(lessThan(code, vec4(0.0)))) return 0.0;
+#endif
+  return -1.0;
+}
 #endif
 
 #if VARIANT_ENVIRONMENT == VARIANT_ENVIRONMENT_MAP
@@ -211,8 +249,23 @@ void main() {
   int aov_cascade = -1, tint_cascade = -1;
 #if VARIANT_HAS_SHADOW && MATERIAL_RECEIVES_SHADOWS
   float view_visibility[SHADOW_VIEWS];
-#if SHADOW_REUSE && VARIANT_SHADOW_REUSE == VARIANT_SHADOW_REUSE_LOAD
+#if SHADOW_STORES
+  vec4 stored = vec4(1.0);
+#if SHADOW_VIEWS == 1
+  stored.y = 0.0;
+#endif
+  const float plane_offset = plane_distance(v_world_pos, geometric_n, u_camera_pos.xyz);
+#endif
+#if SHADOW_REUSE_IS(LOAD)
   const vec4 cached_visibility = texelFetch(u_cached_visibility, ivec2(gl_FragCoord.xy), 0);
+#elif SHADOW_REUSE_IS(REPROJECT)
+  // The four stored pixels span at most a pixel's step along each axis: on a curved surface
+  // their planes' distances differ from this point's by at most about fwidth; on a flat one
+  // by rounding.
+  const float reprojected = reprojected_visibility(
+      v_world_pos, geometric_n,
+      1.5 * fwidth(plane_offset) + 1e-4 * distance(v_world_pos, u_camera_pos.xyz));
+  bool look_up = false;  // discarded at the end: the second pass looks it up
 #endif
   for (int k = 0; k < SHADOW_VIEWS; ++k) {
     float visibility = 1.0;
@@ -220,16 +273,34 @@ void main() {
     if (ENABLED(BIT_RECEIVE_SHADOWS)) {
 #if VARIANT_HAS_AOVS
       visibility = shadow_visibility(k, v_world_pos, geometric_n, view_depth, cascade);
-#elif SHADOW_REUSE && VARIANT_SHADOW_REUSE == VARIANT_SHADOW_REUSE_LOAD
-      visibility = cached_visibility[k];
+#elif SHADOW_REUSE_IS(LOAD)
+      visibility = max(cached_visibility[k], 0.0);
 #else
       // No AOV shows it: where the geometric surface faces away from the light it shadows
       // itself, so the lookup is skipped (visibility 0; only a normal-mapped normal can still
       // face the light there). With AOVs the lookup runs everywhere: the AOV contract and its
       // tests keep today's values on such pixels. llvmpipe runs the masked lookup anyway.
       visibility = 0.0;
-      if (faces_light(u_shadow_views[k].info.x, v_world_pos, geometric_n))
+      const bool lit_side = faces_light(u_shadow_views[k].info.x, v_world_pos, geometric_n);
+      if (lit_side) {
+#if SHADOW_REUSE_IS(REPROJECT)
+        // No lookup here: llvmpipe would run it for every pixel of a SIMD vector whatever the
+        // branch, so the pixels that need one are left to the second pass.
+        visibility = max(reprojected, 0.0);
+        look_up = reprojected < 0.0;
+#else
         visibility = shadow_visibility(k, v_world_pos, geometric_n, view_depth, cascade);
+#endif
+      }
+#if SHADOW_STORES
+      stored[k] = lit_side ? visibility : -1.0;
+#if SHADOW_VIEWS == 1
+      // (A smooth normal may face slightly away from the camera at a silhouette: code 0.)
+      stored.y = !lit_side || plane_offset <= 0.0 ? 0.0
+                 : visibility >= 1.0 - 1e-6 ? plane_offset
+                 : visibility <= 1e-6 ? -plane_offset : 0.0;
+#endif
+#endif
 #endif
     }
     view_visibility[k] = visibility;
@@ -239,9 +310,8 @@ void main() {
     }
     if (k == 0) tint_cascade = cascade;
   }
-#if SHADOW_REUSE && VARIANT_SHADOW_REUSE == VARIANT_SHADOW_REUSE_STORE
-  o_cached_visibility = vec4(1.0);
-  for (int k = 0; k < SHADOW_VIEWS; ++k) o_cached_visibility[k] = view_visibility[k];
+#if SHADOW_STORES
+  o_cached_visibility = stored;
 #endif
 #endif
   for (int i = 0; i < u_counts.x; ++i) {
@@ -317,5 +387,9 @@ void main() {
   o_normal = vec4(geometric_n, view_depth);
   o_visibility = vec2(aov_visibility, float(aov_cascade));
   o_reflection = vec4(reflected, reflector);
+#endif
+#if SHADOW_REUSE_IS(REPROJECT)
+  // Last, so that every derivative above saw the whole quad.
+  if (look_up) discard;
 #endif
 }

@@ -272,6 +272,14 @@ constexpr CsvColumn kCsvColumns[] = {
        return count(std::popcount(f.stats.shadow_layers_scrolled)); }},
     {"shadow_texels_drawn", [](const FrameRow&, const FrameReport& f) { return count(f.stats.shadow_texels_drawn); }},
     {"deformed_meshes", [](const FrameRow&, const FrameReport& f) { return count(f.stats.deformed_meshes); }},
+    // render.visibility_cache: how the forward pass got each pixel's shadow visibility.
+    {"visibility", [](const FrameRow&, const FrameReport& f) {
+       const auto& s = f.stats;
+       return std::string(s.visibility_reused        ? "loaded"
+                          : s.visibility_reprojected ? "reprojected"
+                          : s.visibility_stored      ? "looked_up_stored"
+                                                     : "looked_up");
+     }},
 };
 
 std::string csv_header() {

@@ -71,6 +71,11 @@ struct RenderSettings {
   /// shadow maps) reads each pixel's shadow visibility back instead of looking the maps up.
   /// Images are identical either way; off, every frame looks up (for measurements).
   bool visibility_cache = true;
+  /// Visibility reprojection: with visibility_cache, a frame whose camera alone moved reuses
+  /// the visibility of the frame before where it finds the same surface inside a shadow or a lit
+  /// area, and looks the maps up only at shadow edges and surfaces newly in view. Off, a moving
+  /// camera looks up every pixel (docs/design/shadow_cost.md, "Reprojected visibility").
+  bool visibility_reproject = true;
   /// Multi-draw: draws with the same program, material and winding but different meshes are one
   /// glMultiDrawElementsIndirect (one instanced draw per mesh in it). Off, one call per mesh.
   /// Images are identical either way (for measurements, and drivers that mishandle it).
@@ -106,6 +111,8 @@ constexpr auto field_table(fields::Of<RenderSettings>) {
            "A stable cascade moved by whole texels draws only the texels that came into view"),
       flag("visibility_cache", &R::visibility_cache,
            "A frame that sees what the frame before saw reads its shadow visibility back"),
+      flag("visibility_reproject", &R::visibility_reproject,
+           "A frame whose camera alone moved reuses the visibility of the frame before inside shadows and lit areas"),
       flag("multi_draw", &R::multi_draw,
            "Draws of one program and material but different meshes are one multi-draw"),
       integer("probe_bounces", &R::probe_bounces, kMinProbeBounces, kMaxProbeBounces,

@@ -388,6 +388,9 @@ int run_render(RenderArgs a) {
     if (st.visibility_reused)
       std::printf("          shadow visibility read back from the frame before (nothing it "
                   "depends on changed; render.visibility_cache)\n");
+    if (st.visibility_reprojected)
+      std::printf("          shadow visibility reprojected from the frame before where it held "
+                  "(the camera alone moved; render.visibility_reproject)\n");
     // The first shadowed light's technique is every view's (for_each_shared_field()).
     if (!timings->last.shadows.empty() &&
         timings->last.shadows.front().settings.technique == ShadowTechnique::lom)

@@ -225,11 +225,12 @@ inline constexpr FeatureSpec kFeatureTable[] = {
     {.name = "environment", .kind = FeatureKind::frame, .define = "VARIANT_ENVIRONMENT",
      .stages = kFragmentStage, .offset = 43, .values = {"uniform", "map"}},
     // render.visibility_cache: the main view's single-sample colour pass stores each pixel's
-    // shadow visibility (one float per shadow view), and a frame whose visibility inputs are
-    // those of the frame before loads it instead of looking the shadow maps up (Renderer).
-    // Only shadow-receiving programs keep it (filtered_for()).
+    // shadow visibility (one float per shadow view, and its distance from the camera); a frame
+    // whose visibility inputs are those of the frame before loads it instead of looking the
+    // shadow maps up, and a frame whose camera alone moved reprojects it, looking up only the
+    // pixels it cannot reuse (Renderer). Only shadow-receiving programs keep it (filtered_for()).
     {.name = "shadow_reuse", .kind = FeatureKind::frame, .define = "VARIANT_SHADOW_REUSE",
-     .stages = kFragmentStage, .offset = 44, .values = {"off", "store", "load"},
+     .stages = kFragmentStage, .offset = 44, .values = {"off", "store", "load", "reproject"},
      .requires_ = {"shadow"}},
     // Deform features (bits 48-55): how the deform pass poses a mesh (runtime/assets/
     // mesh_pose.h): skinned by 4 or 8 joints a vertex (glTF JOINTS_0, JOINTS_1), and morphed.
@@ -372,7 +373,7 @@ class VariantKey {
   static constexpr Field kAlphaToCoverage = feature_field("alpha_to_coverage");
   /// The main view's cached shadow visibility: 0 off, 1 store (look up and store), 2 load.
   static constexpr Field kShadowReuse = feature_field("shadow_reuse");
-  static constexpr std::uint32_t kReuseStore = 1, kReuseLoad = 2;
+  static constexpr std::uint32_t kReuseStore = 1, kReuseLoad = 2, kReuseReproject = 3;
   static constexpr std::uint64_t kFrameMask = 0x0000ffffffff0000u;
   // Deform features.
   /// 0 none, 1 four joints a vertex, 2 eight.

@@ -47,6 +47,10 @@ VariantKey frame_variant(const FrameInput& frame) {
   return k;
 }
 
+bool reprojects_visibility(const FrameInput& frame) {
+  return frame.visibility_reproject && frame.shadow_views.size() == 1;
+}
+
 VariantKey capture_frame_variant(VariantKey frame) {
   // Cubes hold linear radiance: no AOVs, no tone mapping.
   VariantKey k = VariantKey(frame.bits() & ~VariantKey::kAovs.mask() & ~VariantKey::kToneMapping.mask() &
@@ -84,9 +88,13 @@ std::vector<ProgramRequest> required_programs(const FrameInput& frame) {
   std::vector<VariantKey> main_fks;
   if (frame.msaa <= 1 || frame.write_aovs) main_fks.push_back(fk);
   if (frame.msaa > 1) main_fks.push_back(msaa_frame_variant(fk));
-  // With the visibility cache, a still frame's programs (the shadow-receiving ones) load it.
-  if (fk.get(VariantKey::kShadowReuse) == VariantKey::kReuseStore)
+  // With the visibility cache, a still frame's programs (the shadow-receiving ones) load it,
+  // and a moving camera's reproject it where there is a channel for the distance.
+  if (fk.get(VariantKey::kShadowReuse) == VariantKey::kReuseStore) {
     main_fks.push_back(VariantKey(fk).set(VariantKey::kShadowReuse, VariantKey::kReuseLoad));
+    if (reprojects_visibility(frame))
+      main_fks.push_back(VariantKey(fk).set(VariantKey::kShadowReuse, VariantKey::kReuseReproject));
+  }
   // The technique's own pass (none without shadows: the key then holds pcf).
   const ShadowExtraPass extra_pass = shadow_technique_of(fk).extra_pass;
   std::vector<ProgramRequest> out;

@@ -35,6 +35,10 @@ static_assert(kFeatureTable[feature_index("shadow_technique")].value_count() ==
 /// says nothing about a point behind it or beside it that a probe face sees: that point would
 /// fall into cascade 0, whose map does not hold it, and come out lit.
 VariantKey capture_frame_variant(VariantKey frame);
+/// render.visibility_reproject: whether a frame whose camera alone moved may reproject the
+/// stored visibility: with one shadow view, whose stored target has room for the reprojection
+/// code beside the visibility (forward.frag).
+bool reprojects_visibility(const FrameInput& frame);
 /// The frame features of the multisampled colour pass (FrameInput::msaa > 1) of a frame with
 /// features `frame`: no AOVs (a single-sample pass draws them), and alpha to coverage.
 VariantKey msaa_frame_variant(VariantKey frame);

@@ -149,15 +149,15 @@ std::span<const ForwardPass::Target> ForwardPass::targets() {
 }
 
 ForwardPass::Target ForwardPass::visibility_target(int views) {
-  if (views <= 1) return {"stored visibility (GL_R32F)", GL_R32F, GL_RED, GL_FLOAT, 4};
-  if (views == 2) return {"stored visibility (GL_RG32F)", GL_RG32F, GL_RG, GL_FLOAT, 8};
+  // A channel per view; with one view a second for the reprojection code (forward.frag).
+  if (views <= 2) return {"stored visibility (GL_RG32F)", GL_RG32F, GL_RG, GL_FLOAT, 8};
   return {"stored visibility (GL_RGBA32F)", GL_RGBA32F, GL_RGBA, GL_FLOAT, 16};
 }
 
 void ForwardPass::prepare(const FrameInput& frame, int samples) {
   const bool resized = !fbo_ || frame.width != width_ || frame.height != height_;
   if (resized) {
-    visibility_.reset();
+    for (gpu::Texture& t : visibility_) t.reset();
     width_ = frame.width;
     height_ = frame.height;
     fbo_ = gpu::make_framebuffer();
@@ -246,41 +246,65 @@ Status ForwardPass::record(const FrameInput& frame, const DrawList& list,
                                 single_colour ? bufs : aov_bufs);
   // The stored visibility (render.visibility_cache, never with AOVs): a storing frame writes it
   // through output 1 into attachment 5, attached for this pass only (a loading frame samples
-  // it, which an attached texture must not be).
+  // it, which an attached texture must not be). There are two targets: a reprojecting frame
+  // reads the one stored last and stores into the other.
   const GLenum visibility_attachment = GL_COLOR_ATTACHMENT5;
-  if (reuse == VariantKey::kReuseStore) {
+  const bool stores = reuse == VariantKey::kReuseStore || reuse == VariantKey::kReuseReproject;
+  const bool reads = reuse == VariantKey::kReuseLoad || reuse == VariantKey::kReuseReproject;
+  if (reads) {
+    KASKAD_CHECK(visibility_[current_], "a frame reads shadow visibility that no frame stored");
+    glBindTextureUnit(kTexCachedVisibility, visibility_[current_].id());
+    glBindSampler(kTexCachedVisibility, 0);
+  }
+  if (stores) {
     const int views = std::min<int>(int(frame.shadow_views.size()), kMaxShadowedLights);
-    if (!visibility_ || views != visibility_views_) {
+    if (views != visibility_views_)
+      for (gpu::Texture& t : visibility_) t.reset();
+    visibility_views_ = views;
+    current_ ^= 1;
+    gpu::Texture& target = visibility_[current_];
+    if (!target) {
       const Target t = visibility_target(views);
-      visibility_ = gpu::make_texture(GL_TEXTURE_2D);
-      glTextureStorage2D(visibility_.id(), 1, t.internal_format, width_, height_);
-      visibility_views_ = views;
+      target = gpu::make_texture(GL_TEXTURE_2D);
+      glTextureStorage2D(target.id(), 1, t.internal_format, width_, height_);
     }
-    glNamedFramebufferTexture(fbo_.id(), visibility_attachment, visibility_.id(), 0);
+    glNamedFramebufferTexture(fbo_.id(), visibility_attachment, target.id(), 0);
     const GLenum store_bufs[2] = {GL_COLOR_ATTACHMENT0, visibility_attachment};
     glNamedFramebufferDrawBuffers(fbo_.id(), 2, store_bufs);
-  } else if (reuse == VariantKey::kReuseLoad) {
-    KASKAD_CHECK(visibility_, "a frame loads shadow visibility that no frame stored");
-    glBindTextureUnit(kTexCachedVisibility, visibility_.id());
-    glBindSampler(kTexCachedVisibility, 0);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
   if (single_colour) glClearBufferfv(GL_COLOR, 0, clear_color);
   if (frame.write_aovs)
     for (int i = 1; i < 5; ++i) glClearBufferfv(GL_COLOR, i, zero);
+  // No surface: reprojection code 0, which a reprojecting frame never reuses.
+  const float no_surface[4] = {-1.0f, 0.0f, -1.0f, -1.0f};
+  if (stores) glClearBufferfv(GL_COLOR, 1, no_surface);
   glClearBufferfv(GL_DEPTH, 0, &one);
   // The AOV pass draws what the colour pass drew: its culling is counted once.
   const int culled = stats.frustum_culled;
   Status st = draw_forward(frame, list.forward_order, keys, nullptr, 0, view_proj,
                            cache, state, stats);
+  // A reprojecting frame's second pass: its first drew every pixel whose visibility it could
+  // reuse and discarded the rest; the shadow-receiving draws again with the lookup, where the
+  // depth test (less) lets through only the pixels the first pass left (and nearer surfaces
+  // it discarded). One pass with a branch would do on a GPU; llvmpipe runs a branch's body
+  // for every pixel of a SIMD vector, but skips vectors whose early depth test fails.
+  if (st && reuse == VariantKey::kReuseReproject) {
+    std::vector<std::uint32_t> receivers;
+    for (std::uint32_t i : list.forward_order)
+      if (keys[i].get(VariantKey::kShadowReuse) == VariantKey::kReuseReproject) receivers.push_back(i);
+    const int culled_once = stats.frustum_culled;
+    st = draw_forward(frame, receivers, list.keys, nullptr, 0, view_proj, cache, state, stats);
+    stats.frustum_culled = culled_once;
+  }
   // The blended draws over the colour; the AOV-only pass beside a multisampled colour pass has
   // no colour to blend into: the AOVs show the opaque surfaces either way.
-  const int draw_buffers = reuse == VariantKey::kReuseStore ? 2 : frame.write_aovs ? 5 : 1;
+  const int draw_buffers = stores ? 2 : frame.write_aovs ? 5 : 1;
   if (st && single_colour)
     st = draw_transparent(frame, list, keys, nullptr, 0, view_proj, depth_plane, draw_buffers,
                           cache, state, stats);
   if (!single_colour) stats.frustum_culled = culled;
-  if (reuse == VariantKey::kReuseStore) glNamedFramebufferTexture(fbo_.id(), visibility_attachment, 0, 0);
+  if (stores) glNamedFramebufferTexture(fbo_.id(), visibility_attachment, 0, 0);
   glDisable(GL_FRAMEBUFFER_SRGB);
   return st;
 }

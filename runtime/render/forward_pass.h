@@ -34,7 +34,9 @@ class ForwardPass {
   /// single-sample pass's (the list's, or with kReuseLoad the loading ones). `reuse` is the
   /// frame's VariantKey::kShadowReuse: with kReuseStore the pass also stores each pixel's
   /// shadow visibility per view; with kReuseLoad the programs read the stored values back (the
-  /// caller's promise: nothing they depend on changed since they were stored).
+  /// caller's promise: nothing they depend on changed since they were stored); with
+  /// kReuseReproject they read the values stored last under another camera (the frame block's
+  /// previous_* members; the caller's promise: only the camera changed) and store their own.
   Status record(const FrameInput& frame, const DrawList& list,
                 const std::vector<VariantKey>& keys, std::uint32_t reuse, GpuCache& cache,
                 DrawState& state, FrameStats& stats);
@@ -47,7 +49,8 @@ class ForwardPass {
   /// The targets, in attachment order (colour 0..4, then depth): what prepare() makes and what
   /// Renderer::check_target_size() asks the driver about.
   static std::span<const Target> targets();
-  /// The stored-visibility target for `views` shadow views: one 32-bit float channel each.
+  /// The stored-visibility target for `views` shadow views: one 32-bit float channel each, and
+  /// one for the distance from the camera when there are fewer than four.
   static Target visibility_target(int views);
 
   int width() const { return width_; }
@@ -56,7 +59,7 @@ class ForwardPass {
   int samples() const { return samples_; }
   bool aovs_written() const { return aovs_written_; }
   /// Whether a storing frame left stored visibility at the current size.
-  bool holds_visibility() const { return bool(visibility_); }
+  bool holds_visibility() const { return bool(visibility_[current_]); }
   gpu::FramebufferRef framebuffer() const { return fbo_; }
   /// Attachment i of targets().
   gpu::TextureRef texture(int i) const { return textures_[std::size_t(i)]; }
@@ -68,7 +71,10 @@ class ForwardPass {
   std::array<gpu::Texture, 6> textures_;
   gpu::Framebuffer msaa_fbo_;                 ///< samples_ > 1: colour and depth, multisampled
   std::array<gpu::Texture, 2> msaa_textures_;  ///< targets() 0 and 5 with samples_ samples
-  gpu::Texture visibility_;  ///< visibility_target(visibility_views_), made by a storing frame
+  /// visibility_target(visibility_views_), made by storing frames: [current_] holds the last
+  /// stored, and the next storing frame writes the other (a reprojecting one reads [current_]).
+  std::array<gpu::Texture, 2> visibility_;
+  int current_ = 0;
   int visibility_views_ = 0;
 };
 

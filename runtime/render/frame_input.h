@@ -223,6 +223,9 @@ struct FrameInput {
   /// whose visibility inputs equal the frame before's reads it back instead of looking the
   /// shadow maps up (Renderer::render()). Not with AOVs, MSAA or the cascade tint.
   bool visibility_cache = true;
+  /// render.visibility_reproject: with visibility_cache, a frame whose camera alone moved
+  /// reprojects the stored visibility and looks up only where it cannot reuse it.
+  bool visibility_reproject = true;
 };
 
 }  // namespace kaskad::render

@@ -74,6 +74,10 @@ struct FrameStats {
   /// render.visibility_cache: the forward pass read each pixel's shadow visibility back from
   /// the frame before instead of looking the shadow maps up (nothing it depends on changed).
   bool visibility_reused = false;
+  /// render.visibility_reproject: the camera alone moved, and the forward pass reused the
+  /// visibility of the frame before where it found the same surface inside a shadow or a lit
+  /// area (looking the maps up elsewhere), and stored its own.
+  bool visibility_reprojected = false;
   /// render.visibility_cache: the forward pass stored each pixel's visibility for the next frame
   /// (a frame that sees what the frame before saw and does not read back).
   bool visibility_stored = false;

@@ -46,6 +46,11 @@ struct alignas(16) FrameBlock {
   glm::vec4 light_pos[kMaxLights];    ///< xyz: world position, w: cos(outer cone)
   glm::vec4 light_cone[kMaxLights];   ///< x: cos(inner cone)
   ShadowViewBlock shadow_views[kMaxShadowedLights];
+  /// render.visibility_cache, a reprojecting frame (VARIANT_SHADOW_REUSE reproject): the camera
+  /// of the frame whose visibility it reads, its view_proj and xyz its position. Written by the
+  /// renderer when it reprojects (Renderer::render()); zero in pack_frame_block().
+  glm::mat4 previous_view_proj{0.0f};
+  glm::vec4 previous_camera_pos{0.0f};
 };
 
 /// The lights the shaders shade: the first kMaxLights of the frame's.

@@ -52,6 +52,11 @@ struct Renderer::Impl {
   std::uint64_t stored_visibility = 0;
   /// visibility_inputs() of the last frame with the cache on, stored or not.
   std::uint64_t last_visibility = 0;
+  /// render.visibility_reproject: world_visibility_inputs() of the visibility held (0: none
+  /// that a frame may reproject) and of the last frame, and the camera it was stored under.
+  std::uint64_t stored_world = 0, last_world = 0;
+  glm::mat4 stored_view_proj{1.0f};
+  glm::vec4 stored_camera_pos{0.0f};
 
   GpuTimers timers;  // GPU time per part of the frame (read a frame late)
   bool layer_from_vertex = false;  // GL_ARB_shader_viewport_layer_array: gl_Layer in the VS
@@ -194,6 +199,41 @@ std::uint64_t visibility_inputs(const FrameInput& frame, const DrawList& list,
   return h.value();
 }
 
+/// What a world point's shadow visibility depends on, so that a frame whose camera alone moved
+/// may reproject the visibility stored under another camera: the lights and the shadow views'
+/// parameters (not their fitted matrices, splits or rectangles, which follow the camera), the
+/// frame's features, the target size, the shaders, and every draw, caster or receiver, with
+/// what it casts and receives.
+std::uint64_t world_visibility_inputs(const FrameInput& frame, const DrawList& list,
+                                      const AssetStore& assets, const FrameBlock& block,
+                                      int shader_reloads) {
+  Hash h;
+  h.add(assets.uid).add(shader_reloads).add(frame.width).add(frame.height);
+  h.add(list.frame_key.bits()).add(block.frame_params).add(block.counts);
+  h.add(block.light_color).add(block.light_info).add(block.light_dir).add(block.light_pos);
+  h.add(block.light_cone).add(frame.shadow_settings.depth_format);
+  for (std::size_t k = 0; k < frame.shadow_views.size(); ++k) {
+    const ShadowView& v = frame.shadow_views[k];
+    h.add(v.light_index).add(v.projection).add(v.first_layer).add(v.layer_count);
+    h.add(v.slope_bias).add(v.constant_bias).add(v.cull);
+    if (k < std::size_t(kMaxShadowedLights)) {
+      const ShadowViewBlock& b = block.shadow_views[k];
+      h.add(b.info).add(b.params).add(b.soft);
+    }
+  }
+  for (std::size_t i = 0; i < frame.draws.size(); ++i) {
+    const DrawItem& d = frame.draws[i];
+    const Material& m = d.material;
+    // (Not shadow_layers: which cascades a caster is drawn into follows their fit, and the
+    // maps hold the same depths either way.)
+    h.add(d.mesh).add(d.model).add(d.pose).add(d.receive_shadows).add(d.cast_shadows);
+    h.add(list.keys[i].bits());
+    h.add(m.double_sided).add(m.alpha_mode).add(m.alpha_cutoff).add(m.base_color.a);
+    h.add(m.base_color_texture).add(m.base_color_transform);
+  }
+  return h.value();
+}
+
 }  // namespace
 
 Status Renderer::check_target_size(int width, int height, bool read_aovs, int msaa) const {
@@ -243,9 +283,9 @@ Status Renderer::check_target_size(int width, int height, bool read_aovs, int ms
     }
   }
   // The stored shadow visibility (render.visibility_cache, single-sample frames without AOVs):
-  // at most one float for each of four shadow views.
+  // two targets (one read while the other is stored) of at most four floats.
   if (!read_aovs && impl_->samples_for(msaa) <= 1)
-    gpu_bytes += pixels * ForwardPass::visibility_target(kMaxShadowedLights).bytes_per_pixel;
+    gpu_bytes += 2.0 * pixels * ForwardPass::visibility_target(kMaxShadowedLights).bytes_per_pixel;
   // Read-backs: colour as float RGBA, and with AOVs 14 float channels plus their staging.
   const double host_bytes = pixels * (16.0 + (read_aovs ? 2.0 * 14 * 4 + 64 : 0.0));
   const std::uint64_t available = available_memory();
@@ -338,54 +378,92 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   //    twice, stores on the second frame and reads back from the third.
   std::uint32_t reuse = list.frame_key.get(VariantKey::kShadowReuse);
   const std::uint64_t stored = std::exchange(im.stored_visibility, 0);
+  const std::uint64_t stored_world = std::exchange(im.stored_world, 0);
   bool store = false;
   if (reuse != 0) {
     const std::uint64_t inputs =
         visibility_inputs(frame, list, assets, block, im.shaders->stats().reloads);
+    const std::uint64_t world =
+        world_visibility_inputs(frame, list, assets, block, im.shaders->stats().reloads);
     const bool maps_kept = stats_.shadow_layers_rendered == 0 && stats_.lom_layers_computed == 0 &&
                            stats_.vsm_layers_computed == 0;
-    if (maps_kept && inputs == stored && im.forward.holds_visibility()) reuse = VariantKey::kReuseLoad;
-    store = reuse == VariantKey::kReuseStore && inputs == im.last_visibility;
+    // A held layer (shadow.far_cascade_interval) may keep depth that its casters have left:
+    // visibility looked up through one is not reprojected, nor stored for reprojection.
+    bool held = false;
+    for (const ShadowView& v : frame.shadow_views) held = held || v.held != 0;
+    if (maps_kept && inputs == stored && im.forward.holds_visibility()) {
+      reuse = VariantKey::kReuseLoad;
+    } else if (reprojects_visibility(frame) && !held && world == stored_world &&
+               im.forward.holds_visibility()) {
+      reuse = VariantKey::kReuseReproject;
+    }
+    // A frame stores when a later one may read it: one that sees what this frame saw (a camera
+    // that stops), or one whose camera alone moved.
+    store = reuse == VariantKey::kReuseStore &&
+            (inputs == im.last_visibility ||
+             (reprojects_visibility(frame) && world == im.last_world));
     im.last_visibility = inputs;
+    im.last_world = world;
     // What the target holds and a later frame may read: this frame's visibility. After a frame
     // that neither stores nor loads, nothing: what changed in between may not all be in the
     // inputs (a caster's cast_shadows redraws the maps, and the maps' inputs are their own).
-    im.stored_visibility = reuse == VariantKey::kReuseLoad || store ? inputs : 0;
+    const bool holds = reuse != VariantKey::kReuseStore || store;
+    im.stored_visibility = holds ? inputs : 0;
+    im.stored_world = holds && !held ? world : 0;
   }
-  // A loading frame draws with the loading programs. Those not built yet are built now
-  // (prewarm() builds them up front), each once (the order runs by program); one that does not
-  // build (a shader edited into an error since the storing programs were built) leaves the
+  // A loading or reprojecting frame draws with its own programs. Those not built yet are built
+  // now (prewarm() builds them up front), each once (the order runs by program); one that does
+  // not build (a shader edited into an error since the storing programs were built) leaves the
   // frame to look up with the programs it has.
-  std::vector<VariantKey> load_keys;
-  if (reuse == VariantKey::kReuseLoad) {
-    load_keys = list.keys;
-    for (VariantKey& k : load_keys)
+  std::vector<VariantKey> reuse_keys;
+  if (reuse == VariantKey::kReuseLoad || reuse == VariantKey::kReuseReproject) {
+    reuse_keys = list.keys;
+    for (VariantKey& k : reuse_keys)
       if (k.get(VariantKey::kShadowReuse) == VariantKey::kReuseStore)
-        k.set(VariantKey::kShadowReuse, VariantKey::kReuseLoad);
+        k.set(VariantKey::kShadowReuse, reuse);
     std::optional<VariantKey> built;
     for (std::uint32_t i : list.forward_order) {
-      const VariantKey load = load_keys[i];
-      if (load.get(VariantKey::kShadowReuse) != VariantKey::kReuseLoad || load == built) continue;
-      if (auto program = im.shaders->program(Pass::forward, load); !program) {
+      const VariantKey key = reuse_keys[i];
+      if (key.get(VariantKey::kShadowReuse) != reuse || key == built) continue;
+      if (auto program = im.shaders->program(Pass::forward, key); !program) {
         log::warn_once("render.visibility_cache: a program that reads the stored visibility does "
                        "not build (%s); frames look the shadow maps up instead",
                        program.error().to_string().c_str());
+        // A reprojecting frame would have stored; the target holds the frame before's.
+        if (reuse == VariantKey::kReuseReproject) im.stored_visibility = im.stored_world = 0;
         reuse = VariantKey::kReuseStore;
         break;
       }
-      built = load;
+      built = key;
     }
   }
   // The storing programs draw a frame that does not store; their visibility output goes to no
   // target.
   const std::uint32_t pass_reuse = reuse == VariantKey::kReuseStore && !store ? 0u : reuse;
   stats_.visibility_reused = reuse == VariantKey::kReuseLoad;
-  stats_.visibility_stored = pass_reuse == VariantKey::kReuseStore;
+  stats_.visibility_reprojected = reuse == VariantKey::kReuseReproject;
+  stats_.visibility_stored = pass_reuse == VariantKey::kReuseStore || stats_.visibility_reprojected;
+  // A reprojecting frame reads the visibility stored under the camera of the frame that stored
+  // it (the block's previous_* members, zero in every other frame's block).
+  if (reuse == VariantKey::kReuseReproject) {
+    struct {
+      glm::mat4 view_proj;
+      glm::vec4 camera_pos;
+    } previous{im.stored_view_proj, im.stored_camera_pos};
+    static_assert(offsetof(FrameBlock, previous_camera_pos) ==
+                  offsetof(FrameBlock, previous_view_proj) + sizeof(glm::mat4));
+    glNamedBufferSubData(im.frame_ubo.id(), offsetof(FrameBlock, previous_view_proj),
+                         sizeof previous, &previous);
+  }
+  if (stats_.visibility_stored) {
+    im.stored_view_proj = block.view_proj;
+    im.stored_camera_pos = block.camera_pos;
+  }
   im.timers.begin(TimedPart::forward);
-  st = im.forward.record(frame, list, reuse == VariantKey::kReuseLoad ? load_keys : list.keys,
-                         pass_reuse, *im.cache, state, stats_);
+  st = im.forward.record(frame, list, reuse_keys.empty() ? list.keys : reuse_keys, pass_reuse,
+                         *im.cache, state, stats_);
   im.timers.end(TimedPart::forward);
-  if (!st) im.stored_visibility = 0;
+  if (!st) im.stored_visibility = im.stored_world = 0;
   KASKAD_TRY(st);
 
   stats_.shaders = im.shaders->stats();

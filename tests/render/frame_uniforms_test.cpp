@@ -77,6 +77,8 @@ TEST_F(FrameUniformsTest, CppLayoutMatchesTheCompiledBlock) {
       {"u_light_dir[0]", offsetof(FrameBlock, light_dir), sizeof(glm::vec4), kMaxLights},
       {"u_light_pos[0]", offsetof(FrameBlock, light_pos), sizeof(glm::vec4), kMaxLights},
       {"u_light_cone[0]", offsetof(FrameBlock, light_cone), sizeof(glm::vec4), kMaxLights},
+      {"u_previous_view_proj", offsetof(FrameBlock, previous_view_proj), 0, 0},
+      {"u_previous_camera_pos", offsetof(FrameBlock, previous_camera_pos), 0, 0},
   };
   for (const Member& m : members) check(m.glsl, m, 0);
   // Every shadow view's members: the struct's own offsets plus the view's place in the array.

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <set>
 
+#include "components/camera.h"
+#include "components/transform.h"
 #include "runtime/app/player.h"
 #include "runtime/gpu/context.h"
 #include "systems/frame.h"
@@ -118,13 +120,21 @@ TEST_F(PermutationTest, CompilesExactlyTheCombinationsTheSceneUses) {
   for (const auto& r : requests) (r.pass == Pass::forward ? forward : depth).insert(r.key.bits());
   // materials.json: ground (none), checker, bumpy metal, glow, foliage (alpha), textured+bumpy,
   // plain cone (no shadow receiving): 7 distinct forward keys, and the 6 that receive shadows
-  // again reading the stored visibility (render.visibility_cache: still frames); depth:
-  // opaque + alpha mask.
-  EXPECT_EQ(forward.size(), 7u + 6u);
+  // again reading the stored visibility (render.visibility_cache: still frames) and again
+  // reprojecting it (render.visibility_reproject: a camera that moves); depth: opaque + alpha
+  // mask.
+  EXPECT_EQ(forward.size(), 7u + 6u + 6u);
   EXPECT_EQ(depth.size(), 2u);
 
   auto r = make_renderer();
   render(*r, s, 3);  // still frames: the second stores the visibility, the third reads it back
+  EXPECT_EQ(r->shaders().built_keys(Pass::forward).size(), 7u + 6u);
+  // A camera move: the frame reprojects what the still frames stored.
+  s.world.view<Camera, Transform>().each([](ecs::Entity, const Camera& c, Transform& t) {
+    if (c.active) t.translation += glm::vec3(0.1f, 0.0f, 0.0f);
+  });
+  render(*r, s, 1);
+  EXPECT_TRUE(r->stats().visibility_reprojected);
   EXPECT_EQ(r->shaders().built_keys(Pass::forward).size(), forward.size());
   EXPECT_EQ(r->shaders().built_keys(Pass::depth).size(), depth.size());
   EXPECT_EQ(r->stats().shaders.programs_compiled, int(forward.size() + depth.size()));

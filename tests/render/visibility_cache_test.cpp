@@ -1,13 +1,17 @@
 // The visibility cache (render.visibility_cache): a frame whose camera, draws, lights
 // and shadow maps are those of the frame that stored its visibility reads each pixel's shadow
-// visibility back instead of looking the maps up; a frame stores only when it sees what the
-// frame before saw (a moving camera's frames do not). Checked by replaying one sequence of scene
-// changes with the cache on and off: every frame's colour is the same bit for bit, still frames
-// store and then read back, and a frame after a change looks up again. Fails when the visibility inputs leave out the draws'
-// matrices (a moved object that casts nothing then shows stale visibility), or when a storing
-// frame stores nothing.
+// visibility back instead of looking the maps up; a frame stores only when a later frame may read
+// it. Checked by replaying one sequence of scene changes with the cache on and off: every frame's
+// colour is the same bit for bit, still frames store and then read back, and a frame after a
+// change looks up again. Fails when the visibility inputs leave out the draws' matrices (a moved
+// object that casts nothing then shows stale visibility), or when a storing frame stores nothing.
+// With one shadow view, a frame whose camera alone moved reprojects the stored visibility
+// (render.visibility_reproject): its colour is within a few pixels of the looked-up frame's
+// (ReprojectedFramesMatchTheLookUpAlongCameraPaths measures how close).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -28,10 +32,10 @@ class VisibilityCacheTest : public PlayerTest {
  protected:
   // One step of the replay: what changes before the frame, and what the frame does with the
   // stored visibility: kLookUp (it changed since the frame before), kStore (the same as the
-  // frame before: it looks up and stores), kReadBack (the same as the frame stored), kEither (not
-  // asserted).
-  enum class Change { none, caster, receiver, light, camera, size, base_colour };
-  static constexpr int kLookUp = 0, kReadBack = 1, kStore = 2, kEither = -1;
+  // frame before: it looks up and stores), kReadBack (the same as the frame stored), kReproject
+  // (only the camera moved since the frame stored), kEither (not asserted).
+  enum class Change { none, caster, receiver, light, camera, turn, size, base_colour };
+  static constexpr int kLookUp = 0, kReadBack = 1, kStore = 2, kReproject = 3, kEither = -1;
   struct Step {
     Change change;
     int use;
@@ -41,6 +45,7 @@ class VisibilityCacheTest : public PlayerTest {
     Image colour;
     bool reused = false;
     bool stored = false;
+    bool reprojected = false;
   };
 
   static ecs::Entity find(const Scene& s, const char* name) {
@@ -50,6 +55,22 @@ class VisibilityCacheTest : public PlayerTest {
     });
     return found;
   }
+
+  // Pixels where a channel of `a` and `b` differs by more than 0.02, the playback goldens'
+  // threshold (docs/guide/playback.md).
+  static int differing_pixels(const Image& a, const Image& b) {
+    int n = 0;
+    for (std::size_t p = 0; p + 3 < a.pixels.size() && p + 3 < b.pixels.size(); p += 4) {
+      float d = 0.0f;
+      for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(a.pixels[p + c] - b.pixels[p + c]));
+      n += d > 0.02f;
+    }
+    return n;
+  }
+  // At most 0.15% of the replay's 320x180 pixels a frame (measured along the paths of
+  // ReprojectedFramesMatchTheLookUpAlongCameraPaths: at most 0.099% in a frame, 0.05% over a
+  // path).
+  static constexpr int kMaxReprojectedPixels = 86;
 
   // Replays `steps` on the scene file with `sets`, one frame each, without AOVs.
   static std::vector<Frame> replay(const std::string& file, std::vector<std::string> sets,
@@ -91,6 +112,11 @@ class VisibilityCacheTest : public PlayerTest {
         case Change::camera:
           scene.world.get<Transform>(camera).translation += glm::vec3(0.2f, 0.0f, -0.1f);
           break;
+        case Change::turn: {
+          Transform& t = scene.world.get<Transform>(camera);
+          t.rotation = glm::angleAxis(glm::radians(0.7f), glm::vec3(0, 1, 0)) * t.rotation;
+          break;
+        }
         case Change::size:
           width = 240;
           height = 136;
@@ -109,7 +135,7 @@ class VisibilityCacheTest : public PlayerTest {
       EXPECT_TRUE(t.ok()) << file << ": " << t.error().to_string();
       if (!t.ok()) return out;
       out.push_back({player_->renderer->read_color(), t->last.stats.visibility_reused,
-                     t->last.stats.visibility_stored});
+                     t->last.stats.visibility_stored, t->last.stats.visibility_reprojected});
     }
     return out;
   }
@@ -120,23 +146,28 @@ TEST_F(VisibilityCacheTest, ReadBackFramesAreThoseLookedUp) {
   // The default scene: a caster, the sun, the camera and the size change in turn. A change of
   // base colours leaves the visibility as it was, but may reorder the draws (they sort by
   // material), which looks up again: either way the colour must be right.
-  const int L = kLookUp, S = kStore, R = kReadBack;
+  // A camera move reprojects what the frame before stored, and the frame after it reads back
+  // what the reprojecting frame stored.
+  const int L = kLookUp, S = kStore, R = kReadBack, P = kReproject;
   const std::vector<Step> with_caster = {
       {C::none, L},  {C::none, S},   {C::none, R},   {C::none, R},
       {C::caster, L}, {C::none, S},  {C::none, R},   {C::light, L},
-      {C::none, S},  {C::none, R},   {C::camera, L}, {C::camera, L},
-      {C::none, S},  {C::none, R},   {C::base_colour, kEither}, {C::size, L},
+      {C::none, S},  {C::none, R},   {C::camera, P}, {C::camera, P},
+      {C::none, R},  {C::none, R},   {C::base_colour, kEither}, {C::size, L},
       {C::none, S},  {C::none, R}};
   // The floating box casts nothing and moves sideways: no shadow layer is redrawn, but the
   // pixels it covers changed.
   const std::vector<Step> receiver = {{C::none, L},     {C::none, S}, {C::none, R},
                                       {C::receiver, L}, {C::none, S}, {C::none, R},
                                       {C::receiver, L}, {C::none, S}, {C::none, R}};
-  // Other shadow views (two suns: two channels; a spot light; a point light's cube faces) and
-  // techniques: the same replay without a named caster.
+  // Other shadow views (a spot light; a point light's cube faces; two suns: two channels and no
+  // reprojection) and techniques: the same replay without a named caster.
   const std::vector<Step> without_caster = {{C::none, L},   {C::none, S}, {C::none, R},
                                             {C::light, L},  {C::none, S}, {C::none, R},
-                                            {C::camera, L}, {C::none, S}, {C::none, R}};
+                                            {C::camera, P}, {C::none, R}, {C::none, R}};
+  const std::vector<Step> two_views = {{C::none, L},   {C::none, S}, {C::none, R},
+                                       {C::light, L},  {C::none, S}, {C::none, R},
+                                       {C::camera, L}, {C::none, S}, {C::none, R}};
   struct Case {
     const char* file;
     std::vector<std::string> sets;
@@ -147,7 +178,8 @@ TEST_F(VisibilityCacheTest, ReadBackFramesAreThoseLookedUp) {
       {"default.json", {"box_floating.renderer.cast_shadows=false"}, &receiver},
       {"default.json", {"shadow.technique=pcss"}, &with_caster},
       {"default.json", {"shadow.technique=vsm"}, &with_caster},
-      {"two_suns.json", {}, &without_caster},
+      {"two_suns.json", {}, &two_views},
+      {"default.json", {"render.visibility_reproject=false"}, &two_views},
       {"spot.json", {}, &without_caster},
       {"point.json", {}, &without_caster},
   };
@@ -160,23 +192,84 @@ TEST_F(VisibilityCacheTest, ReadBackFramesAreThoseLookedUp) {
     const std::vector<Frame> looked_up = replay(c.file, off, *c.steps);
     ASSERT_EQ(cached.size(), c.steps->size()) << what;
     ASSERT_EQ(looked_up.size(), c.steps->size()) << what;
-    int reused = 0;
+    int reused = 0, reprojected = 0, reprojected_frames = 0;
     for (std::size_t i = 0; i < cached.size(); ++i) {
       const int use = (*c.steps)[i].use;
       if (use != kEither) {
         EXPECT_EQ(cached[i].reused, use == kReadBack) << what << ", frame " << i;
-        EXPECT_EQ(cached[i].stored, use == kStore) << what << ", frame " << i;
+        EXPECT_EQ(cached[i].reprojected, use == kReproject) << what << ", frame " << i;
+        EXPECT_EQ(cached[i].stored, use == kStore || use == kReproject) << what << ", frame " << i;
       }
-      EXPECT_FALSE(looked_up[i].reused) << what << ", frame " << i;
+      EXPECT_FALSE(looked_up[i].reused || looked_up[i].reprojected) << what << ", frame " << i;
       EXPECT_FALSE(looked_up[i].stored) << what << ", frame " << i;
       EXPECT_EQ(cached[i].colour.width, looked_up[i].colour.width);
-      EXPECT_TRUE(cached[i].colour.pixels == looked_up[i].colour.pixels)
-          << what << ", frame " << i << " differs from the frame that looked the maps up";
+      // A reprojected frame, and the frames that read back what it stored, are held to the
+      // reprojection's bound (a few pixels at shadow edges: the test below); every other one is
+      // the looked-up frame bit for bit.
+      const bool after_reprojection = reprojected > 0 && use != kLookUp && use != kStore;
+      if (use == kReproject || after_reprojection) {
+        EXPECT_LE(differing_pixels(cached[i].colour, looked_up[i].colour), kMaxReprojectedPixels)
+            << what << ", frame " << i;
+      } else {
+        EXPECT_TRUE(cached[i].colour.pixels == looked_up[i].colour.pixels)
+            << what << ", frame " << i << " differs from the frame that looked the maps up";
+      }
       reused += cached[i].reused;
+      reprojected += cached[i].reprojected;
+      reprojected_frames += cached[i].reprojected;
+      if (use == kLookUp || use == kStore) reprojected = 0;
     }
-    std::printf("[ %s ] %d of %zu frames read the visibility back, every colour equal to the "
-                "looked-up frame's\n",
-                what.c_str(), reused, cached.size());
+    std::printf("[ %s ] %d of %zu frames read the visibility back, %d reprojected it; every "
+                "other colour equal to the looked-up frame's\n",
+                what.c_str(), reused, cached.size(), reprojected_frames);
+  }
+}
+
+// Reprojection against the lookup along camera paths: a camera that walks and turns for 24
+// frames reprojects on every frame after the first two, and each frame's colour differs from the
+// frame looked up with the cache off in at most kMaxReprojectedPixels pixels (0.15%, by more than
+// 0.02). The differences are pixels at the edge of a shadow narrower than a pixel's
+// step, where the four stored pixels around the point agree and the point itself is partly lit.
+// Fails when the reprojection ignores the surface check (pixels across silhouettes) or reuses
+// partly lit pixels.
+TEST_F(VisibilityCacheTest, ReprojectedFramesMatchTheLookUpAlongCameraPaths) {
+  using C = Change;
+  std::vector<Step> path = {{C::none, kLookUp}, {C::none, kStore}};
+  for (int i = 0; i < 24; ++i) path.push_back({i % 3 == 2 ? C::turn : C::camera, kReproject});
+  struct Case {
+    const char* file;
+    std::vector<std::string> sets;
+  };
+  const Case cases[] = {
+      {"default.json", {}},
+      {"default.json", {"shadow.technique=pcss"}},
+      {"default.json", {"shadow.fit_mode=crop"}},
+      {"terrain.json", {}},
+      {"spot.json", {}},
+      {"reflections.json", {}},
+  };
+  for (const Case& c : cases) {
+    std::string what = c.file;
+    for (const std::string& s : c.sets) what += " " + s;
+    std::vector<std::string> off = c.sets;
+    off.push_back("render.visibility_cache=false");
+    const std::vector<Frame> reprojected = replay(c.file, c.sets, path);
+    const std::vector<Frame> looked_up = replay(c.file, off, path);
+    ASSERT_EQ(reprojected.size(), path.size()) << what;
+    ASSERT_EQ(looked_up.size(), path.size()) << what;
+    int worst = 0, total = 0, frames = 0;
+    for (std::size_t i = 0; i < path.size(); ++i) {
+      EXPECT_EQ(reprojected[i].reprojected, path[i].use == kReproject) << what << ", frame " << i;
+      const int n = differing_pixels(reprojected[i].colour, looked_up[i].colour);
+      EXPECT_LE(n, kMaxReprojectedPixels) << what << ", frame " << i;
+      worst = std::max(worst, n);
+      total += n;
+      frames += reprojected[i].reprojected;
+    }
+    std::printf("[ %s ] %d of %zu frames reprojected; pixels differing from the lookup: at most "
+                "%d of %d a frame, %.4f%% over the path\n",
+                what.c_str(), frames, path.size(), worst, 320 * 180,
+                100.0 * total / (double(path.size()) * 320 * 180));
   }
 }
 

@@ -59,7 +59,7 @@ bool documented_rules_hold(VariantKey k) {
   // one per row of the technique table (components/shadow_technique.h)
   if (k.get(V::kShadowTechnique) >= kShadowTechniqueCount) return false;
   if (k.get(V::kShadowKernel) > 4) return false;     // 3x3, 5x5, 7x7, 9x9, poisson
-  if (k.get(V::kShadowReuse) > 2) return false;      // off, store, load
+  if (k.get(V::kShadowReuse) > 3) return false;      // off, store, load, reproject
   if (k.has(V::kReflectionCube) && k.has(V::kReflectionSphere)) return false;
   if (k.has(V::kReflectionBox) && !k.has(V::kReflectionCube)) return false;
   if (k.has(V::kReflectionPbr) && !k.has(V::kReflectionCube)) return false;
@@ -168,8 +168,8 @@ TEST(VariantKey, EveryKeyFollowsTheDocumentedRules) {
   const int shadowed = 3 * 2 * 2 * 2 * 2 * 4 * (8 + 3) * int(kShadowTechniqueCount) * 5 * 2;
   EXPECT_EQ(valid_materials, 3456);
   EXPECT_EQ(valid_frames, 2 * 2 * 3 * (2 + shadowed));
-  // shadow_reuse store and load on every frame key with shadow; "3" is past its values.
-  EXPECT_EQ(valid_reuse, 2 * 2 * 2 * 3 * shadowed);
+  // shadow_reuse store, load and reproject on every frame key with shadow.
+  EXPECT_EQ(valid_reuse, 2 * 2 * 3 * 3 * shadowed);
 }
 
 // The table is the one source: the manifest's features, their fields and the GLSL bit numbers
