@@ -270,6 +270,8 @@ constexpr CsvColumn kCsvColumns[] = {
        return count(std::popcount(f.stats.shadow_layers_rendered)); }},
     {"shadow_layers_scrolled", [](const FrameRow&, const FrameReport& f) {
        return count(std::popcount(f.stats.shadow_layers_scrolled)); }},
+    {"shadow_layers_patched", [](const FrameRow&, const FrameReport& f) {
+       return count(std::popcount(f.stats.shadow_layers_patched)); }},
     {"shadow_texels_drawn", [](const FrameRow&, const FrameReport& f) { return count(f.stats.shadow_texels_drawn); }},
     {"deformed_meshes", [](const FrameRow&, const FrameReport& f) { return count(f.stats.deformed_meshes); }},
     // render.visibility_cache: how the forward pass got each pixel's shadow visibility.

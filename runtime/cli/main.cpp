@@ -379,6 +379,10 @@ int run_render(RenderArgs a) {
       std::printf("          shadow layers scrolled: %d (moved by whole texels, they kept their "
                   "depth and drew only what came into view; render.shadow_scroll)\n",
                   std::popcount(st.shadow_layers_scrolled));
+    if (st.shadow_layers_patched != 0)
+      std::printf("          shadow layers patched: %d (casters moved under the same matrix: "
+                  "only their texels were drawn again; render.shadow_cache)\n",
+                  std::popcount(st.shadow_layers_patched));
     if (st.shadow_texels_drawn > 0)
       std::printf("          shadow texels drawn: %.2f M\n", double(st.shadow_texels_drawn) * 1e-6);
     if (st.shadow_rect_culled > 0)

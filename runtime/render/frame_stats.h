@@ -44,6 +44,9 @@ struct FrameStats {
   /// (or not at all, its read rectangle having grown) and it kept the depth it held, drawing
   /// only the texels it did not hold (if any, its bit in shadow_layers_rendered is set too).
   std::uint32_t shadow_layers_scrolled = 0;
+  /// render.shadow_cache: bit l when layer l kept its depth but for the texels of casters that
+  /// moved, came or went (the same matrix: a still camera), which alone it drew again.
+  std::uint32_t shadow_layers_patched = 0;
   /// Texels cleared and drawn this frame over all layers (each layer's size^2 when redrawn whole).
   std::int64_t shadow_texels_drawn = 0;
   /// Per layer of the shadow map array (all shadow views; view k's layers start at its

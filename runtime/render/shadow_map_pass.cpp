@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <optional>
 #include <string>
 
 #include "runtime/features/shader_interface.h"
@@ -78,6 +79,8 @@ void ShadowMapPass::ensure_storage(int size, int layers, DepthFormat format, Sha
     drawn_matrix_.assign(std::size_t(layers), glm::mat4(0.0f));
     drawn_fixed_.assign(std::size_t(layers), 0);
     drawn_casters_.assign(std::size_t(layers), {});
+    drawn_pass_.assign(std::size_t(layers), 0);
+    drawn_boxes_.assign(std::size_t(layers), {});
     wrapped_ = false;
     fbo_ = gpu::make_framebuffer();
     glNamedFramebufferTextureLayer(fbo_.id(), GL_DEPTH_ATTACHMENT, map_.id(), 0, 0);
@@ -119,7 +122,7 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   stats.shadow_layers = total;
   stats.shadow_layers_rendered = 0;
   stats.shadow_rect_culled = 0;
-  stats.shadow_layers_scrolled = 0;
+  stats.shadow_layers_scrolled = stats.shadow_layers_patched = 0;
   stats.shadow_texels_drawn = 0;
   stats.shadow_draw_calls = stats.shadow_mesh_draws = 0;
   stats.shadow_instances = 0;
@@ -194,11 +197,57 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   };
   // The casters layer c of the view holds (its caster_mask), sorted: a layer that keeps texels
   // must have held every caster that falls on them.
-  auto layer_casters = [&](const ShadowView& v, int c, std::vector<std::uint64_t>& out) {
-    out.clear();
+  auto layer_casters = [&](const ShadowView& v, int c, std::vector<std::uint64_t>& out,
+                           std::vector<Aabb>& boxes) {
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> sorted;
     for (std::uint32_t i : list.depth_order)
-      if (caster_mask(v, frame.draws[i]) & (1u << c)) out.push_back(caster_ids[i]);
-    std::sort(out.begin(), out.end());
+      if (caster_mask(v, frame.draws[i]) & (1u << c)) sorted.push_back({caster_ids[i], i});
+    std::sort(sorted.begin(), sorted.end());
+    out.clear();
+    boxes.clear();
+    for (const auto& [id, i] : sorted) {
+      out.push_back(id);
+      boxes.push_back(frame.draws[i].bounds);
+    }
+  };
+  // A layer drawn with this pass and matrix whose casters alone changed (a caster moved, came or
+  // went under a still camera): the texels to redraw, those of the boxes of the casters it was
+  // drawn with that are gone and of those it did not hold, each two texels wider and cut to the
+  // read rectangle `needed`. None (redraw what is needed) when a box is empty (such a caster is
+  // drawn everywhere) or the parts would cover half of `needed`.
+  auto moved_caster_rects =
+      [&](std::size_t layer, const glm::mat4& vp, const glm::ivec4& needed,
+          const std::vector<std::uint64_t>& now,
+          const std::vector<Aabb>& now_boxes) -> std::optional<std::vector<glm::ivec4>> {
+    const std::vector<std::uint64_t>& before = drawn_casters_[layer];
+    const std::vector<Aabb>& before_boxes = drawn_boxes_[layer];
+    std::vector<glm::ivec4> parts;
+    std::int64_t area = 0;
+    auto add = [&](const Aabb& box) {
+      if (box.empty()) return false;
+      const Aabb b = box.transformed(vp);
+      glm::ivec4 r = texel_rect(glm::vec4(b.min.x, b.min.y, b.max.x, b.max.y), map.map_size);
+      r = glm::ivec4(std::max(r.x - 2, needed.x), std::max(r.y - 2, needed.y),
+                     std::min(r.z + 2, needed.z), std::min(r.w + 2, needed.w));
+      if (empty_rect(r)) return true;
+      parts.push_back(r);
+      area += std::int64_t(r.z - r.x) * (r.w - r.y);
+      return true;
+    };
+    // One merge of the two sorted lists: what is in one and not the other.
+    std::size_t a = 0, b = 0;
+    while (a < before.size() || b < now.size()) {
+      if (b == now.size() || (a < before.size() && before[a] < now[b])) {
+        if (!add(before_boxes[a++])) return std::nullopt;
+      } else if (a == before.size() || now[b] < before[a]) {
+        if (!add(now_boxes[b++])) return std::nullopt;
+      } else {
+        ++a;
+        ++b;
+      }
+    }
+    if (area * 2 >= std::int64_t(needed.z - needed.x) * (needed.w - needed.y)) return std::nullopt;
+    return parts;
   };
   // Whether a caster of layer c that the layer did not hold when drawn (as can happen without
   // any caster moving: shadow.cull_by_receivers assigns casters by the receivers the slice
@@ -243,6 +292,8 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
   inputs_.assign(std::size_t(total), 0);
   fixed_.assign(std::size_t(total), 0);
   casters_.assign(std::size_t(total), {});
+  boxes_.assign(std::size_t(total), {});
+  pass_.assign(std::size_t(total), 0);
   rects_.assign(std::size_t(total), glm::ivec4(0, 0, map.map_size, map.map_size));
   pieces_.assign(std::size_t(total), {});
   std::uint32_t drawn_now = 0;  // layers with texels to draw
@@ -267,7 +318,8 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
         origin_[layer] = glm::ivec2(0);
         if (tracks && !skipped) {
           fixed_[layer] = fixed_inputs(view, c, casters);
-          layer_casters(v, c, casters_[layer]);
+          layer_casters(v, c, casters_[layer], boxes_[layer]);
+          pass_[layer] = fixed_inputs(view, c, 0);
         }
         add_pieces(rects_[layer], origin_[layer], map.map_size, pieces);
         redraw_ |= 1u << layer;
@@ -276,16 +328,26 @@ Status ShadowMapPass::prepare(const FrameInput& frame, const DrawList& list,
       }
       if (keep) continue;
       fixed_[layer] = fixed_inputs(view, c, casters);
-      layer_casters(v, c, casters_[layer]);
+      pass_[layer] = fixed_inputs(view, c, 0);
+      layer_casters(v, c, casters_[layer], boxes_[layer]);
       std::vector<glm::ivec4> regions{rects_[layer]};
       glm::ivec2 shift(0);
+      const glm::mat4& vp = v.view_proj[std::size_t(c)];
       if (drawn_[layer].inputs != 0 && drawn_fixed_[layer] == fixed_[layer] &&
-          moved_by_texels(drawn_matrix_[layer], v.view_proj[std::size_t(c)], map.map_size, shift)) {
+          moved_by_texels(drawn_matrix_[layer], vp, map.map_size, shift)) {
         const glm::ivec4 kept = shifted(drawn_[layer].rect, shift, map.map_size);
         if (!newcomer_over(v, c, layer, kept, casters_[layer])) {
           origin_[layer] = scrolled_origin(origin_[layer], shift, map.map_size);
           regions = outside(rects_[layer], kept);
           stats.shadow_layers_scrolled |= 1u << layer;
+        }
+      } else if (drawn_[layer].inputs != 0 && drawn_pass_[layer] == pass_[layer] &&
+                 drawn_matrix_[layer] == vp && holds(drawn_[layer].rect, rects_[layer])) {
+        // The same pass and matrix, other casters: only where they changed.
+        if (auto parts = moved_caster_rects(layer, vp, rects_[layer], casters_[layer],
+                                            boxes_[layer])) {
+          regions = std::move(*parts);
+          stats.shadow_layers_patched |= 1u << layer;
         }
       }
       for (const glm::ivec4& r : regions) add_pieces(r, origin_[layer], map.map_size, pieces);
@@ -432,6 +494,8 @@ Status ShadowMapPass::record(const FrameInput& frame, const DrawList& list, GpuC
       drawn_matrix_[layer] = v.view_proj[std::size_t(c)];
       drawn_fixed_[layer] = fixed_[layer];
       drawn_casters_[layer].swap(casters_[layer]);
+      drawn_boxes_[layer].swap(boxes_[layer]);
+      drawn_pass_[layer] = pass_[layer];
     }
   return {};
 }

@@ -71,9 +71,17 @@ class ShadowMapPass {
   std::vector<glm::mat4> drawn_matrix_;
   std::vector<std::uint64_t> drawn_fixed_;
   std::vector<std::vector<std::uint64_t>> drawn_casters_;  // sorted caster hashes drawn
+  /// Moved casters (a still camera): per layer, the hash of the pass and matrix without the
+  /// casters it was last drawn with, and the world box of each caster drawn (drawn_casters_'s
+  /// order). A layer whose casters alone changed redraws only the texels of the boxes of those
+  /// that left and those that came (moved_caster_rects()).
+  std::vector<std::uint64_t> drawn_pass_;
+  std::vector<std::vector<Aabb>> drawn_boxes_;
   std::vector<std::vector<LayerPiece>> pieces_;  // this frame's parts drawn, per layer
   std::vector<std::uint64_t> fixed_;        // this frame's hashes of all but the translation
   std::vector<std::vector<std::uint64_t>> casters_;  // this frame's casters per layer, sorted
+  std::vector<std::vector<Aabb>> boxes_;            // and their world boxes, in that order
+  std::vector<std::uint64_t> pass_;                 // this frame's hashes of pass and matrix
   bool wrapped_ = false;                    // the texture's wrap is GL_REPEAT
 };
 

@@ -64,8 +64,9 @@ class ShadowCacheTest : public PlayerTest {
   }
 
   // The same scene state drawn with nothing cached: the scene loaded again (new assets, so no
-  // layer's inputs match) with `scene`'s transforms, into new map storage (a frame with another
-  // map size first), so that nothing of an earlier frame's maps can survive in it.
+  // layer's inputs match) with `scene`'s transforms and box_floating's renderer, into new map
+  // storage (a frame with another map size first), so that nothing of an earlier frame's maps
+  // can survive in it.
   static Frame fresh(const Scene& scene) {
     auto other = load_scene(content_dir() / "scenes" / "default.json", {"shadow.map_size=1024"});
     EXPECT_TRUE(other.ok()) << other.error().to_string();
@@ -76,6 +77,8 @@ class ShadowCacheTest : public PlayerTest {
     for (const char* name : {"box_floating", "camera", "sun"})
       copy->world.get<Transform>(named(*copy, name)) =
           scene.world.get<Transform>(named(scene, name));
+    copy->world.get<MeshRenderer>(named(*copy, "box_floating")) =
+        scene.world.get<MeshRenderer>(named(scene, "box_floating"));
     Frame f = render(*player_, *copy);
     EXPECT_EQ(f.stats.shadow_layers_rendered, (1u << f.stats.shadow_layers) - 1u);
     return f;
@@ -139,6 +142,43 @@ TEST_F(ShadowCacheTest, LayersAreRedrawnOnlyWhenTheirInputsChange) {
   const Frame walked_fresh = fresh(scene);
   EXPECT_EQ(walked.map, walked_fresh.map);
   EXPECT_EQ(walked.visibility, walked_fresh.visibility);
+}
+
+// A caster that moves under a still camera redraws only the texels of its old and new boxes
+// (ShadowMapPass, moved_caster_rects()): each frame's maps and visibility are those drawn with
+// nothing cached, bit for bit, while the layers draw a small part of their texels. Also when it
+// stops casting (its old box alone). Fails when the old box is left out (its stale shadow stays
+// in the map), or the new one.
+TEST_F(ShadowCacheTest, AMovedCasterRedrawsOnlyItsTexels) {
+  auto loaded = load_scene(content_dir() / "scenes" / "default.json", {});
+  ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
+  Scene& scene = *loaded;
+  const Frame first = render(*player_, scene);
+  ASSERT_EQ(first.stats.shadow_layers, 4);
+  std::int64_t needed = 0;  // the texels lookups read, over every layer
+  for (const glm::ivec4& r : first.stats.layer_rect) needed += std::int64_t(r.z - r.x) * (r.w - r.y);
+  ASSERT_GT(needed, 0);
+  const ecs::Entity box = named(scene, "box_floating");
+  for (int step = 0; step < 4; ++step) {
+    const bool last = step == 3;
+    if (last)
+      scene.world.get<MeshRenderer>(box).cast_shadows = false;
+    else
+      scene.world.get<Transform>(box).translation += glm::vec3(0.12f, 0.05f, -0.08f);
+    const Frame moved = render(*player_, scene);
+    EXPECT_NE(moved.stats.shadow_layers_patched, 0u) << "step " << step;
+    EXPECT_EQ(moved.stats.shadow_layers_scrolled, 0u) << "step " << step;
+    EXPECT_LT(moved.stats.shadow_texels_drawn * 5, needed) << "step " << step;
+    std::printf("[ step %d ] %d layers patched, %lld of %lld needed texels drawn (%.1f%%)\n", step,
+                std::popcount(moved.stats.shadow_layers_patched),
+                static_cast<long long>(moved.stats.shadow_texels_drawn),
+                static_cast<long long>(needed), 100.0 * double(moved.stats.shadow_texels_drawn) / double(needed));
+    const Frame moved_fresh = fresh(scene);
+    EXPECT_EQ(moved.map, moved_fresh.map) << "step " << step;
+    EXPECT_EQ(moved.visibility, moved_fresh.visibility) << "step " << step;
+    // The cached scene again: its assets differ from the fresh copy's, so it redraws once.
+    render(*player_, scene);
+  }
 }
 
 // vsm/evsm (MomentsPass): a layer's moments are recomputed exactly when the shadow pass redraws
