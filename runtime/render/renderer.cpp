@@ -55,6 +55,10 @@ struct Renderer::Impl {
   /// render.visibility_reproject: world_visibility_inputs() of the visibility held (0: none
   /// that a frame may reproject) and of the last frame, and the camera it was stored under.
   std::uint64_t stored_world = 0, last_world = 0;
+  /// Whether the visibility held was looked up (or read back from a frame that looked it up):
+  /// a still frame reads back only such, so that a camera that stops shows the lookup itself
+  /// (after one frame that looks up), not the reprojection's approximation.
+  bool stored_exact = false;
   glm::mat4 stored_view_proj{1.0f};
   glm::vec4 stored_camera_pos{0.0f};
 
@@ -391,10 +395,11 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     // visibility looked up through one is not reprojected, nor stored for reprojection.
     bool held = false;
     for (const ShadowView& v : frame.shadow_views) held = held || v.held != 0;
-    if (maps_kept && inputs == stored && im.forward.holds_visibility()) {
+    if (maps_kept && inputs == stored && im.stored_exact && im.forward.holds_visibility()) {
       reuse = VariantKey::kReuseLoad;
     } else if (reprojects_visibility(frame) && !held && world == stored_world &&
-               im.forward.holds_visibility()) {
+               inputs != stored && im.forward.holds_visibility()) {
+      // (A frame that sees what a reprojecting frame saw looks up instead: the camera stopped.)
       reuse = VariantKey::kReuseReproject;
     }
     // A frame stores when a later one may read it: one that sees what this frame saw (a camera
@@ -410,6 +415,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     const bool holds = reuse != VariantKey::kReuseStore || store;
     im.stored_visibility = holds ? inputs : 0;
     im.stored_world = holds && !held ? world : 0;
+    if (reuse != VariantKey::kReuseLoad) im.stored_exact = reuse != VariantKey::kReuseReproject;
   }
   // A loading or reprojecting frame draws with its own programs. Those not built yet are built
   // now (prewarm() builds them up front), each once (the order runs by program); one that does
