@@ -182,6 +182,15 @@ std::string gib(double bytes) {
   return buf;
 }
 
+/// What of draw `d` (forward program `key`) decides which of its fragments end up in front, and
+/// where: mesh, matrix, pose, program, sidedness, alpha mode, and whether it receives shadows.
+void add_visibility_draw(Hash& h, const DrawItem& d, VariantKey key) {
+  const Material& m = d.material;
+  h.add(d.mesh).add(d.model).add(d.pose).add(d.receive_shadows).add(key.bits());
+  h.add(m.double_sided).add(m.alpha_mode).add(m.alpha_cutoff).add(m.base_color.a);
+  h.add(m.base_color_texture).add(m.base_color_transform);
+}
+
 /// What the main view's shadow visibility at each pixel depends on, besides the shadow maps'
 /// depths: the frame block (camera, lights, shadow views' matrices, splits and parameters), the
 /// frame's features, the target size, the shaders (a reload of an edited file looks up again),
@@ -193,13 +202,7 @@ std::uint64_t visibility_inputs(const FrameInput& frame, const DrawList& list,
   Hash h;
   h.add(assets.uid).add(shader_reloads).add(frame.width).add(frame.height);
   h.add(list.frame_key.bits()).add(block);
-  for (std::uint32_t i : list.forward_order) {
-    const DrawItem& d = frame.draws[i];
-    const Material& m = d.material;
-    h.add(d.mesh).add(d.model).add(d.pose).add(d.receive_shadows).add(list.keys[i].bits());
-    h.add(m.double_sided).add(m.alpha_mode).add(m.alpha_cutoff).add(m.base_color.a);
-    h.add(m.base_color_texture).add(m.base_color_transform);
-  }
+  for (std::uint32_t i : list.forward_order) add_visibility_draw(h, frame.draws[i], list.keys[i]);
   return h.value();
 }
 
@@ -225,15 +228,11 @@ std::uint64_t world_visibility_inputs(const FrameInput& frame, const DrawList& l
       h.add(b.info).add(b.params).add(b.soft);
     }
   }
+  // Every draw, with what it casts (not shadow_layers: which cascades a caster is drawn into
+  // follows their fit, and the maps hold the same depths either way).
   for (std::size_t i = 0; i < frame.draws.size(); ++i) {
-    const DrawItem& d = frame.draws[i];
-    const Material& m = d.material;
-    // (Not shadow_layers: which cascades a caster is drawn into follows their fit, and the
-    // maps hold the same depths either way.)
-    h.add(d.mesh).add(d.model).add(d.pose).add(d.receive_shadows).add(d.cast_shadows);
-    h.add(list.keys[i].bits());
-    h.add(m.double_sided).add(m.alpha_mode).add(m.alpha_cutoff).add(m.base_color.a);
-    h.add(m.base_color_texture).add(m.base_color_transform);
+    add_visibility_draw(h, frame.draws[i], list.keys[i]);
+    h.add(frame.draws[i].cast_shadows);
   }
   return h.value();
 }
@@ -387,8 +386,11 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
   if (reuse != 0) {
     const std::uint64_t inputs =
         visibility_inputs(frame, list, assets, block, im.shaders->stats().reloads);
+    // The world inputs (a hash over every draw) only where the frame may reproject.
+    const bool reprojects = reprojects_visibility(frame);
     const std::uint64_t world =
-        world_visibility_inputs(frame, list, assets, block, im.shaders->stats().reloads);
+        reprojects ? world_visibility_inputs(frame, list, assets, block, im.shaders->stats().reloads)
+                   : 0;
     const bool maps_kept = stats_.shadow_layers_rendered == 0 && stats_.lom_layers_computed == 0 &&
                            stats_.vsm_layers_computed == 0;
     // A held layer (shadow.far_cascade_interval) may keep depth that its casters have left:
@@ -397,7 +399,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     for (const ShadowView& v : frame.shadow_views) held = held || v.held != 0;
     if (maps_kept && inputs == stored && im.stored_exact && im.forward.holds_visibility()) {
       reuse = VariantKey::kReuseLoad;
-    } else if (reprojects_visibility(frame) && !held && world == stored_world &&
+    } else if (reprojects && !held && world == stored_world &&
                inputs != stored && im.forward.holds_visibility()) {
       // (A frame that sees what a reprojecting frame saw looks up instead: the camera stopped.)
       reuse = VariantKey::kReuseReproject;
@@ -406,7 +408,7 @@ Status Renderer::render(const FrameInput& frame, const AssetStore& assets) {
     // that stops), or one whose camera alone moved.
     store = reuse == VariantKey::kReuseStore &&
             (inputs == im.last_visibility ||
-             (reprojects_visibility(frame) && world == im.last_world));
+             (reprojects && world == im.last_world));
     im.last_visibility = inputs;
     im.last_world = world;
     // What the target holds and a later frame may read: this frame's visibility. After a frame
